@@ -1,0 +1,94 @@
+#pragma once
+// Basal friction and earth pressure of the depth-averaged model.
+//
+// Coulomb (Savage & Hutter 1989):   tau_b = tan(delta) * N
+// Voellmy (Voellmy 1955; Salm 1993): tau_b = mu * N + rho * g * |u|^2 / xi
+// with N the basal normal stress, which on curved terrain includes the centrifugal part
+// rho * h * kappa * |u|^2 (Savage & Hutter 1991, dissertation eq. 3.48).
+//
+// Earth-pressure coefficient (Savage & Hutter 1989, dissertation eq. 3.36), active where the flow
+// extends (du/dx >= 0), passive where it is compressed:
+//   K_act/pass = 2 / cos^2(phi) * [1 -/+ sqrt(1 - cos^2(phi) / cos^2(delta))] - 1,
+// cross-slope (Hutter et al. 1993):
+//   K_y = 1/2 [K_x + 1 -/+ sqrt((K_x - 1)^2 + 4 tan^2(delta))].
+// It requires delta <= phi. The mode "unity" uses K = 1 (hydrostatic), as most exact solutions do.
+// Angles are radians here; user input in degrees is converted at the boundary of the program.
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "engine/names.hpp"
+
+namespace runout::engine {
+
+enum class Rheology { coulomb, voellmy };
+inline constexpr NameTable<Rheology, 2> kRheologyNames{
+    {{"coulomb", Rheology::coulomb}, {"voellmy", Rheology::voellmy}}};
+
+enum class EarthPressure { unity, active_passive };
+inline constexpr NameTable<EarthPressure, 2> kEarthPressureNames{
+    {{"unity", EarthPressure::unity}, {"active-passive", EarthPressure::active_passive}}};
+
+struct Material {
+  Rheology rheology = Rheology::coulomb;
+  double delta = 0.0;      ///< bed friction angle [rad] (Coulomb)
+  double phi = 0.0;        ///< internal friction angle [rad] (earth pressure)
+  double mu = 0.0;         ///< Voellmy dry-friction coefficient [-]
+  double xi = 1.0e300;     ///< Voellmy turbulent-friction coefficient [m/s^2]
+  EarthPressure earth_pressure = EarthPressure::unity;
+  double density = 300.0;  ///< bulk density [kg/m^3], for pressure outputs only
+
+  /// Basal Coulomb coefficient: tan(delta) for Coulomb, mu for Voellmy.
+  double coulomb_coefficient() const { return rheology == Rheology::coulomb ? std::tan(delta) : mu; }
+  /// 1/xi, zero for pure Coulomb friction.
+  double inv_xi() const { return rheology == Rheology::voellmy ? 1.0 / xi : 0.0; }
+
+  /// Throws std::invalid_argument naming the offending parameter.
+  void validate() const {
+    auto bad = [](const std::string& m) { throw std::invalid_argument("material: " + m); };
+    if (rheology == Rheology::coulomb && !(delta >= 0.0 && delta < M_PI / 2))
+      bad("bed friction angle delta must lie in [0, 90) degrees");
+    if (rheology == Rheology::voellmy) {
+      if (!(mu >= 0.0 && std::isfinite(mu))) bad("Voellmy mu must be >= 0");
+      if (!(xi > 0.0)) bad("Voellmy xi must be > 0 m/s^2");
+    }
+    if (earth_pressure == EarthPressure::active_passive) {
+      if (!(phi > 0.0 && phi < M_PI / 2)) bad("internal friction angle phi must lie in (0, 90) degrees");
+      if (std::atan(coulomb_coefficient()) > phi + 1e-12)
+        bad("earth-pressure mode active-passive needs bed friction <= internal friction (delta <= phi)");
+    }
+    if (!(density > 0.0)) bad("density must be > 0");
+  }
+};
+
+/// K_x active (extension) or passive (compression) from phi and delta [rad].
+inline double k_x(double phi, double delta, bool active) {
+  const double c2p = std::cos(phi) * std::cos(phi);
+  const double c2d = std::cos(delta) * std::cos(delta);
+  const double root = std::sqrt(std::max(0.0, 1.0 - c2p / c2d));
+  return 2.0 / c2p * (1.0 + (active ? -root : root)) - 1.0;
+}
+
+/// K_y from K_x and delta; active (extension across the slope) takes the minus sign.
+inline double k_y(double kx, double delta, bool active) {
+  const double t = std::tan(delta);
+  const double root = std::sqrt((kx - 1.0) * (kx - 1.0) + 4.0 * t * t);
+  return 0.5 * (kx + 1.0 + (active ? -root : root));
+}
+
+/// Apply a friction impulse of magnitude `impulse` (>= 0) against momentum (mx, my) of 3D
+/// magnitude m3 (>= |(mx,my)|): the momentum shrinks towards zero and never reverses. Returns true
+/// when the material is brought exactly to rest.
+inline bool apply_friction(double& mx, double& my, double m3, double impulse) {
+  if (m3 <= impulse) {
+    mx = 0.0;
+    my = 0.0;
+    return true;
+  }
+  const double f = 1.0 - impulse / m3;
+  mx *= f;
+  my *= f;
+  return false;
+}
+
+}  // namespace runout::engine

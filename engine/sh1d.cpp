@@ -1,0 +1,293 @@
+#include "engine/sh1d.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace runout::engine {
+
+Channel1D Channel1D::uniform(int n, double dx, double x0, double zeta) {
+  Channel1D c;
+  c.n = n;
+  c.dx = dx;
+  c.x0 = x0;
+  c.zeta.assign(n, zeta);
+  c.kappa.assign(n, 0.0);
+  return c;
+}
+
+Channel1D Channel1D::from_profile(int n, double dx, double x0, const std::function<double(double)>& zeta) {
+  Channel1D c;
+  c.n = n;
+  c.dx = dx;
+  c.x0 = x0;
+  c.zeta.resize(n);
+  c.kappa.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const double x = c.centre(i);
+    c.zeta[i] = zeta(x);
+    c.kappa[i] = -(zeta(x + 0.5 * dx) - zeta(x - 0.5 * dx)) / dx;
+  }
+  return c;
+}
+
+void Hydrograph::at(double time, double& h_out, double& u_out) const {
+  if (t.empty()) {
+    h_out = 0;
+    u_out = 0;
+    return;
+  }
+  if (time <= t.front()) {
+    h_out = h.front();
+    u_out = u.front();
+    return;
+  }
+  for (std::size_t k = 1; k < t.size(); ++k) {
+    if (time <= t[k]) {
+      const double w = (time - t[k - 1]) / (t[k] - t[k - 1]);
+      h_out = h[k - 1] + w * (h[k] - h[k - 1]);
+      u_out = u[k - 1] + w * (u[k] - u[k - 1]);
+      return;
+    }
+  }
+  h_out = h.back();
+  u_out = u.back();
+}
+
+namespace {
+
+constexpr int G = 3;  // ghost cells on each side
+
+struct Work {
+  std::vector<double> h, m, zeta, kappa, beta, sh, sm, hp, mp, Sh, Sm, sSh, sSm, r;
+  explicit Work(int n)
+      : h(n + 2 * G), m(n + 2 * G), zeta(n + 2 * G), kappa(n + 2 * G), beta(n + 2 * G),
+        sh(n + 2 * G), sm(n + 2 * G), hp(n + 2 * G), mp(n + 2 * G), Sh(n + 2 * G), Sm(n + 2 * G),
+        sSh(n + 2 * G), sSm(n + 2 * G), r(n + 2 * G) {}
+};
+
+void validate(const Channel1D& ch, const Sh1dConfig& cfg, const Sh1dState& s) {
+  auto bad = [](const std::string& m) { throw std::invalid_argument("1D solver: " + m); };
+  if (ch.n < 4) bad("the channel needs at least 4 cells");
+  if (!(ch.dx > 0)) bad("cell size dx must be > 0");
+  if ((int)ch.zeta.size() != ch.n || (int)ch.kappa.size() != ch.n) bad("zeta/kappa size differs from n");
+  if ((int)s.h.size() != ch.n || (int)s.m.size() != ch.n) bad("initial state size differs from n");
+  for (int i = 0; i < ch.n; ++i)
+    if (!(s.h[i] >= 0) || !std::isfinite(s.m[i])) bad("initial depth must be finite and >= 0 (cell " + std::to_string(i) + ")");
+  if (!(cfg.time.cfl > 0 && cfg.time.cfl <= 0.5)) bad("CFL number must lie in (0, 0.5]");
+  if (!(cfg.time.t_end >= 0)) bad("end time must be >= 0");
+  cfg.material.validate();
+  if ((cfg.left == Boundary1D::inflow || cfg.right == Boundary1D::inflow) && cfg.inflow.t.empty())
+    bad("an inflow boundary needs a hydrograph");
+}
+
+}  // namespace
+
+Sh1dResult run_sh1d(const Channel1D& ch, const Sh1dConfig& cfg, Sh1dState init) {
+  validate(ch, cfg, init);
+  const auto wall0 = std::chrono::steady_clock::now();
+  const int n = ch.n;
+  const double dx = ch.dx, g = cfg.gravity, hdry = cfg.dry_depth;
+  const double mu = cfg.material.coulomb_coefficient(), ixi = cfg.material.inv_xi();
+  const bool kap = cfg.material.earth_pressure == EarthPressure::active_passive;
+  const double kact = kap ? k_x(cfg.material.phi, std::atan(mu), true) : 1.0;
+  const double kpas = kap ? k_x(cfg.material.phi, std::atan(mu), false) : 1.0;
+  const Limiter lim = cfg.limiter;
+  const bool open = cfg.left != Boundary1D::wall || cfg.right != Boundary1D::wall;
+
+  Work w(n);
+  for (int i = 0; i < n; ++i) {
+    w.h[i + G] = init.h[i];
+    w.m[i + G] = init.m[i];
+    w.zeta[i + G] = ch.zeta[i];
+    w.kappa[i + G] = ch.kappa[i];
+  }
+  // Ghost geometry: a wall is a mirror, so its ghosts carry the mirrored channel (inclination of the
+  // opposite sign, same curvature) and the solution stays symmetric about the wall: no mass crosses
+  // it. Open boundaries extend the edge geometry.
+  for (int k = 0; k < G; ++k) {
+    const bool lw = cfg.left == Boundary1D::wall, rw = cfg.right == Boundary1D::wall;
+    w.zeta[G - 1 - k] = lw ? -ch.zeta[k] : ch.zeta[0];
+    w.kappa[G - 1 - k] = lw ? ch.kappa[k] : ch.kappa[0];
+    w.zeta[n + G + k] = rw ? -ch.zeta[n - 1 - k] : ch.zeta[n - 1];
+    w.kappa[n + G + k] = rw ? ch.kappa[n - 1 - k] : ch.kappa[n - 1];
+  }
+  auto vel = [hdry](double h, double m) { return h > hdry ? m / h : 0.0; };
+  auto mass = [&] {
+    double s = 0;
+    for (int i = G; i < n + G; ++i) s += w.h[i];
+    return s * dx;
+  };
+
+  Sh1dResult r;
+  r.max_depth.assign(n, 0.0);
+  r.max_speed.assign(n, 0.0);
+  r.mass_initial = mass();
+
+  auto fill_ghosts = [&](double t) {
+    auto side = [&](Boundary1D b, bool left) {
+      for (int k = 0; k < G; ++k) {
+        const int gi = left ? G - 1 - k : n + G + k;    // ghost index, k-th away from the edge
+        const int mi = left ? G + k : n + G - 1 - k;     // mirror index inside
+        const int ei = left ? G : n + G - 1;             // edge cell
+        switch (b) {
+          case Boundary1D::wall:
+            w.h[gi] = w.h[mi];
+            w.m[gi] = -w.m[mi];
+            break;
+          case Boundary1D::outflow:
+            w.h[gi] = w.h[ei];
+            w.m[gi] = w.m[ei];
+            break;
+          case Boundary1D::inflow: {
+            // The hydrograph state holds at the boundary face: the ghosts are the inside reflected
+            // through it (w_g = 2 w_in - w_mirror), so that the piecewise-linear solution passes
+            // through the prescribed depth and discharge there (second order at the boundary).
+            double hi, ui;
+            cfg.inflow.at(t, hi, ui);
+            const double qi = hi * (left ? ui : -ui);
+            w.h[gi] = std::max(0.0, 2 * hi - w.h[mi]);
+            w.m[gi] = w.h[gi] > 0 ? 2 * qi - w.m[mi] : 0.0;
+            break;
+          }
+        }
+      }
+    };
+    side(cfg.left, true);
+    side(cfg.right, false);
+  };
+
+  // Per-cell earth pressure: active where the flow extends (du/dxi >= 0).
+  auto set_beta = [&] {
+    for (int k = 1; k < n + 2 * G - 1; ++k) {
+      double K = 1.0;
+      if (kap) K = (vel(w.h[k + 1], w.m[k + 1]) - vel(w.h[k - 1], w.m[k - 1]) >= 0) ? kact : kpas;
+      w.beta[k] = K * g * std::cos(w.zeta[k]);
+    }
+    w.beta[0] = w.beta[1];
+    w.beta[n + 2 * G - 1] = w.beta[n + 2 * G - 2];
+  };
+
+  const double curv = cfg.curvature ? 1.0 : 0.0;
+  auto resistance = [&](double h, double u, double zeta, double kappa) {
+    return h * (mu * std::max(0.0, g * std::cos(zeta) + curv * kappa * u * u) + g * ixi * u * u);
+  };
+
+  double t = 0, ke_peak = 0;
+  const auto& tc = cfg.time;
+  while (t < tc.t_end) {
+    if (r.steps >= tc.max_steps) {
+      r.stop = StopReason::max_steps;
+      break;
+    }
+    fill_ghosts(t);
+    set_beta();
+    double amax = 0;
+    for (int k = 0; k < n + 2 * G; ++k)
+      amax = std::max(amax, std::abs(vel(w.h[k], w.m[k])) + std::sqrt(w.beta[k] * std::max(w.h[k], 0.0)));
+    double dt = amax > 0 ? tc.cfl * dx / amax : tc.dt_max;
+    dt = std::min({dt, tc.dt_max, tc.t_end - t});
+    if (!(dt > 0) || !std::isfinite(dt)) dt = tc.t_end - t;
+    const double lam = dt / dx;
+    const double mass_before = open ? mass() : 0.0;
+
+    // Predictor (4.78): limited slopes and a half step with the flux Jacobian (4.79, 4.86).
+    for (int k = 1; k < n + 2 * G - 1; ++k) {
+      w.sh[k] = limited_slope(lim, w.h[k] - w.h[k - 1], w.h[k + 1] - w.h[k]);
+      w.sm[k] = limited_slope(lim, w.m[k] - w.m[k - 1], w.m[k + 1] - w.m[k]);
+      const double h = w.h[k], u = vel(h, w.m[k]), b = w.beta[k];
+      w.hp[k] = std::max(0.0, h - 0.5 * lam * w.sm[k]);
+      double mp = w.m[k] - 0.5 * lam * ((b * h - u * u) * w.sh[k] + 2.0 * u * w.sm[k]) +
+                  0.5 * dt * h * g * std::sin(w.zeta[k]);
+      double dummy = 0;
+      apply_friction(mp, dummy, std::abs(mp), 0.5 * dt * resistance(h, u, w.zeta[k], w.kappa[k]));
+      w.mp[k] = mp;
+    }
+    auto flux_m = [&](int k) {
+      const double h = w.hp[k], u = vel(h, w.mp[k]);
+      return w.mp[k] * u + 0.5 * w.beta[k] * h * h;
+    };
+    auto src = [&](double h, int k) { return h * g * std::sin(w.zeta[k]); };
+    // The predicted values at the cell centres x_k are the fluxes through the faces of the staggered
+    // cells [x_k, x_k+1]. Draining-time limiter: no staggered cell sends out more mass than it holds;
+    // the factor of the sending cell scales the whole flux, which keeps mass conservative.
+    for (int k = 1; k < n + 2 * G - 2; ++k) {
+      const double content = 0.5 * (w.h[k] + w.h[k + 1]) + (w.sh[k] - w.sh[k + 1]) / 8.0;
+      const double out = lam * (std::max(w.mp[k + 1], 0.0) + std::max(-w.mp[k], 0.0));
+      w.r[k] = out > content ? std::max(content, 0.0) / out : 1.0;
+    }
+    w.r[0] = w.r[n + 2 * G - 2] = 1.0;
+    auto scale = [&](int k) {  // factor for the flux through x_k
+      if (w.mp[k] > 0) return w.r[k - 1];
+      if (w.mp[k] < 0) return w.r[k];
+      return 1.0;
+    };
+    // Corrector (4.73, 4.74, 4.77, 4.80) on the staggered cell between k and k+1.
+    for (int k = 1; k < n + 2 * G - 2; ++k) {
+      const double s0 = scale(k), s1 = scale(k + 1);
+      double Sh = 0.5 * (w.h[k] + w.h[k + 1]) + (w.sh[k] - w.sh[k + 1]) / 8.0 - lam * (s1 * w.mp[k + 1] - s0 * w.mp[k]);
+      double Sm = 0.5 * (w.m[k] + w.m[k + 1]) + (w.sm[k] - w.sm[k + 1]) / 8.0 - lam * (s1 * flux_m(k + 1) - s0 * flux_m(k));
+      const double hq1 = std::max(0.0, w.hp[k] + 0.25 * w.sh[k]);
+      const double hq3 = std::max(0.0, w.hp[k + 1] - 0.25 * w.sh[k + 1]);
+      Sm += 0.5 * dt * (src(hq1, k) + src(hq3, k + 1));
+      if (Sh < 0) {  // round-off only, after the limiter above
+        ++r.positivity_clips;
+        r.positivity_mass -= Sh * dx;
+        Sh = 0;
+      }
+      // Friction at the half step (midpoint rule, second order), bounded so it never reverses u.
+      const double uq1 = vel(w.hp[k], w.mp[k]), uq3 = vel(w.hp[k + 1], w.mp[k + 1]);
+      const double R = 0.5 * (resistance(hq1, uq1, w.zeta[k], w.kappa[k]) +
+                              resistance(hq3, uq3, w.zeta[k + 1], w.kappa[k + 1]));
+      double dummy = 0;
+      apply_friction(Sm, dummy, std::abs(Sm), dt * R);
+      w.Sh[k] = Sh;
+      w.Sm[k] = Sm;
+    }
+    // Average back onto the cells: cell k lies between staggered cells k-1 and k.
+    for (int k = 2; k < n + 2 * G - 3; ++k) {
+      w.sSh[k] = limited_slope(lim, w.Sh[k] - w.Sh[k - 1], w.Sh[k + 1] - w.Sh[k]);
+      w.sSm[k] = limited_slope(lim, w.Sm[k] - w.Sm[k - 1], w.Sm[k + 1] - w.Sm[k]);
+    }
+    for (int k = G; k < n + G; ++k) {
+      const double h = 0.5 * (w.Sh[k - 1] + w.Sh[k]) - (w.sSh[k] - w.sSh[k - 1]) / 8.0;
+      const double m = 0.5 * (w.Sm[k - 1] + w.Sm[k]) - (w.sSm[k] - w.sSm[k - 1]) / 8.0;
+      w.h[k] = h;
+      w.m[k] = h > hdry ? m : 0.0;
+    }
+    t += dt;
+    ++r.steps;
+    if (open) r.boundary_exchange += mass() - mass_before;
+
+    double ke = 0, umax = 0;
+    for (int i = 0; i < n; ++i) {
+      const double h = w.h[i + G], u = vel(h, w.m[i + G]);
+      r.max_depth[i] = std::max(r.max_depth[i], h);
+      r.max_speed[i] = std::max(r.max_speed[i], std::abs(u));
+      ke += 0.5 * h * u * u * dx;
+      umax = std::max(umax, std::abs(u));
+    }
+    ke_peak = std::max(ke_peak, ke);
+    if (tc.progress && r.steps % tc.progress_every == 0) {
+      Progress p{t, dt, mass(), umax, ke, 1.0, r.steps};
+      if (!tc.progress(p)) {
+        r.stop = StopReason::cancelled;
+        break;
+      }
+    }
+    if (tc.stop_fraction > 0 && ke_peak > 0 && ke < tc.stop_fraction * ke_peak) {
+      r.stop = StopReason::kinetic_energy;
+      break;
+    }
+  }
+  r.t = t;
+  r.state.h.assign(w.h.begin() + G, w.h.begin() + G + n);
+  r.state.m.assign(w.m.begin() + G, w.m.begin() + G + n);
+  r.mass_final = mass();
+  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return r;
+}
+
+}  // namespace runout::engine

@@ -1,0 +1,15 @@
+#pragma once
+// Subcommands of the `runout` program. Each returns the process exit code.
+#include <string>
+#include <vector>
+
+namespace runout::cli {
+
+/// Exit codes (documented in `runout --help`).
+enum Exit : int { kOk = 0, kFailed = 1, kUsage = 2, kInternal = 3 };
+
+int verify(const std::vector<std::string>& args);
+int version(const std::vector<std::string>& args);
+std::string version_report();
+
+}  // namespace runout::cli

@@ -1,0 +1,52 @@
+// runout: hazard mapping for rapid granular flows. Thin command-line front end over the libraries.
+#include <exception>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "service/cli/commands.hpp"
+
+namespace {
+
+const char* kHelp = R"(runout - hazard mapping for rapid granular flows (depth-averaged Savage-Hutter engine)
+
+usage: runout <command> [options]
+
+commands:
+  verify [CASE...] [--full] [--resolutions R1,R2,...] [--limiter NAME] [--csv] [--threads N]
+        Run the verification cases against exact solutions and invariants and print a table
+        (or CSV). Cases: A1 A2 A3 A4 A5 A6 A7 STRESS (default: all). --full adds the finest
+        resolutions. --resolutions overrides a case's cell sizes in metres (A2: cells across the cap).
+        Limiters: minmod (default), vanleer, superbee.
+  version
+        Print the program version and the versions of the libraries it links.
+  help
+        Print this text.
+
+exit codes:
+  0  success (verify: every checked figure within its tolerance)
+  1  verify: at least one figure outside its tolerance
+  2  bad command line (unknown command, option or name)
+  3  internal error
+)";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args[0] == "help" || args[0] == "--help" || args[0] == "-h") {
+    std::cout << kHelp;
+    return args.empty() ? runout::cli::kUsage : runout::cli::kOk;
+  }
+  const std::string cmd = args[0];
+  args.erase(args.begin());
+  try {
+    if (cmd == "verify") return runout::cli::verify(args);
+    if (cmd == "version" || cmd == "--version") return runout::cli::version(args);
+    std::cerr << "runout: unknown command '" << cmd << "' (valid: verify, version, help)\n";
+    return runout::cli::kUsage;
+  } catch (const std::exception& e) {
+    std::cerr << "runout: internal error: " << e.what() << "\n";
+    return runout::cli::kInternal;
+  }
+}
