@@ -106,10 +106,17 @@ class Solver {
     }
     for (auto* v : {&sHx_, &sux_, &svx_, &sHy_, &suy_, &svy_, &Hp_, &Up_, &Vp_}) v->assign(n_, 0.0);
     held_.assign(n_, 0);
+    U_.resize(n_);
+    V_.resize(n_);
+    for (std::size_t k = 0; k < n_; ++k) {
+      U_[k] = vel(H_[k], HU_[k]);
+      V_[k] = vel(H_[k], HV_[k]);
+    }
     r_.assign(n_, 1.0);
     Pxx_.resize(n_);
     Pxy_.resize(n_);
     Pyy_.resize(n_);
+    Ps_.resize(n_);
     for (std::size_t k = 0; k < n_; ++k) set_pressure(k, 1.0, 1.0, 1.0, 0.0);
     Fx_.assign(std::size_t(nx_ + 1) * ny_, Face{0, 0, 0});
     Fy_.assign(std::size_t(ny_ + 1) * nx_, Face{0, 0, 0});
@@ -160,6 +167,7 @@ class Solver {
     Pxx_[k] = a * ddx * ddx + b * ddy * ddy;
     Pxy_[k] = (a - b) * ddx * ddy;
     Pyy_[k] = a * ddy * ddy + b * ddx * ddx;
+    Ps_[k] = std::sqrt(Pxx_[k]) / t_.dx + std::sqrt(Pyy_[k]) / t_.dy;
   }
 
   // Driving acceleration factor (g + Q)_+ with Q = U^T Hess(b) U.
@@ -185,6 +193,8 @@ class Solver {
   void record_hazard(std::size_t k, double t);
   void rebuild_active();
   void predictor(int tt, double dt);
+  template <Limiter L>
+  void predictor_t(int tt, double dt);
   void faces(int tt);
   void positivity(int tt, double dt);
   void update(int tt, double t, double dt);
@@ -200,8 +210,9 @@ class Solver {
   double g_ = 9.81, mu_ = 0, ixi_ = 0;
   bool kap_ = false;
   double kx_[2] = {1, 1}, ky_[2][2] = {{1, 1}, {1, 1}};
-  std::vector<double> H_, HU_, HV_;
+  std::vector<double> H_, HU_, HV_, U_, V_;  // U_, V_: velocity (zero where dry)
   std::vector<double> sHx_, sux_, svx_, sHy_, suy_, svy_, Hp_, Up_, Vp_, r_, Pxx_, Pxy_, Pyy_;
+  std::vector<double> Ps_;  // sqrt(Pxx) / dx + sqrt(Pyy) / dy: the gravity-wave part of the CFL rate per sqrt(H)
   std::vector<std::uint8_t> held_;
   std::vector<Face> Fx_, Fy_;
   std::vector<double> tile_mass_, tile_ke_, tile_speed_, tile_rate_, tile_out_, tile_travel_;
@@ -242,7 +253,7 @@ void Solver::record_hazard(std::size_t k, double t) {
   hz_.max_depth[k] = std::max(hz_.max_depth[k], h);
   hz_.max_speed[k] = std::max(hz_.max_speed[k], sp);
   hz_.max_pressure[k] = std::max(hz_.max_pressure[k], cfg_.material.density * sp * sp);
-  if (std::isnan(hz_.arrival_time[k]) && h > cfg_.arrival_threshold) hz_.arrival_time[k] = t;
+  if (h > cfg_.arrival_threshold && std::isnan(hz_.arrival_time[k])) hz_.arrival_time[k] = t;
 }
 
 void Solver::rebuild_active() {
@@ -265,7 +276,7 @@ void Solver::rebuild_active() {
       int i0, i1, j0, j1;
       tile_range(tt, i0, i1, j0, j1);
       for (int j = j0; j < j1; ++j)
-        for (int i = i0; i < i1; ++i) HU_[idx(i, j)] = HV_[idx(i, j)] = 0.0;
+        for (int i = i0; i < i1; ++i) HU_[idx(i, j)] = HV_[idx(i, j)] = U_[idx(i, j)] = V_[idx(i, j)] = 0.0;
       tile_ke_[tt] = 0;
       tile_speed_[tt] = 0;
     }
@@ -275,15 +286,23 @@ void Solver::rebuild_active() {
 }
 
 void Solver::predictor(int tt, double dt) {
+  switch (cfg_.limiter) {
+    case Limiter::minmod: return predictor_t<Limiter::minmod>(tt, dt);
+    case Limiter::vanleer: return predictor_t<Limiter::vanleer>(tt, dt);
+    case Limiter::superbee: return predictor_t<Limiter::superbee>(tt, dt);
+  }
+}
+
+template <Limiter lim>
+void Solver::predictor_t(int tt, double dt) {
   int i0, i1, j0, j1;
   tile_range(tt, i0, i1, j0, j1);
-  const Limiter lim = cfg_.limiter;
   const double hx = 0.5 * dt / t_.dx, hy = 0.5 * dt / t_.dy;
   for (int j = j0; j < j1; ++j)
     for (int i = i0; i < i1; ++i) {
       const std::size_t k = idx(i, j);
       const double H = H_[k], MU = HU_[k], MV = HV_[k];
-      const double U = vel(H, MU), V = vel(H, MV);
+      const double U = U_[k], V = V_[k];
       // Limited slopes of the depth and of the velocity (primitive variables: reconstructing the
       // velocity rather than the momentum keeps the speed of thin flow fronts; see docs/engine.md).
       double sHx = 0, sux = 0, svx = 0, sHy = 0, suy = 0, svy = 0;
@@ -292,16 +311,16 @@ void Solver::predictor(int tt, double dt) {
         const std::size_t l = k - 1, r = k + 1;
         sHx = limited_slope(lim, H - H_[l], H_[r] - H);
         if (H_[l] > dry && H_[r] > dry) {
-          sux = limited_slope(lim, U - HU_[l] / H_[l], HU_[r] / H_[r] - U);
-          svx = limited_slope(lim, V - HV_[l] / H_[l], HV_[r] / H_[r] - V);
+          sux = limited_slope(lim, U - U_[l], U_[r] - U);
+          svx = limited_slope(lim, V - V_[l], V_[r] - V);
         }
       }
       if (j > 0 && j < ny_ - 1) {
         const std::size_t b = k - nx_, a = k + nx_;
         sHy = limited_slope(lim, H - H_[b], H_[a] - H);
         if (H_[b] > dry && H_[a] > dry) {
-          suy = limited_slope(lim, U - HU_[b] / H_[b], HU_[a] / H_[a] - U);
-          svy = limited_slope(lim, V - HV_[b] / H_[b], HV_[a] / H_[a] - V);
+          suy = limited_slope(lim, U - U_[b], U_[a] - U);
+          svy = limited_slope(lim, V - V_[b], V_[a] - V);
         }
       }
       if (kap_) {
@@ -320,8 +339,8 @@ void Solver::predictor(int tt, double dt) {
           ii = std::clamp(ii, 0, nx_ - 1);
           jj = std::clamp(jj, 0, ny_ - 1);
           const std::size_t q = idx(ii, jj);
-          u = vel(H_[q], HU_[q]);
-          v = vel(H_[q], HV_[q]);
+          u = U_[q];
+          v = V_[q];
         };
         double ue, ve, uw, vw, un, vn, us, vs;
         vel_at(i + 1, j, ue, ve);
@@ -367,86 +386,70 @@ void Solver::predictor(int tt, double dt) {
     }
 }
 
-// Local speed of the central flux: the largest characteristic speed |u| + c on either side.
-// (Raising it to the dry-bed front speed u + 2c at wet/dry faces was tried: it adds diffusion and
-// makes thin fronts lag more; docs/engine.md.)
+// Local speed of the central flux: an upper bound of the characteristic speeds |u| + c on both
+// sides, max|u| + sqrt(max c^2) (one square root instead of two). Raising it to the dry-bed front
+// speed u + 2c at wet/dry faces was tried: it adds diffusion and makes thin fronts lag more
+// (docs/engine.md).
 inline double face_speed(double uL, double c2L, double uR, double c2R) {
-  return std::max(std::abs(uL) + std::sqrt(c2L), std::abs(uR) + std::sqrt(c2R));
+  return std::max(std::abs(uL), std::abs(uR)) + std::sqrt(std::max(c2L, c2R));
 }
 
-// Central local-speed flux (Kurganov & Tadmor 2000) between the predicted face values.
+// A reconstructed state on one side of a face, in face coordinates: depth, normal and tangential
+// velocity, and the pressure coefficients Pi_nn, Pi_nt of that side's cell.
+struct FaceState {
+  double H, un, ut, Pnn, Pnt;
+};
+
+// Ghost state beyond a domain edge: a wall mirrors the inside (normal velocity and the off-diagonal
+// pressure coefficient change sign, so no mass crosses and the wall pushes only normally); an
+// outflow boundary copies it.
+inline FaceState boundary_ghost(const FaceState& in, Boundary2D b) {
+  if (b == Boundary2D::wall) return {in.H, -in.un, in.ut, in.Pnn, -in.Pnt};
+  return in;
+}
+
+// Central local-speed flux (Kurganov & Tadmor 2000) between the predicted face values, with
+// a = max(|u_n| + sqrt(Pi_nn H)) over both sides. Returns (mass, normal momentum, tangential momentum).
+inline Face central_flux(const FaceState& L, const FaceState& R) {
+  const double a = face_speed(L.un, L.Pnn * std::max(L.H, 0.0), R.un, R.Pnn * std::max(R.H, 0.0));
+  const double mL = L.H * L.un, mR = R.H * R.un;
+  return Face{0.5 * (mL + mR) - 0.5 * a * (R.H - L.H),
+              0.5 * (mL * L.un + 0.5 * L.Pnn * L.H * L.H + mR * R.un + 0.5 * R.Pnn * R.H * R.H) - 0.5 * a * (mR - mL),
+              0.5 * (mL * L.ut + 0.5 * L.Pnt * L.H * L.H + mR * R.ut + 0.5 * R.Pnt * R.H * R.H) -
+                  0.5 * a * (R.H * R.ut - L.H * L.ut)};
+}
+
+// Between two cells that friction holds at rest: the pressure only, no numerical diffusion, so that
+// material at rest stays exactly at rest.
+inline Face held_face(const FaceState& L, const FaceState& R) {
+  return Face{0.0, 0.25 * (L.Pnn * L.H * L.H + R.Pnn * R.H * R.H), 0.25 * (L.Pnt * L.H * L.H + R.Pnt * R.H * R.H)};
+}
 Face Solver::x_face(int i, int j) const {
-  // Face between cells (i-1, j) and (i, j); i in [0, nx].
+  // Face between cells (i-1, j) and (i, j); i in [0, nx]. Face states: depth H, normal velocity un,
+  // tangential velocity ut, pressure coefficients Pnn (= Pxx) and Pnt (= Pxy).
   const bool west = i == 0, east = i == nx_;
   const std::size_t kl = west ? idx(0, j) : idx(i - 1, j), kr = east ? idx(nx_ - 1, j) : idx(i, j);
-  double HL = 0, UL_ = 0, VL_ = 0, HR = 0, UR_ = 0, VR_ = 0, PxxL = 0, PxyL = 0, PxxR = 0, PxyR = 0;
-  if (!west) {
-    HL = Hp_[kl] + 0.5 * sHx_[kl];
-    UL_ = HL * (Up_[kl] + 0.5 * sux_[kl]);
-    VL_ = HL * (Vp_[kl] + 0.5 * svx_[kl]);
-    PxxL = Pxx_[kl];
-    PxyL = Pxy_[kl];
-  }
-  if (!east) {
-    HR = Hp_[kr] - 0.5 * sHx_[kr];
-    UR_ = HR * (Up_[kr] - 0.5 * sux_[kr]);
-    VR_ = HR * (Vp_[kr] - 0.5 * svx_[kr]);
-    PxxR = Pxx_[kr];
-    PxyR = Pxy_[kr];
-  }
-  if (west || east) {
-    const bool wall = (west ? cfg_.west : cfg_.east) == Boundary2D::wall;
-    const double s = wall ? -1.0 : 1.0;  // the ghost mirrors (wall) or copies (outflow) the inside
-    if (west) {
-      HL = HR; UL_ = s * UR_; VL_ = VR_; PxxL = PxxR; PxyL = s * PxyR;
-    } else {
-      HR = HL; UR_ = s * UL_; VR_ = VL_; PxxR = PxxL; PxyR = s * PxyL;
-    }
-  } else if (held_[kl] && held_[kr]) {
-    return Face{0.0, 0.25 * (PxxL * HL * HL + PxxR * HR * HR), 0.25 * (PxyL * HL * HL + PxyR * HR * HR)};
-  }
-  const double uL = vel(HL, UL_), uR = vel(HR, UR_);
-  const double a = face_speed(uL, PxxL * std::max(HL, 0.0), uR, PxxR * std::max(HR, 0.0));
-  return Face{0.5 * (UL_ + UR_) - 0.5 * a * (HR - HL),
-              0.5 * (UL_ * uL + 0.5 * PxxL * HL * HL + UR_ * uR + 0.5 * PxxR * HR * HR) - 0.5 * a * (UR_ - UL_),
-              0.5 * (VL_ * uL + 0.5 * PxyL * HL * HL + VR_ * uR + 0.5 * PxyR * HR * HR) - 0.5 * a * (VR_ - VL_)};
+  FaceState L{}, R{};
+  if (!west) L = {Hp_[kl] + 0.5 * sHx_[kl], Up_[kl] + 0.5 * sux_[kl], Vp_[kl] + 0.5 * svx_[kl], Pxx_[kl], Pxy_[kl]};
+  if (!east) R = {Hp_[kr] - 0.5 * sHx_[kr], Up_[kr] - 0.5 * sux_[kr], Vp_[kr] - 0.5 * svx_[kr], Pxx_[kr], Pxy_[kr]};
+  if (west) L = boundary_ghost(R, cfg_.west);
+  if (east) R = boundary_ghost(L, cfg_.east);
+  if (!west && !east && held_[kl] && held_[kr]) return held_face(L, R);
+  return central_flux(L, R);
 }
 
 Face Solver::y_face(int i, int j) const {
-  // Face between cells (i, j-1) and (i, j); j in [0, ny].
+  // Face between cells (i, j-1) and (i, j); j in [0, ny]. Normal = y: the flux components come back
+  // as (mass, x-momentum, y-momentum).
   const bool south = j == 0, north = j == ny_;
   const std::size_t kl = south ? idx(i, 0) : idx(i, j - 1), kr = north ? idx(i, ny_ - 1) : idx(i, j);
-  double HL = 0, UL_ = 0, VL_ = 0, HR = 0, UR_ = 0, VR_ = 0, PyyL = 0, PxyL = 0, PyyR = 0, PxyR = 0;
-  if (!south) {
-    HL = Hp_[kl] + 0.5 * sHy_[kl];
-    UL_ = HL * (Up_[kl] + 0.5 * suy_[kl]);
-    VL_ = HL * (Vp_[kl] + 0.5 * svy_[kl]);
-    PyyL = Pyy_[kl];
-    PxyL = Pxy_[kl];
-  }
-  if (!north) {
-    HR = Hp_[kr] - 0.5 * sHy_[kr];
-    UR_ = HR * (Up_[kr] - 0.5 * suy_[kr]);
-    VR_ = HR * (Vp_[kr] - 0.5 * svy_[kr]);
-    PyyR = Pyy_[kr];
-    PxyR = Pxy_[kr];
-  }
-  if (south || north) {
-    const bool wall = (south ? cfg_.south : cfg_.north) == Boundary2D::wall;
-    const double s = wall ? -1.0 : 1.0;
-    if (south) {
-      HL = HR; UL_ = UR_; VL_ = s * VR_; PyyL = PyyR; PxyL = s * PxyR;
-    } else {
-      HR = HL; UR_ = UL_; VR_ = s * VL_; PyyR = PyyL; PxyR = s * PxyL;
-    }
-  } else if (held_[kl] && held_[kr]) {
-    return Face{0.0, 0.25 * (PxyL * HL * HL + PxyR * HR * HR), 0.25 * (PyyL * HL * HL + PyyR * HR * HR)};
-  }
-  const double vL = vel(HL, VL_), vR = vel(HR, VR_);
-  const double a = face_speed(vL, PyyL * std::max(HL, 0.0), vR, PyyR * std::max(HR, 0.0));
-  return Face{0.5 * (VL_ + VR_) - 0.5 * a * (HR - HL),
-              0.5 * (UL_ * vL + 0.5 * PxyL * HL * HL + UR_ * vR + 0.5 * PxyR * HR * HR) - 0.5 * a * (UR_ - UL_),
-              0.5 * (VL_ * vL + 0.5 * PyyL * HL * HL + VR_ * vR + 0.5 * PyyR * HR * HR) - 0.5 * a * (VR_ - VL_)};
+  FaceState L{}, R{};
+  if (!south) L = {Hp_[kl] + 0.5 * sHy_[kl], Vp_[kl] + 0.5 * svy_[kl], Up_[kl] + 0.5 * suy_[kl], Pyy_[kl], Pxy_[kl]};
+  if (!north) R = {Hp_[kr] - 0.5 * sHy_[kr], Vp_[kr] - 0.5 * svy_[kr], Up_[kr] - 0.5 * suy_[kr], Pyy_[kr], Pxy_[kr]};
+  if (south) L = boundary_ghost(R, cfg_.south);
+  if (north) R = boundary_ghost(L, cfg_.north);
+  const Face f = (!south && !north && held_[kl] && held_[kr]) ? held_face(L, R) : central_flux(L, R);
+  return Face{f.f0, f.f2, f.f1};  // (mass, normal, tangential) -> (mass, x, y)
 }
 
 void Solver::faces(int tt) {
@@ -497,27 +500,24 @@ void Solver::positivity(int tt, double dt) {
 void Solver::update(int tt, double t, double dt) {
   int i0, i1, j0, j1;
   tile_range(tt, i0, i1, j0, j1);
-  const double lx = dt / t_.dx, ly = dt / t_.dy;
-  double out = 0, travel = 0;
+  const double lx = dt / t_.dx, ly = dt / t_.dy, dry = cfg_.dry_depth;
+  double out = 0, travel = 0, mass = 0, ke = 0, vmax = 0, rate = 0;
+  bool wet = false;
   // Scaled face flux: the limiter factor of the upwind (sending) cell.
-  auto xf = [&](int i, int j) {
-    Face f = Fx_[std::size_t(j) * (nx_ + 1) + i];
+  auto scaled = [&](const Face& f, std::size_t left, std::size_t right, bool has_left, bool has_right) {
     double s = 1.0;
-    if (f.f0 > 0 && i > 0) s = r_[idx(i - 1, j)];
-    else if (f.f0 < 0 && i < nx_) s = r_[idx(i, j)];
-    return Face{f.f0 * s, f.f1 * s, f.f2 * s};
-  };
-  auto yf = [&](int i, int j) {
-    Face f = Fy_[std::size_t(j) * nx_ + i];
-    double s = 1.0;
-    if (f.f0 > 0 && j > 0) s = r_[idx(i, j - 1)];
-    else if (f.f0 < 0 && j < ny_) s = r_[idx(i, j)];
+    if (f.f0 > 0 && has_left) s = r_[left];
+    else if (f.f0 < 0 && has_right) s = r_[right];
     return Face{f.f0 * s, f.f1 * s, f.f2 * s};
   };
   for (int j = j0; j < j1; ++j)
     for (int i = i0; i < i1; ++i) {
       const std::size_t k = idx(i, j);
-      const Face w = xf(i, j), e = xf(i + 1, j), s = yf(i, j), nn = yf(i, j + 1);
+      const std::size_t fx = std::size_t(j) * (nx_ + 1) + i, fy = std::size_t(j) * nx_ + i;
+      const Face w = scaled(Fx_[fx], k - 1, k, i > 0, true);
+      const Face e = scaled(Fx_[fx + 1], k, k + 1, true, i < nx_ - 1);
+      const Face s = scaled(Fy_[fy], k - nx_, k, j > 0, true);
+      const Face nn = scaled(Fy_[fy + nx_], k, k + nx_, true, j < ny_ - 1);
       if (i == 0) out -= w.f0 * dt * t_.dy;
       if (i == nx_ - 1) out += e.f0 * dt * t_.dy;
       if (j == 0) out -= s.f0 * dt * t_.dx;
@@ -530,21 +530,43 @@ void Solver::update(int tt, double t, double dt) {
       const double drive = -Hp * geo_.c[k] * geo_.c[k] * gn;
       double MU = HU_[k] - lx * (e.f1 - w.f1) - ly * (nn.f1 - s.f1) + dt * drive * geo_.bx[k];
       double MV = HV_[k] - lx * (e.f2 - w.f2) - ly * (nn.f2 - s.f2) + dt * drive * geo_.by[k];
-      if (H > cfg_.dry_depth) {
+      double U = 0, V = 0, sp = 0;
+      if (H > dry) {
         // Friction at the half step (midpoint rule), as a bounded impulse that never reverses u.
-        apply_friction(MU, MV, m3(k, MU, MV), dt * resistance(k, Hp, Up, Vp, gn));
+        const double M3 = m3(k, MU, MV), impulse = dt * resistance(k, Hp, Up, Vp, gn);
+        apply_friction(MU, MV, M3, impulse);
+        const double inv = 1.0 / H;
+        U = MU * inv;
+        V = MV * inv;
+        sp = std::max(M3 - impulse, 0.0) * inv;  // surface speed after friction
       } else {
         MU = MV = 0;
       }
       H_[k] = H;
       HU_[k] = MU;
       HV_[k] = MV;
-      travel += dt * std::sqrt(MU * MU + MV * MV);
-      record_hazard(k, t + dt);
+      U_[k] = U;
+      V_[k] = V;
+      if (cfg_.track_travel) travel += dt * std::sqrt(MU * MU + MV * MV);
+      // Hazard maps and tile sums from the new state.
+      const double h = H * geo_.c[k], sp2 = sp * sp;
+      hz_.max_depth[k] = std::max(hz_.max_depth[k], h);
+      hz_.max_speed[k] = std::max(hz_.max_speed[k], sp);
+      hz_.max_pressure[k] = std::max(hz_.max_pressure[k], cfg_.material.density * sp2);
+      if (h > cfg_.arrival_threshold && std::isnan(hz_.arrival_time[k])) hz_.arrival_time[k] = t + dt;
+      mass += H;
+      ke += 0.5 * H * sp2;
+      vmax = std::max(vmax, sp);
+      rate = std::max(rate, std::abs(U) / t_.dx + std::abs(V) / t_.dy + Ps_[k] * std::sqrt(H));
+      wet = wet || H > cfg_.activation_depth;
     }
   tile_out_[tt] += out;
   tile_travel_[tt] += travel;
-  tile_scan(tt);
+  tile_mass_[tt] = mass;
+  tile_ke_[tt] = ke;
+  tile_speed_[tt] = vmax;
+  tile_rate_[tt] = rate;
+  tile_wet_[tt] = wet;
 }
 
 Sh2dResult Solver::run() {
@@ -560,8 +582,7 @@ Sh2dResult Solver::run() {
   const double cell_area = t_.dx * t_.dy;
   d.volume_initial = sum_tiles(tile_mass_) * cell_area;
   double t = 0, active_sum = 0;
-  const int nact_max = ntiles_;
-  (void)nact_max;
+  const auto loop0 = std::chrono::steady_clock::now();
   while (t < tc.t_end) {
     if (d.steps >= tc.max_steps) {
       d.stop = StopReason::max_steps;
@@ -614,6 +635,7 @@ Sh2dResult Solver::run() {
       break;
     }
   }
+  d.loop_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loop0).count();
   d.t = t;
   d.volume_final = sum_tiles(tile_mass_) * cell_area;
   d.volume_outflow = sum_tiles(tile_out_);

@@ -76,6 +76,7 @@ struct Sh2dConfig {
   int tile = 32;                    ///< tile edge in cells
   bool curvature = true;            ///< the centrifugal part of the normal load raises friction
   bool skip_inactive = true;        ///< false: compute every tile every step (for comparison)
+  bool track_travel = false;        ///< accumulate Sh2dDiagnostics::mean_travel (costs a sqrt per cell)
 };
 
 /// Solver state: H = h / cos(theta) and the horizontal momentum H U, H V per horizontal area.
@@ -99,13 +100,15 @@ struct Sh2dDiagnostics {
   double volume_initial = 0, volume_final = 0;  ///< [m^3]
   double volume_outflow = 0;                    ///< left through outflow boundaries [m^3]
   double kinetic_energy_peak = 0;               ///< per unit density [m^5/s^2]
-  /// Mass-averaged horizontal distance travelled: (1/V0) * integral over time and area of H |U| [m].
+  /// Mass-averaged horizontal distance travelled: (1/V0) * integral over time and area of H |U| [m]
+  /// (only with Sh2dConfig::track_travel).
   double mean_travel = 0;
   double max_speed = 0;                         ///< over the whole run [m/s]
   long positivity_limited = 0;                  ///< cell-steps whose outflow had to be limited
   double cell_updates = 0;                      ///< cells computed, summed over steps
   double mean_active_fraction = 0, max_active_fraction = 0;
-  double wall_seconds = 0;
+  double wall_seconds = 0;  ///< whole run, set-up included
+  double loop_seconds = 0;  ///< time loop only
   /// Relative volume error: |final + outflow - initial| / initial.
   double volume_error() const {
     return volume_initial > 0 ? std::abs(volume_final + volume_outflow - volume_initial) / volume_initial : 0.0;

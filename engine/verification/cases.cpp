@@ -106,6 +106,7 @@ std::vector<Row> case_a1(const Options& o) {
         s.m.assign(n, 0);
         for (int i = 0; i < n; ++i) s.h[i] = ch.centre(i) <= 0 ? ex.h0 : 0.0;
         const auto r = run_sh1d(ch, cfg, s);
+        row.cell_updates = double(r.steps) * n;
         h = r.state.h;
         for (int i = 0; i < n; ++i) xc[i] = ch.centre(i);
         row.variant = variant("1d", o);
@@ -122,6 +123,7 @@ std::vector<Row> case_a1(const Options& o) {
         for (int j = 0; j < ny; ++j)
           for (int i = 0; i < n; ++i) h0[std::size_t(j) * n + i] = xa + (i + 0.5) * ds <= 0 ? ex.h0 : 0.0;
         const auto r = run_sh2d(terr, cfg, state_from_normal_depth(terr, h0));
+        row.cell_updates = r.diag.cell_updates;
         for (int i = 0; i < n; ++i) {
           h[i] = r.hazard.final_depth[std::size_t(1) * n + i];
           xc[i] = xa + (i + 0.5) * ds;
@@ -274,6 +276,7 @@ std::vector<Row> case_a3(const Options& o) {
     Row row;
     row.case_id = "A3";
     row.variant = variant("2d", o);
+    row.cell_updates = r.diag.cell_updates;
     row.cells = long(nx) * ny;
     row.dx = ds;
     const bool target = ds <= 1.0 + 1e-9;
@@ -440,6 +443,7 @@ RunoutFigures runout_run(double angle_deg, double dx, const Options& o, bool cur
   cfg.time.t_end = 150;
   cfg.time.stop_fraction = 1e-4;
   cfg.curvature = curvature;
+  cfg.track_travel = true;
   const auto init = state_from_normal_depth(t, h0);
   const auto r = run_sh2d(t, cfg, init);
   RunoutFigures f;

@@ -1,1 +1,248 @@
 #include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cmath>
+
+#include "engine/sh2d.hpp"
+
+using namespace runout::engine;
+constexpr double kDeg = M_PI / 180.0;
+
+namespace {
+
+// Slope falling in direction `aspect` (radians from +x) at `slope_deg`, plus a run-out bowl.
+Terrain2D hillside(int nx, int ny, double dx, double slope_deg, double aspect) {
+  Terrain2D t;
+  t.nx = nx;
+  t.ny = ny;
+  t.dx = t.dy = dx;
+  t.z.resize(t.cells());
+  const double s = std::tan(slope_deg * kDeg);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const double x = i * dx, y = j * dx;
+      const double along = std::cos(aspect) * x + std::sin(aspect) * y;
+      t.z[std::size_t(j) * nx + i] = -s * along + 0.0005 * along * along + 0.3 * std::sin(0.05 * x) * std::cos(0.07 * y);
+    }
+  return t;
+}
+
+std::vector<double> blob(const Terrain2D& t, double ci, double cj, double r, double h) {
+  std::vector<double> v(t.cells(), 0.0);
+  for (int j = 0; j < t.ny; ++j)
+    for (int i = 0; i < t.nx; ++i) {
+      const double q = ((i - ci) * (i - ci) + (j - cj) * (j - cj)) / (r * r);
+      v[std::size_t(j) * t.nx + i] = q < 1 ? h * (1 - q) : 0.0;
+    }
+  return v;
+}
+
+Sh2dConfig coulomb(double delta_deg, double t_end) {
+  Sh2dConfig c;
+  c.material.delta = delta_deg * kDeg;
+  c.time.t_end = t_end;
+  return c;
+}
+
+}  // namespace
+
+TEST(Sh2d, ResultsAreIdenticalForAnyThreadCount) {
+  const auto t = hillside(150, 120, 5.0, 32, 0.4);
+  auto cfg = coulomb(22, 30.0);
+  cfg.tile = 16;
+  const auto init = state_from_normal_depth(t, blob(t, 30, 30, 10, 3.0));
+  omp_set_num_threads(1);
+  const auto a = run_sh2d(t, cfg, init);
+  omp_set_num_threads(2);
+  const auto b = run_sh2d(t, cfg, init);
+  ASSERT_EQ(a.diag.steps, b.diag.steps);
+  EXPECT_EQ(a.state.H, b.state.H);
+  EXPECT_EQ(a.state.HU, b.state.HU);
+  EXPECT_EQ(a.hazard.max_speed, b.hazard.max_speed);
+  EXPECT_EQ(a.diag.volume_final, b.diag.volume_final);
+  EXPECT_GT(a.diag.max_speed, 5.0);  // it did flow
+}
+
+TEST(Sh2d, SkippingDryTilesChangesNothingButTheCost) {
+  const auto t = hillside(256, 256, 4.0, 30, 0.0);
+  auto cfg = coulomb(24, 20.0);
+  const auto init = state_from_normal_depth(t, blob(t, 40, 128, 8, 3.0));
+  const auto fast = run_sh2d(t, cfg, init);
+  cfg.skip_inactive = false;
+  const auto full = run_sh2d(t, cfg, init);
+  ASSERT_EQ(fast.diag.steps, full.diag.steps);
+  double dmax = 0;
+  for (std::size_t k = 0; k < t.cells(); ++k) dmax = std::max(dmax, std::abs(fast.hazard.max_depth[k] - full.hazard.max_depth[k]));
+  EXPECT_LT(dmax, 1e-9);
+  EXPECT_LT(fast.diag.cell_updates, 0.25 * full.diag.cell_updates);
+  EXPECT_LT(fast.diag.mean_active_fraction, 0.25);
+  EXPECT_NEAR(full.diag.mean_active_fraction, 1.0, 1e-12);
+}
+
+TEST(Sh2d, TransposedTerrainGivesTheTransposedResult) {
+  const int n = 96;
+  const auto tx = hillside(n, n, 3.0, 30, 0.0);
+  auto ty = tx;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) ty.z[std::size_t(j) * n + i] = tx.z[std::size_t(i) * n + j];
+  auto cfg = coulomb(20, 15.0);
+  const auto hx = blob(tx, 20, 48, 8, 2.0);
+  std::vector<double> hy(hx.size());
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) hy[std::size_t(j) * n + i] = hx[std::size_t(i) * n + j];
+  const auto a = run_sh2d(tx, cfg, state_from_normal_depth(tx, hx));
+  const auto b = run_sh2d(ty, cfg, state_from_normal_depth(ty, hy));
+  double d = 0;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      d = std::max(d, std::abs(a.hazard.max_depth[std::size_t(j) * n + i] - b.hazard.max_depth[std::size_t(i) * n + j]));
+  EXPECT_LT(d, 1e-10);
+}
+
+TEST(Sh2d, ClosedBoxConservesVolumeToRoundOff) {
+  const auto t = hillside(80, 60, 5.0, 40, 0.7);
+  auto cfg = coulomb(15, 60.0);
+  cfg.west = cfg.east = cfg.south = cfg.north = Boundary2D::wall;
+  const auto r = run_sh2d(t, cfg, state_from_normal_depth(t, blob(t, 30, 20, 12, 5.0)));
+  EXPECT_EQ(r.diag.volume_outflow, 0.0);
+  EXPECT_LT(r.diag.volume_error(), 1e-13);
+  for (double H : r.state.H) EXPECT_GE(H, 0.0);
+}
+
+TEST(Sh2d, OutflowIsAccountedFor) {
+  const auto t = hillside(60, 40, 5.0, 35, 0.0);
+  auto cfg = coulomb(10, 40.0);
+  const auto r = run_sh2d(t, cfg, state_from_normal_depth(t, blob(t, 20, 20, 8, 3.0)));
+  EXPECT_GT(r.diag.volume_outflow, 0.5 * r.diag.volume_initial);
+  EXPECT_LT(r.diag.volume_error(), 1e-12);
+}
+
+TEST(Sh2d, VoellmyLayerReachesItsTerminalSpeed) {
+  // Uniform 1 m layer on an infinite 30 degree slope: g sin - mu g cos - g u^2 / (xi h) = 0.
+  Terrain2D t;
+  t.nx = t.ny = 12;
+  t.dx = t.dy = 5.0;
+  t.z.resize(t.cells());
+  const double th = 30 * kDeg;
+  for (int j = 0; j < t.ny; ++j)
+    for (int i = 0; i < t.nx; ++i) t.z[std::size_t(j) * t.nx + i] = -std::tan(th) * i * t.dx;
+  Sh2dConfig cfg;
+  cfg.material.rheology = Rheology::voellmy;
+  cfg.material.mu = 0.2;
+  cfg.material.xi = 1000.0;
+  cfg.time.t_end = 120.0;
+  cfg.south = cfg.north = Boundary2D::wall;
+  // An infinite slope: the outflow ghosts copy the state, so the uniform layer stays uniform.
+  const auto r = run_sh2d(t, cfg, state_from_normal_depth(t, std::vector<double>(t.cells(), 1.0)));
+  const double expect = std::sqrt(1000.0 * 1.0 * (std::sin(th) - 0.2 * std::cos(th)));
+  const std::size_t k = std::size_t(6) * t.nx + 6;
+  EXPECT_NEAR(r.hazard.max_speed[k], expect, 0.005 * expect);
+  EXPECT_NEAR(r.hazard.final_depth[k], 1.0, 1e-9);
+}
+
+TEST(Sh2d, HazardMapsAreConsistent) {
+  const auto t = hillside(120, 80, 5.0, 30, 0.0);
+  auto cfg = coulomb(22, 40.0);
+  cfg.material.density = 300;
+  cfg.arrival_threshold = 0.05;
+  const auto r = run_sh2d(t, cfg, state_from_normal_depth(t, blob(t, 20, 40, 8, 3.0)));
+  const auto& hz = r.hazard;
+  int reached = 0, never = 0;
+  for (std::size_t k = 0; k < t.cells(); ++k) {
+    EXPECT_GE(hz.max_depth[k] + 1e-15, hz.final_depth[k]);
+    EXPECT_NEAR(hz.max_pressure[k], 300 * hz.max_speed[k] * hz.max_speed[k], 1e-9 * (1 + hz.max_pressure[k]));
+    if (std::isnan(hz.arrival_time[k])) {
+      EXPECT_LE(hz.max_depth[k], 0.05);
+      ++never;
+    } else {
+      EXPECT_GT(hz.max_depth[k], 0.05);
+      EXPECT_LE(hz.arrival_time[k], r.diag.t);
+      ++reached;
+    }
+  }
+  EXPECT_GT(reached, 100);
+  EXPECT_GT(never, 100);
+  // Release cells have arrival time 0; cells further down arrive later.
+  EXPECT_EQ(hz.arrival_time[std::size_t(40) * t.nx + 20], 0.0);
+  EXPECT_GT(hz.arrival_time[std::size_t(40) * t.nx + 35], hz.arrival_time[std::size_t(40) * t.nx + 30]);
+  EXPECT_GT(hz.arrival_time[std::size_t(40) * t.nx + 30], 0.0);
+}
+
+TEST(Sh2d, StopsWhenKineticEnergyHasDecayed) {
+  auto t = hillside(150, 60, 4.0, 30, 0.0);
+  for (int j = 0; j < t.ny; ++j)  // flat run-out beyond x = 300 m
+    for (int i = 0; i < t.nx; ++i) {
+      auto& z = t.z[std::size_t(j) * t.nx + i];
+      z = std::max(z, t.z[std::size_t(j) * t.nx + 75]);
+    }
+  auto cfg = coulomb(25, 1000.0);
+  cfg.time.stop_fraction = 0.01;
+  const auto r = run_sh2d(t, cfg, state_from_normal_depth(t, blob(t, 20, 30, 8, 3.0)));
+  EXPECT_EQ(r.diag.stop, StopReason::kinetic_energy);
+  EXPECT_LT(r.diag.t, 200.0);
+}
+
+TEST(Sh2d, EarthPressureActivePassiveRunsAndConserves) {
+  const auto t = hillside(100, 80, 4.0, 35, 0.3);
+  auto cfg = coulomb(20, 30.0);
+  cfg.material.earth_pressure = EarthPressure::active_passive;
+  cfg.material.phi = 32 * kDeg;
+  cfg.west = cfg.east = cfg.south = cfg.north = Boundary2D::wall;
+  const auto r = run_sh2d(t, cfg, state_from_normal_depth(t, blob(t, 25, 40, 10, 4.0)));
+  EXPECT_LT(r.diag.volume_error(), 1e-13);
+  EXPECT_GT(r.diag.max_speed, 3.0);
+}
+
+TEST(Sh2d, ProgressIsReportedAndCancellationStopsTheRun) {
+  const auto t = hillside(60, 60, 5.0, 30, 0.0);
+  auto cfg = coulomb(20, 100.0);
+  cfg.time.progress_every = 10;
+  int calls = 0;
+  double last_t = 0;
+  cfg.time.progress = [&](const Progress& p) {
+    ++calls;
+    EXPECT_GT(p.t, last_t);
+    last_t = p.t;
+    EXPECT_GT(p.mass, 0.0);
+    EXPECT_GT(p.active_fraction, 0.0);
+    return calls < 4;
+  };
+  const auto r = run_sh2d(t, cfg, state_from_normal_depth(t, blob(t, 20, 30, 8, 2.0)));
+  EXPECT_EQ(r.diag.stop, StopReason::cancelled);
+  EXPECT_EQ(r.diag.steps, 40);
+}
+
+TEST(Sh2d, BadInputIsRejectedWithAMessage) {
+  auto t = hillside(20, 20, 5.0, 30, 0.0);
+  auto cfg = coulomb(20, 1.0);
+  auto s = state_from_normal_depth(t, std::vector<double>(t.cells(), 1.0));
+  t.z[5] = std::nan("");
+  try {
+    run_sh2d(t, cfg, s);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("finite"), std::string::npos);
+  }
+  t.z[5] = 0;
+  cfg.time.cfl = 0.6;
+  EXPECT_THROW(run_sh2d(t, cfg, s), std::invalid_argument);
+  cfg.time.cfl = 0.4;
+  s.H[3] = -0.1;
+  EXPECT_THROW(run_sh2d(t, cfg, s), std::invalid_argument);
+  s.H[3] = 1;
+  cfg.material.delta = 95 * kDeg;
+  EXPECT_THROW(run_sh2d(t, cfg, s), std::invalid_argument);
+  EXPECT_THROW(state_from_normal_depth(t, std::vector<double>(3, 1.0)), std::invalid_argument);
+}
+
+TEST(Sh2d, NormalDepthConventionOnASlope) {
+  Terrain2D t;
+  t.nx = t.ny = 5;
+  t.dx = t.dy = 1;
+  t.z.resize(25);
+  for (int j = 0; j < 5; ++j)
+    for (int i = 0; i < 5; ++i) t.z[std::size_t(j) * 5 + i] = -std::tan(30 * kDeg) * i;
+  const auto s = state_from_normal_depth(t, std::vector<double>(25, 2.0));
+  EXPECT_NEAR(s.H[12], 2.0 / std::cos(30 * kDeg), 1e-12);  // volume per horizontal area
+  EXPECT_NEAR(normal_depth(t, s)[12], 2.0, 1e-12);
+}
