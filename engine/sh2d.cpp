@@ -87,12 +87,72 @@ struct Face {
   double f0, f1, f2;
 };
 
+// A reconstructed state on one side of a face, in face coordinates: depth, normal and tangential
+// velocity, and the pressure coefficients Pi_nn, Pi_nt of that side's cell.
+struct FaceState {
+  double H, un, ut, Pnn, Pnt;
+};
+
+// Local speed of the central flux: an upper bound of the characteristic speeds |u| + c on both
+// sides, max|u| + sqrt(max c^2) (one square root instead of two). Raising it to the dry-bed front
+// speed u + 2c at wet/dry faces was tried: it adds diffusion and makes thin fronts lag more
+// (docs/engine.md).
+inline double face_speed(double uL, double c2L, double uR, double c2R) {
+  return std::max(std::abs(uL), std::abs(uR)) + std::sqrt(std::max(c2L, c2R));
+}
+
+// Ghost state beyond a domain edge: a wall mirrors the inside (normal velocity and the off-diagonal
+// pressure coefficient change sign, so no mass crosses and the wall pushes only normally); an
+// outflow boundary copies it.
+inline FaceState boundary_ghost(const FaceState& in, Boundary2D b) {
+  if (b == Boundary2D::wall) return {in.H, -in.un, in.ut, in.Pnn, -in.Pnt};
+  return in;
+}
+
+// Central local-speed flux (Kurganov & Tadmor 2000) between the predicted face values.
+// Returns (mass, normal momentum, tangential momentum).
+inline Face central_flux(const FaceState& L, const FaceState& R) {
+  const double a = face_speed(L.un, L.Pnn * std::max(L.H, 0.0), R.un, R.Pnn * std::max(R.H, 0.0));
+  const double mL = L.H * L.un, mR = R.H * R.un;
+  return Face{0.5 * (mL + mR) - 0.5 * a * (R.H - L.H),
+              0.5 * (mL * L.un + 0.5 * L.Pnn * L.H * L.H + mR * R.un + 0.5 * R.Pnn * R.H * R.H) - 0.5 * a * (mR - mL),
+              0.5 * (mL * L.ut + 0.5 * L.Pnt * L.H * L.H + mR * R.ut + 0.5 * R.Pnt * R.H * R.H) -
+                  0.5 * a * (R.H * R.ut - L.H * L.ut)};
+}
+
+// Between two cells that friction holds at rest: the pressure only, no numerical diffusion, so that
+// material at rest stays exactly at rest.
+inline Face held_face(const FaceState& L, const FaceState& R) {
+  return Face{0.0, 0.25 * (L.Pnn * L.H * L.H + R.Pnn * R.H * R.H), 0.25 * (L.Pnt * L.H * L.H + R.Pnt * R.H * R.H)};
+}
+
+// Work space of one tile's step, private to the thread computing it. A tile's step runs the whole
+// scheme on its cells and a halo: predictor on the tile grown by two cells, face fluxes and the
+// positivity factors on the tile grown by one, the update on the tile. The halo work is repeated by
+// the neighbouring tile, bit for bit the same, so the scheme stays conservative; in exchange the
+// intermediate fields never leave the cache.
+struct TileWork {
+  int bi0 = 0, bj0 = 0, bw = 0, bh = 0;  // box = tile grown by 2, clipped to the grid
+  std::vector<double> sHx, sux, svx, sHy, suy, svy, Hp, Up, Vp, Pxx, Pxy, Pyy, r;
+  std::vector<std::uint8_t> held;
+  std::vector<Face> Fx, Fy;  // Fx[(j - bj0) * (bw + 1) + (i - bi0)]: face left of cell (i, j)
+  void reserve(int T) {
+    const std::size_t n = std::size_t(T + 4) * (T + 4);
+    for (auto* v : {&sHx, &sux, &svx, &sHy, &suy, &svy, &Hp, &Up, &Vp, &Pxx, &Pxy, &Pyy, &r}) v->assign(n, 0.0);
+    held.assign(n, 0);
+    Fx.assign(std::size_t(T + 5) * (T + 4), Face{0, 0, 0});
+    Fy.assign(std::size_t(T + 4) * (T + 5), Face{0, 0, 0});
+  }
+  std::size_t at(int i, int j) const { return std::size_t(j - bj0) * bw + (i - bi0); }
+  std::size_t fx(int i, int j) const { return std::size_t(j - bj0) * (bw + 1) + (i - bi0); }
+  std::size_t fy(int i, int j) const { return std::size_t(j - bj0) * bw + (i - bi0); }
+};
+
 class Solver {
  public:
   Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
       : t_(t), cfg_(cfg), geo_(SurfaceGeometry::from(t)), nx_(t.nx), ny_(t.ny), n_(t.cells()),
-        T_(cfg.tile), ntx_((nx_ + T_ - 1) / T_), nty_((ny_ + T_ - 1) / T_), ntiles_(ntx_ * nty_),
-        H_(std::move(s.H)), HU_(std::move(s.HU)), HV_(std::move(s.HV)) {
+        T_(cfg.tile), ntx_((nx_ + T_ - 1) / T_), nty_((ny_ + T_ - 1) / T_), ntiles_(ntx_ * nty_) {
     g_ = cfg.gravity;
     mu_ = cfg.material.coulomb_coefficient();
     ixi_ = cfg.material.inv_xi();
@@ -104,22 +164,21 @@ class Solver {
       for (int a = 0; a < 2; ++a)
         for (int b = 0; b < 2; ++b) ky_[a][b] = k_y(kx_[a], d, b == 0);
     }
-    for (auto* v : {&sHx_, &sux_, &svx_, &sHy_, &suy_, &svy_, &Hp_, &Up_, &Vp_}) v->assign(n_, 0.0);
-    held_.assign(n_, 0);
-    U_.resize(n_);
-    V_.resize(n_);
-    for (std::size_t k = 0; k < n_; ++k) {
-      U_[k] = vel(H_[k], HU_[k]);
-      V_[k] = vel(H_[k], HV_[k]);
+    for (int b = 0; b < 2; ++b) {
+      H_[b] = s.H;
+      HU_[b] = s.HU;
+      HV_[b] = s.HV;
+      U_[b].resize(n_);
+      V_[b].resize(n_);
+      for (std::size_t k = 0; k < n_; ++k) {
+        U_[b][k] = vel(H_[b][k], HU_[b][k]);
+        V_[b][k] = vel(H_[b][k], HV_[b][k]);
+      }
     }
-    r_.assign(n_, 1.0);
     Pxx_.resize(n_);
     Pxy_.resize(n_);
     Pyy_.resize(n_);
-    Ps_.resize(n_);
-    for (std::size_t k = 0; k < n_; ++k) set_pressure(k, 1.0, 1.0, 1.0, 0.0);
-    Fx_.assign(std::size_t(nx_ + 1) * ny_, Face{0, 0, 0});
-    Fy_.assign(std::size_t(ny_ + 1) * nx_, Face{0, 0, 0});
+    for (std::size_t k = 0; k < n_; ++k) pressure(k, 1.0, 1.0, 1.0, 0.0, Pxx_[k], Pxy_[k], Pyy_[k]);
     tile_mass_.assign(ntiles_, 0);
     tile_ke_.assign(ntiles_, 0);
     tile_speed_.assign(ntiles_, 0);
@@ -134,7 +193,6 @@ class Solver {
     hz_.max_speed.assign(n_, 0);
     hz_.max_pressure.assign(n_, 0);
     hz_.arrival_time.assign(n_, nan);
-    // Initial tile sums, wet flags, wave speeds.
     for (int tt = 0; tt < ntiles_; ++tt) tile_scan(tt);
     for (std::size_t k = 0; k < n_; ++k) record_hazard(k, 0.0);
     rebuild_active();
@@ -151,26 +209,23 @@ class Solver {
     j0 = tj * T_;
     j1 = std::min(j0 + T_, ny_);
   }
-  bool tile_active(int ti, int tj) const {
-    return ti >= 0 && tj >= 0 && ti < ntx_ && tj < nty_ && active_flag_[tj * ntx_ + ti];
-  }
+  bool cell_active(int i, int j) const { return active_flag_[(j / T_) * ntx_ + i / T_]; }
   double vel(double H, double M) const { return H > cfg_.dry_depth ? M / H : 0.0; }
 
   // Pi = g [c^4 Kx d d^T + c^2 Ky s s^T], d the downslope unit vector (or (dx, dy) on flat ground).
-  void set_pressure(std::size_t k, double Kx, double Ky, double ddx, double ddy) {
+  void pressure(std::size_t k, double Kx, double Ky, double ddx, double ddy, double& pxx, double& pxy,
+                double& pyy) const {
     const double bx = geo_.bx[k], by = geo_.by[k], c = geo_.c[k], gb = std::hypot(bx, by);
     if (gb > 1e-12) {
       ddx = bx / gb;
       ddy = by / gb;
     }
     const double a = g_ * c * c * c * c * Kx, b = g_ * c * c * Ky;
-    Pxx_[k] = a * ddx * ddx + b * ddy * ddy;
-    Pxy_[k] = (a - b) * ddx * ddy;
-    Pyy_[k] = a * ddy * ddy + b * ddx * ddx;
-    Ps_[k] = std::sqrt(Pxx_[k]) / t_.dx + std::sqrt(Pyy_[k]) / t_.dy;
+    pxx = a * ddx * ddx + b * ddy * ddy;
+    pxy = (a - b) * ddx * ddy;
+    pyy = a * ddy * ddy + b * ddx * ddx;
   }
 
-  // Driving acceleration factor (g + Q)_+ with Q = U^T Hess(b) U.
   // The normal reaction keeps the flow on the surface and always includes Q: it turns the velocity
   // in curved terrain without loss of energy. The option `curvature` only decides whether the
   // centrifugal part raises the basal friction (as in eq. 3.48), as in the 1D solver.
@@ -192,14 +247,12 @@ class Solver {
   void tile_scan(int tt);
   void record_hazard(std::size_t k, double t);
   void rebuild_active();
-  void predictor(int tt, double dt);
+  void step_tile(int tt, double t, double dt, TileWork& w);
   template <Limiter L>
-  void predictor_t(int tt, double dt);
-  void faces(int tt);
-  void positivity(int tt, double dt);
-  void update(int tt, double t, double dt);
-  Face x_face(int i, int j) const;
-  Face y_face(int i, int j) const;
+  void predictor(TileWork& w, double dt) const;
+  void faces(TileWork& w) const;
+  long positivity(TileWork& w, int i0, int i1, int j0, int j1, double dt) const;
+  void update(int tt, const TileWork& w, double t, double dt);
 
   const Terrain2D& t_;
   const Sh2dConfig& cfg_;
@@ -210,11 +263,10 @@ class Solver {
   double g_ = 9.81, mu_ = 0, ixi_ = 0;
   bool kap_ = false;
   double kx_[2] = {1, 1}, ky_[2][2] = {{1, 1}, {1, 1}};
-  std::vector<double> H_, HU_, HV_, U_, V_;  // U_, V_: velocity (zero where dry)
-  std::vector<double> sHx_, sux_, svx_, sHy_, suy_, svy_, Hp_, Up_, Vp_, r_, Pxx_, Pxy_, Pyy_;
-  std::vector<double> Ps_;  // sqrt(Pxx) / dx + sqrt(Pyy) / dy: the gravity-wave part of the CFL rate per sqrt(H)
-  std::vector<std::uint8_t> held_;
-  std::vector<Face> Fx_, Fy_;
+  // State at t (index cur_) and t + dt (1 - cur_); U, V the velocity (zero where dry).
+  std::vector<double> H_[2], HU_[2], HV_[2], U_[2], V_[2];
+  int cur_ = 0;
+  std::vector<double> Pxx_, Pxy_, Pyy_;  // pressure coefficients for K = 1 (also the start values)
   std::vector<double> tile_mass_, tile_ke_, tile_speed_, tile_rate_, tile_out_, tile_travel_;
   std::vector<long> tile_limited_;
   std::vector<std::uint8_t> tile_wet_, active_flag_;
@@ -225,20 +277,21 @@ class Solver {
 void Solver::tile_scan(int tt) {
   int i0, i1, j0, j1;
   tile_range(tt, i0, i1, j0, j1);
+  const auto &H = H_[cur_], &HU = HU_[cur_], &HV = HV_[cur_];
   double mass = 0, ke = 0, vmax = 0, rate = 0;
   bool wet = false;
   for (int j = j0; j < j1; ++j)
     for (int i = i0; i < i1; ++i) {
       const std::size_t k = idx(i, j);
-      const double H = H_[k], U = vel(H, HU_[k]), V = vel(H, HV_[k]);
+      const double h = H[k], U = vel(h, HU[k]), V = vel(h, HV[k]);
       const double w = geo_.bx[k] * U + geo_.by[k] * V, sp2 = U * U + V * V + w * w;
-      mass += H;
-      ke += 0.5 * H * sp2;
+      mass += h;
+      ke += 0.5 * h * sp2;
       vmax = std::max(vmax, std::sqrt(sp2));
-      const double Hs = std::max(H, 0.0);
+      const double Hs = std::max(h, 0.0);
       rate = std::max(rate, (std::abs(U) + std::sqrt(Pxx_[k] * Hs)) / t_.dx +
                                 (std::abs(V) + std::sqrt(Pyy_[k] * Hs)) / t_.dy);
-      wet = wet || H > cfg_.activation_depth;
+      wet = wet || h > cfg_.activation_depth;
     }
   tile_mass_[tt] = mass;
   tile_ke_[tt] = ke;
@@ -248,8 +301,8 @@ void Solver::tile_scan(int tt) {
 }
 
 void Solver::record_hazard(std::size_t k, double t) {
-  const double H = H_[k], h = H * geo_.c[k];
-  const double sp = H > cfg_.dry_depth ? m3(k, HU_[k], HV_[k]) / H : 0.0;
+  const double H = H_[cur_][k], h = H * geo_.c[k];
+  const double sp = H > cfg_.dry_depth ? m3(k, HU_[cur_][k], HV_[cur_][k]) / H : 0.0;
   hz_.max_depth[k] = std::max(hz_.max_depth[k], h);
   hz_.max_speed[k] = std::max(hz_.max_speed[k], sp);
   hz_.max_pressure[k] = std::max(hz_.max_pressure[k], cfg_.material.density * sp * sp);
@@ -272,11 +325,17 @@ void Solver::rebuild_active() {
   for (int tt = 0; tt < ntiles_; ++tt) {
     if (active_flag_[tt] && !next[tt]) {
       // A tile leaves the computation: its thin remains (below the activation depth) stay where they
-      // are, at rest, so that the volume is kept exactly.
+      // are, at rest, so that the volume is kept exactly. Both time levels hold the frozen state.
       int i0, i1, j0, j1;
       tile_range(tt, i0, i1, j0, j1);
       for (int j = j0; j < j1; ++j)
-        for (int i = i0; i < i1; ++i) HU_[idx(i, j)] = HV_[idx(i, j)] = U_[idx(i, j)] = V_[idx(i, j)] = 0.0;
+        for (int i = i0; i < i1; ++i) {
+          const std::size_t k = idx(i, j);
+          for (int b = 0; b < 2; ++b) {
+            H_[b][k] = H_[cur_][k];
+            HU_[b][k] = HV_[b][k] = U_[b][k] = V_[b][k] = 0.0;
+          }
+        }
       tile_ke_[tt] = 0;
       tile_speed_[tt] = 0;
     }
@@ -285,44 +344,34 @@ void Solver::rebuild_active() {
   }
 }
 
-void Solver::predictor(int tt, double dt) {
-  switch (cfg_.limiter) {
-    case Limiter::minmod: return predictor_t<Limiter::minmod>(tt, dt);
-    case Limiter::vanleer: return predictor_t<Limiter::vanleer>(tt, dt);
-    case Limiter::superbee: return predictor_t<Limiter::superbee>(tt, dt);
-  }
-}
-
 template <Limiter lim>
-void Solver::predictor_t(int tt, double dt) {
-  int i0, i1, j0, j1;
-  tile_range(tt, i0, i1, j0, j1);
-  const double hx = 0.5 * dt / t_.dx, hy = 0.5 * dt / t_.dy;
-  for (int j = j0; j < j1; ++j)
-    for (int i = i0; i < i1; ++i) {
-      const std::size_t k = idx(i, j);
-      const double H = H_[k], MU = HU_[k], MV = HV_[k];
-      const double U = U_[k], V = V_[k];
+void Solver::predictor(TileWork& w, double dt) const {
+  const auto &Hs = H_[cur_], &HUs = HU_[cur_], &HVs = HV_[cur_], &Us = U_[cur_], &Vs = V_[cur_];
+  const double hx = 0.5 * dt / t_.dx, hy = 0.5 * dt / t_.dy, dry = cfg_.dry_depth;
+  for (int j = w.bj0; j < w.bj0 + w.bh; ++j)
+    for (int i = w.bi0; i < w.bi0 + w.bw; ++i) {
+      const std::size_t k = idx(i, j), q = w.at(i, j);
+      const double H = Hs[k], MU = HUs[k], MV = HVs[k], U = Us[k], V = Vs[k];
       // Limited slopes of the depth and of the velocity (primitive variables: reconstructing the
-      // velocity rather than the momentum keeps the speed of thin flow fronts; see docs/engine.md).
+      // velocity rather than the momentum keeps thin layers from producing spurious speeds).
       double sHx = 0, sux = 0, svx = 0, sHy = 0, suy = 0, svy = 0;
-      const double dry = cfg_.dry_depth;
       if (i > 0 && i < nx_ - 1) {
         const std::size_t l = k - 1, r = k + 1;
-        sHx = limited_slope(lim, H - H_[l], H_[r] - H);
-        if (H_[l] > dry && H_[r] > dry) {
-          sux = limited_slope(lim, U - U_[l], U_[r] - U);
-          svx = limited_slope(lim, V - V_[l], V_[r] - V);
+        sHx = limited_slope(lim, H - Hs[l], Hs[r] - H);
+        if (Hs[l] > dry && Hs[r] > dry) {
+          sux = limited_slope(lim, U - Us[l], Us[r] - U);
+          svx = limited_slope(lim, V - Vs[l], Vs[r] - V);
         }
       }
       if (j > 0 && j < ny_ - 1) {
         const std::size_t b = k - nx_, a = k + nx_;
-        sHy = limited_slope(lim, H - H_[b], H_[a] - H);
-        if (H_[b] > dry && H_[a] > dry) {
-          suy = limited_slope(lim, U - U_[b], U_[a] - U);
-          svy = limited_slope(lim, V - V_[b], V_[a] - V);
+        sHy = limited_slope(lim, H - Hs[b], Hs[a] - H);
+        if (Hs[b] > dry && Hs[a] > dry) {
+          suy = limited_slope(lim, U - Us[b], Us[a] - U);
+          svy = limited_slope(lim, V - Vs[b], Vs[a] - V);
         }
       }
+      double Pxx = Pxx_[k], Pxy = Pxy_[k], Pyy = Pyy_[k];
       if (kap_) {
         // Active (extension) or passive (compression) along and across the slope.
         const double bx = geo_.bx[k], by = geo_.by[k], gb = std::hypot(bx, by);
@@ -335,27 +384,16 @@ void Solver::predictor_t(int tt, double dt) {
           dx = U / s;
           dy = V / s;
         }
-        auto vel_at = [&](int ii, int jj, double& u, double& v) {
-          ii = std::clamp(ii, 0, nx_ - 1);
-          jj = std::clamp(jj, 0, ny_ - 1);
-          const std::size_t q = idx(ii, jj);
-          u = U_[q];
-          v = V_[q];
-        };
-        double ue, ve, uw, vw, un, vn, us, vs;
-        vel_at(i + 1, j, ue, ve);
-        vel_at(i - 1, j, uw, vw);
-        vel_at(i, j + 1, un, vn);
-        vel_at(i, j - 1, us, vs);
-        // d/dx and d/dy of the along (d) and across (s = (-dy, dx)) velocity components
-        const double dUx = (ue - uw) / (2 * t_.dx), dVx = (ve - vw) / (2 * t_.dx);
-        const double dUy = (un - us) / (2 * t_.dy), dVy = (vn - vs) / (2 * t_.dy);
+        const std::size_t e = idx(std::min(i + 1, nx_ - 1), j), wst = idx(std::max(i - 1, 0), j);
+        const std::size_t nn = idx(i, std::min(j + 1, ny_ - 1)), s = idx(i, std::max(j - 1, 0));
+        // d/dx and d/dy of the velocity, then along (d) and across (s = (-dy, dx)) components
+        const double dUx = (Us[e] - Us[wst]) / (2 * t_.dx), dVx = (Vs[e] - Vs[wst]) / (2 * t_.dx);
+        const double dUy = (Us[nn] - Us[s]) / (2 * t_.dy), dVy = (Vs[nn] - Vs[s]) / (2 * t_.dy);
         const double along = dx * (dx * dUx + dy * dVx) + dy * (dx * dUy + dy * dVy);
         const double across = -dy * (-dy * dUx + dx * dVx) + dx * (-dy * dUy + dx * dVy);
         const int ax = along >= 0 ? 0 : 1;
-        set_pressure(k, kx_[ax], ky_[ax][across >= 0 ? 0 : 1], dx, dy);
+        pressure(k, kx_[ax], ky_[ax][across >= 0 ? 0 : 1], dx, dy, Pxx, Pxy, Pyy);
       }
-      const double Pxx = Pxx_[k], Pxy = Pxy_[k], Pyy = Pyy_[k];
       // Predictor to t + dt/2 (eq. 4.78 in primitive form, pressure coefficients frozen in the cell).
       const double gn = normal_g(k, U, V);
       const double acc = -geo_.c[k] * geo_.c[k] * gn;  // gravity + normal reaction per unit volume
@@ -373,163 +411,129 @@ void Solver::predictor_t(int tt, double dt) {
         Vp = H > dry ? V + 0.5 * dt * acc * geo_.by[k] : 0.0;
       }
       const bool rest = apply_friction(Up, Vp, m3(k, Up, Vp), 0.5 * dt * resistance(k, 1.0, U, V, gn));
-      held_[k] = rest && MU == 0.0 && MV == 0.0;
-      sHx_[k] = sHx;
-      sux_[k] = sux;
-      svx_[k] = svx;
-      sHy_[k] = sHy;
-      suy_[k] = suy;
-      svy_[k] = svy;
-      Hp_[k] = Hp;
-      Up_[k] = Up;
-      Vp_[k] = Vp;
+      w.held[q] = rest && MU == 0.0 && MV == 0.0;
+      w.sHx[q] = sHx;
+      w.sux[q] = sux;
+      w.svx[q] = svx;
+      w.sHy[q] = sHy;
+      w.suy[q] = suy;
+      w.svy[q] = svy;
+      w.Hp[q] = Hp;
+      w.Up[q] = Up;
+      w.Vp[q] = Vp;
+      w.Pxx[q] = Pxx;
+      w.Pxy[q] = Pxy;
+      w.Pyy[q] = Pyy;
     }
 }
 
-// Local speed of the central flux: an upper bound of the characteristic speeds |u| + c on both
-// sides, max|u| + sqrt(max c^2) (one square root instead of two). Raising it to the dry-bed front
-// speed u + 2c at wet/dry faces was tried: it adds diffusion and makes thin fronts lag more
-// (docs/engine.md).
-inline double face_speed(double uL, double c2L, double uR, double c2R) {
-  return std::max(std::abs(uL), std::abs(uR)) + std::sqrt(std::max(c2L, c2R));
-}
-
-// A reconstructed state on one side of a face, in face coordinates: depth, normal and tangential
-// velocity, and the pressure coefficients Pi_nn, Pi_nt of that side's cell.
-struct FaceState {
-  double H, un, ut, Pnn, Pnt;
-};
-
-// Ghost state beyond a domain edge: a wall mirrors the inside (normal velocity and the off-diagonal
-// pressure coefficient change sign, so no mass crosses and the wall pushes only normally); an
-// outflow boundary copies it.
-inline FaceState boundary_ghost(const FaceState& in, Boundary2D b) {
-  if (b == Boundary2D::wall) return {in.H, -in.un, in.ut, in.Pnn, -in.Pnt};
-  return in;
-}
-
-// Central local-speed flux (Kurganov & Tadmor 2000) between the predicted face values, with
-// a = max(|u_n| + sqrt(Pi_nn H)) over both sides. Returns (mass, normal momentum, tangential momentum).
-inline Face central_flux(const FaceState& L, const FaceState& R) {
-  const double a = face_speed(L.un, L.Pnn * std::max(L.H, 0.0), R.un, R.Pnn * std::max(R.H, 0.0));
-  const double mL = L.H * L.un, mR = R.H * R.un;
-  return Face{0.5 * (mL + mR) - 0.5 * a * (R.H - L.H),
-              0.5 * (mL * L.un + 0.5 * L.Pnn * L.H * L.H + mR * R.un + 0.5 * R.Pnn * R.H * R.H) - 0.5 * a * (mR - mL),
-              0.5 * (mL * L.ut + 0.5 * L.Pnt * L.H * L.H + mR * R.ut + 0.5 * R.Pnt * R.H * R.H) -
-                  0.5 * a * (R.H * R.ut - L.H * L.ut)};
-}
-
-// Between two cells that friction holds at rest: the pressure only, no numerical diffusion, so that
-// material at rest stays exactly at rest.
-inline Face held_face(const FaceState& L, const FaceState& R) {
-  return Face{0.0, 0.25 * (L.Pnn * L.H * L.H + R.Pnn * R.H * R.H), 0.25 * (L.Pnt * L.H * L.H + R.Pnt * R.H * R.H)};
-}
-Face Solver::x_face(int i, int j) const {
-  // Face between cells (i-1, j) and (i, j); i in [0, nx]. Face states: depth H, normal velocity un,
-  // tangential velocity ut, pressure coefficients Pnn (= Pxx) and Pnt (= Pxy).
-  const bool west = i == 0, east = i == nx_;
-  const std::size_t kl = west ? idx(0, j) : idx(i - 1, j), kr = east ? idx(nx_ - 1, j) : idx(i, j);
-  FaceState L{}, R{};
-  if (!west) L = {Hp_[kl] + 0.5 * sHx_[kl], Up_[kl] + 0.5 * sux_[kl], Vp_[kl] + 0.5 * svx_[kl], Pxx_[kl], Pxy_[kl]};
-  if (!east) R = {Hp_[kr] - 0.5 * sHx_[kr], Up_[kr] - 0.5 * sux_[kr], Vp_[kr] - 0.5 * svx_[kr], Pxx_[kr], Pxy_[kr]};
-  if (west) L = boundary_ghost(R, cfg_.west);
-  if (east) R = boundary_ghost(L, cfg_.east);
-  if (!west && !east && held_[kl] && held_[kr]) return held_face(L, R);
-  return central_flux(L, R);
-}
-
-Face Solver::y_face(int i, int j) const {
-  // Face between cells (i, j-1) and (i, j); j in [0, ny]. Normal = y: the flux components come back
-  // as (mass, x-momentum, y-momentum).
-  const bool south = j == 0, north = j == ny_;
-  const std::size_t kl = south ? idx(i, 0) : idx(i, j - 1), kr = north ? idx(i, ny_ - 1) : idx(i, j);
-  FaceState L{}, R{};
-  if (!south) L = {Hp_[kl] + 0.5 * sHy_[kl], Vp_[kl] + 0.5 * svy_[kl], Up_[kl] + 0.5 * suy_[kl], Pyy_[kl], Pxy_[kl]};
-  if (!north) R = {Hp_[kr] - 0.5 * sHy_[kr], Vp_[kr] - 0.5 * svy_[kr], Up_[kr] - 0.5 * suy_[kr], Pyy_[kr], Pxy_[kr]};
-  if (south) L = boundary_ghost(R, cfg_.south);
-  if (north) R = boundary_ghost(L, cfg_.north);
-  const Face f = (!south && !north && held_[kl] && held_[kr]) ? held_face(L, R) : central_flux(L, R);
-  return Face{f.f0, f.f2, f.f1};  // (mass, normal, tangential) -> (mass, x, y)
-}
-
-void Solver::faces(int tt) {
-  int i0, i1, j0, j1;
-  tile_range(tt, i0, i1, j0, j1);
-  const int ti = tt % ntx_, tj = tt / ntx_;
-  const bool left_in = tile_active(ti - 1, tj), right_in = tile_active(ti + 1, tj);
-  const bool below_in = tile_active(ti, tj - 1), above_in = tile_active(ti, tj + 1);
-  // x faces: the tile owns the left faces of its cells, and its right edge where no active tile does.
-  const int ie = (i1 == nx_ || !right_in) ? i1 : i1 - 1;
+void Solver::faces(TileWork& w) const {
+  // Every face of the box whose two cells lie in it, and the domain's edges. A face between an active
+  // tile and an inactive one carries nothing: both its cells hold less than the activation depth and
+  // the inactive side is not updated, so this keeps the volume exact.
+  const int i0 = w.bi0, i1 = w.bi0 + w.bw, j0 = w.bj0, j1 = w.bj0 + w.bh;
   for (int j = j0; j < j1; ++j)
-    for (int i = i0; i <= ie; ++i) {
-      Face& f = Fx_[std::size_t(j) * (nx_ + 1) + i];
-      const bool to_inactive = (i == i0 && i > 0 && !left_in) || (i == i1 && i < nx_);
-      f = to_inactive ? Face{0, 0, 0} : x_face(i, j);
-    }
-  const int je = (j1 == ny_ || !above_in) ? j1 : j1 - 1;
-  for (int j = j0; j <= je; ++j)
-    for (int i = i0; i < i1; ++i) {
-      Face& f = Fy_[std::size_t(j) * nx_ + i];
-      const bool to_inactive = (j == j0 && j > 0 && !below_in) || (j == j1 && j < ny_);
-      f = to_inactive ? Face{0, 0, 0} : y_face(i, j);
-    }
-}
-
-void Solver::positivity(int tt, double dt) {
-  // Draining-time limiter: a cell may not send out more volume than it holds.
-  int i0, i1, j0, j1;
-  tile_range(tt, i0, i1, j0, j1);
-  long limited = 0;
-  for (int j = j0; j < j1; ++j)
-    for (int i = i0; i < i1; ++i) {
-      const std::size_t k = idx(i, j);
-      const double out = dt / t_.dx * (std::max(Fx_[std::size_t(j) * (nx_ + 1) + i + 1].f0, 0.0) +
-                                       std::max(-Fx_[std::size_t(j) * (nx_ + 1) + i].f0, 0.0)) +
-                         dt / t_.dy * (std::max(Fy_[std::size_t(j + 1) * nx_ + i].f0, 0.0) +
-                                       std::max(-Fy_[std::size_t(j) * nx_ + i].f0, 0.0));
-      double r = 1.0;
-      if (out > H_[k]) {
-        r = H_[k] / out;
-        ++limited;
+    for (int i = i0; i <= i1; ++i) {
+      const bool west = i == 0, east = i == nx_;
+      if ((i == i0 && !west) || (i == i1 && !east)) continue;  // the other cell lies outside the box
+      Face& f = w.Fx[w.fx(i, j)];
+      if (!west && !east && cell_active(i - 1, j) != cell_active(i, j)) {
+        f = Face{0, 0, 0};
+        continue;
       }
-      r_[k] = r;
+      FaceState L{}, R{};
+      if (!west) {
+        const std::size_t q = w.at(i - 1, j);
+        L = {w.Hp[q] + 0.5 * w.sHx[q], w.Up[q] + 0.5 * w.sux[q], w.Vp[q] + 0.5 * w.svx[q], w.Pxx[q], w.Pxy[q]};
+      }
+      if (!east) {
+        const std::size_t q = w.at(i, j);
+        R = {w.Hp[q] - 0.5 * w.sHx[q], w.Up[q] - 0.5 * w.sux[q], w.Vp[q] - 0.5 * w.svx[q], w.Pxx[q], w.Pxy[q]};
+      }
+      if (west) L = boundary_ghost(R, cfg_.west);
+      if (east) R = boundary_ghost(L, cfg_.east);
+      f = (!west && !east && w.held[w.at(i - 1, j)] && w.held[w.at(i, j)]) ? held_face(L, R) : central_flux(L, R);
     }
-  tile_limited_[tt] += limited;
+  for (int j = j0; j <= j1; ++j)
+    for (int i = i0; i < i1; ++i) {
+      const bool south = j == 0, north = j == ny_;
+      if ((j == j0 && !south) || (j == j1 && !north)) continue;
+      Face& f = w.Fy[w.fy(i, j)];
+      if (!south && !north && cell_active(i, j - 1) != cell_active(i, j)) {
+        f = Face{0, 0, 0};
+        continue;
+      }
+      // Face coordinates: normal = y, tangential = x.
+      FaceState L{}, R{};
+      if (!south) {
+        const std::size_t q = w.at(i, j - 1);
+        L = {w.Hp[q] + 0.5 * w.sHy[q], w.Vp[q] + 0.5 * w.svy[q], w.Up[q] + 0.5 * w.suy[q], w.Pyy[q], w.Pxy[q]};
+      }
+      if (!north) {
+        const std::size_t q = w.at(i, j);
+        R = {w.Hp[q] - 0.5 * w.sHy[q], w.Vp[q] - 0.5 * w.svy[q], w.Up[q] - 0.5 * w.suy[q], w.Pyy[q], w.Pxy[q]};
+      }
+      if (south) L = boundary_ghost(R, cfg_.south);
+      if (north) R = boundary_ghost(L, cfg_.north);
+      const Face g = (!south && !north && w.held[w.at(i, j - 1)] && w.held[w.at(i, j)]) ? held_face(L, R)
+                                                                                         : central_flux(L, R);
+      f = Face{g.f0, g.f2, g.f1};  // (mass, normal, tangential) -> (mass, x, y)
+    }
 }
 
-void Solver::update(int tt, double t, double dt) {
+long Solver::positivity(TileWork& w, int i0, int i1, int j0, int j1, double dt) const {
+  // Draining-time limiter on the tile grown by one: a cell may not send out more volume than it holds.
+  const auto& Hs = H_[cur_];
+  long limited = 0;
+  for (int j = std::max(j0 - 1, 0); j < std::min(j1 + 1, ny_); ++j)
+    for (int i = std::max(i0 - 1, 0); i < std::min(i1 + 1, nx_); ++i) {
+      const double out = dt / t_.dx * (std::max(w.Fx[w.fx(i + 1, j)].f0, 0.0) + std::max(-w.Fx[w.fx(i, j)].f0, 0.0)) +
+                         dt / t_.dy * (std::max(w.Fy[w.fy(i, j + 1)].f0, 0.0) + std::max(-w.Fy[w.fy(i, j)].f0, 0.0));
+      const double H = Hs[idx(i, j)];
+      double r = 1.0;
+      if (out > H) {
+        r = H / out;
+        limited += i >= i0 && i < i1 && j >= j0 && j < j1;
+      }
+      w.r[w.at(i, j)] = r;
+    }
+  return limited;
+}
+
+void Solver::update(int tt, const TileWork& w, double t, double dt) {
   int i0, i1, j0, j1;
   tile_range(tt, i0, i1, j0, j1);
+  const auto &H0 = H_[cur_], &HU0 = HU_[cur_], &HV0 = HV_[cur_];
+  auto &H1 = H_[1 - cur_], &HU1 = HU_[1 - cur_], &HV1 = HV_[1 - cur_], &U1 = U_[1 - cur_], &V1 = V_[1 - cur_];
   const double lx = dt / t_.dx, ly = dt / t_.dy, dry = cfg_.dry_depth;
   double out = 0, travel = 0, mass = 0, ke = 0, vmax = 0, rate = 0;
   bool wet = false;
   // Scaled face flux: the limiter factor of the upwind (sending) cell.
-  auto scaled = [&](const Face& f, std::size_t left, std::size_t right, bool has_left, bool has_right) {
+  auto scaled = [&](const Face& f, int il, int jl, int ir, int jr, bool has_l, bool has_r) {
     double s = 1.0;
-    if (f.f0 > 0 && has_left) s = r_[left];
-    else if (f.f0 < 0 && has_right) s = r_[right];
+    if (f.f0 > 0 && has_l) s = w.r[w.at(il, jl)];
+    else if (f.f0 < 0 && has_r) s = w.r[w.at(ir, jr)];
     return Face{f.f0 * s, f.f1 * s, f.f2 * s};
   };
   for (int j = j0; j < j1; ++j)
     for (int i = i0; i < i1; ++i) {
-      const std::size_t k = idx(i, j);
-      const std::size_t fx = std::size_t(j) * (nx_ + 1) + i, fy = std::size_t(j) * nx_ + i;
-      const Face w = scaled(Fx_[fx], k - 1, k, i > 0, true);
-      const Face e = scaled(Fx_[fx + 1], k, k + 1, true, i < nx_ - 1);
-      const Face s = scaled(Fy_[fy], k - nx_, k, j > 0, true);
-      const Face nn = scaled(Fy_[fy + nx_], k, k + nx_, true, j < ny_ - 1);
-      if (i == 0) out -= w.f0 * dt * t_.dy;
-      if (i == nx_ - 1) out += e.f0 * dt * t_.dy;
-      if (j == 0) out -= s.f0 * dt * t_.dx;
-      if (j == ny_ - 1) out += nn.f0 * dt * t_.dx;
-      double H = H_[k] - lx * (e.f0 - w.f0) - ly * (nn.f0 - s.f0);
+      const std::size_t k = idx(i, j), q = w.at(i, j);
+      const Face fw = scaled(w.Fx[w.fx(i, j)], i - 1, j, i, j, i > 0, true);
+      const Face fe = scaled(w.Fx[w.fx(i + 1, j)], i, j, i + 1, j, true, i < nx_ - 1);
+      const Face fs = scaled(w.Fy[w.fy(i, j)], i, j - 1, i, j, j > 0, true);
+      const Face fn = scaled(w.Fy[w.fy(i, j + 1)], i, j, i, j + 1, true, j < ny_ - 1);
+      if (i == 0) out -= fw.f0 * dt * t_.dy;
+      if (i == nx_ - 1) out += fe.f0 * dt * t_.dy;
+      if (j == 0) out -= fs.f0 * dt * t_.dx;
+      if (j == ny_ - 1) out += fn.f0 * dt * t_.dx;
+      double H = H0[k] - lx * (fe.f0 - fw.f0) - ly * (fn.f0 - fs.f0);
       if (H < 0) H = 0;  // round-off only: the limiter above bounds the outflow by the content
       // Source at the half step (midpoint rule).
-      const double Hp = Hp_[k], Up = Up_[k], Vp = Vp_[k];
+      const double Hp = w.Hp[q], Up = w.Up[q], Vp = w.Vp[q];
       const double gn = normal_g(k, Up, Vp);
       const double drive = -Hp * geo_.c[k] * geo_.c[k] * gn;
-      double MU = HU_[k] - lx * (e.f1 - w.f1) - ly * (nn.f1 - s.f1) + dt * drive * geo_.bx[k];
-      double MV = HV_[k] - lx * (e.f2 - w.f2) - ly * (nn.f2 - s.f2) + dt * drive * geo_.by[k];
+      double MU = HU0[k] - lx * (fe.f1 - fw.f1) - ly * (fn.f1 - fs.f1) + dt * drive * geo_.bx[k];
+      double MV = HV0[k] - lx * (fe.f2 - fw.f2) - ly * (fn.f2 - fs.f2) + dt * drive * geo_.by[k];
       double U = 0, V = 0, sp = 0;
       if (H > dry) {
         // Friction at the half step (midpoint rule), as a bounded impulse that never reverses u.
@@ -542,11 +546,11 @@ void Solver::update(int tt, double t, double dt) {
       } else {
         MU = MV = 0;
       }
-      H_[k] = H;
-      HU_[k] = MU;
-      HV_[k] = MV;
-      U_[k] = U;
-      V_[k] = V;
+      H1[k] = H;
+      HU1[k] = MU;
+      HV1[k] = MV;
+      U1[k] = U;
+      V1[k] = V;
       if (cfg_.track_travel) travel += dt * std::sqrt(MU * MU + MV * MV);
       // Hazard maps and tile sums from the new state.
       const double h = H * geo_.c[k], sp2 = sp * sp;
@@ -557,7 +561,8 @@ void Solver::update(int tt, double t, double dt) {
       mass += H;
       ke += 0.5 * H * sp2;
       vmax = std::max(vmax, sp);
-      rate = std::max(rate, std::abs(U) / t_.dx + std::abs(V) / t_.dy + Ps_[k] * std::sqrt(H));
+      const double ps = std::sqrt(w.Pxx[q]) / t_.dx + std::sqrt(w.Pyy[q]) / t_.dy;
+      rate = std::max(rate, std::abs(U) / t_.dx + std::abs(V) / t_.dy + ps * std::sqrt(H));
       wet = wet || H > cfg_.activation_depth;
     }
   tile_out_[tt] += out;
@@ -567,6 +572,23 @@ void Solver::update(int tt, double t, double dt) {
   tile_speed_[tt] = vmax;
   tile_rate_[tt] = rate;
   tile_wet_[tt] = wet;
+}
+
+void Solver::step_tile(int tt, double t, double dt, TileWork& w) {
+  int i0, i1, j0, j1;
+  tile_range(tt, i0, i1, j0, j1);
+  w.bi0 = std::max(i0 - 2, 0);
+  w.bj0 = std::max(j0 - 2, 0);
+  w.bw = std::min(i1 + 2, nx_) - w.bi0;
+  w.bh = std::min(j1 + 2, ny_) - w.bj0;
+  switch (cfg_.limiter) {
+    case Limiter::minmod: predictor<Limiter::minmod>(w, dt); break;
+    case Limiter::vanleer: predictor<Limiter::vanleer>(w, dt); break;
+    case Limiter::superbee: predictor<Limiter::superbee>(w, dt); break;
+  }
+  faces(w);
+  tile_limited_[tt] += positivity(w, i0, i1, j0, j1, dt);
+  update(tt, w, t, dt);
 }
 
 Sh2dResult Solver::run() {
@@ -583,6 +605,8 @@ Sh2dResult Solver::run() {
   d.volume_initial = sum_tiles(tile_mass_) * cell_area;
   double t = 0, active_sum = 0;
   const auto loop0 = std::chrono::steady_clock::now();
+  std::vector<TileWork> work(omp_get_max_threads());
+  for (auto& w : work) w.reserve(T_);
   while (t < tc.t_end) {
     if (d.steps >= tc.max_steps) {
       d.stop = StopReason::max_steps;
@@ -600,17 +624,9 @@ Sh2dResult Solver::run() {
       tile_range(tt, i0, i1, j0, j1);
       ncells += std::size_t(i1 - i0) * (j1 - j0);
     }
-#pragma omp parallel
-    {
-#pragma omp for schedule(static)
-      for (int a = 0; a < na; ++a) predictor(active_[a], dt);
-#pragma omp for schedule(static)
-      for (int a = 0; a < na; ++a) faces(active_[a]);
-#pragma omp for schedule(static)
-      for (int a = 0; a < na; ++a) positivity(active_[a], dt);
-#pragma omp for schedule(static)
-      for (int a = 0; a < na; ++a) update(active_[a], t, dt);
-    }
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int a = 0; a < na; ++a) step_tile(active_[a], t, dt, work[omp_get_thread_num()]);
+    cur_ = 1 - cur_;
     t += dt;
     ++d.steps;
     d.cell_updates += double(ncells);
@@ -643,11 +659,11 @@ Sh2dResult Solver::run() {
   for (int tt = 0; tt < ntiles_; ++tt) d.positivity_limited += tile_limited_[tt];
   d.mean_active_fraction = d.steps > 0 ? active_sum / double(d.steps) : 0.0;
   hz_.final_depth.resize(n_);
-  for (std::size_t k = 0; k < n_; ++k) hz_.final_depth[k] = H_[k] * geo_.c[k];
+  for (std::size_t k = 0; k < n_; ++k) hz_.final_depth[k] = H_[cur_][k] * geo_.c[k];
   res.hazard = std::move(hz_);
-  res.state.H = std::move(H_);
-  res.state.HU = std::move(HU_);
-  res.state.HV = std::move(HV_);
+  res.state.H = std::move(H_[cur_]);
+  res.state.HU = std::move(HU_[cur_]);
+  res.state.HV = std::move(HV_[cur_]);
   d.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return res;
 }
