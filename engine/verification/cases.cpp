@@ -227,71 +227,81 @@ std::vector<Row> case_a2(const Options& o) {
 }
 
 // ---------------------------------------------------------------- A3 elliptic cap (2D)
+// The similarity solution takes the friction along the slope's fall line (|u| ~ u), which is exact
+// only without friction: with delta = 25 deg its own error is a few tenths of a percent, so the L1
+// error against it levels off near 0.5 %. The figures of the issue (centre, depth, half-axes) are
+// checked on that case; the frictionless run checks the convergence order.
 std::vector<Row> case_a3(const Options& o) {
-  const exact::EllipticCap ex{35 * kDeg, 25 * kDeg, 1.0, 1.0, 80.0, 80.0, 4.0};
-  const double t_end = 5.0, xa = -100, xb = 125, yb = 95;
-  const auto sh = ex.at(t_end);
   std::vector<Row> rows;
-  for (double ds : pick(o, {4.0, 2.0, 1.0}, {0.5})) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const int nx = int(std::lround((xb - xa) / ds)), ny = int(std::lround(2 * yb / ds));
-    auto terr = plane(nx, ny, ds, ds, ex.zeta, xa, -yb);
-    std::vector<double> h0(terr.cells());
-    auto xs = [&](int i) { return xa + (i + 0.5) * ds; };
-    auto ys = [&](int j) { return -yb + (j + 0.5) * ds; };
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        const double X = xs(i) / ex.Lx, Y = ys(j) / ex.Ly;
-        h0[std::size_t(j) * nx + i] = std::max(0.0, ex.H * (1 - X * X - Y * Y));
-      }
-    Sh2dConfig cfg;
-    cfg.material = coulomb(25);
-    cfg.limiter = o.limiter;
-    cfg.time.t_end = t_end;
-    const auto r = run_sh2d(terr, cfg, state_from_normal_depth(terr, h0));
-    const auto& h = r.hazard.final_depth;
-    double m = 0, mx = 0, my = 0, hmax = 0, e1 = 0, s1 = 0;
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        const double v = h[std::size_t(j) * nx + i];
-        m += v;
-        mx += v * xs(i);
-        my += v * ys(j);
-        hmax = std::max(hmax, v);
-        const double X = (xs(i) - sh.centre) / sh.half_length, Y = ys(j) / sh.half_width;
-        const double he = std::max(0.0, sh.max_depth * (1 - X * X - Y * Y));
-        e1 += std::abs(v - he);
-        s1 += he;
-      }
-    const double cx = mx / m, cy = my / m;
-    double vx = 0, vy = 0;
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        const double v = h[std::size_t(j) * nx + i];
-        vx += v * (xs(i) - cx) * (xs(i) - cx);
-        vy += v * (ys(j) - cy) * (ys(j) - cy);
-      }
-    // For a paraboloid cap the second moment is a^2 / 6 of the half-axis a.
-    const double a = std::sqrt(6 * vx / m), b = std::sqrt(6 * vy / m);
-    Row row;
-    row.case_id = "A3";
-    row.variant = variant("2d", o);
-    row.cell_updates = r.diag.cell_updates;
-    row.cells = long(nx) * ny;
-    row.dx = ds;
-    const bool target = ds <= 1.0 + 1e-9;
-    auto lim = [&](double v) { return target ? v : kNaN; };
-    row.metrics.push_back({"centre_rel_err", std::abs(cx - sh.centre) / sh.centre, lim(0.005)});
-    row.metrics.push_back({"max_depth_rel_err", std::abs(hmax - sh.max_depth) / sh.max_depth, lim(0.02)});
-    row.metrics.push_back({"half_length_rel_err", std::abs(a - sh.half_length) / sh.half_length, lim(0.02)});
-    row.metrics.push_back({"half_width_rel_err", std::abs(b - sh.half_width) / sh.half_width, lim(0.02)});
-    row.metrics.push_back({"L1_rel_depth", e1 / s1});
-    row.metrics.push_back({"mass_rel_err", r.diag.volume_error(), 1e-12});
-    row.checked = true;
-    row.wall_s = seconds_since(t0);
-    rows.push_back(row);
+  for (const double delta : {25.0, 0.0}) {
+    const exact::EllipticCap ex{35 * kDeg, delta * kDeg, 1.0, 1.0, 80.0, 80.0, 4.0};
+    const double t_end = 5.0, xa = -100, xb = delta > 0 ? 125 : 180, yb = 95;
+    const auto sh = ex.at(t_end);
+    std::vector<Row> part;
+    for (double ds : pick(o, {4.0, 2.0, 1.0}, {0.5})) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const int nx = int(std::lround((xb - xa) / ds)), ny = int(std::lround(2 * yb / ds));
+      auto terr = plane(nx, ny, ds, ds, ex.zeta, xa, -yb);
+      std::vector<double> h0(terr.cells());
+      auto xs = [&](int i) { return xa + (i + 0.5) * ds; };
+      auto ys = [&](int j) { return -yb + (j + 0.5) * ds; };
+      for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+          const double X = xs(i) / ex.Lx, Y = ys(j) / ex.Ly;
+          h0[std::size_t(j) * nx + i] = std::max(0.0, ex.H * (1 - X * X - Y * Y));
+        }
+      Sh2dConfig cfg;
+      cfg.material = coulomb(delta);
+      cfg.limiter = o.limiter;
+      cfg.time.t_end = t_end;
+      const auto r = run_sh2d(terr, cfg, state_from_normal_depth(terr, h0));
+      const auto& h = r.hazard.final_depth;
+      double m = 0, mx = 0, my = 0, hmax = 0, e1 = 0, s1 = 0;
+      for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+          const double v = h[std::size_t(j) * nx + i];
+          m += v;
+          mx += v * xs(i);
+          my += v * ys(j);
+          hmax = std::max(hmax, v);
+          const double X = (xs(i) - sh.centre) / sh.half_length, Y = ys(j) / sh.half_width;
+          const double he = std::max(0.0, sh.max_depth * (1 - X * X - Y * Y));
+          e1 += std::abs(v - he);
+          s1 += he;
+        }
+      const double cx = mx / m, cy = my / m;
+      double vx = 0, vy = 0;
+      for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+          const double v = h[std::size_t(j) * nx + i];
+          vx += v * (xs(i) - cx) * (xs(i) - cx);
+          vy += v * (ys(j) - cy) * (ys(j) - cy);
+        }
+      // For a paraboloid cap the second moment is a^2 / 6 of the half-axis a.
+      const double a = std::sqrt(6 * vx / m), b = std::sqrt(6 * vy / m);
+      Row row;
+      row.case_id = "A3";
+      row.variant = variant("2d", o) + (delta > 0 ? "" : "-frictionless");
+      row.cell_updates = r.diag.cell_updates;
+      row.cells = long(nx) * ny;
+      row.dx = ds;
+      const bool target = delta > 0 && ds <= 1.0 + 1e-9;
+      auto lim = [&](double v) { return target ? v : kNaN; };
+      row.metrics.push_back({"centre_rel_err", std::abs(cx - sh.centre) / sh.centre, lim(0.005)});
+      row.metrics.push_back({"max_depth_rel_err", std::abs(hmax - sh.max_depth) / sh.max_depth, lim(0.02)});
+      row.metrics.push_back({"half_length_rel_err", std::abs(a - sh.half_length) / sh.half_length, lim(0.02)});
+      row.metrics.push_back({"half_width_rel_err", std::abs(b - sh.half_width) / sh.half_width, lim(0.02)});
+      row.metrics.push_back({"L1_rel_depth", e1 / s1});
+      row.metrics.push_back({"mass_rel_err", r.diag.volume_error(), 1e-12});
+      row.checked = true;
+      row.wall_s = seconds_since(t0);
+      part.push_back(row);
+    }
+    fill_orders(part, "L1_rel_depth");
+    if (delta == 0 && part.size() >= 2 && std::isfinite(part.back().order))
+      part.back().metrics.push_back({"order", part.back().order, 1.2, false});
+    for (auto& r : part) rows.push_back(std::move(r));
   }
-  fill_orders(rows, "L1_rel_depth");
   return rows;
 }
 
