@@ -171,6 +171,14 @@ Sh1dResult run_sh1d(const Channel1D& ch, const Sh1dConfig& cfg, Sh1dState init) 
   };
 
   const double curv = cfg.curvature ? 1.0 : 0.0;
+  // Slope of the discharge m = h u from the limited slopes of h and of the velocity (product rule):
+  // limiting m itself would clip it where it peaks, ahead of the depth's crest, although the velocity
+  // is smooth and monotone there. Dry neighbours leave the velocity slope at zero.
+  auto momentum_slope = [&](const std::vector<double>& H, const std::vector<double>& M, double sh, int k) {
+    if (!(H[k - 1] > hdry && H[k] > hdry && H[k + 1] > hdry)) return limited_slope(lim, M[k] - M[k - 1], M[k + 1] - M[k]);
+    const double u = M[k] / H[k];
+    return u * sh + H[k] * limited_slope(lim, u - M[k - 1] / H[k - 1], M[k + 1] / H[k + 1] - u);
+  };
   auto resistance = [&](double h, double u, double zeta, double kappa) {
     return h * (mu * std::max(0.0, g * std::cos(zeta) + curv * kappa * u * u) + g * ixi * u * u);
   };
@@ -196,7 +204,7 @@ Sh1dResult run_sh1d(const Channel1D& ch, const Sh1dConfig& cfg, Sh1dState init) 
     // Predictor (4.78): limited slopes and a half step with the flux Jacobian (4.79, 4.86).
     for (int k = 1; k < n + 2 * G - 1; ++k) {
       w.sh[k] = limited_slope(lim, w.h[k] - w.h[k - 1], w.h[k + 1] - w.h[k]);
-      w.sm[k] = limited_slope(lim, w.m[k] - w.m[k - 1], w.m[k + 1] - w.m[k]);
+      w.sm[k] = momentum_slope(w.h, w.m, w.sh[k], k);
       const double h = w.h[k], u = vel(h, w.m[k]), b = w.beta[k];
       w.hp[k] = std::max(0.0, h - 0.5 * lam * w.sm[k]);
       double mp = w.m[k] - 0.5 * lam * ((b * h - u * u) * w.sh[k] + 2.0 * u * w.sm[k]) +
@@ -249,7 +257,7 @@ Sh1dResult run_sh1d(const Channel1D& ch, const Sh1dConfig& cfg, Sh1dState init) 
     // Average back onto the cells: cell k lies between staggered cells k-1 and k.
     for (int k = 2; k < n + 2 * G - 3; ++k) {
       w.sSh[k] = limited_slope(lim, w.Sh[k] - w.Sh[k - 1], w.Sh[k + 1] - w.Sh[k]);
-      w.sSm[k] = limited_slope(lim, w.Sm[k] - w.Sm[k - 1], w.Sm[k + 1] - w.Sm[k]);
+      w.sSm[k] = momentum_slope(w.Sh, w.Sm, w.sSh[k], k);
     }
     for (int k = G; k < n + G; ++k) {
       const double h = 0.5 * (w.Sh[k - 1] + w.Sh[k]) - (w.sSh[k] - w.sSh[k - 1]) / 8.0;
