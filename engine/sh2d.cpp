@@ -251,6 +251,8 @@ class Solver {
   template <Limiter L>
   void predictor(TileWork& w, double dt) const;
   void faces(TileWork& w) const;
+  template <bool X>
+  Face face(const TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi, Boundary2D blo, Boundary2D bhi) const;
   long positivity(TileWork& w, int i0, int i1, int j0, int j1, double dt) const;
   void update(int tt, const TileWork& w, double t, double dt);
 
@@ -427,6 +429,31 @@ void Solver::predictor(TileWork& w, double dt) const {
     }
 }
 
+// Face state of cell q on the side `sign` (+1: its upper face, -1: its lower face) in face
+// coordinates (normal, tangential): x faces use (U, V, Pxx), y faces (V, U, Pyy).
+template <bool X>
+inline FaceState side_state(const TileWork& w, std::size_t q, double sign) {
+  if constexpr (X)
+    return {w.Hp[q] + sign * 0.5 * w.sHx[q], w.Up[q] + sign * 0.5 * w.sux[q], w.Vp[q] + sign * 0.5 * w.svx[q],
+            w.Pxx[q], w.Pxy[q]};
+  else
+    return {w.Hp[q] + sign * 0.5 * w.sHy[q], w.Vp[q] + sign * 0.5 * w.svy[q], w.Up[q] + sign * 0.5 * w.suy[q],
+            w.Pyy[q], w.Pxy[q]};
+}
+
+template <bool X>
+Face Solver::face(const TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi, Boundary2D blo,
+                  Boundary2D bhi) const {
+  // Flux through the face between cells a (left/below) and b; lo/hi: the face is a domain edge.
+  if (!lo && !hi && cell_active(ia, ja) != cell_active(ib, jb)) return Face{0, 0, 0};
+  FaceState L{}, R{};
+  if (!lo) L = side_state<X>(w, w.at(ia, ja), +1.0);
+  if (!hi) R = side_state<X>(w, w.at(ib, jb), -1.0);
+  if (lo) L = boundary_ghost(R, blo);
+  if (hi) R = boundary_ghost(L, bhi);
+  return (!lo && !hi && w.held[w.at(ia, ja)] && w.held[w.at(ib, jb)]) ? held_face(L, R) : central_flux(L, R);
+}
+
 void Solver::faces(TileWork& w) const {
   // Every face of the box whose two cells lie in it, and the domain's edges. A face between an active
   // tile and an inactive one carries nothing: both its cells hold less than the activation depth and
@@ -436,48 +463,14 @@ void Solver::faces(TileWork& w) const {
     for (int i = i0; i <= i1; ++i) {
       const bool west = i == 0, east = i == nx_;
       if ((i == i0 && !west) || (i == i1 && !east)) continue;  // the other cell lies outside the box
-      Face& f = w.Fx[w.fx(i, j)];
-      if (!west && !east && cell_active(i - 1, j) != cell_active(i, j)) {
-        f = Face{0, 0, 0};
-        continue;
-      }
-      FaceState L{}, R{};
-      if (!west) {
-        const std::size_t q = w.at(i - 1, j);
-        L = {w.Hp[q] + 0.5 * w.sHx[q], w.Up[q] + 0.5 * w.sux[q], w.Vp[q] + 0.5 * w.svx[q], w.Pxx[q], w.Pxy[q]};
-      }
-      if (!east) {
-        const std::size_t q = w.at(i, j);
-        R = {w.Hp[q] - 0.5 * w.sHx[q], w.Up[q] - 0.5 * w.sux[q], w.Vp[q] - 0.5 * w.svx[q], w.Pxx[q], w.Pxy[q]};
-      }
-      if (west) L = boundary_ghost(R, cfg_.west);
-      if (east) R = boundary_ghost(L, cfg_.east);
-      f = (!west && !east && w.held[w.at(i - 1, j)] && w.held[w.at(i, j)]) ? held_face(L, R) : central_flux(L, R);
+      w.Fx[w.fx(i, j)] = face<true>(w, i - 1, j, i, j, west, east, cfg_.west, cfg_.east);
     }
   for (int j = j0; j <= j1; ++j)
     for (int i = i0; i < i1; ++i) {
       const bool south = j == 0, north = j == ny_;
       if ((j == j0 && !south) || (j == j1 && !north)) continue;
-      Face& f = w.Fy[w.fy(i, j)];
-      if (!south && !north && cell_active(i, j - 1) != cell_active(i, j)) {
-        f = Face{0, 0, 0};
-        continue;
-      }
-      // Face coordinates: normal = y, tangential = x.
-      FaceState L{}, R{};
-      if (!south) {
-        const std::size_t q = w.at(i, j - 1);
-        L = {w.Hp[q] + 0.5 * w.sHy[q], w.Vp[q] + 0.5 * w.svy[q], w.Up[q] + 0.5 * w.suy[q], w.Pyy[q], w.Pxy[q]};
-      }
-      if (!north) {
-        const std::size_t q = w.at(i, j);
-        R = {w.Hp[q] - 0.5 * w.sHy[q], w.Vp[q] - 0.5 * w.svy[q], w.Up[q] - 0.5 * w.suy[q], w.Pyy[q], w.Pxy[q]};
-      }
-      if (south) L = boundary_ghost(R, cfg_.south);
-      if (north) R = boundary_ghost(L, cfg_.north);
-      const Face g = (!south && !north && w.held[w.at(i, j - 1)] && w.held[w.at(i, j)]) ? held_face(L, R)
-                                                                                         : central_flux(L, R);
-      f = Face{g.f0, g.f2, g.f1};  // (mass, normal, tangential) -> (mass, x, y)
+      const Face g = face<false>(w, i, j - 1, i, j, south, north, cfg_.south, cfg_.north);
+      w.Fy[w.fy(i, j)] = Face{g.f0, g.f2, g.f1};  // (mass, normal, tangential) -> (mass, x, y)
     }
 }
 

@@ -41,6 +41,13 @@ void fill_orders(std::vector<Row>& rows, const std::string& metric) {
   }
 }
 
+/// Orders from `metric`, and the finest pair's order checked against `min_order` as `name`.
+void check_order(std::vector<Row>& rows, const std::string& metric, const std::string& name, double min_order) {
+  fill_orders(rows, metric);
+  if (rows.size() >= 2 && std::isfinite(rows.back().order))
+    rows.back().metrics.push_back({name, rows.back().order, min_order, false});
+}
+
 /// An inclined plane in map coordinates with cells of size ds along the slope (dx = ds cos zeta),
 /// falling in +x; cell centre i lies at slope coordinate xs0 + (i + 1/2) ds.
 Terrain2D plane(int nx, int ny, double ds, double dy, double zeta, double xs0, double y0) {
@@ -146,7 +153,6 @@ std::vector<Row> case_a1(const Options& o) {
       row.metrics.push_back({"front_err_cells", std::abs(front - x_at(0.1)) / ds, target ? 2.0 : kNaN});
       row.metrics.push_back({"front_m", front});
       row.metrics.push_back({"front_1mm_lag_m", x_at(1e-3) - front_thin});
-      row.checked = true;
       row.wall_s = seconds_since(t0);
       rows.push_back(row);
     }
@@ -204,14 +210,11 @@ std::vector<Row> case_a2(const Options& o) {
     row.metrics.push_back({"L1_rel_depth_core", e_in / s_in});
     row.metrics.push_back({"mass_rel_err", std::abs(r.mass_final - r.mass_initial) / r.mass_initial, 1e-12});
     row.metrics.push_back({"cells_across_cap", across});
-    row.checked = true;
     row.wall_s = seconds_since(t0);
     rows.push_back(row);
   }
-  fill_orders(rows, "L1_rel_depth_core");
   // The observed order away from the margins must reach 1.5 on the finest pair.
-  if (rows.size() >= 2 && std::isfinite(rows.back().order))
-    rows.back().metrics.push_back({"order_core", rows.back().order, 1.5, false});
+  check_order(rows, "L1_rel_depth_core", "order_core", 1.5);
   return rows;
 }
 
@@ -282,13 +285,11 @@ std::vector<Row> case_a3(const Options& o) {
       row.metrics.push_back({"half_width_rel_err", std::abs(b - sh.half_width) / sh.half_width, lim(0.02)});
       row.metrics.push_back({"L1_rel_depth", e1 / s1});
       row.metrics.push_back({"mass_rel_err", r.diag.volume_error(), 1e-12});
-      row.checked = true;
       row.wall_s = seconds_since(t0);
       part.push_back(row);
     }
-    fill_orders(part, "L1_rel_depth");
-    if (delta == 0 && part.size() >= 2 && std::isfinite(part.back().order))
-      part.back().metrics.push_back({"order", part.back().order, 1.2, false});
+    if (delta == 0) check_order(part, "L1_rel_depth", "order", 1.2);
+    else fill_orders(part, "L1_rel_depth");
     for (auto& r : part) rows.push_back(std::move(r));
   }
   return rows;
@@ -346,7 +347,6 @@ std::vector<Row> case_a4(const Options& o) {
     row.metrics.push_back({"max_depth_change", dh, 1e-12});
     row.metrics.push_back({"mass_rel_err", r.diag.volume_error(), 1e-12});
     row.metrics.push_back({"t_end", r.diag.t});
-    row.checked = true;
     row.wall_s = seconds_since(t0);
     rows.push_back(row);
   }
@@ -389,14 +389,11 @@ std::vector<Row> case_a5(const Options& o) {
     const bool target = ds <= 0.5 + 1e-9;
     row.metrics.push_back({"L1_rel_velocity", eu / su, target ? 0.01 : kNaN});
     row.metrics.push_back({"L1_rel_depth", eh / shh, target ? 0.02 : kNaN});
-    row.checked = true;
     row.wall_s = seconds_since(t0);
     rows.push_back(row);
   }
-  fill_orders(rows, "L1_rel_depth");
   // Converging to the exact profile: the depth error must fall at least at first order.
-  if (rows.size() >= 2 && std::isfinite(rows.back().order))
-    rows.back().metrics.push_back({"order_depth", rows.back().order, 1.0, false});
+  check_order(rows, "L1_rel_depth", "order_depth", 1.0);
   return rows;
 }
 
@@ -499,7 +496,6 @@ std::vector<Row> case_a6(const Options& o) {
     // One cell: the area may differ by at most the ring of outline cells of the unrotated run.
     row.metrics.push_back({"area_diff_rings", std::abs(f.area - ref.area) / ref.ring, 1.0});
     row.metrics.push_back({"mass_rel_err", f.mass_err, 1e-12});
-    row.checked = true;
     row.wall_s = f.wall;
     rows.push_back(row);
   }
@@ -522,7 +518,6 @@ std::vector<Row> case_a7(const Options& o) {
     row.metrics.push_back({"tan_delta", tan_delta});
     row.metrics.push_back({"rel_diff", std::abs(ta / tan_delta - 1), checked ? 0.02 : kNaN});
     row.metrics.push_back({"mass_rel_err", merr, 1e-12});
-    row.checked = true;
     row.wall_s = wall;
     rows.push_back(row);
   };
@@ -677,7 +672,6 @@ std::vector<Row> case_stress(const Options& o) {
   row.metrics.push_back({"negative_cells", double(negative), 0.0});
   row.metrics.push_back({"worst_mass_rel_err", worst_mass, 1e-12});
   row.metrics.push_back({"cell_updates", cell_updates});
-  row.checked = true;
   row.wall_s = seconds_since(t0);
   return {row};
 }

@@ -30,7 +30,6 @@ struct Row {
   double order = std::numeric_limits<double>::quiet_NaN();  ///< observed order vs the next coarser row
   double wall_s = 0;
   double cell_updates = 0;  ///< cells computed, summed over steps (throughput = cell_updates / wall_s)
-  bool checked = false;  ///< whether this row carries pass/fail tolerances
   bool pass() const {
     for (const auto& m : metrics)
       if (!m.ok()) return false;
