@@ -133,12 +133,12 @@ inline Face held_face(const FaceState& L, const FaceState& R) {
 // intermediate fields never leave the cache.
 struct TileWork {
   int bi0 = 0, bj0 = 0, bw = 0, bh = 0;  // box = tile grown by 2, clipped to the grid
-  std::vector<double> sHx, sux, svx, sHy, suy, svy, Hp, Up, Vp, Pxx, Pxy, Pyy, r;
+  std::vector<double> sHx, sux, svx, sHy, suy, svy, Hp, Up, Vp, Pxx, Pxy, Pyy, Ps, r;
   std::vector<std::uint8_t> held;
   std::vector<Face> Fx, Fy;  // Fx[(j - bj0) * (bw + 1) + (i - bi0)]: face left of cell (i, j)
   void reserve(int T) {
     const std::size_t n = std::size_t(T + 4) * (T + 4);
-    for (auto* v : {&sHx, &sux, &svx, &sHy, &suy, &svy, &Hp, &Up, &Vp, &Pxx, &Pxy, &Pyy, &r}) v->assign(n, 0.0);
+    for (auto* v : {&sHx, &sux, &svx, &sHy, &suy, &svy, &Hp, &Up, &Vp, &Pxx, &Pxy, &Pyy, &Ps, &r}) v->assign(n, 0.0);
     held.assign(n, 0);
     Fx.assign(std::size_t(T + 5) * (T + 4), Face{0, 0, 0});
     Fy.assign(std::size_t(T + 4) * (T + 5), Face{0, 0, 0});
@@ -178,7 +178,11 @@ class Solver {
     Pxx_.resize(n_);
     Pxy_.resize(n_);
     Pyy_.resize(n_);
-    for (std::size_t k = 0; k < n_; ++k) pressure(k, 1.0, 1.0, 1.0, 0.0, Pxx_[k], Pxy_[k], Pyy_[k]);
+    Ps_.resize(n_);
+    for (std::size_t k = 0; k < n_; ++k) {
+      pressure(k, 1.0, 1.0, 1.0, 0.0, Pxx_[k], Pxy_[k], Pyy_[k]);
+      Ps_[k] = wave_factor(Pxx_[k], Pyy_[k]);
+    }
     tile_mass_.assign(ntiles_, 0);
     tile_ke_.assign(ntiles_, 0);
     tile_speed_.assign(ntiles_, 0);
@@ -239,6 +243,8 @@ class Solver {
     const double load = cfg_.curvature ? gn : g_;
     return H * (mu_ * geo_.c[k] * load + g_ * ixi_ * (U * U + V * V + w * w));
   }
+  // sqrt(Pxx)/dx + sqrt(Pyy)/dy: the gravity-wave part of the CFL rate, per sqrt(H).
+  double wave_factor(double pxx, double pyy) const { return std::sqrt(pxx) / t_.dx + std::sqrt(pyy) / t_.dy; }
   double m3(std::size_t k, double MU, double MV) const {
     const double w = geo_.bx[k] * MU + geo_.by[k] * MV;
     return std::sqrt(MU * MU + MV * MV + w * w);
@@ -269,6 +275,7 @@ class Solver {
   std::vector<double> H_[2], HU_[2], HV_[2], U_[2], V_[2];
   int cur_ = 0;
   std::vector<double> Pxx_, Pxy_, Pyy_;  // pressure coefficients for K = 1 (also the start values)
+  std::vector<double> Ps_;                // wave_factor of those
   std::vector<double> tile_mass_, tile_ke_, tile_speed_, tile_rate_, tile_out_, tile_travel_;
   std::vector<long> tile_limited_;
   std::vector<std::uint8_t> tile_wet_, active_flag_;
@@ -373,7 +380,7 @@ void Solver::predictor(TileWork& w, double dt) const {
           svy = limited_slope(lim, V - Vs[b], Vs[a] - V);
         }
       }
-      double Pxx = Pxx_[k], Pxy = Pxy_[k], Pyy = Pyy_[k];
+      double Pxx = Pxx_[k], Pxy = Pxy_[k], Pyy = Pyy_[k], Ps = Ps_[k];
       if (kap_) {
         // Active (extension) or passive (compression) along and across the slope.
         const double bx = geo_.bx[k], by = geo_.by[k], gb = std::hypot(bx, by);
@@ -395,6 +402,7 @@ void Solver::predictor(TileWork& w, double dt) const {
         const double across = -dy * (-dy * dUx + dx * dVx) + dx * (-dy * dUy + dx * dVy);
         const int ax = along >= 0 ? 0 : 1;
         pressure(k, kx_[ax], ky_[ax][across >= 0 ? 0 : 1], dx, dy, Pxx, Pxy, Pyy);
+        Ps = wave_factor(Pxx, Pyy);
       }
       // Predictor to t + dt/2 (eq. 4.78 in primitive form, pressure coefficients frozen in the cell).
       const double gn = normal_g(k, U, V);
@@ -426,6 +434,7 @@ void Solver::predictor(TileWork& w, double dt) const {
       w.Pxx[q] = Pxx;
       w.Pxy[q] = Pxy;
       w.Pyy[q] = Pyy;
+      w.Ps[q] = Ps;
     }
 }
 
@@ -554,8 +563,7 @@ void Solver::update(int tt, const TileWork& w, double t, double dt) {
       mass += H;
       ke += 0.5 * H * sp2;
       vmax = std::max(vmax, sp);
-      const double ps = std::sqrt(w.Pxx[q]) / t_.dx + std::sqrt(w.Pyy[q]) / t_.dy;
-      rate = std::max(rate, std::abs(U) / t_.dx + std::abs(V) / t_.dy + ps * std::sqrt(H));
+      rate = std::max(rate, std::abs(U) / t_.dx + std::abs(V) / t_.dy + w.Ps[q] * std::sqrt(H));
       wet = wet || H > cfg_.activation_depth;
     }
   tile_out_[tt] += out;
