@@ -133,6 +133,7 @@ inline Face held_face(const FaceState& L, const FaceState& R) {
 // intermediate fields never leave the cache.
 struct TileWork {
   int bi0 = 0, bj0 = 0, bw = 0, bh = 0;  // box = tile grown by 2, clipped to the grid
+  bool all_active = true;                // every tile the box touches is active
   std::vector<double> sHx, sux, svx, sHy, suy, svy, Hp, Up, Vp, Pxx, Pxy, Pyy, Ps, r;
   std::vector<std::uint8_t> held;
   std::vector<Face> Fx, Fy;  // Fx[(j - bj0) * (bw + 1) + (i - bi0)]: face left of cell (i, j)
@@ -454,7 +455,7 @@ template <bool X>
 Face Solver::face(const TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi, Boundary2D blo,
                   Boundary2D bhi) const {
   // Flux through the face between cells a (left/below) and b; lo/hi: the face is a domain edge.
-  if (!lo && !hi && cell_active(ia, ja) != cell_active(ib, jb)) return Face{0, 0, 0};
+  if (!lo && !hi && !w.all_active && cell_active(ia, ja) != cell_active(ib, jb)) return Face{0, 0, 0};
   FaceState L{}, R{};
   if (!lo) L = side_state<X>(w, w.at(ia, ja), +1.0);
   if (!hi) R = side_state<X>(w, w.at(ib, jb), -1.0);
@@ -582,6 +583,13 @@ void Solver::step_tile(int tt, double t, double dt, TileWork& w) {
   w.bj0 = std::max(j0 - 2, 0);
   w.bw = std::min(i1 + 2, nx_) - w.bi0;
   w.bh = std::min(j1 + 2, ny_) - w.bj0;
+  const int ti = tt % ntx_, tj = tt / ntx_;
+  w.all_active = true;
+  for (int dj = -1; dj <= 1; ++dj)
+    for (int di = -1; di <= 1; ++di) {
+      const int u = ti + di, v = tj + dj;
+      if (u >= 0 && v >= 0 && u < ntx_ && v < nty_ && !active_flag_[v * ntx_ + u]) w.all_active = false;
+    }
   switch (cfg_.limiter) {
     case Limiter::minmod: predictor<Limiter::minmod>(w, dt); break;
     case Limiter::vanleer: predictor<Limiter::vanleer>(w, dt); break;
