@@ -135,14 +135,18 @@ struct TileWork {
   int bi0 = 0, bj0 = 0, bw = 0, bh = 0;  // box = tile grown by 2, clipped to the grid
   bool all_active = true;                // every tile the box touches is active
   std::vector<double> sHx, sux, svx, sHy, suy, svy, Hp, Up, Vp, Pxx, Pxy, Pyy, Ps, r;
-  std::vector<std::uint8_t> held;
-  std::vector<Face> Fx, Fy;  // Fx[(j - bj0) * (bw + 1) + (i - bi0)]: face left of cell (i, j)
+  std::vector<double> held;  // 1 where friction holds the cell at rest, else 0
+  // Face fluxes (mass, x-momentum, y-momentum); Fx*[(j - bj0) * (bw + 1) + (i - bi0)]: face left of
+  // cell (i, j), Fy*[(j - bj0) * bw + (i - bi0)]: face below it.
+  std::vector<double> Fx0, Fx1, Fx2, Fy0, Fy1, Fy2;
+  Face fxf(std::size_t k) const { return Face{Fx0[k], Fx1[k], Fx2[k]}; }
+  Face fyf(std::size_t k) const { return Face{Fy0[k], Fy1[k], Fy2[k]}; }
   void reserve(int T) {
     const std::size_t n = std::size_t(T + 4) * (T + 4);
     for (auto* v : {&sHx, &sux, &svx, &sHy, &suy, &svy, &Hp, &Up, &Vp, &Pxx, &Pxy, &Pyy, &Ps, &r}) v->assign(n, 0.0);
-    held.assign(n, 0);
-    Fx.assign(std::size_t(T + 5) * (T + 4), Face{0, 0, 0});
-    Fy.assign(std::size_t(T + 4) * (T + 5), Face{0, 0, 0});
+    held.assign(n, 0.0);
+    for (auto* v : {&Fx0, &Fx1, &Fx2}) v->assign(std::size_t(T + 5) * (T + 4), 0.0);
+    for (auto* v : {&Fy0, &Fy1, &Fy2}) v->assign(std::size_t(T + 4) * (T + 5), 0.0);
   }
   std::size_t at(int i, int j) const { return std::size_t(j - bj0) * bw + (i - bi0); }
   std::size_t fx(int i, int j) const { return std::size_t(j - bj0) * (bw + 1) + (i - bi0); }
@@ -257,6 +261,7 @@ class Solver {
   void step_tile(int tt, double t, double dt, TileWork& w);
   template <Limiter L>
   void predictor(TileWork& w, double dt) const;
+  void predictor_row_minmod(TileWork& w, int j, int ia, int ib, double dt) const;
   void faces(TileWork& w) const;
   template <bool X>
   Face face(const TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi, Boundary2D blo, Boundary2D bhi) const;
@@ -358,8 +363,17 @@ template <Limiter lim>
 void Solver::predictor(TileWork& w, double dt) const {
   const auto &Hs = H_[cur_], &HUs = HU_[cur_], &HVs = HV_[cur_], &Us = U_[cur_], &Vs = V_[cur_];
   const double hx = 0.5 * dt / t_.dx, hy = 0.5 * dt / t_.dy, dry = cfg_.dry_depth;
+  // Cells away from the domain's edges take the branch-free row kernel (minmod, K = 1: the default
+  // set-up); which kernel a cell takes depends only on its position, so every tile that computes
+  // it gets the same bits.
+  const bool fast = lim == Limiter::minmod && !kap_;
+  const int fa = std::max(w.bi0, 1), fb = std::min(w.bi0 + w.bw, nx_ - 1);
   for (int j = w.bj0; j < w.bj0 + w.bh; ++j)
     for (int i = w.bi0; i < w.bi0 + w.bw; ++i) {
+      if (fast && j > 0 && j < ny_ - 1 && i >= fa && i < fb) {
+        if (i == fa) predictor_row_minmod(w, j, fa, fb, dt);
+        continue;
+      }
       const std::size_t k = idx(i, j), q = w.at(i, j);
       const double H = Hs[k], MU = HUs[k], MV = HVs[k], U = Us[k], V = Vs[k];
       // Limited slopes of the depth and of the velocity (primitive variables: reconstructing the
@@ -422,7 +436,7 @@ void Solver::predictor(TileWork& w, double dt) const {
         Vp = H > dry ? V + 0.5 * dt * acc * geo_.by[k] : 0.0;
       }
       const bool rest = apply_friction(Up, Vp, m3(k, Up, Vp), 0.5 * dt * resistance(k, 1.0, U, V, gn));
-      w.held[q] = rest && MU == 0.0 && MV == 0.0;
+      w.held[q] = rest && MU == 0.0 && MV == 0.0 ? 1.0 : 0.0;
       w.sHx[q] = sHx;
       w.sux[q] = sux;
       w.svx[q] = svx;
@@ -461,7 +475,113 @@ Face Solver::face(const TileWork& w, int ia, int ja, int ib, int jb, bool lo, bo
   if (!hi) R = side_state<X>(w, w.at(ib, jb), -1.0);
   if (lo) L = boundary_ghost(R, blo);
   if (hi) R = boundary_ghost(L, bhi);
-  return (!lo && !hi && w.held[w.at(ia, ja)] && w.held[w.at(ib, jb)]) ? held_face(L, R) : central_flux(L, R);
+  return (!lo && !hi && w.held[w.at(ia, ja)] != 0.0 && w.held[w.at(ib, jb)] != 0.0) ? held_face(L, R)
+                                                                                      : central_flux(L, R);
+}
+
+// The interior faces of one box row (x) or between two box rows (y) in one branch-free loop the
+// compiler can vectorise: the same arithmetic as side_state + central_flux / held_face. Cell
+// pointers point at the right/upper cell of the first face; the left/lower cell is `s` before it.
+// Outputs: mass, normal and tangential momentum flux.
+inline void face_row(int n, std::ptrdiff_t s, const double* __restrict Hp, const double* __restrict sH,
+                     const double* __restrict Un, const double* __restrict sUn, const double* __restrict Ut,
+                     const double* __restrict sUt, const double* __restrict Pnn, const double* __restrict Pnt,
+                     const double* __restrict held, double* __restrict o0, double* __restrict on,
+                     double* __restrict ot) {
+  for (int k = 0; k < n; ++k) {
+    const std::ptrdiff_t r = k, l = k - s;
+    const double HL = Hp[l] + 0.5 * sH[l], uL = Un[l] + 0.5 * sUn[l], tL = Ut[l] + 0.5 * sUt[l];
+    const double HR = Hp[r] - 0.5 * sH[r], uR = Un[r] - 0.5 * sUn[r], tR = Ut[r] - 0.5 * sUt[r];
+    const double a = std::max(std::abs(uL), std::abs(uR)) +
+                     std::sqrt(std::max(Pnn[l] * std::max(HL, 0.0), Pnn[r] * std::max(HR, 0.0)));
+    const double mL = HL * uL, mR = HR * uR;
+    const double pL = 0.5 * Pnn[l] * HL * HL, pR = 0.5 * Pnn[r] * HR * HR;
+    const double qL = 0.5 * Pnt[l] * HL * HL, qR = 0.5 * Pnt[r] * HR * HR;
+    const double h = held[l] * held[r], m = 1.0 - h;  // 1 / 0 masks: exact selects, no branch
+    o0[k] = m * (0.5 * (mL + mR) - 0.5 * a * (HR - HL));
+    on[k] = m * (0.5 * (mL * uL + pL + mR * uR + pR) - 0.5 * a * (mR - mL)) + h * (0.5 * (pL + pR));
+    ot[k] = m * (0.5 * (mL * tL + qL + mR * tR + qR) - 0.5 * a * (HR * tR - HL * tL)) + h * (0.5 * (qL + qR));
+  }
+}
+
+// The predictor of the branch-free kind for cells (ia..ib-1, j), all away from the domain's edges,
+// minmod slopes, K = 1. Same arithmetic as the general loop in Solver::predictor, written with 0/1
+// masks instead of branches so that the compiler can vectorise it.
+void Solver::predictor_row_minmod(TileWork& w, int j, int ia, int ib, double dt) const {
+  const double* __restrict Hs = H_[cur_].data();
+  const double* __restrict HUs = HU_[cur_].data();
+  const double* __restrict HVs = HV_[cur_].data();
+  const double* __restrict Us = U_[cur_].data();
+  const double* __restrict Vs = V_[cur_].data();
+  const double *__restrict bx = geo_.bx.data(), *__restrict by = geo_.by.data(), *__restrict cc = geo_.c.data();
+  const double *__restrict hxx = geo_.hxx.data(), *__restrict hxy = geo_.hxy.data(), *__restrict hyy = geo_.hyy.data();
+  const double *__restrict Pxx = Pxx_.data(), *__restrict Pxy = Pxy_.data(), *__restrict Pyy = Pyy_.data();
+  const double* __restrict Ps = Ps_.data();
+  const std::size_t q0 = w.at(ia, j), k0 = idx(ia, j);
+  double *__restrict oHx = &w.sHx[q0], *__restrict oux = &w.sux[q0], *__restrict ovx = &w.svx[q0];
+  double *__restrict oHy = &w.sHy[q0], *__restrict ouy = &w.suy[q0], *__restrict ovy = &w.svy[q0];
+  double *__restrict oHp = &w.Hp[q0], *__restrict oUp = &w.Up[q0], *__restrict oVp = &w.Vp[q0];
+  double *__restrict oPxx = &w.Pxx[q0], *__restrict oPxy = &w.Pxy[q0], *__restrict oPyy = &w.Pyy[q0];
+  double *__restrict oPs = &w.Ps[q0], *__restrict oheld = &w.held[q0];
+  const double hx = 0.5 * dt / t_.dx, hy = 0.5 * dt / t_.dy, dry = cfg_.dry_depth, g = g_, mu = mu_, ixi = ixi_;
+  const double curv = cfg_.curvature ? 1.0 : 0.0;
+  const std::ptrdiff_t N = nx_;
+  auto mm = [](double a, double b) {
+    return 0.5 * (std::copysign(1.0, a) + std::copysign(1.0, b)) * std::min(std::abs(a), std::abs(b));
+  };
+  const int n = ib - ia;
+#pragma omp simd
+  for (int t = 0; t < n; ++t) {
+    const std::ptrdiff_t k = std::ptrdiff_t(k0) + t;
+    const double H = Hs[k], U = Us[k], V = Vs[k];
+    const double wx = std::min(Hs[k - 1], Hs[k + 1]) > dry ? 1.0 : 0.0;
+    const double wy = std::min(Hs[k - N], Hs[k + N]) > dry ? 1.0 : 0.0;
+    double sHx = mm(H - Hs[k - 1], Hs[k + 1] - H);
+    double sux = wx * mm(U - Us[k - 1], Us[k + 1] - U), svx = wx * mm(V - Vs[k - 1], Vs[k + 1] - V);
+    double sHy = mm(H - Hs[k - N], Hs[k + N] - H);
+    double suy = wy * mm(U - Us[k - N], Us[k + N] - U), svy = wy * mm(V - Vs[k - N], Vs[k + N] - V);
+    const double pxx = Pxx[k], pxy = Pxy[k], pyy = Pyy[k];
+    const double gn = std::max(0.0, g + U * U * hxx[k] + 2 * U * V * hxy[k] + V * V * hyy[k]);
+    const double c = cc[k], acc = -c * c * gn, wet = H > dry ? 1.0 : 0.0;
+    const double Hp1 = H - hx * (U * sHx + H * sux) - hy * (V * sHy + H * svy);
+    const double Up1 = wet * (U - hx * (U * sux + pxx * sHx) - hy * (V * suy + pxy * sHy) + 0.5 * dt * acc * bx[k]);
+    const double Vp1 = wet * (V - hx * (U * svx + pxy * sHx) - hy * (V * svy + pyy * sHy) + 0.5 * dt * acc * by[k]);
+    // First order where a predicted face depth would be negative.
+    const double bad = Hp1 - 0.5 * std::abs(sHx) - 0.5 * std::abs(sHy) < 0 ? 1.0 : 0.0, good = 1.0 - bad;
+    sHx *= good;
+    sux *= good;
+    svx *= good;
+    sHy *= good;
+    suy *= good;
+    svy *= good;
+    const double Hp = good * Hp1 + bad * H;
+    double Up = good * Up1 + bad * (wet * (U + 0.5 * dt * acc * bx[k]));
+    double Vp = good * Vp1 + bad * (wet * (V + 0.5 * dt * acc * by[k]));
+    // Friction over the half step, bounded: the same numbers as apply_friction.
+    const double wv = bx[k] * U + by[k] * V;
+    const double load = curv * gn + (1.0 - curv) * g;
+    const double imp = 0.5 * dt * (mu * c * load + g * ixi * (U * U + V * V + wv * wv));
+    const double wp = bx[k] * Up + by[k] * Vp;
+    const double M3 = std::sqrt(Up * Up + Vp * Vp + wp * wp);
+    const double f = std::max(0.0, 1.0 - imp / std::max(M3, 1e-300));
+    const double rest = M3 <= imp ? 1.0 : 0.0;
+    Up *= f;
+    Vp *= f;
+    oheld[t] = std::abs(HUs[k]) + std::abs(HVs[k]) == 0.0 ? rest : 0.0;
+    oHx[t] = sHx;
+    oux[t] = sux;
+    ovx[t] = svx;
+    oHy[t] = sHy;
+    ouy[t] = suy;
+    ovy[t] = svy;
+    oHp[t] = Hp;
+    oUp[t] = Up;
+    oVp[t] = Vp;
+    oPxx[t] = pxx;
+    oPxy[t] = pxy;
+    oPyy[t] = pyy;
+    oPs[t] = Ps[k];
+  }
 }
 
 void Solver::faces(TileWork& w) const {
@@ -469,19 +589,45 @@ void Solver::faces(TileWork& w) const {
   // tile and an inactive one carries nothing: both its cells hold less than the activation depth and
   // the inactive side is not updated, so this keeps the volume exact.
   const int i0 = w.bi0, i1 = w.bi0 + w.bw, j0 = w.bj0, j1 = w.bj0 + w.bh;
-  for (int j = j0; j < j1; ++j)
+  auto put_x = [&](int i, int j, const Face& f) {
+    const std::size_t k = w.fx(i, j);
+    w.Fx0[k] = f.f0;
+    w.Fx1[k] = f.f1;
+    w.Fx2[k] = f.f2;
+  };
+  auto put_y = [&](int i, int j, const Face& g) {  // g in (mass, normal, tangential)
+    const std::size_t k = w.fy(i, j);
+    w.Fy0[k] = g.f0;
+    w.Fy1[k] = g.f2;
+    w.Fy2[k] = g.f1;
+  };
+  // x faces: interior ones (both cells in the box, not a domain edge) by rows, the rest one by one.
+  const int xa = std::max(i0 + 1, 1), xb = std::min(i1 - 1, nx_ - 1);  // interior face range [xa, xb]
+  for (int j = j0; j < j1; ++j) {
+    if (w.all_active && xb >= xa) {
+      const std::size_t q = w.at(xa, j), f = w.fx(xa, j);
+      face_row(xb - xa + 1, 1, &w.Hp[q], &w.sHx[q], &w.Up[q], &w.sux[q], &w.Vp[q], &w.svx[q], &w.Pxx[q], &w.Pxy[q],
+               &w.held[q], &w.Fx0[f], &w.Fx1[f], &w.Fx2[f]);
+    }
     for (int i = i0; i <= i1; ++i) {
       const bool west = i == 0, east = i == nx_;
       if ((i == i0 && !west) || (i == i1 && !east)) continue;  // the other cell lies outside the box
-      w.Fx[w.fx(i, j)] = face<true>(w, i - 1, j, i, j, west, east, cfg_.west, cfg_.east);
+      if (w.all_active && i >= xa && i <= xb) continue;        // done above
+      put_x(i, j, face<true>(w, i - 1, j, i, j, west, east, cfg_.west, cfg_.east));
     }
-  for (int j = j0; j <= j1; ++j)
-    for (int i = i0; i < i1; ++i) {
-      const bool south = j == 0, north = j == ny_;
-      if ((j == j0 && !south) || (j == j1 && !north)) continue;
-      const Face g = face<false>(w, i, j - 1, i, j, south, north, cfg_.south, cfg_.north);
-      w.Fy[w.fy(i, j)] = Face{g.f0, g.f2, g.f1};  // (mass, normal, tangential) -> (mass, x, y)
+  }
+  // y faces: interior rows of faces (between box rows j-1 and j) in one go, domain edges one by one.
+  for (int j = j0; j <= j1; ++j) {
+    const bool south = j == 0, north = j == ny_;
+    if ((j == j0 && !south) || (j == j1 && !north)) continue;
+    if (w.all_active && !south && !north) {
+      const std::size_t q = w.at(i0, j), f = w.fy(i0, j);
+      face_row(w.bw, w.bw, &w.Hp[q], &w.sHy[q], &w.Vp[q], &w.svy[q], &w.Up[q], &w.suy[q], &w.Pyy[q], &w.Pxy[q],
+               &w.held[q], &w.Fy0[f], &w.Fy2[f], &w.Fy1[f]);
+      continue;
     }
+    for (int i = i0; i < i1; ++i) put_y(i, j, face<false>(w, i, j - 1, i, j, south, north, cfg_.south, cfg_.north));
+  }
 }
 
 long Solver::positivity(TileWork& w, int i0, int i1, int j0, int j1, double dt) const {
@@ -490,8 +636,8 @@ long Solver::positivity(TileWork& w, int i0, int i1, int j0, int j1, double dt) 
   long limited = 0;
   for (int j = std::max(j0 - 1, 0); j < std::min(j1 + 1, ny_); ++j)
     for (int i = std::max(i0 - 1, 0); i < std::min(i1 + 1, nx_); ++i) {
-      const double out = dt / t_.dx * (std::max(w.Fx[w.fx(i + 1, j)].f0, 0.0) + std::max(-w.Fx[w.fx(i, j)].f0, 0.0)) +
-                         dt / t_.dy * (std::max(w.Fy[w.fy(i, j + 1)].f0, 0.0) + std::max(-w.Fy[w.fy(i, j)].f0, 0.0));
+      const double out = dt / t_.dx * (std::max(w.Fx0[w.fx(i + 1, j)], 0.0) + std::max(-w.Fx0[w.fx(i, j)], 0.0)) +
+                         dt / t_.dy * (std::max(w.Fy0[w.fy(i, j + 1)], 0.0) + std::max(-w.Fy0[w.fy(i, j)], 0.0));
       const double H = Hs[idx(i, j)];
       double r = 1.0;
       if (out > H) {
@@ -521,10 +667,10 @@ void Solver::update(int tt, const TileWork& w, double t, double dt) {
   for (int j = j0; j < j1; ++j)
     for (int i = i0; i < i1; ++i) {
       const std::size_t k = idx(i, j), q = w.at(i, j);
-      const Face fw = scaled(w.Fx[w.fx(i, j)], i - 1, j, i, j, i > 0, true);
-      const Face fe = scaled(w.Fx[w.fx(i + 1, j)], i, j, i + 1, j, true, i < nx_ - 1);
-      const Face fs = scaled(w.Fy[w.fy(i, j)], i, j - 1, i, j, j > 0, true);
-      const Face fn = scaled(w.Fy[w.fy(i, j + 1)], i, j, i, j + 1, true, j < ny_ - 1);
+      const Face fw = scaled(w.fxf(w.fx(i, j)), i - 1, j, i, j, i > 0, true);
+      const Face fe = scaled(w.fxf(w.fx(i + 1, j)), i, j, i + 1, j, true, i < nx_ - 1);
+      const Face fs = scaled(w.fyf(w.fy(i, j)), i, j - 1, i, j, j > 0, true);
+      const Face fn = scaled(w.fyf(w.fy(i, j + 1)), i, j, i, j + 1, true, j < ny_ - 1);
       if (i == 0) out -= fw.f0 * dt * t_.dy;
       if (i == nx_ - 1) out += fe.f0 * dt * t_.dy;
       if (j == 0) out -= fs.f0 * dt * t_.dx;
