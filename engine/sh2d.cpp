@@ -9,6 +9,14 @@
 #include <stdexcept>
 #include <string>
 
+// The vectorisable kernels are compiled twice, for AVX2 (four doubles per instruction) and for the
+// baseline x86-64 (two), and the loader picks the one the CPU supports.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define RUNOUT_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define RUNOUT_SIMD_CLONES
+#endif
+
 namespace runout::engine {
 
 SurfaceGeometry SurfaceGeometry::from(const Terrain2D& t) {
@@ -483,7 +491,7 @@ Face Solver::face(const TileWork& w, int ia, int ja, int ib, int jb, bool lo, bo
 // compiler can vectorise: the same arithmetic as side_state + central_flux / held_face. Cell
 // pointers point at the right/upper cell of the first face; the left/lower cell is `s` before it.
 // Outputs: mass, normal and tangential momentum flux.
-inline void face_row(int n, std::ptrdiff_t s, const double* __restrict Hp, const double* __restrict sH,
+RUNOUT_SIMD_CLONES void face_row(int n, std::ptrdiff_t s, const double* __restrict Hp, const double* __restrict sH,
                      const double* __restrict Un, const double* __restrict sUn, const double* __restrict Ut,
                      const double* __restrict sUt, const double* __restrict Pnn, const double* __restrict Pnt,
                      const double* __restrict held, double* __restrict o0, double* __restrict on,
@@ -507,7 +515,7 @@ inline void face_row(int n, std::ptrdiff_t s, const double* __restrict Hp, const
 // The predictor of the branch-free kind for cells (ia..ib-1, j), all away from the domain's edges,
 // minmod slopes, K = 1. Same arithmetic as the general loop in Solver::predictor, written with 0/1
 // masks instead of branches so that the compiler can vectorise it.
-void Solver::predictor_row_minmod(TileWork& w, int j, int ia, int ib, double dt) const {
+RUNOUT_SIMD_CLONES void Solver::predictor_row_minmod(TileWork& w, int j, int ia, int ib, double dt) const {
   const double* __restrict Hs = H_[cur_].data();
   const double* __restrict HUs = HU_[cur_].data();
   const double* __restrict HVs = HV_[cur_].data();
