@@ -269,7 +269,8 @@ class Solver {
   void step_tile(int tt, double t, double dt, TileWork& w);
   template <Limiter L>
   void predictor(TileWork& w, double dt) const;
-  void predictor_row_minmod(TileWork& w, int j, int ia, int ib, double dt) const;
+  template <Limiter L>
+  void predictor_row(TileWork& w, int j, int ia, int ib, double dt) const;
   void faces(TileWork& w) const;
   template <bool X>
   Face face(const TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi, Boundary2D blo, Boundary2D bhi) const;
@@ -371,15 +372,15 @@ template <Limiter lim>
 void Solver::predictor(TileWork& w, double dt) const {
   const auto &Hs = H_[cur_], &HUs = HU_[cur_], &HVs = HV_[cur_], &Us = U_[cur_], &Vs = V_[cur_];
   const double hx = 0.5 * dt / t_.dx, hy = 0.5 * dt / t_.dy, dry = cfg_.dry_depth;
-  // Cells away from the domain's edges take the branch-free row kernel (minmod, K = 1: the default
-  // set-up); which kernel a cell takes depends only on its position, so every tile that computes
-  // it gets the same bits.
-  const bool fast = lim == Limiter::minmod && !kap_;
+  // Cells away from the domain's edges take the branch-free row kernel (K = 1, the default set-up);
+  // which kernel a cell takes depends only on its position, so every tile that computes it gets the
+  // same bits.
+  const bool fast = !kap_;
   const int fa = std::max(w.bi0, 1), fb = std::min(w.bi0 + w.bw, nx_ - 1);
   for (int j = w.bj0; j < w.bj0 + w.bh; ++j)
     for (int i = w.bi0; i < w.bi0 + w.bw; ++i) {
       if (fast && j > 0 && j < ny_ - 1 && i >= fa && i < fb) {
-        if (i == fa) predictor_row_minmod(w, j, fa, fb, dt);
+        if (i == fa) predictor_row<lim>(w, j, fa, fb, dt);
         continue;
       }
       const std::size_t k = idx(i, j), q = w.at(i, j);
@@ -513,9 +514,10 @@ RUNOUT_SIMD_CLONES void face_row(int n, std::ptrdiff_t s, const double* __restri
 }
 
 // The predictor of the branch-free kind for cells (ia..ib-1, j), all away from the domain's edges,
-// minmod slopes, K = 1. Same arithmetic as the general loop in Solver::predictor, written with 0/1
+// K = 1. Same arithmetic as the general loop in Solver::predictor, written with 0/1
 // masks instead of branches so that the compiler can vectorise it.
-RUNOUT_SIMD_CLONES void Solver::predictor_row_minmod(TileWork& w, int j, int ia, int ib, double dt) const {
+template <Limiter lim>
+RUNOUT_SIMD_CLONES void Solver::predictor_row(TileWork& w, int j, int ia, int ib, double dt) const {
   const double* __restrict Hs = H_[cur_].data();
   const double* __restrict HUs = HU_[cur_].data();
   const double* __restrict HVs = HV_[cur_].data();
@@ -534,9 +536,7 @@ RUNOUT_SIMD_CLONES void Solver::predictor_row_minmod(TileWork& w, int j, int ia,
   const double hx = 0.5 * dt / t_.dx, hy = 0.5 * dt / t_.dy, dry = cfg_.dry_depth, g = g_, mu = mu_, ixi = ixi_;
   const double curv = cfg_.curvature ? 1.0 : 0.0;
   const std::ptrdiff_t N = nx_;
-  auto mm = [](double a, double b) {
-    return 0.5 * (std::copysign(1.0, a) + std::copysign(1.0, b)) * std::min(std::abs(a), std::abs(b));
-  };
+  auto mm = [](double a, double b) { return limited_slope(lim, a, b); };
   const int n = ib - ia;
 #pragma omp simd
   for (int t = 0; t < n; ++t) {
