@@ -328,9 +328,11 @@ void Solver::record_hazard(std::size_t k, double t) {
   const double H = H_[cur_][k], h = H * geo_.c[k];
   const double sp = H > cfg_.dry_depth ? m3(k, HU_[cur_][k], HV_[cur_][k]) / H : 0.0;
   hz_.max_depth[k] = std::max(hz_.max_depth[k], h);
-  hz_.max_speed[k] = std::max(hz_.max_speed[k], sp);
-  hz_.max_pressure[k] = std::max(hz_.max_pressure[k], cfg_.material.density * sp * sp);
-  if (h > cfg_.arrival_threshold && std::isnan(hz_.arrival_time[k])) hz_.arrival_time[k] = t;
+  if (h > cfg_.flow_threshold) {
+    hz_.max_speed[k] = std::max(hz_.max_speed[k], sp);
+    hz_.max_pressure[k] = std::max(hz_.max_pressure[k], cfg_.material.density * sp * sp);
+    if (std::isnan(hz_.arrival_time[k])) hz_.arrival_time[k] = t;
+  }
 }
 
 void Solver::rebuild_active() {
@@ -712,9 +714,11 @@ void Solver::update(int tt, const TileWork& w, double t, double dt) {
       // Hazard maps and tile sums from the new state.
       const double h = H * geo_.c[k], sp2 = sp * sp;
       hz_.max_depth[k] = std::max(hz_.max_depth[k], h);
-      hz_.max_speed[k] = std::max(hz_.max_speed[k], sp);
-      hz_.max_pressure[k] = std::max(hz_.max_pressure[k], cfg_.material.density * sp2);
-      if (h > cfg_.arrival_threshold && std::isnan(hz_.arrival_time[k])) hz_.arrival_time[k] = t + dt;
+      if (h > cfg_.flow_threshold) {
+        hz_.max_speed[k] = std::max(hz_.max_speed[k], sp);
+        hz_.max_pressure[k] = std::max(hz_.max_pressure[k], cfg_.material.density * sp2);
+        if (std::isnan(hz_.arrival_time[k])) hz_.arrival_time[k] = t + dt;
+      }
       mass += H;
       ke += 0.5 * H * sp2;
       vmax = std::max(vmax, sp);

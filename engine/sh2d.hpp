@@ -72,7 +72,10 @@ struct Sh2dConfig {
   double gravity = 9.81;
   double dry_depth = 1e-8;          ///< volume per area below which velocity is zero [m]
   double activation_depth = 1e-9;   ///< a tile with any cell deeper than this is active [m]
-  double arrival_threshold = 0.01;  ///< normal depth that counts as arrival [m]
+  /// Normal depth above which a cell counts as flowing [m]: its arrival time, and the maximum speed
+  /// and pressure maps (films thinner than this, which pure Coulomb friction lets slide on at speed,
+  /// are left out of the hazard maps; the maximum depth and the diagnostics see every cell).
+  double flow_threshold = 0.01;
   int tile = 32;                    ///< tile edge in cells
   bool curvature = true;            ///< the centrifugal part of the normal load raises friction
   bool skip_inactive = true;        ///< false: compute every tile every step (for comparison)

@@ -6,8 +6,9 @@
 namespace runout::cli {
 
 /// Exit codes (documented in `runout --help`).
-enum Exit : int { kOk = 0, kFailed = 1, kUsage = 2, kInternal = 3 };
+enum Exit : int { kOk = 0, kFailed = 1, kUsage = 2, kInternal = 3, kBadInput = 4, kOutput = 5, kCancelled = 6 };
 
+int run(const std::vector<std::string>& args);
 int verify(const std::vector<std::string>& args);
 int version(const std::vector<std::string>& args);
 std::string version_report();

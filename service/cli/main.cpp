@@ -13,6 +13,11 @@ const char* kHelp = R"(runout - hazard mapping for rapid granular flows (depth-a
 usage: runout <command> [options]
 
 commands:
+  run SCENARIO.json --out DIR [--force] [--quiet] [--threads N]
+        Run a scenario (JSON form of runout.v1.Scenario, see README) and write the hazard rasters
+        (COG GeoTIFF), the runout outline (GeoJSON in WGS84, GeoPackage) and the run record (run.json)
+        into DIR. Results appear only when the run succeeded; an existing DIR is replaced only with
+        --force. A progress line goes to standard error unless --quiet.
   verify [CASE...] [--full] [--resolutions R1,R2,...] [--limiter NAME] [--csv] [--threads N]
         Run the verification cases against exact solutions and invariants and print a table
         (or CSV). Cases: A1 A2 A3 A4 A5 A6 A7 STRESS (default: all). --full adds the finest
@@ -28,6 +33,9 @@ exit codes:
   1  verify: at least one figure outside its tolerance
   2  bad command line (unknown command, option or name)
   3  internal error
+  4  run: invalid scenario or input data (the message names the field or file)
+  5  run: output directory exists (use --force) or cannot be written
+  6  run: cancelled (interrupt)
 )";
 
 }  // namespace
@@ -41,9 +49,10 @@ int main(int argc, char** argv) {
   const std::string cmd = args[0];
   args.erase(args.begin());
   try {
+    if (cmd == "run") return runout::cli::run(args);
     if (cmd == "verify") return runout::cli::verify(args);
     if (cmd == "version" || cmd == "--version") return runout::cli::version(args);
-    std::cerr << "runout: unknown command '" << cmd << "' (valid: verify, version, help)\n";
+    std::cerr << "runout: unknown command '" << cmd << "' (valid: run, verify, version, help)\n";
     return runout::cli::kUsage;
   } catch (const std::exception& e) {
     std::cerr << "runout: internal error: " << e.what() << "\n";

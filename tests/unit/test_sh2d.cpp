@@ -144,7 +144,7 @@ TEST(Sh2d, HazardMapsAreConsistent) {
   const auto t = hillside(120, 80, 5.0, 30, 0.0);
   auto cfg = coulomb(22, 40.0);
   cfg.material.density = 300;
-  cfg.arrival_threshold = 0.05;
+  cfg.flow_threshold = 0.05;
   const auto r = run_sh2d(t, cfg, state_from_normal_depth(t, blob(t, 20, 40, 8, 3.0)));
   const auto& hz = r.hazard;
   int reached = 0, never = 0;
@@ -153,6 +153,8 @@ TEST(Sh2d, HazardMapsAreConsistent) {
     EXPECT_NEAR(hz.max_pressure[k], 300 * hz.max_speed[k] * hz.max_speed[k], 1e-9 * (1 + hz.max_pressure[k]));
     if (std::isnan(hz.arrival_time[k])) {
       EXPECT_LE(hz.max_depth[k], 0.05);
+      EXPECT_EQ(hz.max_speed[k], 0.0);  // thin films do not enter the speed and pressure maps
+      EXPECT_EQ(hz.max_pressure[k], 0.0);
       ++never;
     } else {
       EXPECT_GT(hz.max_depth[k], 0.05);

@@ -1,0 +1,194 @@
+#include "jobs/run.hpp"
+
+#include <google/protobuf/util/json_util.h>
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "engine/sh2d.hpp"
+
+#ifndef RUNOUT_VERSION
+#define RUNOUT_VERSION "unknown"
+#endif
+
+namespace runout::jobs {
+namespace fs = std::filesystem;
+
+namespace {
+
+double since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string jstr(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"': o += "\\\""; break;
+      case '\\': o += "\\\\"; break;
+      case '\n': o += "\\n"; break;
+      case '\t': o += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char b[8];
+          std::snprintf(b, sizeof b, "\\u%04x", c);
+          o += b;
+        } else {
+          o += c;
+        }
+    }
+  }
+  return o + "\"";
+}
+
+std::string jnum(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream o;
+  o.precision(10);
+  o << v;
+  return o.str();
+}
+
+}  // namespace
+
+RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt) {
+  RunSummary sum;
+  const auto t0 = std::chrono::steady_clock::now();
+  terrain::DemReport dem_rep;
+  const terrain::Grid grid = terrain::prepare_grid(s.dem, &dem_rep);
+  terrain::ReleaseReport rel_rep;
+  const auto h0 = terrain::rasterize_releases(grid, s.releases, &rel_rep);
+  sum.nx = grid.nx;
+  sum.ny = grid.ny;
+  sum.dx = grid.dx;
+  sum.crs = grid.crs_name;
+  sum.release_area_m2 = rel_rep.area_m2;
+  sum.release_volume_m3 = rel_rep.volume_m3;
+  sum.notes = rel_rep.notes;
+
+  // Engine grid: local origin at the grid's centre.
+  engine::Terrain2D t;
+  t.nx = grid.nx;
+  t.ny = grid.ny;
+  t.dx = t.dy = grid.dx;
+  t.x0 = -0.5 * (grid.nx - 1) * grid.dx;
+  t.y0 = -0.5 * (grid.ny - 1) * grid.dx;
+  t.z = grid.z;
+  auto cfg = s.config;
+  cfg.time.progress = opt.progress;
+  cfg.time.progress_every = opt.progress_every;
+  sum.seconds_prepare = since(t0);
+
+  const auto t1 = std::chrono::steady_clock::now();
+  const auto res = engine::run_sh2d(t, cfg, engine::state_from_normal_depth(t, h0));
+  sum.seconds_run = since(t1);
+  const auto& d = res.diag;
+  sum.volume_initial = d.volume_initial;
+  sum.volume_final = d.volume_final;
+  sum.volume_outflow = d.volume_outflow;
+  sum.volume_error = d.volume_error();
+  sum.t = d.t;
+  sum.steps = d.steps;
+  sum.stop = std::string(engine::to_string(d.stop));
+  sum.max_speed = d.max_speed;
+
+  // Figures of the hazard map.
+  const auto& hz = res.hazard;
+  double mx = 0, my = 0, m = 0;
+  for (int j = 0; j < grid.ny; ++j)
+    for (int i = 0; i < grid.nx; ++i) {
+      const double v = h0[std::size_t(j) * grid.nx + i];
+      m += v;
+      mx += v * grid.cx(i);
+      my += v * grid.cy(j);
+    }
+  mx /= m;
+  my /= m;
+  long affected = 0;
+  for (int j = 0; j < grid.ny; ++j)
+    for (int i = 0; i < grid.nx; ++i) {
+      const std::size_t k = std::size_t(j) * grid.nx + i;
+      sum.max_depth = std::max(sum.max_depth, hz.max_depth[k]);
+      if (hz.max_depth[k] <= s.outline_threshold) continue;
+      ++affected;
+      sum.runout_m = std::max(sum.runout_m, std::hypot(grid.cx(i) - mx, grid.cy(j) - my));
+    }
+  sum.affected_area_m2 = double(affected) * grid.dx * grid.dx;
+
+  // Outputs.
+  const auto t2 = std::chrono::steady_clock::now();
+  auto out = [&](const std::string& name) { return (fs::path(out_dir) / name).string(); };
+  for (const auto& name : s.rasters) {
+    const std::vector<double>* v = nullptr;
+    std::string desc;
+    if (name == "max_depth") v = &hz.max_depth, desc = "maximum flow depth normal to the surface [m]";
+    if (name == "max_speed") v = &hz.max_speed, desc = "maximum flow speed [m/s]";
+    if (name == "max_pressure") v = &hz.max_pressure, desc = "maximum pressure rho u^2 [Pa]";
+    if (name == "deposit") v = &hz.final_depth, desc = "deposit depth normal to the surface at the end [m]";
+    if (name == "arrival_time") v = &hz.arrival_time, desc = "arrival time of the flow [s]";
+    terrain::write_cog(out(name + ".tif"), grid, *v, desc);
+    sum.files.push_back(name + ".tif");
+  }
+  const auto outline = terrain::write_outline(out("outline.geojson"), out("outline.gpkg"), grid, hz.max_depth, s.outline_threshold);
+  sum.files.push_back("outline.geojson");
+  sum.files.push_back("outline.gpkg");
+  sum.seconds_write = since(t2);
+
+  // Run record.
+  std::string scenario_json;
+  google::protobuf::util::JsonPrintOptions po;
+  po.always_print_primitive_fields = true;
+  po.preserve_proto_field_names = true;
+  (void)google::protobuf::util::MessageToJsonString(s.scenario, &scenario_json, po);
+  std::ostringstream r;
+  r << "{\n  \"software\": {\"name\": \"runout\", \"version\": " << jstr(RUNOUT_VERSION) << "},\n";
+  r << "  \"created_utc\": " << jstr([] {
+    char b[32];
+    const std::time_t now = std::time(nullptr);
+    std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+    return std::string(b);
+  }()) << ",\n";
+  r << "  \"scenario_file\": " << jstr(s.source) << ",\n  \"scenario\": " << scenario_json << ",\n";
+  r << "  \"inputs\": [";
+  for (std::size_t k = 0; k < s.input_files.size(); ++k)
+    r << (k ? ", " : "") << "{\"path\": " << jstr(s.input_files[k]) << ", \"sha256\": " << jstr(terrain::sha256_file(s.input_files[k])) << "}";
+  r << "],\n";
+  r << "  \"dem\": {\"source_crs\": " << jstr(dem_rep.source_crs) << ", \"source_resolution_m\": " << jnum(dem_rep.source_resolution_m)
+    << ", \"z_min_m\": " << jnum(dem_rep.z_min) << ", \"z_max_m\": " << jnum(dem_rep.z_max)
+    << ", \"slope_mean_deg\": " << jnum(dem_rep.slope_mean_deg) << ", \"slope_p90_deg\": " << jnum(dem_rep.slope_p90_deg)
+    << ", \"slope_max_deg\": " << jnum(dem_rep.slope_max_deg) << "},\n";
+  r << "  \"grid\": {\"crs\": " << jstr(grid.crs_name) << ", \"nx\": " << grid.nx << ", \"ny\": " << grid.ny
+    << ", \"cell_size_m\": " << jnum(grid.dx) << ", \"x_min\": " << jnum(grid.x_min) << ", \"y_min\": " << jnum(grid.y_min)
+    << ", \"local_origin\": [" << jnum(grid.x_min + 0.5 * grid.nx * grid.dx) << ", " << jnum(grid.y_min + 0.5 * grid.ny * grid.dx)
+    << "]},\n";
+  r << "  \"release\": {\"polygons\": " << rel_rep.polygons << ", \"cells\": " << rel_rep.cells << ", \"area_m2\": "
+    << jnum(rel_rep.area_m2) << ", \"volume_m3\": " << jnum(rel_rep.volume_m3) << ", \"notes\": [";
+  for (std::size_t k = 0; k < rel_rep.notes.size(); ++k) r << (k ? ", " : "") << jstr(rel_rep.notes[k]);
+  r << "]},\n";
+  r << "  \"mass_balance\": {\"volume_initial_m3\": " << jnum(d.volume_initial) << ", \"volume_final_m3\": " << jnum(d.volume_final)
+    << ", \"volume_outflow_m3\": " << jnum(d.volume_outflow) << ", \"relative_error\": " << jnum(d.volume_error()) << "},\n";
+  r << "  \"solver\": {\"steps\": " << d.steps << ", \"simulated_s\": " << jnum(d.t) << ", \"stop\": " << jstr(sum.stop)
+    << ", \"max_speed_m_s\": " << jnum(d.max_speed) << ", \"kinetic_energy_peak\": " << jnum(d.kinetic_energy_peak)
+    << ", \"positivity_limited\": " << d.positivity_limited << ", \"cell_updates\": " << jnum(d.cell_updates)
+    << ", \"mean_active_fraction\": " << jnum(d.mean_active_fraction) << ", \"max_active_fraction\": " << jnum(d.max_active_fraction)
+    << "},\n";
+  r << "  \"results\": {\"affected_area_m2\": " << jnum(sum.affected_area_m2) << ", \"outline_polygons\": " << outline.polygons
+    << ", \"outline_area_m2\": " << jnum(outline.area_m2) << ", \"runout_from_release_centroid_m\": " << jnum(sum.runout_m)
+    << ", \"max_depth_m\": " << jnum(sum.max_depth) << ", \"outline_threshold_m\": " << jnum(s.outline_threshold) << "},\n";
+  r << "  \"timings_s\": {\"prepare\": " << jnum(sum.seconds_prepare) << ", \"run\": " << jnum(sum.seconds_run)
+    << ", \"write\": " << jnum(sum.seconds_write) << "},\n";
+  r << "  \"outputs\": [";
+  for (std::size_t k = 0; k < sum.files.size(); ++k) r << (k ? ", " : "") << jstr(sum.files[k]);
+  r << ", \"run.json\"]\n}\n";
+  std::ofstream f(out("run.json"));
+  f << r.str();
+  if (!f) throw std::runtime_error("writing run.json failed");
+  sum.files.push_back("run.json");
+  return sum;
+}
+
+}  // namespace runout::jobs

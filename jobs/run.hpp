@@ -1,0 +1,36 @@
+#pragma once
+// The run driver: terrain -> engine -> outputs for one resolved scenario, writing into a directory.
+// The command line's `runout run` and (later) the service's workers call the same code.
+#include <string>
+#include <vector>
+
+#include "engine/run_control.hpp"
+#include "jobs/scenario.hpp"
+
+namespace runout::jobs {
+
+struct RunOptions {
+  engine::ProgressHook progress;  ///< optional; returning false cancels the run
+  long progress_every = 50;
+};
+
+struct RunSummary {
+  int nx = 0, ny = 0;
+  double dx = 0;
+  std::string crs;
+  double release_area_m2 = 0, release_volume_m3 = 0;
+  double affected_area_m2 = 0, runout_m = 0, max_speed = 0, max_depth = 0;
+  double volume_initial = 0, volume_final = 0, volume_outflow = 0, volume_error = 0;
+  double t = 0;
+  long steps = 0;
+  std::string stop;
+  double seconds_prepare = 0, seconds_run = 0, seconds_write = 0;
+  std::vector<std::string> files;  ///< written, relative to the output directory
+  std::vector<std::string> notes;
+};
+
+/// Run a scenario and write every output into `out_dir` (which must exist). Throws ScenarioError or
+/// terrain::TerrainError for bad input; returns the summary also written to run.json.
+RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt = {});
+
+}  // namespace runout::jobs

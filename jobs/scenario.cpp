@@ -1,0 +1,213 @@
+#include "jobs/scenario.hpp"
+
+#include <google/protobuf/util/json_util.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "engine/names.hpp"
+
+namespace runout::jobs {
+namespace fs = std::filesystem;
+
+namespace {
+
+[[noreturn]] void bad(const std::string& field, const std::string& problem) { throw ScenarioError(field + ": " + problem); }
+
+std::string num(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
+
+std::string path_in(const std::string& base, const std::string& p, const std::string& field) {
+  if (p.empty()) bad(field, "missing");
+  fs::path q(p);
+  if (q.is_relative()) q = fs::path(base) / q;
+  if (!fs::exists(q)) bad(field, "file '" + q.string() + "' does not exist");
+  return q.string();
+}
+
+template <class E, std::size_t N>
+E enum_of(const engine::NameTable<E, N>& t, const std::string& field, const std::string& value, const std::string& dflt) {
+  try {
+    return engine::parse_name(t, field, value.empty() ? dflt : value);
+  } catch (const std::invalid_argument& e) {
+    throw ScenarioError(field + ": " + e.what());
+  }
+}
+
+double angle(const std::string& field, double deg) {
+  if (!(deg >= 0 && deg < 90)) bad(field, "must lie in [0, 90) degrees, got " + num(deg));
+  return deg * M_PI / 180.0;
+}
+
+}  // namespace
+
+const std::vector<std::string>& raster_names() {
+  static const std::vector<std::string> n = {"max_depth", "max_speed", "max_pressure", "deposit", "arrival_time"};
+  return n;
+}
+
+v1::Scenario parse_scenario_json(const std::string& json) {
+  v1::Scenario s;
+  google::protobuf::util::JsonParseOptions opt;
+  opt.ignore_unknown_fields = false;
+  const auto st = google::protobuf::util::JsonStringToMessage(json, &s, opt);
+  if (!st.ok()) throw ScenarioError("scenario JSON: " + std::string(st.message()));
+  return s;
+}
+
+ResolvedScenario load_scenario(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ScenarioError("scenario '" + path + "': cannot read the file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  v1::Scenario s;
+  try {
+    s = parse_scenario_json(ss.str());
+  } catch (const ScenarioError& e) {
+    throw ScenarioError("scenario '" + path + "': " + e.what());
+  }
+  auto r = resolve_scenario(std::move(s), fs::absolute(fs::path(path)).parent_path().string());
+  r.source = path;
+  return r;
+}
+
+ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
+  ResolvedScenario r;
+  if (s.engine().empty()) s.set_engine("depth-averaged");
+  if (s.engine() != "depth-averaged") bad("engine", "unknown '" + s.engine() + "' (valid: depth-averaged)");
+
+  // DEM, area, grid.
+  r.dem.dem_path = path_in(base, s.dem().path(), "dem.path");
+  r.dem.dem_crs = s.dem().crs();
+  r.input_files.push_back(r.dem.dem_path);
+  // Companion files that change how the DEM reads (ESRI ASCII .prj) are part of the input.
+  for (const char* ext : {".prj", ".aux.xml"}) {
+    fs::path side = fs::path(r.dem.dem_path).replace_extension(ext);
+    if (fs::exists(side)) r.input_files.push_back(side.string());
+  }
+  if (!s.area_of_interest().path().empty()) {
+    r.dem.aoi_path = path_in(base, s.area_of_interest().path(), "area_of_interest.path");
+    r.input_files.push_back(r.dem.aoi_path);
+  }
+  const auto& gcrs = s.grid().crs();
+  if (!(gcrs.empty() || gcrs == "utm" || gcrs == "dem" || gcrs.rfind("EPSG:", 0) == 0))
+    bad("grid.crs", "unknown '" + gcrs + "' (valid: \"utm\" (default), \"dem\", \"EPSG:<code>\")");
+  r.dem.target_crs = gcrs;
+  if (s.grid().resolution_m() < 0 || !std::isfinite(s.grid().resolution_m()))
+    bad("grid.resolution_m", "must be > 0 m, got " + num(s.grid().resolution_m()));
+  r.dem.resolution = s.grid().resolution_m();
+  static const std::vector<std::string> resamplings = {"near", "bilinear", "cubic", "cubicspline", "lanczos", "average"};
+  if (s.grid().resampling().empty()) s.mutable_grid()->set_resampling("cubic");
+  if (std::find(resamplings.begin(), resamplings.end(), s.grid().resampling()) == resamplings.end())
+    bad("grid.resampling", "unknown '" + s.grid().resampling() + "' (valid: near, bilinear, cubic, cubicspline, lanczos, average)");
+  r.dem.resampling = s.grid().resampling();
+
+  // Releases.
+  if (s.releases().empty()) bad("releases", "at least one release is needed");
+  for (int k = 0; k < s.releases_size(); ++k) {
+    const auto& rl = s.releases(k);
+    const std::string f = "releases[" + std::to_string(k) + "]";
+    terrain::ReleaseRequest q;
+    q.path = path_in(base, rl.path(), f + ".path");
+    r.input_files.push_back(q.path);
+    for (const char* ext : {".shx", ".dbf", ".prj", ".cpg"}) {
+      fs::path side = fs::path(q.path).replace_extension(ext);
+      if (fs::exists(side) && fs::path(q.path).extension() == ".shp") r.input_files.push_back(side.string());
+    }
+    q.has_thickness = rl.has_thickness_m();
+    q.thickness = rl.thickness_m();
+    q.thickness_attribute = rl.thickness_attribute();
+    if (q.has_thickness && !(q.thickness > 0)) bad(f + ".thickness_m", "must be > 0 m, got " + num(q.thickness));
+    if (!q.has_thickness && q.thickness_attribute.empty())
+      bad(f, "needs thickness_m or thickness_attribute");
+    if (!(rl.thickness_measured().empty() || rl.thickness_measured() == "normal" || rl.thickness_measured() == "vertical"))
+      bad(f + ".thickness_measured", "unknown '" + rl.thickness_measured() + "' (valid: normal, vertical)");
+    q.vertical = rl.thickness_measured() == "vertical";
+    q.has_min_slope = rl.has_min_slope_deg();
+    q.min_slope = rl.min_slope_deg();
+    q.has_max_slope = rl.has_max_slope_deg();
+    q.max_slope = rl.max_slope_deg();
+    if (q.has_min_slope && !(q.min_slope >= 0 && q.min_slope < 90)) bad(f + ".min_slope_deg", "must lie in [0, 90)");
+    if (q.has_max_slope && !(q.max_slope > 0 && q.max_slope <= 90)) bad(f + ".max_slope_deg", "must lie in (0, 90]");
+    if (q.has_min_slope && q.has_max_slope && !(q.min_slope < q.max_slope))
+      bad(f, "min_slope_deg must be below max_slope_deg");
+    q.min_slope_attribute = rl.min_slope_attribute();
+    q.max_slope_attribute = rl.max_slope_attribute();
+    r.releases.push_back(q);
+  }
+
+  // Material.
+  auto* m = s.mutable_material();
+  auto& mat = r.config.material;
+  mat.rheology = enum_of(engine::kRheologyNames, "material.rheology", m->rheology(), "coulomb");
+  if (m->rheology().empty()) m->set_rheology("coulomb");
+  if (m->density_kg_m3() == 0) m->set_density_kg_m3(300);
+  if (!(m->density_kg_m3() > 0)) bad("material.density_kg_m3", "must be > 0, got " + num(m->density_kg_m3()));
+  mat.density = m->density_kg_m3();
+  if (mat.rheology == engine::Rheology::coulomb) {
+    if (!m->has_bed_friction_deg()) bad("material.bed_friction_deg", "needed by the coulomb rheology");
+    mat.delta = angle("material.bed_friction_deg", m->bed_friction_deg());
+  } else {
+    if (!m->has_voellmy_mu()) bad("material.voellmy_mu", "needed by the voellmy rheology");
+    if (!m->has_voellmy_xi()) bad("material.voellmy_xi", "needed by the voellmy rheology");
+    if (!(m->voellmy_mu() >= 0 && m->voellmy_mu() < 5)) bad("material.voellmy_mu", "must lie in [0, 5), got " + num(m->voellmy_mu()));
+    if (!(m->voellmy_xi() > 0)) bad("material.voellmy_xi", "must be > 0 m/s^2, got " + num(m->voellmy_xi()));
+    mat.mu = m->voellmy_mu();
+    mat.xi = m->voellmy_xi();
+  }
+  mat.earth_pressure = enum_of(engine::kEarthPressureNames, "material.earth_pressure", m->earth_pressure(), "unity");
+  if (m->earth_pressure().empty()) m->set_earth_pressure("unity");
+  if (m->has_internal_friction_deg()) mat.phi = angle("material.internal_friction_deg", m->internal_friction_deg());
+  if (mat.earth_pressure == engine::EarthPressure::active_passive && !m->has_internal_friction_deg())
+    bad("material.internal_friction_deg", "needed by earth_pressure active-passive");
+  try {
+    mat.validate();
+  } catch (const std::invalid_argument& e) {
+    throw ScenarioError(e.what());
+  }
+
+  // Numerics.
+  auto* nm = s.mutable_numerics();
+  r.config.limiter = enum_of(engine::kLimiterNames, "numerics.limiter", nm->limiter(), "minmod");
+  if (nm->limiter().empty()) nm->set_limiter("minmod");
+  if (!nm->has_cfl()) nm->set_cfl(0.45);
+  if (!(nm->cfl() > 0 && nm->cfl() <= 0.5)) bad("numerics.cfl", "must lie in (0, 0.5], got " + num(nm->cfl()));
+  if (!nm->has_end_time_s()) nm->set_end_time_s(600);
+  if (!(nm->end_time_s() > 0)) bad("numerics.end_time_s", "must be > 0 s, got " + num(nm->end_time_s()));
+  if (!nm->has_stop_fraction()) nm->set_stop_fraction(0.01);
+  if (!(nm->stop_fraction() >= 0 && nm->stop_fraction() < 1))
+    bad("numerics.stop_fraction", "must lie in [0, 1), got " + num(nm->stop_fraction()));
+  const auto b = enum_of(engine::kBoundary2DNames, "numerics.boundary", nm->boundary(), "outflow");
+  if (nm->boundary().empty()) nm->set_boundary("outflow");
+  r.config.west = r.config.east = r.config.south = r.config.north = b;
+  r.config.time.cfl = nm->cfl();
+  r.config.time.t_end = nm->end_time_s();
+  r.config.time.stop_fraction = nm->stop_fraction();
+  r.config.curvature = !nm->curvature_off();
+
+  // Outputs.
+  auto* o = s.mutable_outputs();
+  if (o->rasters().empty())
+    for (const auto& n : raster_names()) o->add_rasters(n);
+  for (const auto& n : o->rasters()) {
+    if (std::find(raster_names().begin(), raster_names().end(), n) == raster_names().end())
+      bad("outputs.rasters", "unknown '" + n + "' (valid: max_depth, max_speed, max_pressure, deposit, arrival_time)");
+    r.rasters.push_back(n);
+  }
+  if (!o->has_outline_threshold_m()) o->set_outline_threshold_m(0.1);
+  if (!(o->outline_threshold_m() > 0)) bad("outputs.outline_threshold_m", "must be > 0 m");
+  r.outline_threshold = o->outline_threshold_m();
+  if (!o->has_flow_threshold_m()) o->set_flow_threshold_m(0.01);
+  if (!(o->flow_threshold_m() > 0)) bad("outputs.flow_threshold_m", "must be > 0 m");
+  r.config.flow_threshold = o->flow_threshold_m();
+  r.scenario = std::move(s);
+  return r;
+}
+
+}  // namespace runout::jobs

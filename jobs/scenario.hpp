@@ -1,0 +1,40 @@
+#pragma once
+// Scenario files: JSON read through protobuf's JSON mapping into runout.v1.Scenario, then resolved
+// (defaults, paths relative to the file, names to enums) and validated before anything runs. Every
+// error names the field and the problem.
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "engine/sh2d.hpp"
+#include "runout/v1/scenario.pb.h"
+#include "terrain/terrain.hpp"
+
+namespace runout::jobs {
+
+struct ScenarioError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct ResolvedScenario {
+  v1::Scenario scenario;  ///< as given, with the defaults filled in
+  std::string source;     ///< the file it came from (empty when given as a message)
+  terrain::DemRequest dem;
+  std::vector<terrain::ReleaseRequest> releases;
+  engine::Sh2dConfig config;  ///< material, numerics, boundaries (progress hook left empty)
+  std::vector<std::string> rasters;
+  double outline_threshold = 0.1;
+  std::vector<std::string> input_files;  ///< for hashing
+};
+
+/// The raster names an output list may hold.
+const std::vector<std::string>& raster_names();
+
+/// Parse a scenario from JSON text. Throws ScenarioError.
+v1::Scenario parse_scenario_json(const std::string& json);
+/// Read, parse, resolve and validate a scenario file. Throws ScenarioError.
+ResolvedScenario load_scenario(const std::string& path);
+/// Resolve and validate a message; relative paths are taken from `base_dir`. Throws ScenarioError.
+ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base_dir);
+
+}  // namespace runout::jobs

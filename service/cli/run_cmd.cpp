@@ -1,0 +1,169 @@
+// `runout run SCENARIO.json --out DIR`: one scenario, locally, with a progress line.
+#include <omp.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "jobs/run.hpp"
+#include "service/cli/commands.hpp"
+
+namespace runout::cli {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_interrupt(int) { g_interrupted = true; }
+
+}  // namespace
+
+int run(const std::vector<std::string>& args) {
+  std::string scenario, out;
+  bool force = false, quiet = false;
+  for (std::size_t k = 0; k < args.size(); ++k) {
+    const auto& a = args[k];
+    if (a == "--out" || a == "--threads") {
+      if (k + 1 >= args.size()) {
+        std::cerr << "runout run: " << a << " needs a value\n";
+        return kUsage;
+      }
+      if (a == "--out") {
+        out = args[++k];
+      } else {
+        int n = 0;
+        try {
+          n = std::stoi(args[++k]);
+        } catch (...) {
+        }
+        if (n < 1) {
+          std::cerr << "runout run: --threads takes a positive integer\n";
+          return kUsage;
+        }
+        omp_set_num_threads(n);
+      }
+    } else if (a == "--force") {
+      force = true;
+    } else if (a == "--quiet") {
+      quiet = true;
+    } else if (!a.empty() && a[0] == '-') {
+      std::cerr << "runout run: unknown option '" << a << "' (see runout help)\n";
+      return kUsage;
+    } else if (scenario.empty()) {
+      scenario = a;
+    } else {
+      std::cerr << "runout run: more than one scenario given ('" << scenario << "', '" << a << "')\n";
+      return kUsage;
+    }
+  }
+  if (scenario.empty() || out.empty()) {
+    std::cerr << "runout run: usage: runout run SCENARIO.json --out DIR [--force] [--quiet] [--threads N]\n";
+    return kUsage;
+  }
+  const fs::path dest = fs::absolute(out);
+  if (fs::exists(dest) && !force) {
+    std::cerr << "runout run: output directory '" << out << "' exists (use --force to replace it)\n";
+    return kOutput;
+  }
+
+  jobs::ResolvedScenario resolved;
+  try {
+    resolved = jobs::load_scenario(scenario);
+  } catch (const jobs::ScenarioError& e) {
+    std::cerr << "runout run: " << e.what() << "\n";
+    return kBadInput;
+  }
+
+  // Results go to a temporary sibling directory first and appear under DIR only when complete.
+  std::error_code ec;
+  fs::create_directories(dest.parent_path(), ec);
+  std::string tmp_name = ".";
+  tmp_name += dest.filename().string();
+  tmp_name += ".tmp-";
+  tmp_name += std::to_string(getpid());
+  const fs::path tmp = dest.parent_path() / tmp_name;
+  fs::remove_all(tmp, ec);
+  if (!fs::create_directory(tmp, ec)) {
+    std::cerr << "runout run: cannot create '" << tmp.string() << "': " << ec.message() << "\n";
+    return kOutput;
+  }
+  auto cleanup = [&] { fs::remove_all(tmp, ec); };
+
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+  const auto wall0 = std::chrono::steady_clock::now();
+  const bool tty = isatty(fileno(stderr));
+  jobs::RunOptions opt;
+  const double t_end = resolved.config.time.t_end;
+  opt.progress = [&](const engine::Progress& p) {
+    if (!quiet) {
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+      const double left = p.t > 0 ? wall * (t_end - p.t) / p.t : 0.0;
+      std::fprintf(stderr, "%st = %7.2f s  dt = %.4f s  volume = %.4g m3  max speed = %6.2f m/s  active = %5.1f %%  time left <= %.0f s%s",
+                   tty ? "\r" : "", p.t, p.dt, p.mass, p.max_speed, 100 * p.active_fraction, left, tty ? "   " : "\n");
+      std::fflush(stderr);
+    }
+    return !g_interrupted.load();
+  };
+  jobs::RunSummary sum;
+  try {
+    sum = jobs::run_scenario(resolved, tmp.string(), opt);
+  } catch (const jobs::ScenarioError& e) {
+    if (!quiet && tty) std::fprintf(stderr, "\n");
+    std::cerr << "runout run: " << e.what() << "\n";
+    cleanup();
+    return kBadInput;
+  } catch (const terrain::TerrainError& e) {
+    if (!quiet && tty) std::fprintf(stderr, "\n");
+    std::cerr << "runout run: " << e.what() << "\n";
+    cleanup();
+    return kBadInput;
+  } catch (const std::invalid_argument& e) {
+    if (!quiet && tty) std::fprintf(stderr, "\n");
+    std::cerr << "runout run: " << e.what() << "\n";
+    cleanup();
+    return kBadInput;
+  } catch (const std::exception& e) {
+    if (!quiet && tty) std::fprintf(stderr, "\n");
+    std::cerr << "runout run: failed: " << e.what() << "\n";
+    cleanup();
+    return kInternal;
+  }
+  if (!quiet && tty) std::fprintf(stderr, "\n");
+  if (sum.stop == "cancelled") {
+    std::cerr << "runout run: cancelled at t = " << sum.t << " s; no results written\n";
+    cleanup();
+    return kCancelled;
+  }
+  if (fs::exists(dest)) fs::remove_all(dest, ec);
+  fs::rename(tmp, dest, ec);
+  if (ec) {
+    std::cerr << "runout run: cannot move the results to '" << dest.string() << "': " << ec.message() << "\n";
+    cleanup();
+    return kOutput;
+  }
+  if (!quiet) {
+    for (const auto& n : sum.notes) std::cerr << "note: " << n << "\n";
+    std::printf("grid        %d x %d cells of %.1f m in %s\n", sum.nx, sum.ny, sum.dx, sum.crs.c_str());
+    std::printf("release     %.0f m2, %.0f m3\n", sum.release_area_m2, sum.release_volume_m3);
+    std::printf("run         %ld steps to t = %.1f s (stop: %s), %.2f s wall (prepare %.2f, solve %.2f, write %.2f)\n",
+                sum.steps, sum.t, sum.stop.c_str(), sum.seconds_prepare + sum.seconds_run + sum.seconds_write,
+                sum.seconds_prepare, sum.seconds_run, sum.seconds_write);
+    std::printf("volume      %.6g m3 initial, %.6g m3 final, %.6g m3 left the grid (error %.1e)\n", sum.volume_initial,
+                sum.volume_final, sum.volume_outflow, sum.volume_error);
+    std::printf("hazard      affected area %.0f m2, runout %.0f m from the release centroid, max speed %.1f m/s, max depth %.2f m\n",
+                sum.affected_area_m2, sum.runout_m, sum.max_speed, sum.max_depth);
+    std::printf("results in  %s:", dest.string().c_str());
+    for (const auto& f : sum.files) std::printf(" %s", f.c_str());
+    std::printf("\n");
+  }
+  return kOk;
+}
+
+}  // namespace runout::cli

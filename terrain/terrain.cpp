@@ -1,0 +1,507 @@
+#include "terrain/terrain.hpp"
+
+#include <cpl_conv.h>
+#include <cpl_error.h>
+#include <gdal_alg.h>
+#include <gdal_priv.h>
+#include <gdal_utils.h>
+#include <ogr_geometry.h>
+#include <ogr_spatialref.h>
+#include <ogrsf_frmts.h>
+#include <openssl/evp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <sstream>
+
+namespace runout::terrain {
+namespace {
+
+void init_gdal() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    GDALAllRegister();
+    CPLSetErrorHandler(CPLQuietErrorHandler);  // errors are read back and reported by us
+  });
+}
+
+std::string gdal_message() {
+  const char* m = CPLGetLastErrorMsg();
+  return (m && *m) ? std::string(": ") + m : std::string();
+}
+
+std::string fmt(double v, int prec = 1) {
+  std::ostringstream o;
+  o.setf(std::ios::fixed);
+  o.precision(prec);
+  o << v;
+  return o.str();
+}
+
+OGRSpatialReference srs_from(const std::string& text, const std::string& what) {
+  OGRSpatialReference s;
+  if (s.SetFromUserInput(text.c_str()) != OGRERR_NONE)
+    throw TerrainError(what + ": unknown CRS '" + text + "' (use e.g. EPSG:2056 or a WKT/PROJ string)");
+  s.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  return s;
+}
+
+OGRSpatialReference wgs84() {
+  OGRSpatialReference s;
+  s.importFromEPSG(4326);
+  s.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  return s;
+}
+
+std::unique_ptr<OGRCoordinateTransformation> transform(const OGRSpatialReference& from, const OGRSpatialReference& to,
+                                                       const std::string& what) {
+  std::unique_ptr<OGRCoordinateTransformation> t(OGRCreateCoordinateTransformation(&from, &to));
+  if (!t) throw TerrainError(what + ": no coordinate transformation between the CRSs" + gdal_message());
+  return t;
+}
+
+std::string wkt(const OGRSpatialReference& s) {
+  char* w = nullptr;
+  s.exportToWkt(&w);
+  std::string out = w ? w : "";
+  CPLFree(w);
+  return out;
+}
+
+std::string crs_name(const OGRSpatialReference& s) {
+  const char* auth = s.GetAuthorityName(nullptr);
+  const char* code = s.GetAuthorityCode(nullptr);
+  if (auth && code) return std::string(auth) + ":" + code;
+  const char* n = s.GetName();
+  return n ? n : "unnamed CRS";
+}
+
+// Union of the polygons of every layer of a vector file, with its CRS.
+std::unique_ptr<OGRGeometry> read_area(const std::string& path, OGRSpatialReference& srs) {
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR));
+  if (!ds) throw TerrainError("area of interest '" + path + "': cannot read it as a vector file" + gdal_message());
+  auto out = std::make_unique<OGRMultiPolygon>();
+  bool have_srs = false;
+  for (auto* layer : ds->GetLayers()) {
+    if (const auto* s = layer->GetSpatialRef()) {
+      srs = *s;
+      srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+      have_srs = true;
+    }
+    for (auto& f : layer) {
+      const OGRGeometry* g = f->GetGeometryRef();
+      if (!g) continue;
+      const auto type = wkbFlatten(g->getGeometryType());
+      if (type == wkbPolygon) out->addGeometry(g);
+      else if (type == wkbMultiPolygon)
+        for (const auto* p : g->toMultiPolygon()) out->addGeometry(p);
+    }
+  }
+  if (out->IsEmpty()) throw TerrainError("area of interest '" + path + "': no polygon in the file");
+  if (!have_srs) throw TerrainError("area of interest '" + path + "': the file has no CRS");
+  return out;
+}
+
+struct Raster {
+  GDALDatasetUniquePtr ds;
+};
+
+double source_resolution_m(GDALDataset* ds, const OGRSpatialReference& s) {
+  double gt[6];
+  if (ds->GetGeoTransform(gt) != CE_None) return 0;
+  if (s.IsGeographic()) {
+    const double lat = gt[3] + gt[5] * ds->GetRasterYSize() / 2.0;
+    const double mx = std::abs(gt[1]) * 111320.0 * std::cos(lat * M_PI / 180), my = std::abs(gt[5]) * 110540.0;
+    return std::sqrt(mx * my);
+  }
+  return std::sqrt(std::abs(gt[1] * gt[5])) * s.GetLinearUnits();
+}
+
+}  // namespace
+
+Grid prepare_grid(const DemRequest& req, DemReport* report) {
+  init_gdal();
+  DemReport rep;
+  GDALDatasetUniquePtr dem(GDALDataset::Open(req.dem_path.c_str(), GDAL_OF_RASTER));
+  if (!dem) throw TerrainError("DEM '" + req.dem_path + "': cannot read it as a raster" + gdal_message());
+  double gt[6];
+  if (dem->GetGeoTransform(gt) != CE_None)
+    throw TerrainError("DEM '" + req.dem_path + "': the raster has no georeferencing");
+  OGRSpatialReference src;
+  if (!req.dem_crs.empty()) {
+    if (dem->GetSpatialRef() && !dem->GetSpatialRef()->IsEmpty()) {
+      // The file's own CRS wins; an explicit one is only for files without.
+      src = *dem->GetSpatialRef();
+      src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    } else {
+      src = srs_from(req.dem_crs, "dem.crs");
+    }
+  } else if (dem->GetSpatialRef() && !dem->GetSpatialRef()->IsEmpty()) {
+    src = *dem->GetSpatialRef();
+    src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  } else {
+    throw TerrainError("DEM '" + req.dem_path + "' has no CRS and none is given: set dem.crs (e.g. \"EPSG:2056\")");
+  }
+  rep.source_crs = crs_name(src);
+  rep.source_resolution_m = source_resolution_m(dem.get(), src);
+
+  // Area of interest (optional) and the extent's centre in lon/lat.
+  std::unique_ptr<OGRGeometry> aoi;
+  OGRSpatialReference aoi_srs;
+  if (!req.aoi_path.empty()) {
+    aoi = read_area(req.aoi_path, aoi_srs);
+    rep.used_aoi = true;
+  }
+  const auto ll = wgs84();
+  double clon, clat;
+  if (aoi) {
+    OGREnvelope e;
+    aoi->getEnvelope(&e);
+    clon = 0.5 * (e.MinX + e.MaxX);
+    clat = 0.5 * (e.MinY + e.MaxY);
+    transform(aoi_srs, ll, "area of interest")->Transform(1, &clon, &clat);
+  } else {
+    clon = gt[0] + gt[1] * dem->GetRasterXSize() / 2.0 + gt[2] * dem->GetRasterYSize() / 2.0;
+    clat = gt[3] + gt[4] * dem->GetRasterXSize() / 2.0 + gt[5] * dem->GetRasterYSize() / 2.0;
+    transform(src, ll, "DEM")->Transform(1, &clon, &clat);
+  }
+
+  // Computation CRS.
+  OGRSpatialReference dst;
+  if (req.target_crs.empty() || req.target_crs == "utm") {
+    const int zone = std::clamp(int(std::floor((clon + 180.0) / 6.0)) + 1, 1, 60);
+    dst.importFromEPSG((clat >= 0 ? 32600 : 32700) + zone);
+  } else if (req.target_crs == "dem") {
+    dst = src;
+  } else {
+    dst = srs_from(req.target_crs, "grid.crs");
+  }
+  dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  if (!dst.IsProjected())
+    throw TerrainError("grid.crs: the computation needs a projected CRS in metres, got " + crs_name(dst));
+
+  const double res = req.resolution > 0 ? req.resolution : std::max(1.0, std::round(rep.source_resolution_m));
+  if (rep.source_resolution_m > 0 && res < rep.source_resolution_m / 10.0)
+    throw TerrainError("grid.resolution_m = " + fmt(res, 2) + " m is finer than a tenth of the DEM's resolution (" +
+                       fmt(rep.source_resolution_m, 1) + " m)");
+
+  // Warp options.
+  std::vector<std::string> args = {"-of", "MEM", "-t_srs", wkt(dst), "-tr", fmt(res, 6), fmt(res, 6),
+                                   "-r", req.resampling.empty() ? "cubic" : req.resampling, "-dstnodata", "-99999",
+                                   "-ot", "Float64"};
+  if (!req.dem_crs.empty() && !(dem->GetSpatialRef() && !dem->GetSpatialRef()->IsEmpty())) {
+    args.push_back("-s_srs");
+    args.push_back(wkt(src));
+  }
+  if (aoi) {
+    auto g = std::unique_ptr<OGRGeometry>(aoi->clone());
+    if (g->transform(transform(aoi_srs, dst, "area of interest").get()) != OGRERR_NONE)
+      throw TerrainError("area of interest '" + req.aoi_path + "': cannot transform it to " + crs_name(dst));
+    OGREnvelope e;
+    g->getEnvelope(&e);
+    const double x0 = std::floor(e.MinX / res) * res, y0 = std::floor(e.MinY / res) * res;
+    const double x1 = std::ceil(e.MaxX / res) * res, y1 = std::ceil(e.MaxY / res) * res;
+    args.push_back("-te");
+    args.push_back(fmt(x0, 6));
+    args.push_back(fmt(y0, 6));
+    args.push_back(fmt(x1, 6));
+    args.push_back(fmt(y1, 6));
+  } else {
+    args.push_back("-tap");
+  }
+  {
+    // Size check before warping: an extent estimate from the AOI or the DEM.
+    double w = 0, h = 0;
+    if (aoi) {
+      const auto& te = args;
+      const std::size_t k = std::find(te.begin(), te.end(), "-te") - te.begin();
+      w = std::stod(te[k + 3]) - std::stod(te[k + 1]);
+      h = std::stod(te[k + 4]) - std::stod(te[k + 2]);
+    } else {
+      w = dem->GetRasterXSize() * rep.source_resolution_m;
+      h = dem->GetRasterYSize() * rep.source_resolution_m;
+    }
+    const double cells = (w / res) * (h / res);
+    if (cells * req.bytes_per_cell > req.memory_budget_bytes)
+      throw TerrainError("grid of about " + fmt(cells / 1e6, 1) + " million cells at " + fmt(res, 2) +
+                         " m exceeds the memory budget of " + fmt(req.memory_budget_bytes / (1u << 30), 1) +
+                         " GiB: choose a coarser grid.resolution_m or a smaller area of interest");
+  }
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> wopt(
+      GDALWarpAppOptionsNew(argv.data(), nullptr), GDALWarpAppOptionsFree);
+  if (!wopt) throw TerrainError("internal: warp options rejected" + gdal_message());
+  GDALDatasetH srch = GDALDataset::ToHandle(dem.get());
+  int usage_error = 0;
+  GDALDatasetUniquePtr warped(GDALDataset::FromHandle(GDALWarp("", nullptr, 1, &srch, wopt.get(), &usage_error)));
+  if (!warped) throw TerrainError("DEM '" + req.dem_path + "': reprojection failed" + gdal_message());
+
+  Grid g;
+  g.nx = warped->GetRasterXSize();
+  g.ny = warped->GetRasterYSize();
+  double wgt[6];
+  warped->GetGeoTransform(wgt);
+  g.dx = wgt[1];
+  g.x_min = wgt[0];
+  g.y_min = wgt[3] + wgt[5] * g.ny;
+  g.crs_wkt = wkt(dst);
+  g.crs_name = crs_name(dst);
+  if (g.nx < 3 || g.ny < 3) throw TerrainError("the area of interest covers fewer than 3 x 3 cells at " + fmt(res, 2) + " m");
+  std::vector<double> rows(g.cells());
+  if (warped->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, g.nx, g.ny, rows.data(), g.nx, g.ny, GDT_Float64, 0, 0) != CE_None)
+    throw TerrainError("DEM '" + req.dem_path + "': reading the reprojected raster failed" + gdal_message());
+  g.z.resize(g.cells());
+  long missing = 0;
+  int mi = -1, mj = -1;
+  for (int r = 0; r < g.ny; ++r)
+    for (int i = 0; i < g.nx; ++i) {
+      const double v = rows[std::size_t(r) * g.nx + i];
+      const int j = g.ny - 1 - r;
+      if (!(v > -99998) || !std::isfinite(v)) {
+        if (missing++ == 0) {
+          mi = i;
+          mj = j;
+        }
+      }
+      g.z[std::size_t(j) * g.nx + i] = v;
+    }
+  if (missing > 0)
+    throw TerrainError("DEM '" + req.dem_path + "' has no data for " + std::to_string(missing) + " of the " +
+                       std::to_string(g.cells()) + " cells of the area (first at " + fmt(g.cx(mi), 0) + ", " +
+                       fmt(g.cy(mj), 0) + " in " + g.crs_name + "): the area of interest must lie inside the DEM");
+  const auto sl = slope_deg(g);
+  auto sorted = sl;
+  std::sort(sorted.begin(), sorted.end());
+  double sum = 0;
+  for (double v : sl) sum += v;
+  rep.slope_mean_deg = sum / double(sl.size());
+  rep.slope_max_deg = sorted.back();
+  rep.slope_p90_deg = sorted[std::size_t(0.9 * double(sorted.size() - 1))];
+  rep.z_min = *std::min_element(g.z.begin(), g.z.end());
+  rep.z_max = *std::max_element(g.z.begin(), g.z.end());
+  if (report) *report = rep;
+  return g;
+}
+
+std::vector<double> slope_deg(const Grid& g) {
+  std::vector<double> s(g.cells());
+  auto z = [&](int i, int j) { return g.z[std::size_t(std::clamp(j, 0, g.ny - 1)) * g.nx + std::clamp(i, 0, g.nx - 1)]; };
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      const int il = std::max(i - 1, 0), ir = std::min(i + 1, g.nx - 1), jl = std::max(j - 1, 0), jr = std::min(j + 1, g.ny - 1);
+      const double bx = (z(ir, j) - z(il, j)) / ((ir - il) * g.dx), by = (z(i, jr) - z(i, jl)) / ((jr - jl) * g.dx);
+      s[std::size_t(j) * g.nx + i] = std::atan(std::hypot(bx, by)) * 180.0 / M_PI;
+    }
+  return s;
+}
+
+namespace {
+
+GDALDatasetUniquePtr mem_raster(const Grid& g, GDALDataType type) {
+  auto* drv = GetGDALDriverManager()->GetDriverByName("MEM");
+  GDALDatasetUniquePtr ds(drv->Create("", g.nx, g.ny, 1, type, nullptr));
+  double gt[6] = {g.x_min, g.dx, 0, g.y_min + g.ny * g.dx, 0, -g.dx};
+  ds->SetGeoTransform(gt);
+  ds->SetProjection(g.crs_wkt.c_str());
+  return ds;
+}
+
+double field_value(OGRFeature& f, const std::string& attr, const std::string& what) {
+  const int idx = f.GetFieldIndex(attr.c_str());
+  if (idx < 0) {
+    std::string names;
+    for (int k = 0; k < f.GetFieldCount(); ++k) names += (k ? ", " : "") + std::string(f.GetFieldDefnRef(k)->GetNameRef());
+    throw TerrainError(what + ": no attribute '" + attr + "' (attributes: " + (names.empty() ? "none" : names) + ")");
+  }
+  if (!f.IsFieldSetAndNotNull(idx)) throw TerrainError(what + ": attribute '" + attr + "' is empty");
+  return f.GetFieldAsDouble(idx);
+}
+
+}  // namespace
+
+std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseRequest>& releases, ReleaseReport* report) {
+  init_gdal();
+  ReleaseReport rep;
+  std::vector<double> h(g.cells(), 0.0);
+  const auto slope = slope_deg(g);
+  OGRSpatialReference dst;
+  dst.importFromWkt(g.crs_wkt.c_str());
+  dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  const std::string extent = "the grid covers x " + fmt(g.x_min, 0) + ".." + fmt(g.x_min + g.nx * g.dx, 0) + ", y " +
+                             fmt(g.y_min, 0) + ".." + fmt(g.y_min + g.ny * g.dx, 0) + " in " + g.crs_name;
+  for (const auto& rq : releases) {
+    GDALDatasetUniquePtr ds(GDALDataset::Open(rq.path.c_str(), GDAL_OF_VECTOR));
+    if (!ds) throw TerrainError("release '" + rq.path + "': cannot read it as a vector file" + gdal_message());
+    int n = 0;
+    for (auto* layer : ds->GetLayers()) {
+      const OGRSpatialReference* ls = layer->GetSpatialRef();
+      if (!ls) throw TerrainError("release '" + rq.path + "': the file has no CRS");
+      OGRSpatialReference src = *ls;
+      src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+      auto ct = transform(src, dst, "release '" + rq.path + "'");
+      for (auto& f : layer) {
+        ++n;
+        const std::string what = "release polygon " + std::to_string(n) + " of '" + rq.path + "'";
+        const OGRGeometry* g0 = f->GetGeometryRef();
+        if (!g0 || g0->IsEmpty()) throw TerrainError(what + ": no geometry");
+        const auto type = wkbFlatten(g0->getGeometryType());
+        if (type != wkbPolygon && type != wkbMultiPolygon) throw TerrainError(what + ": not a polygon");
+        double t = rq.has_thickness ? rq.thickness : 0.0;
+        if (!rq.has_thickness) {
+          if (rq.thickness_attribute.empty()) throw TerrainError(what + ": no thickness (set thickness_m or thickness_attribute)");
+          t = field_value(*f, rq.thickness_attribute, what);
+        }
+        if (!(t > 0) || !std::isfinite(t)) throw TerrainError(what + ": thickness must be > 0 m, got " + fmt(t, 3));
+        double smin = rq.has_min_slope ? rq.min_slope : 0.0, smax = rq.has_max_slope ? rq.max_slope : 90.0;
+        if (!rq.has_min_slope && !rq.min_slope_attribute.empty()) smin = field_value(*f, rq.min_slope_attribute, what);
+        if (!rq.has_max_slope && !rq.max_slope_attribute.empty()) smax = field_value(*f, rq.max_slope_attribute, what);
+        if (!(smin >= 0 && smax <= 90 && smin < smax))
+          throw TerrainError(what + ": slope window [" + fmt(smin) + ", " + fmt(smax) + "] deg must satisfy 0 <= min < max <= 90");
+        std::unique_ptr<OGRGeometry> geom(g0->clone());
+        if (!geom->IsValid()) {
+          std::unique_ptr<OGRGeometry> fixed(geom->MakeValid());
+          if (!fixed || fixed->IsEmpty()) throw TerrainError(what + ": invalid geometry that GEOS cannot repair");
+          geom = std::move(fixed);
+          rep.notes.push_back(what + ": invalid geometry (e.g. self-intersecting) repaired with GEOS MakeValid");
+        }
+        if (geom->transform(ct.get()) != OGRERR_NONE) throw TerrainError(what + ": cannot transform it to " + g.crs_name);
+        auto mask_ds = mem_raster(g, GDT_Byte);
+        int band = 1;
+        double burn = 1;
+        OGRGeometryH gh = OGRGeometry::ToHandle(geom.get());
+        if (GDALRasterizeGeometries(GDALDataset::ToHandle(mask_ds.get()), 1, &band, 1, &gh, nullptr, nullptr, &burn,
+                                    nullptr, nullptr, nullptr) != CE_None)
+          throw TerrainError(what + ": rasterisation failed" + gdal_message());
+        std::vector<unsigned char> m(g.cells());
+        if (mask_ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, g.nx, g.ny, m.data(), g.nx, g.ny, GDT_Byte, 0, 0) != CE_None)
+          throw TerrainError(what + ": reading the rasterised polygon failed" + gdal_message());
+        long inside = 0, kept = 0;
+        double smin_seen = 90, smax_seen = 0;
+        for (int r = 0; r < g.ny; ++r)
+          for (int i = 0; i < g.nx; ++i) {
+            if (!m[std::size_t(r) * g.nx + i]) continue;
+            const std::size_t k = std::size_t(g.ny - 1 - r) * g.nx + i;
+            ++inside;
+            smin_seen = std::min(smin_seen, slope[k]);
+            smax_seen = std::max(smax_seen, slope[k]);
+            if (slope[k] < smin || slope[k] > smax) continue;
+            ++kept;
+            const double hn = rq.vertical ? t * std::cos(slope[k] * M_PI / 180) : t;
+            h[k] = std::max(h[k], hn);
+          }
+        if (inside == 0) throw TerrainError(what + " lies outside the grid or is thinner than a cell (" + extent + ")");
+        if (kept == 0)
+          throw TerrainError(what + ": no cell has a slope within [" + fmt(smin) + ", " + fmt(smax) +
+                             "] deg (slopes inside the polygon: " + fmt(smin_seen) + " to " + fmt(smax_seen) + " deg)");
+        ++rep.polygons;
+      }
+    }
+    if (n == 0) throw TerrainError("release '" + rq.path + "': no polygon in the file");
+  }
+  for (std::size_t k = 0; k < h.size(); ++k)
+    if (h[k] > 0) {
+      ++rep.cells;
+      rep.area_m2 += g.dx * g.dx;
+      rep.volume_m3 += h[k] * g.dx * g.dx / std::cos(slope[k] * M_PI / 180);
+    }
+  if (report) *report = rep;
+  return h;
+}
+
+void write_cog(const std::string& path, const Grid& g, const std::vector<double>& values, const std::string& description) {
+  init_gdal();
+  auto ds = mem_raster(g, GDT_Float32);
+  auto* band = ds->GetRasterBand(1);
+  const float nodata = -9999.0f;
+  band->SetNoDataValue(nodata);
+  band->SetDescription(description.c_str());
+  std::vector<float> rows(g.cells());
+  for (int r = 0; r < g.ny; ++r)
+    for (int i = 0; i < g.nx; ++i) {
+      const double v = values[std::size_t(g.ny - 1 - r) * g.nx + i];
+      rows[std::size_t(r) * g.nx + i] = std::isfinite(v) ? float(v) : nodata;
+    }
+  if (band->RasterIO(GF_Write, 0, 0, g.nx, g.ny, rows.data(), g.nx, g.ny, GDT_Float32, 0, 0) != CE_None)
+    throw TerrainError("writing '" + path + "' failed" + gdal_message());
+  auto* cog = GetGDALDriverManager()->GetDriverByName("COG");
+  const char* opts[] = {"COMPRESS=DEFLATE", "PREDICTOR=YES", nullptr};
+  GDALDatasetUniquePtr out(cog->CreateCopy(path.c_str(), ds.get(), FALSE, const_cast<char**>(opts), nullptr, nullptr));
+  if (!out) throw TerrainError("writing '" + path + "' failed" + gdal_message());
+}
+
+OutlineReport write_outline(const std::string& geojson_path, const std::string& gpkg_path, const Grid& g,
+                            const std::vector<double>& values, double threshold) {
+  init_gdal();
+  OutlineReport rep;
+  auto mask = mem_raster(g, GDT_Byte);
+  std::vector<unsigned char> m(g.cells());
+  for (int r = 0; r < g.ny; ++r)
+    for (int i = 0; i < g.nx; ++i) m[std::size_t(r) * g.nx + i] = values[std::size_t(g.ny - 1 - r) * g.nx + i] > threshold;
+  if (mask->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, g.nx, g.ny, m.data(), g.nx, g.ny, GDT_Byte, 0, 0) != CE_None)
+    throw TerrainError("outline: writing the mask failed" + gdal_message());
+  OGRSpatialReference srs;
+  srs.importFromWkt(g.crs_wkt.c_str());
+  srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  auto* gpkg = GetGDALDriverManager()->GetDriverByName("GPKG");
+  GDALDatasetUniquePtr vds(gpkg->Create(gpkg_path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+  if (!vds) throw TerrainError("writing '" + gpkg_path + "' failed" + gdal_message());
+  OGRLayer* layer = vds->CreateLayer("runout_outline", &srs, wkbPolygon, nullptr);
+  OGRFieldDefn fd("inside", OFTInteger);
+  layer->CreateField(&fd);
+  if (GDALPolygonize(mask->GetRasterBand(1), mask->GetRasterBand(1), layer, 0, nullptr, nullptr, nullptr) != CE_None)
+    throw TerrainError("outline: polygonising failed" + gdal_message());
+  // GeoJSON in WGS84 (RFC 7946) from the same polygons.
+  auto* gj = GetGDALDriverManager()->GetDriverByName("GeoJSON");
+  const char* gjopts[] = {"RFC7946=YES", nullptr};
+  GDALDatasetUniquePtr jds(gj->Create(geojson_path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+  if (!jds) throw TerrainError("writing '" + geojson_path + "' failed" + gdal_message());
+  auto ll = wgs84();
+  OGRLayer* jl = jds->CreateLayer("runout_outline", &ll, wkbPolygon, const_cast<char**>(gjopts));
+  OGRFieldDefn area("area_m2", OFTReal);
+  jl->CreateField(&area);
+  auto ct = transform(srs, ll, "outline");
+  layer->ResetReading();
+  for (auto& f : layer) {
+    const OGRGeometry* geom = f->GetGeometryRef();
+    if (!geom) continue;
+    const double a = geom->toPolygon()->get_Area();
+    rep.area_m2 += a;
+    ++rep.polygons;
+    std::unique_ptr<OGRGeometry> w(geom->clone());
+    w->transform(ct.get());
+    OGRFeature out(jl->GetLayerDefn());
+    out.SetField("area_m2", a);
+    out.SetGeometry(w.get());
+    if (jl->CreateFeature(&out) != OGRERR_NONE) throw TerrainError("writing '" + geojson_path + "' failed" + gdal_message());
+  }
+  return rep;
+}
+
+std::string sha256_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw TerrainError("cannot read '" + path + "' to hash it");
+  std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> ctx(EVP_MD_CTX_new(), EVP_MD_CTX_free);
+  EVP_DigestInit_ex(ctx.get(), EVP_sha256(), nullptr);
+  char buf[1 << 16];
+  while (in) {
+    in.read(buf, sizeof buf);
+    EVP_DigestUpdate(ctx.get(), buf, std::size_t(in.gcount()));
+  }
+  unsigned char md[EVP_MAX_MD_SIZE];
+  unsigned int len = 0;
+  EVP_DigestFinal_ex(ctx.get(), md, &len);
+  static const char* hex = "0123456789abcdef";
+  std::string s;
+  for (unsigned k = 0; k < len; ++k) {
+    s += hex[md[k] >> 4];
+    s += hex[md[k] & 15];
+  }
+  return s;
+}
+
+}  // namespace runout::terrain

@@ -1,0 +1,94 @@
+#pragma once
+// terrain/: everything geospatial between the user's files and the engine's typed grids.
+// DEM ingestion (any raster GDAL reads), choice of the computation CRS (UTM zone of the area's
+// centre by default), reprojection and resampling with GDAL's warper (PROJ underneath), clipping to
+// the area of interest, release polygons rasterised onto the grid with thickness and slope windows,
+// and the raster/vector outputs. Errors are `TerrainError` with a message that names the input.
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace runout::terrain {
+
+struct TerrainError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// The computation grid: north-up, square cells, in a projected CRS. Row 0 is the SOUTHERN row
+/// (the engine's convention: y grows with j); cell (i, j) has its centre at
+/// (x_min + (i + 1/2) dx, y_min + (j + 1/2) dx).
+struct Grid {
+  int nx = 0, ny = 0;
+  double dx = 0;
+  double x_min = 0, y_min = 0;
+  std::string crs_wkt;   ///< WKT of the projected CRS
+  std::string crs_name;  ///< e.g. "EPSG:32632"
+  std::vector<double> z; ///< elevation [m]
+  std::size_t cells() const { return std::size_t(nx) * std::size_t(ny); }
+  double cx(int i) const { return x_min + (i + 0.5) * dx; }
+  double cy(int j) const { return y_min + (j + 0.5) * dx; }
+};
+
+struct DemRequest {
+  std::string dem_path;
+  std::string dem_crs;        ///< used when the file has none ("EPSG:2056")
+  std::string aoi_path;       ///< optional polygon file
+  std::string target_crs;     ///< "" / "utm", "EPSG:nnnn", "dem"
+  double resolution = 0;      ///< [m]; 0: the DEM's (in metres)
+  std::string resampling = "cubic";
+  double memory_budget_bytes = 8.0 * (1ull << 30);
+  double bytes_per_cell = 600;  ///< the solver's working set per cell, for the budget check
+};
+
+struct DemReport {
+  std::string source_crs;
+  double source_resolution_m = 0;
+  double slope_mean_deg = 0, slope_max_deg = 0, slope_p90_deg = 0;
+  double z_min = 0, z_max = 0;
+  bool used_aoi = false;
+};
+
+/// Read, reproject, resample and clip the DEM. Throws TerrainError.
+Grid prepare_grid(const DemRequest& req, DemReport* report = nullptr);
+
+/// Slope angle [deg] per cell from centred differences (one-sided at the edges).
+std::vector<double> slope_deg(const Grid& g);
+
+struct ReleaseRequest {
+  std::string path;
+  bool has_thickness = false;
+  double thickness = 0;
+  std::string thickness_attribute;
+  bool vertical = false;  ///< thickness measured vertically (converted to normal: t cos(slope))
+  bool has_min_slope = false, has_max_slope = false;
+  double min_slope = 0, max_slope = 90;
+  std::string min_slope_attribute, max_slope_attribute;
+};
+
+struct ReleaseReport {
+  int polygons = 0;
+  long cells = 0;
+  double area_m2 = 0;   ///< plan area of the released cells
+  double volume_m3 = 0; ///< sum of normal thickness x surface area
+  std::vector<std::string> notes;  ///< e.g. repaired geometries
+};
+
+/// Normal release thickness per cell (row 0 south), maximum over overlapping polygons.
+std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseRequest>& releases,
+                                       ReleaseReport* report = nullptr);
+
+/// Cloud-optimised GeoTIFF, Float32, DEFLATE, CRS and nodata set; NaN cells are written as nodata.
+void write_cog(const std::string& path, const Grid& g, const std::vector<double>& values, const std::string& description);
+
+struct OutlineReport {
+  int polygons = 0;
+  double area_m2 = 0;
+};
+/// Outline of the cells where values > threshold: GeoJSON in WGS84 lon/lat and GeoPackage in the grid's CRS.
+OutlineReport write_outline(const std::string& geojson_path, const std::string& gpkg_path, const Grid& g,
+                            const std::vector<double>& values, double threshold);
+
+/// SHA-256 of a file, hex.
+std::string sha256_file(const std::string& path);
+
+}  // namespace runout::terrain

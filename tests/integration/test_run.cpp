@@ -1,0 +1,315 @@
+// The terrain pipeline and the run driver end to end: synthetic inputs made here with GDAL, and the
+// bundled In den Arelen scenario at a coarse resolution.
+#include <gdal_priv.h>
+#include <gtest/gtest.h>
+#include <ogr_geometry.h>
+#include <ogr_spatialref.h>
+#include <ogrsf_frmts.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "jobs/run.hpp"
+#include "jobs/scenario.hpp"
+#include "terrain/terrain.hpp"
+
+namespace fs = std::filesystem;
+using namespace runout;
+
+namespace {
+
+struct TempDir {
+  fs::path p;
+  TempDir() {
+    p = fs::temp_directory_path() / ("runout-test-" + std::to_string(getpid()) + "-" + std::to_string(counter()++));
+    fs::create_directories(p);
+  }
+  ~TempDir() { fs::remove_all(p); }
+  static int& counter() {
+    static int c = 0;
+    return c;
+  }
+  std::string operator/(const std::string& n) const { return (p / n).string(); }
+};
+
+// A DEM in UTM 32N (EPSG:32632): a slope of `deg` falling to the east, flattening into a valley.
+void make_dem(const std::string& path, int n, double cell, double deg, const char* epsg = "EPSG:32632", bool with_crs = true) {
+  GDALAllRegister();
+  auto* drv = GetGDALDriverManager()->GetDriverByName(path.size() > 4 && path.substr(path.size() - 4) == ".asc" ? "AAIGrid" : "GTiff");
+  auto* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  GDALDatasetUniquePtr ds(mem->Create("", n, n, 1, GDT_Float32, nullptr));
+  const double x0 = 500000, y0 = 5200000;
+  double gt[6] = {x0, cell, 0, y0 + n * cell, 0, -cell};
+  ds->SetGeoTransform(gt);
+  if (with_crs) {
+    OGRSpatialReference s;
+    s.SetFromUserInput(epsg);
+    ds->SetSpatialRef(&s);
+  }
+  std::vector<float> z(std::size_t(n) * n);
+  for (int r = 0; r < n; ++r)
+    for (int i = 0; i < n; ++i) {
+      const double x = i * cell;
+      z[std::size_t(r) * n + i] = float(std::max(0.0, (0.6 * n * cell - x)) * std::tan(deg * M_PI / 180) + 0.02 * r * cell);
+    }
+  EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, n, n, z.data(), n, n, GDT_Float32, 0, 0), CE_None);
+  GDALDatasetUniquePtr out(drv->CreateCopy(path.c_str(), ds.get(), FALSE, nullptr, nullptr, nullptr));
+  ASSERT_TRUE(out);
+}
+
+// A GeoJSON polygon file; coordinates in `epsg` (axis order x/lon first).
+void make_polygons(const std::string& path, const std::vector<std::vector<std::pair<double, double>>>& rings,
+                   const char* epsg, const char* extra_props = "") {
+  std::ofstream f(path);
+  f << R"({"type":"FeatureCollection","crs":{"type":"name","properties":{"name":")"
+    << (std::string(epsg) == "EPSG:4326" ? "urn:ogc:def:crs:OGC:1.3:CRS84" : std::string("urn:ogc:def:crs:EPSG::") + (epsg + 5))
+    << R"("}},"features":[)";
+  for (std::size_t k = 0; k < rings.size(); ++k) {
+    f << (k ? "," : "") << R"({"type":"Feature","properties":{"id":)" << k << extra_props << R"(},"geometry":{"type":"Polygon","coordinates":[[)";
+    for (std::size_t v = 0; v < rings[k].size(); ++v) f << (v ? "," : "") << "[" << std::setprecision(12) << rings[k][v].first << "," << rings[k][v].second << "]";
+    f << "]]}}";
+  }
+  f << "]}";
+}
+
+std::vector<std::pair<double, double>> square(double x0, double y0, double a) {
+  return {{x0, y0}, {x0 + a, y0}, {x0 + a, y0 + a}, {x0, y0 + a}, {x0, y0}};
+}
+
+v1::Scenario base_scenario(const std::string& dem, const std::string& release, double res = 20) {
+  v1::Scenario s;
+  s.mutable_dem()->set_path(dem);
+  s.mutable_grid()->set_resolution_m(res);
+  auto* r = s.add_releases();
+  r->set_path(release);
+  r->set_thickness_m(2.0);
+  s.mutable_material()->set_bed_friction_deg(20);
+  s.mutable_numerics()->set_end_time_s(400);
+  return s;
+}
+
+}  // namespace
+
+TEST(Terrain, SyntheticSlopeRunsAndWritesEveryOutput) {
+  TempDir d;
+  make_dem(d / "dem.tif", 120, 20.0, 30);
+  make_polygons(d / "rel.geojson", {square(500200, 5201000, 300)}, "EPSG:32632");
+  auto r = jobs::resolve_scenario(base_scenario(d / "dem.tif", d / "rel.geojson"), d.p.string());
+  fs::create_directories(d / "out");
+  const auto sum = jobs::run_scenario(r, d / "out");
+  EXPECT_EQ(sum.crs, "EPSG:32632");
+  EXPECT_NEAR(sum.release_area_m2, 300.0 * 300.0, 4 * 20 * 300.0);
+  EXPECT_LT(sum.volume_error, 1e-12);
+  EXPECT_GT(sum.runout_m, 500.0);
+  for (const char* f : {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "arrival_time.tif",
+                        "outline.geojson", "outline.gpkg", "run.json"})
+    EXPECT_TRUE(fs::exists(fs::path(d / "out") / f)) << f;
+  GDALDatasetUniquePtr md(GDALDataset::Open((d / "out/max_depth.tif").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(md);
+  EXPECT_EQ(md->GetRasterBand(1)->GetRasterDataType(), GDT_Float32);
+  int has = 0;
+  EXPECT_EQ(md->GetRasterBand(1)->GetNoDataValue(&has), -9999.0);
+  EXPECT_TRUE(has);
+  EXPECT_STREQ(md->GetSpatialRef()->GetAuthorityCode(nullptr), "32632");
+  EXPECT_STREQ(md->GetMetadataItem("LAYOUT", "IMAGE_STRUCTURE"), "COG");
+  // The outline is a valid polygon in WGS84 whose area matches the affected area.
+  GDALDatasetUniquePtr ol(GDALDataset::Open((d / "out/outline.geojson").c_str(), GDAL_OF_VECTOR));
+  ASSERT_TRUE(ol);
+  double area = 0;
+  for (auto& f : ol->GetLayer(0)) {
+    ASSERT_TRUE(f->GetGeometryRef()->IsValid());
+    area += f->GetFieldAsDouble("area_m2");
+    OGREnvelope e;
+    f->GetGeometryRef()->getEnvelope(&e);
+    EXPECT_GT(e.MinX, 8.9);  // lon/lat around 9 E, 47 N
+    EXPECT_LT(e.MaxX, 9.2);
+    EXPECT_GT(e.MinY, 46.8);
+  }
+  EXPECT_NEAR(area, sum.affected_area_m2, 1e-6 * area);
+  std::ifstream rec(d / "out/run.json");
+  std::stringstream ss;
+  ss << rec.rdbuf();
+  EXPECT_NE(ss.str().find("\"sha256\""), std::string::npos);
+  EXPECT_NE(ss.str().find("\"mass_balance\""), std::string::npos);
+}
+
+TEST(Terrain, ReleaseInWgs84AndInUtmGiveTheSameGrid) {
+  TempDir d;
+  make_dem(d / "dem.tif", 80, 25.0, 30);
+  const std::vector<std::pair<double, double>> utm = {{500300, 5200500}, {500700, 5200520}, {500650, 5200900}, {500280, 5200850}, {500300, 5200500}};
+  OGRSpatialReference u, ll;
+  u.importFromEPSG(32632);
+  ll.importFromEPSG(4326);
+  u.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  ll.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  std::unique_ptr<OGRCoordinateTransformation> ct(OGRCreateCoordinateTransformation(&u, &ll));
+  auto geo = utm;
+  for (auto& p : geo) ct->Transform(1, &p.first, &p.second);
+  make_polygons(d / "utm.geojson", {utm}, "EPSG:32632");
+  make_polygons(d / "ll.geojson", {geo}, "EPSG:4326");
+  terrain::DemRequest rq;
+  rq.dem_path = d / "dem.tif";
+  rq.resolution = 10;
+  const auto g = terrain::prepare_grid(rq);
+  terrain::ReleaseRequest a, b;
+  a.path = d / "utm.geojson";
+  b.path = d / "ll.geojson";
+  a.has_thickness = b.has_thickness = true;
+  a.thickness = b.thickness = 1.5;
+  const auto ha = terrain::rasterize_releases(g, {a}), hb = terrain::rasterize_releases(g, {b});
+  EXPECT_EQ(ha, hb);
+  long cells = 0;
+  for (double v : ha) cells += v > 0;
+  EXPECT_GT(cells, 1000);
+}
+
+TEST(Terrain, SlopeWindowAndVerticalThickness) {
+  TempDir d;
+  make_dem(d / "dem.tif", 100, 20.0, 35);
+  // Half on the 35 degree slope, half on the flat valley floor (x > 0.6 * 2000 m).
+  make_polygons(d / "rel.geojson", {square(501000, 5200800, 400)}, "EPSG:32632");
+  terrain::DemRequest rq;
+  rq.dem_path = d / "dem.tif";
+  rq.resolution = 20;
+  const auto g = terrain::prepare_grid(rq);
+  const auto slope = terrain::slope_deg(g);
+  terrain::ReleaseRequest r;
+  r.path = d / "rel.geojson";
+  r.has_thickness = true;
+  r.thickness = 2.0;
+  r.vertical = true;
+  r.has_min_slope = true;
+  r.min_slope = 28;
+  r.has_max_slope = true;
+  r.max_slope = 50;
+  terrain::ReleaseReport rep;
+  const auto h = terrain::rasterize_releases(g, {r}, &rep);
+  long kept = 0;
+  for (std::size_t k = 0; k < h.size(); ++k)
+    if (h[k] > 0) {
+      ++kept;
+      EXPECT_GE(slope[k], 28.0);
+      EXPECT_NEAR(h[k], 2.0 * std::cos(slope[k] * M_PI / 180), 1e-12);
+    }
+  EXPECT_GT(kept, 50);
+  EXPECT_LT(kept, 400 / 20 * 400 / 20);
+  EXPECT_EQ(rep.cells, kept);
+}
+
+TEST(Terrain, SelfIntersectingPolygonIsRepairedAndSaid) {
+  TempDir d;
+  make_dem(d / "dem.tif", 80, 25.0, 30);
+  // A bow tie.
+  make_polygons(d / "bow.geojson", {{{500300, 5200500}, {500700, 5200900}, {500700, 5200500}, {500300, 5200900}, {500300, 5200500}}},
+                "EPSG:32632");
+  terrain::DemRequest rq;
+  rq.dem_path = d / "dem.tif";
+  rq.resolution = 25;
+  const auto g = terrain::prepare_grid(rq);
+  terrain::ReleaseRequest r;
+  r.path = d / "bow.geojson";
+  r.has_thickness = true;
+  r.thickness = 1;
+  terrain::ReleaseReport rep;
+  const auto h = terrain::rasterize_releases(g, {r}, &rep);
+  ASSERT_EQ(rep.notes.size(), 1u);
+  EXPECT_NE(rep.notes[0].find("repaired"), std::string::npos);
+  EXPECT_GT(rep.cells, 50);
+}
+
+TEST(Terrain, BadInputNamesWhatIsWrong) {
+  TempDir d;
+  make_dem(d / "dem.tif", 60, 25.0, 30);
+  make_dem(d / "nocrs.asc", 60, 25.0, 30, "", false);
+  make_polygons(d / "rel.geojson", {square(500300, 5200500, 300)}, "EPSG:32632");
+  make_polygons(d / "far.geojson", {square(600000, 5300000, 300)}, "EPSG:32632");
+  make_polygons(d / "neg.geojson", {square(500300, 5200500, 300)}, "EPSG:32632", R"(,"t":-1)");
+  auto expect = [&](v1::Scenario s, const std::string& needle) {
+    try {
+      auto r = jobs::resolve_scenario(s, d.p.string());
+      fs::create_directories(d / "o");
+      jobs::run_scenario(r, d / "o");
+      ADD_FAILURE() << "no error, expected one containing: " << needle;
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  auto s = base_scenario("missing.tif", "rel.geojson");
+  expect(s, "dem.path: file");
+  expect(base_scenario("nocrs.asc", "rel.geojson"), "has no CRS and none is given");
+  s = base_scenario("nocrs.asc", "rel.geojson");
+  s.mutable_dem()->set_crs("EPSG:32632");
+  EXPECT_NO_THROW(jobs::resolve_scenario(s, d.p.string()));
+  expect(base_scenario("dem.tif", "far.geojson"), "lies outside the grid");
+  s = base_scenario("dem.tif", "neg.geojson");
+  s.mutable_releases(0)->clear_thickness_m();
+  s.mutable_releases(0)->set_thickness_attribute("t");
+  expect(s, "thickness must be > 0 m");
+  s = base_scenario("dem.tif", "rel.geojson");
+  s.mutable_releases(0)->set_thickness_m(-2);
+  expect(s, "releases[0].thickness_m: must be > 0 m");
+  s = base_scenario("dem.tif", "rel.geojson");
+  s.mutable_material()->set_bed_friction_deg(95);
+  expect(s, "material.bed_friction_deg: must lie in [0, 90)");
+  s = base_scenario("dem.tif", "rel.geojson");
+  s.mutable_numerics()->set_limiter("vanLeer");
+  expect(s, "numerics.limiter: unknown numerics.limiter 'vanLeer' (valid: minmod, vanleer, superbee)");
+  s = base_scenario("dem.tif", "rel.geojson");
+  s.mutable_material()->set_rheology("bingham");
+  expect(s, "valid: coulomb, voellmy");
+  s = base_scenario("dem.tif", "rel.geojson", 1.0);
+  expect(s, "finer than a tenth of the DEM's resolution");
+  s = base_scenario("dem.tif", "rel.geojson");
+  s.mutable_releases(0)->set_min_slope_deg(60);
+  s.mutable_releases(0)->set_max_slope_deg(70);
+  expect(s, "no cell has a slope within [60.0, 70.0] deg");
+  s = base_scenario("dem.tif", "rel.geojson");
+  s.mutable_outputs()->add_rasters("max_height");
+  expect(s, "outputs.rasters: unknown 'max_height'");
+  EXPECT_THROW(jobs::parse_scenario_json(R"({"dem": {"path": "x"}, "relases": []})"), jobs::ScenarioError);
+}
+
+TEST(Terrain, GridOverTheMemoryBudgetIsRefused) {
+  TempDir d;
+  make_dem(d / "dem.tif", 400, 100.0, 20);  // 40 km square
+  terrain::DemRequest rq;
+  rq.dem_path = d / "dem.tif";
+  rq.resolution = 10;  // 16 million cells
+  rq.memory_budget_bytes = 1e9;
+  try {
+    terrain::prepare_grid(rq);
+    FAIL();
+  } catch (const terrain::TerrainError& e) {
+    EXPECT_NE(std::string(e.what()).find("exceeds the memory budget"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Scenarios, InDenArelenReachesTheValleyFloor) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/in-den-arelen.json");
+  r.dem.resolution = 30;  // coarser than the scenario's 10 m, to stay fast
+  TempDir d;
+  const auto sum = jobs::run_scenario(r, d.p.string());
+  EXPECT_EQ(sum.crs, "EPSG:32632");
+  EXPECT_LT(sum.volume_error, 1e-12);
+  EXPECT_NEAR(sum.release_volume_m3, 2.9e5, 0.5e5);
+  // (Pure Coulomb friction with delta = 15 deg lets thin layers slide on over the long slopes above
+  // 15 deg, so at 30 m the run may end by the end time rather than the kinetic-energy rule.)
+  // The flow reaches the farmhouse (46.8367 N, 9.8539 E).
+  GDALDatasetUniquePtr md(GDALDataset::Open((d / "max_depth.tif").c_str(), GDAL_OF_RASTER));
+  OGRSpatialReference ll;
+  ll.importFromEPSG(4326);
+  ll.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  OGRSpatialReference utm = *md->GetSpatialRef();
+  utm.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  std::unique_ptr<OGRCoordinateTransformation> ct(OGRCreateCoordinateTransformation(&ll, &utm));
+  double x = 9.8539, y = 46.8367;
+  ct->Transform(1, &x, &y);
+  double gt[6];
+  md->GetGeoTransform(gt);
+  const int i = int((x - gt[0]) / gt[1]), rr = int((y - gt[3]) / gt[5]);
+  float v = 0;
+  ASSERT_EQ(md->GetRasterBand(1)->RasterIO(GF_Read, i, rr, 1, 1, &v, 1, 1, GDT_Float32, 0, 0), CE_None);
+  EXPECT_GT(v, 0.01f);
+}
