@@ -34,7 +34,7 @@ std::string path_in(const std::string& base, const std::string& p, const std::st
 template <class E, std::size_t N>
 E enum_of(const engine::NameTable<E, N>& t, const std::string& field, const std::string& value, const std::string& dflt) {
   try {
-    return engine::parse_name(t, field, value.empty() ? dflt : value);
+    return engine::parse_name(t, "value", value.empty() ? dflt : value);
   } catch (const std::invalid_argument& e) {
     throw ScenarioError(field + ": " + e.what());
   }

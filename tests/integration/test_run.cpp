@@ -255,7 +255,7 @@ TEST(Terrain, BadInputNamesWhatIsWrong) {
   expect(s, "material.bed_friction_deg: must lie in [0, 90)");
   s = base_scenario("dem.tif", "rel.geojson");
   s.mutable_numerics()->set_limiter("vanLeer");
-  expect(s, "numerics.limiter: unknown numerics.limiter 'vanLeer' (valid: minmod, vanleer, superbee)");
+  expect(s, "numerics.limiter: unknown value 'vanLeer' (valid: minmod, vanleer, superbee)");
   s = base_scenario("dem.tif", "rel.geojson");
   s.mutable_material()->set_rheology("bingham");
   expect(s, "valid: coulomb, voellmy");
