@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "engine/sh2d.hpp"
+#include "terrain/map.hpp"
 
 #ifndef RUNOUT_VERSION
 #define RUNOUT_VERSION "unknown"
@@ -136,6 +137,13 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   const auto outline = terrain::write_outline(out("outline.geojson"), out("outline.gpkg"), grid, hz.max_depth, s.outline_threshold);
   sum.files.push_back("outline.geojson");
   sum.files.push_back("outline.gpkg");
+  terrain::MapRequest mreq;
+  mreq.title = s.scenario.name().empty() ? "runout" : s.scenario.name();
+  if (mreq.title.size() > 60) mreq.title = mreq.title.substr(0, 57) + "...";
+  mreq.outline_threshold = s.outline_threshold;
+  mreq.scale = grid.nx * grid.ny > 1000000 ? 1 : 2;
+  terrain::write_map_png(out("map.png"), grid, hz.max_depth, h0, mreq);
+  sum.files.push_back("map.png");
   sum.seconds_write = since(t2);
 
   // Run record.

@@ -1,5 +1,6 @@
 #pragma once
-// The run driver: terrain -> engine -> outputs for one resolved scenario, writing into a directory.
+// The run driver: terrain -> engine -> outputs (rasters, outline, map, run record) for one resolved
+// scenario, writing into a directory.
 // The command line's `runout run` and (later) the service's workers call the same code.
 #include <string>
 #include <vector>

@@ -104,8 +104,12 @@ TEST(Terrain, SyntheticSlopeRunsAndWritesEveryOutput) {
   EXPECT_LT(sum.volume_error, 1e-12);
   EXPECT_GT(sum.runout_m, 500.0);
   for (const char* f : {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "arrival_time.tif",
-                        "outline.geojson", "outline.gpkg", "run.json"})
+                        "outline.geojson", "outline.gpkg", "run.json", "map.png"})
     EXPECT_TRUE(fs::exists(fs::path(d / "out") / f)) << f;
+  GDALDatasetUniquePtr png(GDALDataset::Open((d / "out/map.png").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(png);
+  EXPECT_EQ(png->GetRasterCount(), 3);
+  EXPECT_GE(png->GetRasterXSize(), 2 * 100);  // the grid (2000 m / 20 m) upscaled twice, plus the legend
   GDALDatasetUniquePtr md(GDALDataset::Open((d / "out/max_depth.tif").c_str(), GDAL_OF_RASTER));
   ASSERT_TRUE(md);
   EXPECT_EQ(md->GetRasterBand(1)->GetRasterDataType(), GDT_Float32);
