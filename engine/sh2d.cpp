@@ -774,6 +774,14 @@ Sh2dResult Solver::run() {
   const auto loop0 = std::chrono::steady_clock::now();
   std::vector<TileWork> work(omp_get_max_threads());
   for (auto& w : work) w.reserve(T_);
+  const bool snapshots = cfg_.snapshot && cfg_.snapshot_interval > 0;
+  double next_snapshot = 0, last_snapshot = -1;
+  auto snapshot = [&] {
+    cfg_.snapshot(t, Sh2dStateView{H_[cur_], HU_[cur_], HV_[cur_]});
+    last_snapshot = t;
+    while (next_snapshot <= t) next_snapshot += cfg_.snapshot_interval;
+  };
+  if (snapshots) snapshot();
   while (t < tc.t_end) {
     if (d.steps >= tc.max_steps) {
       d.stop = StopReason::max_steps;
@@ -801,6 +809,7 @@ Sh2dResult Solver::run() {
     active_sum += frac;
     d.max_active_fraction = std::max(d.max_active_fraction, frac);
     rebuild_active();
+    if (snapshots && t >= next_snapshot) snapshot();
     const double ke = sum_tiles(tile_ke_);
     d.kinetic_energy_peak = std::max(d.kinetic_energy_peak, ke * cell_area);
     double vmax = 0;
@@ -818,6 +827,7 @@ Sh2dResult Solver::run() {
       break;
     }
   }
+  if (snapshots && last_snapshot != t) snapshot();  // the final state, unless just written
   d.loop_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loop0).count();
   d.t = t;
   d.volume_final = sum_tiles(tile_mass_) * cell_area;

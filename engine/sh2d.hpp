@@ -42,6 +42,7 @@
 // OpenMP runs over the active tiles; every reduction is done per tile and summed in tile order,
 // so results are bitwise identical for any thread count.
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "engine/limiters.hpp"
@@ -63,6 +64,16 @@ enum class Boundary2D { wall, outflow };
 inline constexpr NameTable<Boundary2D, 2> kBoundary2DNames{
     {{"wall", Boundary2D::wall}, {"outflow", Boundary2D::outflow}}};
 
+/// Read-only view of the solver state, handed to a snapshot hook (valid during the call only).
+struct Sh2dStateView {
+  const std::vector<double>& H;
+  const std::vector<double>& HU;
+  const std::vector<double>& HV;
+};
+/// Called with the simulated time and the state: at t = 0, at the end of the first step at or after
+/// each multiple of `snapshot_interval`, and at the end of the run. Snapshots do not change the steps.
+using SnapshotHook = std::function<void(double t, const Sh2dStateView& state)>;
+
 struct Sh2dConfig {
   Material material;
   Limiter limiter = Limiter::minmod;
@@ -80,6 +91,8 @@ struct Sh2dConfig {
   bool curvature = true;            ///< the centrifugal part of the normal load raises friction
   bool skip_inactive = true;        ///< false: compute every tile every step (for comparison)
   bool track_travel = false;        ///< accumulate Sh2dDiagnostics::mean_travel (costs a sqrt per cell)
+  double snapshot_interval = 0;     ///< [s]; 0: no snapshots
+  SnapshotHook snapshot;            ///< optional
 };
 
 /// Solver state: H = h / cos(theta) and the horizontal momentum H U, H V per horizontal area.

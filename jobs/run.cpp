@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "engine/sh2d.hpp"
+#include "jobs/timeseries.hpp"
 #include "terrain/map.hpp"
 
 #ifndef RUNOUT_VERSION
@@ -84,8 +85,16 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   cfg.time.progress_every = opt.progress_every;
   sum.seconds_prepare = since(t0);
 
+  std::unique_ptr<TimeSeriesWriter> series;
+  if (s.timeseries_interval > 0) {
+    series = std::make_unique<TimeSeriesWriter>(out_dir, grid, t);
+    cfg.snapshot_interval = s.timeseries_interval;
+    cfg.snapshot = [&](double time, const engine::Sh2dStateView& v) { series->write(time, v); };
+  }
   const auto t1 = std::chrono::steady_clock::now();
   const auto res = engine::run_sh2d(t, cfg, engine::state_from_normal_depth(t, h0));
+  int frames = 0;
+  if (series) frames = series->finish();
   sum.seconds_run = since(t1);
   const auto& d = res.diag;
   sum.volume_initial = d.volume_initial;
@@ -144,6 +153,10 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   mreq.scale = grid.nx * grid.ny > 1000000 ? 1 : 2;
   terrain::write_map_png(out("map.png"), grid, hz.max_depth, h0, mreq);
   sum.files.push_back("map.png");
+  if (series) {
+    sum.files.push_back("timeseries.h5");
+    sum.files.push_back("timeseries.xmf");
+  }
   sum.seconds_write = since(t2);
 
   // Run record.
@@ -186,7 +199,8 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
     << "},\n";
   r << "  \"results\": {\"affected_area_m2\": " << jnum(sum.affected_area_m2) << ", \"outline_polygons\": " << outline.polygons
     << ", \"outline_area_m2\": " << jnum(outline.area_m2) << ", \"runout_from_release_centroid_m\": " << jnum(sum.runout_m)
-    << ", \"max_depth_m\": " << jnum(sum.max_depth) << ", \"outline_threshold_m\": " << jnum(s.outline_threshold) << "},\n";
+    << ", \"max_depth_m\": " << jnum(sum.max_depth) << ", \"outline_threshold_m\": " << jnum(s.outline_threshold)
+    << ", \"timeseries_frames\": " << frames << "},\n";
   r << "  \"timings_s\": {\"prepare\": " << jnum(sum.seconds_prepare) << ", \"run\": " << jnum(sum.seconds_run)
     << ", \"write\": " << jnum(sum.seconds_write) << "},\n";
   r << "  \"outputs\": [";

@@ -206,6 +206,8 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   if (!o->has_flow_threshold_m()) o->set_flow_threshold_m(0.01);
   if (!(o->flow_threshold_m() > 0)) bad("outputs.flow_threshold_m", "must be > 0 m");
   r.config.flow_threshold = o->flow_threshold_m();
+  if (!(o->timeseries_interval_s() >= 0)) bad("outputs.timeseries_interval_s", "must be >= 0 s (0: none)");
+  r.timeseries_interval = o->timeseries_interval_s();
   r.scenario = std::move(s);
   return r;
 }

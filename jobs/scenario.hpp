@@ -24,6 +24,7 @@ struct ResolvedScenario {
   engine::Sh2dConfig config;  ///< material, numerics, boundaries (progress hook left empty)
   std::vector<std::string> rasters;
   double outline_threshold = 0.1;
+  double timeseries_interval = 0;  ///< [s]; 0: no time series
   std::vector<std::string> input_files;  ///< for hashing
 };
 

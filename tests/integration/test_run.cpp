@@ -96,7 +96,9 @@ TEST(Terrain, SyntheticSlopeRunsAndWritesEveryOutput) {
   TempDir d;
   make_dem(d / "dem.tif", 120, 20.0, 30);
   make_polygons(d / "rel.geojson", {square(500200, 5201000, 300)}, "EPSG:32632");
-  auto r = jobs::resolve_scenario(base_scenario(d / "dem.tif", d / "rel.geojson"), d.p.string());
+  auto sc = base_scenario(d / "dem.tif", d / "rel.geojson");
+  sc.mutable_outputs()->set_timeseries_interval_s(10);
+  auto r = jobs::resolve_scenario(sc, d.p.string());
   fs::create_directories(d / "out");
   const auto sum = jobs::run_scenario(r, d / "out");
   EXPECT_EQ(sum.crs, "EPSG:32632");
@@ -104,7 +106,7 @@ TEST(Terrain, SyntheticSlopeRunsAndWritesEveryOutput) {
   EXPECT_LT(sum.volume_error, 1e-12);
   EXPECT_GT(sum.runout_m, 500.0);
   for (const char* f : {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "arrival_time.tif",
-                        "outline.geojson", "outline.gpkg", "run.json", "map.png"})
+                        "outline.geojson", "outline.gpkg", "run.json", "map.png", "timeseries.h5", "timeseries.xmf"})
     EXPECT_TRUE(fs::exists(fs::path(d / "out") / f)) << f;
   GDALDatasetUniquePtr png(GDALDataset::Open((d / "out/map.png").c_str(), GDAL_OF_RASTER));
   ASSERT_TRUE(png);
@@ -137,6 +139,17 @@ TEST(Terrain, SyntheticSlopeRunsAndWritesEveryOutput) {
   ss << rec.rdbuf();
   EXPECT_NE(ss.str().find("\"sha256\""), std::string::npos);
   EXPECT_NE(ss.str().find("\"mass_balance\""), std::string::npos);
+  // One XDMF frame per 10 s of simulated time, plus the first and the last; HDF5 readable by GDAL.
+  std::ifstream xmf(d / "out/timeseries.xmf");
+  std::stringstream xs;
+  xs << xmf.rdbuf();
+  int frames = 0;
+  for (std::size_t p = xs.str().find("<Time "); p != std::string::npos; p = xs.str().find("<Time ", p + 1)) ++frames;
+  EXPECT_GE(frames, int(sum.t / 10) + 1);
+  EXPECT_LE(frames, int(sum.t / 10) + 2);
+  GDALDatasetUniquePtr f0(GDALDataset::Open(("HDF5:\"" + d / "out/timeseries.h5" + "\"://frames/00000/depth").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(f0);
+  EXPECT_EQ(f0->GetRasterXSize(), 100);
 }
 
 TEST(Terrain, ReleaseInWgs84AndInUtmGiveTheSameGrid) {

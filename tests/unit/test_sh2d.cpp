@@ -237,6 +237,33 @@ TEST(Sh2d, BadInputIsRejectedWithAMessage) {
   EXPECT_THROW(state_from_normal_depth(t, std::vector<double>(3, 1.0)), std::invalid_argument);
 }
 
+TEST(Sh2d, SnapshotsComeAtTheIntervalAndChangeNothing) {
+  const auto t = hillside(80, 60, 5.0, 30, 0.0);
+  auto cfg = coulomb(22, 20.0);
+  const auto init = state_from_normal_depth(t, blob(t, 20, 30, 8, 3.0));
+  const auto plain = run_sh2d(t, cfg, init);
+  std::vector<double> times;
+  double volume0 = -1;
+  cfg.snapshot_interval = 5.0;
+  cfg.snapshot = [&](double time, const Sh2dStateView& s) {
+    times.push_back(time);
+    if (volume0 < 0) volume0 = 0;
+    double v = 0;
+    for (double H : s.H) v += H;
+    if (times.size() == 1) volume0 = v;
+    EXPECT_NEAR(v, volume0, 1e-12 * volume0);
+  };
+  const auto with = run_sh2d(t, cfg, init);
+  EXPECT_EQ(plain.state.H, with.state.H);  // snapshots do not change the steps
+  ASSERT_EQ(times.size(), 5u);             // 0, >= 5, >= 10, >= 15, end (20)
+  EXPECT_EQ(times[0], 0.0);
+  for (int k = 1; k < 4; ++k) {
+    EXPECT_GE(times[k], 5.0 * k);
+    EXPECT_LT(times[k], 5.0 * k + 0.5);
+  }
+  EXPECT_EQ(times.back(), with.diag.t);
+}
+
 TEST(Sh2d, NormalDepthConventionOnASlope) {
   Terrain2D t;
   t.nx = t.ny = 5;

@@ -1,0 +1,31 @@
+#pragma once
+// Time series of a run for ParaView and friends: HDF5 (one group per frame: normal depth and speed,
+// Float32) plus an XDMF file that describes them as a temporal collection on a co-rectilinear grid.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "engine/sh2d.hpp"
+#include "terrain/terrain.hpp"
+
+namespace runout::jobs {
+
+class TimeSeriesWriter {
+ public:
+  /// Creates `<dir>/timeseries.h5` with the grid and the terrain. Throws std::runtime_error.
+  TimeSeriesWriter(const std::string& dir, const terrain::Grid& grid, const engine::Terrain2D& terrain);
+  ~TimeSeriesWriter();
+  TimeSeriesWriter(const TimeSeriesWriter&) = delete;
+  TimeSeriesWriter& operator=(const TimeSeriesWriter&) = delete;
+
+  /// Append one frame (state as the solver holds it).
+  void write(double t, const engine::Sh2dStateView& s);
+  /// Close the HDF5 file and write `<dir>/timeseries.xmf`. Returns the number of frames.
+  int finish();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace runout::jobs
