@@ -111,7 +111,7 @@ TEST(Terrain, SyntheticSlopeRunsAndWritesEveryOutput) {
   GDALDatasetUniquePtr png(GDALDataset::Open((d / "out/map.png").c_str(), GDAL_OF_RASTER));
   ASSERT_TRUE(png);
   EXPECT_EQ(png->GetRasterCount(), 3);
-  EXPECT_GE(png->GetRasterXSize(), 2 * 100);  // the grid (2000 m / 20 m) upscaled twice, plus the legend
+  EXPECT_GE(png->GetRasterXSize(), 2 * 120);  // the grid (2400 m / 20 m) upscaled twice, plus the legend
   GDALDatasetUniquePtr md(GDALDataset::Open((d / "out/max_depth.tif").c_str(), GDAL_OF_RASTER));
   ASSERT_TRUE(md);
   EXPECT_EQ(md->GetRasterBand(1)->GetRasterDataType(), GDT_Float32);
@@ -149,7 +149,7 @@ TEST(Terrain, SyntheticSlopeRunsAndWritesEveryOutput) {
   EXPECT_LE(frames, int(sum.t / 10) + 2);
   GDALDatasetUniquePtr f0(GDALDataset::Open(("HDF5:\"" + d / "out/timeseries.h5" + "\"://frames/00000/depth").c_str(), GDAL_OF_RASTER));
   ASSERT_TRUE(f0);
-  EXPECT_EQ(f0->GetRasterXSize(), 100);
+  EXPECT_EQ(f0->GetRasterXSize(), 120);  // 2400 m of DEM at 20 m
 }
 
 TEST(Terrain, ReleaseInWgs84AndInUtmGiveTheSameGrid) {
