@@ -111,29 +111,23 @@ int run(const std::vector<std::string>& args) {
     }
     return !g_interrupted.load();
   };
+  auto fail = [&](const std::string& message, int code) {
+    if (!quiet && tty) std::fprintf(stderr, "\n");
+    std::cerr << "runout run: " << message << "\n";
+    cleanup();
+    return code;
+  };
   jobs::RunSummary sum;
   try {
     sum = jobs::run_scenario(resolved, tmp.string(), opt);
   } catch (const jobs::ScenarioError& e) {
-    if (!quiet && tty) std::fprintf(stderr, "\n");
-    std::cerr << "runout run: " << e.what() << "\n";
-    cleanup();
-    return kBadInput;
+    return fail(e.what(), kBadInput);
   } catch (const terrain::TerrainError& e) {
-    if (!quiet && tty) std::fprintf(stderr, "\n");
-    std::cerr << "runout run: " << e.what() << "\n";
-    cleanup();
-    return kBadInput;
-  } catch (const std::invalid_argument& e) {
-    if (!quiet && tty) std::fprintf(stderr, "\n");
-    std::cerr << "runout run: " << e.what() << "\n";
-    cleanup();
-    return kBadInput;
+    return fail(e.what(), kBadInput);
+  } catch (const std::invalid_argument& e) {  // the engine's checks of its input
+    return fail(e.what(), kBadInput);
   } catch (const std::exception& e) {
-    if (!quiet && tty) std::fprintf(stderr, "\n");
-    std::cerr << "runout run: failed: " << e.what() << "\n";
-    cleanup();
-    return kInternal;
+    return fail(std::string("failed: ") + e.what(), kInternal);
   }
   if (!quiet && tty) std::fprintf(stderr, "\n");
   if (sum.stop == "cancelled") {
