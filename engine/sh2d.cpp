@@ -82,6 +82,11 @@ void validate(const Terrain2D& t, const Sh2dConfig& cfg, const Sh2dState& s) {
     if (!std::isfinite(v)) bad("terrain elevations must be finite (fill nodata before the engine)");
   if (s.H.size() != t.cells() || s.HU.size() != t.cells() || s.HV.size() != t.cells())
     bad("initial state size differs from the terrain grid");
+  if (!t.outside.empty()) {
+    if (t.outside.size() != t.cells()) bad("outside mask size differs from the terrain grid");
+    for (std::size_t k = 0; k < t.cells(); ++k)
+      if (t.outside[k] && s.H[k] != 0) bad("initial depth must be 0 in cells outside the domain (cell " + std::to_string(k) + ")");
+  }
   for (std::size_t k = 0; k < s.H.size(); ++k)
     if (!(s.H[k] >= 0) || !std::isfinite(s.HU[k]) || !std::isfinite(s.HV[k]))
       bad("initial depth must be finite and >= 0 (cell " + std::to_string(k) + ")");
@@ -117,6 +122,14 @@ inline FaceState boundary_ghost(const FaceState& in, Boundary2D b) {
   return in;
 }
 
+// Ghost state in a cell outside the domain: free outflow. The inside state is copied while it flows
+// out; a flow towards the inside meets a mirror instead, so nothing comes in from where there is no
+// terrain. `ghost_right`: the ghost lies on the face's right (upper) side.
+inline FaceState outflow_ghost(const FaceState& in, bool ghost_right) {
+  const bool leaving = ghost_right ? in.un >= 0 : in.un <= 0;
+  return leaving ? in : FaceState{in.H, -in.un, in.ut, in.Pnn, -in.Pnt};
+}
+
 // Central local-speed flux (Kurganov & Tadmor 2000) between the predicted face values.
 // Returns (mass, normal momentum, tangential momentum).
 inline Face central_flux(const FaceState& L, const FaceState& R) {
@@ -142,6 +155,7 @@ inline Face held_face(const FaceState& L, const FaceState& R) {
 struct TileWork {
   int bi0 = 0, bj0 = 0, bw = 0, bh = 0;  // box = tile grown by 2, clipped to the grid
   bool all_active = true;                // every tile the box touches is active
+  bool has_outside = false;              // the box holds cells outside the domain
   std::vector<double> sHx, sux, svx, sHy, suy, svy, Hp, Up, Vp, Pxx, Pxy, Pyy, Ps, r;
   std::vector<double> held;  // 1 where friction holds the cell at rest, else 0
   // Face fluxes (mass, x-momentum, y-momentum); Fx*[(j - bj0) * (bw + 1) + (i - bi0)]: face left of
@@ -188,6 +202,22 @@ class Solver {
         V_[b][k] = vel(H_[b][k], HV_[b][k]);
       }
     }
+    if (std::any_of(t.outside.begin(), t.outside.end(), [](std::uint8_t o) { return o != 0; })) {
+      out_ = t.outside;
+      near_out_.assign(n_, 0);
+      for (int j = 0; j < ny_; ++j)
+        for (int i = 0; i < nx_; ++i)
+          near_out_[idx(i, j)] = outside(i, j) || (i > 0 && outside(i - 1, j)) || (i < nx_ - 1 && outside(i + 1, j)) ||
+                                 (j > 0 && outside(i, j - 1)) || (j < ny_ - 1 && outside(i, j + 1));
+    }
+    box_out_.assign(ntiles_, 0);
+    if (!out_.empty())
+      for (int tt = 0; tt < ntiles_; ++tt) {
+        int i0, i1, j0, j1;
+        tile_range(tt, i0, i1, j0, j1);
+        for (int j = std::max(j0 - 2, 0); j < std::min(j1 + 2, ny_); ++j)
+          for (int i = std::max(i0 - 2, 0); i < std::min(i1 + 2, nx_); ++i) box_out_[tt] |= out_[idx(i, j)];
+      }
     Pxx_.resize(n_);
     Pxy_.resize(n_);
     Pyy_.resize(n_);
@@ -227,6 +257,9 @@ class Solver {
     j1 = std::min(j0 + T_, ny_);
   }
   bool cell_active(int i, int j) const { return active_flag_[(j / T_) * ntx_ + i / T_]; }
+  bool outside(int i, int j) const { return !out_.empty() && out_[idx(i, j)]; }
+  // The cell or one of its four neighbours lies outside the domain (such cells take the general loop).
+  bool near_outside(std::size_t k) const { return !near_out_.empty() && near_out_[k]; }
   double vel(double H, double M) const { return H > cfg_.dry_depth ? M / H : 0.0; }
 
   // Pi = g [c^4 Kx d d^T + c^2 Ky s s^T], d the downslope unit vector (or (dx, dy) on flat ground).
@@ -289,6 +322,8 @@ class Solver {
   // State at t (index cur_) and t + dt (1 - cur_); U, V the velocity (zero where dry).
   std::vector<double> H_[2], HU_[2], HV_[2], U_[2], V_[2];
   int cur_ = 0;
+  std::vector<std::uint8_t> out_, near_out_;  // empty when every cell is inside
+  std::vector<std::uint8_t> box_out_;         // per tile: its box (tile grown by 2) holds outside cells
   std::vector<double> Pxx_, Pxy_, Pyy_;  // pressure coefficients for K = 1 (also the start values)
   std::vector<double> Ps_;                // wave_factor of those
   std::vector<double> tile_mass_, tile_ke_, tile_speed_, tile_rate_, tile_out_, tile_travel_;
@@ -381,8 +416,11 @@ void Solver::predictor(TileWork& w, double dt) const {
   const int fa = std::max(w.bi0, 1), fb = std::min(w.bi0 + w.bw, nx_ - 1);
   for (int j = w.bj0; j < w.bj0 + w.bh; ++j)
     for (int i = w.bi0; i < w.bi0 + w.bw; ++i) {
-      if (fast && j > 0 && j < ny_ - 1 && i >= fa && i < fb) {
-        if (i == fa) predictor_row<lim>(w, j, fa, fb, dt);
+      if (fast && j > 0 && j < ny_ - 1 && i >= fa && i < fb && !near_outside(idx(i, j))) {
+        int e = i + 1;  // a run of cells for the row kernel
+        while (e < fb && !near_outside(idx(e, j))) ++e;
+        predictor_row<lim>(w, j, i, e, dt);
+        i = e - 1;
         continue;
       }
       const std::size_t k = idx(i, j), q = w.at(i, j);
@@ -390,7 +428,8 @@ void Solver::predictor(TileWork& w, double dt) const {
       // Limited slopes of the depth and of the velocity (primitive variables: reconstructing the
       // velocity rather than the momentum keeps thin layers from producing spurious speeds).
       double sHx = 0, sux = 0, svx = 0, sHy = 0, suy = 0, svy = 0;
-      if (i > 0 && i < nx_ - 1) {
+      const bool edge = near_outside(k);  // slopes only between cells of the domain
+      if (i > 0 && i < nx_ - 1 && !(edge && (outside(i - 1, j) || outside(i + 1, j) || outside(i, j)))) {
         const std::size_t l = k - 1, r = k + 1;
         sHx = limited_slope(lim, H - Hs[l], Hs[r] - H);
         if (Hs[l] > dry && Hs[r] > dry) {
@@ -398,7 +437,7 @@ void Solver::predictor(TileWork& w, double dt) const {
           svx = limited_slope(lim, V - Vs[l], Vs[r] - V);
         }
       }
-      if (j > 0 && j < ny_ - 1) {
+      if (j > 0 && j < ny_ - 1 && !(edge && (outside(i, j - 1) || outside(i, j + 1) || outside(i, j)))) {
         const std::size_t b = k - nx_, a = k + nx_;
         sHy = limited_slope(lim, H - Hs[b], Hs[a] - H);
         if (Hs[b] > dry && Hs[a] > dry) {
@@ -481,11 +520,15 @@ Face Solver::face(const TileWork& w, int ia, int ja, int ib, int jb, bool lo, bo
                   Boundary2D bhi) const {
   // Flux through the face between cells a (left/below) and b; lo/hi: the face is a domain edge.
   if (!lo && !hi && !w.all_active && cell_active(ia, ja) != cell_active(ib, jb)) return Face{0, 0, 0};
+  const bool oa = !lo && w.has_outside && outside(ia, ja), ob = !hi && w.has_outside && outside(ib, jb);
+  if (oa && ob) return Face{0, 0, 0};
   FaceState L{}, R{};
-  if (!lo) L = side_state<X>(w, w.at(ia, ja), +1.0);
-  if (!hi) R = side_state<X>(w, w.at(ib, jb), -1.0);
+  if (!lo && !oa) L = side_state<X>(w, w.at(ia, ja), +1.0);
+  if (!hi && !ob) R = side_state<X>(w, w.at(ib, jb), -1.0);
   if (lo) L = boundary_ghost(R, blo);
   if (hi) R = boundary_ghost(L, bhi);
+  if (oa) return central_flux(outflow_ghost(R, false), R);
+  if (ob) return central_flux(L, outflow_ghost(L, true));
   return (!lo && !hi && w.held[w.at(ia, ja)] != 0.0 && w.held[w.at(ib, jb)] != 0.0) ? held_face(L, R)
                                                                                       : central_flux(L, R);
 }
@@ -614,7 +657,7 @@ void Solver::faces(TileWork& w) const {
   // x faces: interior ones (both cells in the box, not a domain edge) by rows, the rest one by one.
   const int xa = std::max(i0 + 1, 1), xb = std::min(i1 - 1, nx_ - 1);  // interior face range [xa, xb]
   for (int j = j0; j < j1; ++j) {
-    if (w.all_active && xb >= xa) {
+    if (w.all_active && !w.has_outside && xb >= xa) {
       const std::size_t q = w.at(xa, j), f = w.fx(xa, j);
       face_row(xb - xa + 1, 1, &w.Hp[q], &w.sHx[q], &w.Up[q], &w.sux[q], &w.Vp[q], &w.svx[q], &w.Pxx[q], &w.Pxy[q],
                &w.held[q], &w.Fx0[f], &w.Fx1[f], &w.Fx2[f]);
@@ -622,7 +665,7 @@ void Solver::faces(TileWork& w) const {
     for (int i = i0; i <= i1; ++i) {
       const bool west = i == 0, east = i == nx_;
       if ((i == i0 && !west) || (i == i1 && !east)) continue;  // the other cell lies outside the box
-      if (w.all_active && i >= xa && i <= xb) continue;        // done above
+      if (w.all_active && !w.has_outside && i >= xa && i <= xb) continue;  // done above
       put_x(i, j, face<true>(w, i - 1, j, i, j, west, east, cfg_.west, cfg_.east));
     }
   }
@@ -630,7 +673,7 @@ void Solver::faces(TileWork& w) const {
   for (int j = j0; j <= j1; ++j) {
     const bool south = j == 0, north = j == ny_;
     if ((j == j0 && !south) || (j == j1 && !north)) continue;
-    if (w.all_active && !south && !north) {
+    if (w.all_active && !w.has_outside && !south && !north) {
       const std::size_t q = w.at(i0, j), f = w.fy(i0, j);
       face_row(w.bw, w.bw, &w.Hp[q], &w.sHy[q], &w.Vp[q], &w.svy[q], &w.Up[q], &w.suy[q], &w.Pyy[q], &w.Pxy[q],
                &w.held[q], &w.Fy0[f], &w.Fy2[f], &w.Fy1[f]);
@@ -677,14 +720,17 @@ void Solver::update(int tt, const TileWork& w, double t, double dt) {
   for (int j = j0; j < j1; ++j)
     for (int i = i0; i < i1; ++i) {
       const std::size_t k = idx(i, j), q = w.at(i, j);
+      if (w.has_outside && outside(i, j)) continue;  // never holds material (both buffers stay 0)
       const Face fw = scaled(w.fxf(w.fx(i, j)), i - 1, j, i, j, i > 0, true);
       const Face fe = scaled(w.fxf(w.fx(i + 1, j)), i, j, i + 1, j, true, i < nx_ - 1);
       const Face fs = scaled(w.fyf(w.fy(i, j)), i, j - 1, i, j, j > 0, true);
       const Face fn = scaled(w.fyf(w.fy(i, j + 1)), i, j, i, j + 1, true, j < ny_ - 1);
-      if (i == 0) out -= fw.f0 * dt * t_.dy;
-      if (i == nx_ - 1) out += fe.f0 * dt * t_.dy;
-      if (j == 0) out -= fs.f0 * dt * t_.dx;
-      if (j == ny_ - 1) out += fn.f0 * dt * t_.dx;
+      const bool ow = w.has_outside && i > 0 && outside(i - 1, j), oe = w.has_outside && i < nx_ - 1 && outside(i + 1, j);
+      const bool os = w.has_outside && j > 0 && outside(i, j - 1), on = w.has_outside && j < ny_ - 1 && outside(i, j + 1);
+      if (i == 0 || ow) out -= fw.f0 * dt * t_.dy;
+      if (i == nx_ - 1 || oe) out += fe.f0 * dt * t_.dy;
+      if (j == 0 || os) out -= fs.f0 * dt * t_.dx;
+      if (j == ny_ - 1 || on) out += fn.f0 * dt * t_.dx;
       double H = H0[k] - lx * (fe.f0 - fw.f0) - ly * (fn.f0 - fs.f0);
       if (H < 0) H = 0;  // round-off only: the limiter above bounds the outflow by the content
       // Source at the half step (midpoint rule).
@@ -742,6 +788,7 @@ void Solver::step_tile(int tt, double t, double dt, TileWork& w) {
   w.bw = std::min(i1 + 2, nx_) - w.bi0;
   w.bh = std::min(j1 + 2, ny_) - w.bj0;
   const int ti = tt % ntx_, tj = tt / ntx_;
+  w.has_outside = box_out_[tt] != 0;
   w.all_active = true;
   for (int dj = -1; dj <= 1; ++dj)
     for (int di = -1; di <= 1; ++di) {

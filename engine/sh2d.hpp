@@ -57,6 +57,10 @@ struct Terrain2D {
   double dx = 1.0, dy = 1.0;
   double x0 = 0.0, y0 = 0.0;
   std::vector<double> z;
+  /// Optional: 1 for cells that are not part of the domain (no terrain data, outside the area of
+  /// interest). Material that reaches them leaves the domain (free outflow, counted as outflow);
+  /// they never hold material. Their z must still be finite (it shapes the neighbours' gradients).
+  std::vector<std::uint8_t> outside;
   std::size_t cells() const { return std::size_t(nx) * std::size_t(ny); }
 };
 
