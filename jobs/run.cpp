@@ -7,6 +7,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "engine/sh2d.hpp"
@@ -80,6 +81,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   t.x0 = -0.5 * (grid.nx - 1) * grid.dx;
   t.y0 = -0.5 * (grid.ny - 1) * grid.dx;
   t.z = grid.z;
+  t.outside = grid.outside;
   auto cfg = s.config;
   cfg.time.progress = opt.progress;
   cfg.time.progress_every = opt.progress_every;
@@ -132,6 +134,13 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   // Outputs.
   const auto t2 = std::chrono::steady_clock::now();
   auto out = [&](const std::string& name) { return (fs::path(out_dir) / name).string(); };
+  // Cells outside the domain are nodata in every raster.
+  auto masked = [&](const std::vector<double>& v) {
+    std::vector<double> m = v;
+    for (std::size_t k = 0; k < m.size(); ++k)
+      if (grid.outside[k]) m[k] = std::numeric_limits<double>::quiet_NaN();
+    return m;
+  };
   for (const auto& name : s.rasters) {
     const std::vector<double>* v = nullptr;
     std::string desc;
@@ -140,7 +149,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
     if (name == "max_pressure") v = &hz.max_pressure, desc = "maximum pressure rho u^2 [Pa]";
     if (name == "deposit") v = &hz.final_depth, desc = "deposit depth normal to the surface at the end [m]";
     if (name == "arrival_time") v = &hz.arrival_time, desc = "arrival time of the flow [s]";
-    terrain::write_cog(out(name + ".tif"), grid, *v, desc);
+    terrain::write_cog(out(name + ".tif"), grid, masked(*v), desc);
     sum.files.push_back(name + ".tif");
   }
   const auto outline = terrain::write_outline(out("outline.geojson"), out("outline.gpkg"), grid, hz.max_depth, s.outline_threshold);
@@ -181,7 +190,8 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   r << "  \"dem\": {\"source_crs\": " << jstr(dem_rep.source_crs) << ", \"source_resolution_m\": " << jnum(dem_rep.source_resolution_m)
     << ", \"z_min_m\": " << jnum(dem_rep.z_min) << ", \"z_max_m\": " << jnum(dem_rep.z_max)
     << ", \"slope_mean_deg\": " << jnum(dem_rep.slope_mean_deg) << ", \"slope_p90_deg\": " << jnum(dem_rep.slope_p90_deg)
-    << ", \"slope_max_deg\": " << jnum(dem_rep.slope_max_deg) << "},\n";
+    << ", \"slope_max_deg\": " << jnum(dem_rep.slope_max_deg) << ", \"cells_without_data\": " << dem_rep.cells_without_data
+    << ", \"cells_outside_area\": " << dem_rep.cells_outside_area << "},\n";
   r << "  \"grid\": {\"crs\": " << jstr(grid.crs_name) << ", \"nx\": " << grid.nx << ", \"ny\": " << grid.ny
     << ", \"cell_size_m\": " << jnum(grid.dx) << ", \"x_min\": " << jnum(grid.x_min) << ", \"y_min\": " << jnum(grid.y_min)
     << ", \"local_origin\": [" << jnum(grid.x_min + 0.5 * grid.nx * grid.dx) << ", " << jnum(grid.y_min + 0.5 * grid.ny * grid.dx)

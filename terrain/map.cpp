@@ -142,6 +142,11 @@ void write_map_png(const std::string& path, const Grid& g, const std::vector<dou
     for (int i = 0; i < g.nx; ++i) {
       const double sh = shade[std::size_t(r) * g.nx + i] / 255.0;
       std::array<std::uint8_t, 3> c;
+      if (!g.outside.empty() && g.outside[std::size_t(g.ny - 1 - r) * g.nx + i]) {  // outside the domain: pale
+        const auto v = std::uint8_t(215 + 40 * sh);
+        img.rect(pad + i * s, top + r * s, pad + (i + 1) * s, top + (r + 1) * s, {v, v, v});
+        continue;
+      }
       const int k = cls(at(max_depth, i, r));
       for (int q = 0; q < 3; ++q) {
         const double base = 60 + 195 * sh;

@@ -256,34 +256,89 @@ Grid prepare_grid(const DemRequest& req, DemReport* report) {
   if (warped->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, g.nx, g.ny, rows.data(), g.nx, g.ny, GDT_Float64, 0, 0) != CE_None)
     throw TerrainError("DEM '" + req.dem_path + "': reading the reprojected raster failed" + gdal_message());
   g.z.resize(g.cells());
-  long missing = 0;
-  int mi = -1, mj = -1;
+  g.outside.assign(g.cells(), 0);
   for (int r = 0; r < g.ny; ++r)
     for (int i = 0; i < g.nx; ++i) {
       const double v = rows[std::size_t(r) * g.nx + i];
-      const int j = g.ny - 1 - r;
+      const std::size_t k = std::size_t(g.ny - 1 - r) * g.nx + i;
       if (!(v > -99998) || !std::isfinite(v)) {
-        if (missing++ == 0) {
-          mi = i;
-          mj = j;
+        g.outside[k] = 1;
+        ++rep.cells_without_data;
+      }
+      g.z[k] = v;
+    }
+  // Cells outside the area-of-interest polygon are outside the domain too.
+  if (aoi) {
+    auto poly = std::unique_ptr<OGRGeometry>(aoi->clone());
+    poly->transform(transform(aoi_srs, dst, "area of interest").get());
+    GDALDatasetUniquePtr mask(GetGDALDriverManager()->GetDriverByName("MEM")->Create("", g.nx, g.ny, 1, GDT_Byte, nullptr));
+    double mgt[6] = {g.x_min, g.dx, 0, g.y_min + g.ny * g.dx, 0, -g.dx};
+    mask->SetGeoTransform(mgt);
+    int band = 1;
+    double burn = 1;
+    OGRGeometryH gh = OGRGeometry::ToHandle(poly.get());
+    std::vector<unsigned char> m(g.cells());
+    if (GDALRasterizeGeometries(GDALDataset::ToHandle(mask.get()), 1, &band, 1, &gh, nullptr, nullptr, &burn, nullptr,
+                                nullptr, nullptr) != CE_None ||
+        mask->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, g.nx, g.ny, m.data(), g.nx, g.ny, GDT_Byte, 0, 0) != CE_None)
+      throw TerrainError("area of interest '" + req.aoi_path + "': rasterisation failed" + gdal_message());
+    for (int r = 0; r < g.ny; ++r)
+      for (int i = 0; i < g.nx; ++i) {
+        const std::size_t k = std::size_t(g.ny - 1 - r) * g.nx + i;
+        if (!m[std::size_t(r) * g.nx + i] && !g.outside[k]) {
+          g.outside[k] = 1;
+          ++rep.cells_outside_area;
         }
       }
-      g.z[std::size_t(j) * g.nx + i] = v;
+  }
+  const long inside = long(g.cells()) - rep.cells_without_data - rep.cells_outside_area;
+  if (inside < 9)
+    throw TerrainError("DEM '" + req.dem_path + "' has data for only " + std::to_string(inside) + " cells of the area (" +
+                       std::to_string(rep.cells_without_data) + " without data, " + std::to_string(rep.cells_outside_area) +
+                       " outside the area of interest): the area of interest must lie inside the DEM");
+  // Cells without data get the elevation of the nearest cells with data (breadth-first), so that
+  // the gradients of the domain's edge cells stay finite; the engine keeps material out of them.
+  {
+    std::vector<std::size_t> front, next;
+    std::vector<std::uint8_t> known(g.cells());
+    for (std::size_t k = 0; k < g.cells(); ++k) {
+      known[k] = std::isfinite(g.z[k]) && g.z[k] > -99998;
+      if (known[k]) front.push_back(k);
     }
-  if (missing > 0)
-    throw TerrainError("DEM '" + req.dem_path + "' has no data for " + std::to_string(missing) + " of the " +
-                       std::to_string(g.cells()) + " cells of the area (first at " + fmt(g.cx(mi), 0) + ", " +
-                       fmt(g.cy(mj), 0) + " in " + g.crs_name + "): the area of interest must lie inside the DEM");
+    while (!front.empty()) {
+      next.clear();
+      for (std::size_t k : front) {
+        const int i = int(k % g.nx), j = int(k / g.nx);
+        const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
+        for (int d = 0; d < 4; ++d) {
+          const int u = i + di[d], v = j + dj[d];
+          if (u < 0 || v < 0 || u >= g.nx || v >= g.ny) continue;
+          const std::size_t q = std::size_t(v) * g.nx + u;
+          if (known[q]) continue;
+          known[q] = 1;
+          g.z[q] = g.z[k];
+          next.push_back(q);
+        }
+      }
+      front.swap(next);
+    }
+  }
   const auto sl = slope_deg(g);
-  auto sorted = sl;
-  std::sort(sorted.begin(), sorted.end());
+  std::vector<double> sorted;
   double sum = 0;
-  for (double v : sl) sum += v;
-  rep.slope_mean_deg = sum / double(sl.size());
+  rep.z_min = 1e300;
+  rep.z_max = -1e300;
+  for (std::size_t k = 0; k < g.cells(); ++k) {
+    if (g.outside[k]) continue;
+    sorted.push_back(sl[k]);
+    sum += sl[k];
+    rep.z_min = std::min(rep.z_min, g.z[k]);
+    rep.z_max = std::max(rep.z_max, g.z[k]);
+  }
+  std::sort(sorted.begin(), sorted.end());
+  rep.slope_mean_deg = sum / double(sorted.size());
   rep.slope_max_deg = sorted.back();
   rep.slope_p90_deg = sorted[std::size_t(0.9 * double(sorted.size() - 1))];
-  rep.z_min = *std::min_element(g.z.begin(), g.z.end());
-  rep.z_max = *std::max_element(g.z.begin(), g.z.end());
   if (report) *report = rep;
   return g;
 }
@@ -386,6 +441,7 @@ std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseR
           for (int i = 0; i < g.nx; ++i) {
             if (!m[std::size_t(r) * g.nx + i]) continue;
             const std::size_t k = std::size_t(g.ny - 1 - r) * g.nx + i;
+            if (!g.outside.empty() && g.outside[k]) continue;  // no release where the domain has no terrain
             ++inside;
             smin_seen = std::min(smin_seen, slope[k]);
             smax_seen = std::max(smax_seen, slope[k]);
@@ -394,7 +450,8 @@ std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseR
             const double hn = rq.vertical ? t * std::cos(slope[k] * M_PI / 180) : t;
             h[k] = std::max(h[k], hn);
           }
-        if (inside == 0) throw TerrainError(what + " lies outside the grid or is thinner than a cell (" + extent + ")");
+        if (inside == 0)
+          throw TerrainError(what + " lies outside the grid, outside the area of interest or where the DEM has no data, or is thinner than a cell (" + extent + ")");
         if (kept == 0)
           throw TerrainError(what + ": no cell has a slope within [" + fmt(smin) + ", " + fmt(smax) +
                              "] deg (slopes inside the polygon: " + fmt(smin_seen) + " to " + fmt(smax_seen) + " deg)");

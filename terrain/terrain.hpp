@@ -4,6 +4,7 @@
 // centre by default), reprojection and resampling with GDAL's warper (PROJ underneath), clipping to
 // the area of interest, release polygons rasterised onto the grid with thickness and slope windows,
 // and the raster/vector outputs. Errors are `TerrainError` with a message that names the input.
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -23,7 +24,9 @@ struct Grid {
   double x_min = 0, y_min = 0;
   std::string crs_wkt;   ///< WKT of the projected CRS
   std::string crs_name;  ///< e.g. "EPSG:32632"
-  std::vector<double> z; ///< elevation [m]
+  std::vector<double> z; ///< elevation [m] (filled from the nearest data where `outside`)
+  /// 1 for cells outside the domain: no DEM data there, or outside the area-of-interest polygon.
+  std::vector<std::uint8_t> outside;
   std::size_t cells() const { return std::size_t(nx) * std::size_t(ny); }
   double cx(int i) const { return x_min + (i + 0.5) * dx; }
   double cy(int j) const { return y_min + (j + 0.5) * dx; }
@@ -46,6 +49,8 @@ struct DemReport {
   double slope_mean_deg = 0, slope_max_deg = 0, slope_p90_deg = 0;
   double z_min = 0, z_max = 0;
   bool used_aoi = false;
+  long cells_without_data = 0;   ///< DEM nodata inside the grid (outside the domain)
+  long cells_outside_area = 0;   ///< outside the area-of-interest polygon
 };
 
 /// Read, reproject, resample and clip the DEM. Throws TerrainError.

@@ -35,7 +35,8 @@ struct TempDir {
 };
 
 // A DEM in UTM 32N (EPSG:32632): a slope of `deg` falling to the east, flattening into a valley.
-void make_dem(const std::string& path, int n, double cell, double deg, const char* epsg = "EPSG:32632", bool with_crs = true) {
+void make_dem(const std::string& path, int n, double cell, double deg, const char* epsg = "EPSG:32632", bool with_crs = true,
+              int hole_i0 = -1, int hole_i1 = -1) {
   GDALAllRegister();
   auto* drv = GetGDALDriverManager()->GetDriverByName(path.size() > 4 && path.substr(path.size() - 4) == ".asc" ? "AAIGrid" : "GTiff");
   auto* mem = GetGDALDriverManager()->GetDriverByName("MEM");
@@ -53,7 +54,9 @@ void make_dem(const std::string& path, int n, double cell, double deg, const cha
     for (int i = 0; i < n; ++i) {
       const double x = i * cell;
       z[std::size_t(r) * n + i] = float(std::max(0.0, (0.6 * n * cell - x)) * std::tan(deg * M_PI / 180) + 0.02 * r * cell);
+      if (i >= hole_i0 && i < hole_i1 && r >= n / 3 && r < 2 * n / 3) z[std::size_t(r) * n + i] = -9999.0f;
     }
+  ds->GetRasterBand(1)->SetNoDataValue(-9999.0);
   EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, n, n, z.data(), n, n, GDT_Float32, 0, 0), CE_None);
   GDALDatasetUniquePtr out(drv->CreateCopy(path.c_str(), ds.get(), FALSE, nullptr, nullptr, nullptr));
   ASSERT_TRUE(out);
@@ -286,6 +289,33 @@ TEST(Terrain, BadInputNamesWhatIsWrong) {
   s.mutable_outputs()->add_rasters("max_height");
   expect(s, "outputs.rasters: unknown 'max_height'");
   EXPECT_THROW(jobs::parse_scenario_json(R"({"dem": {"path": "x"}, "relases": []})"), jobs::ScenarioError);
+}
+
+TEST(Terrain, DemGapsAndTheAreaPolygonAreOutsideTheDomain) {
+  TempDir d;
+  // A 2.4 km slope with a gap in the DEM right below the release; the area of interest leaves out
+  // the northern third.
+  make_dem(d / "dem.tif", 120, 20.0, 30, "EPSG:32632", true, 40, 55);
+  make_polygons(d / "rel.geojson", {square(500250, 5201050, 300)}, "EPSG:32632");
+  make_polygons(d / "aoi.geojson", {{{500000, 5200000}, {502400, 5200000}, {502400, 5201600}, {500000, 5201600}, {500000, 5200000}}},
+                "EPSG:32632");
+  auto sc = base_scenario(d / "dem.tif", d / "rel.geojson");
+  sc.mutable_area_of_interest()->set_path(d / "aoi.geojson");
+  auto r = jobs::resolve_scenario(sc, d.p.string());
+  fs::create_directories(d / "out");
+  const auto sum = jobs::run_scenario(r, d / "out");
+  EXPECT_GT(sum.volume_outflow, 0.01 * sum.volume_initial);  // material ran into the gap
+  EXPECT_LT(sum.volume_error, 1e-12);
+  std::ifstream rec(d / "out/run.json");
+  std::stringstream ss;
+  ss << rec.rdbuf();
+  EXPECT_NE(ss.str().find("\"cells_without_data\": 600"), std::string::npos) << ss.str().substr(0, 2000);  // 15 x 40 cells
+  EXPECT_EQ(ss.str().find("\"cells_outside_area\": 0,"), std::string::npos);
+  // The gap (DEM rows 40-79 = grid rows 0-39 of the clipped grid, columns 40-54) is nodata in the rasters.
+  GDALDatasetUniquePtr md(GDALDataset::Open((d / "out/max_depth.tif").c_str(), GDAL_OF_RASTER));
+  float v = 0;
+  ASSERT_EQ(md->GetRasterBand(1)->RasterIO(GF_Read, 45, 20, 1, 1, &v, 1, 1, GDT_Float32, 0, 0), CE_None);
+  EXPECT_EQ(v, -9999.0f);
 }
 
 TEST(Terrain, GridOverTheMemoryBudgetIsRefused) {

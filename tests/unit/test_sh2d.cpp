@@ -282,7 +282,9 @@ TEST(Sh2d, CellsOutsideTheDomainSwallowWhatReachesThem) {
   EXPECT_GT(a.diag.volume_outflow, 0.05 * a.diag.volume_initial);  // material ran into the hole
   EXPECT_LT(a.diag.volume_error(), 1e-12);
   for (std::size_t k = 0; k < t.cells(); ++k) {
-    if (t.outside[k]) ASSERT_EQ(a.state.H[k], 0.0);
+    if (t.outside[k]) {
+      ASSERT_EQ(a.state.H[k], 0.0);
+    }
   }
   for (double H : a.state.H) EXPECT_GE(H, 0.0);
 }
