@@ -91,4 +91,13 @@ inline bool apply_friction(double& mx, double& my, double m3, double impulse) {
   return false;
 }
 
+/// Voellmy's turbulent drag g |u|^2 / xi (per unit area, over density) integrated implicitly over a
+/// time span `dt` for material of normal depth h: du/dt = -g u^2 / (xi h) gives
+/// u_new = 2 u / (1 + sqrt(1 + 4 a u)), a = dt g / (xi h). Returns u_new / u (1 without drag), which is
+/// stable for any dt and thin layers (an explicit step is not: thin films would accelerate freely).
+inline double turbulent_factor(double speed, double h, double g_inv_xi_dt) {
+  const double a = g_inv_xi_dt / h;
+  return 2.0 / (1.0 + std::sqrt(1.0 + 4.0 * a * speed));
+}
+
 }  // namespace runout::engine

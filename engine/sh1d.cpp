@@ -179,8 +179,12 @@ Sh1dResult run_sh1d(const Channel1D& ch, const Sh1dConfig& cfg, Sh1dState init) 
     const double u = M[k] / H[k];
     return u * sh + H[k] * limited_slope(lim, u - M[k - 1] / H[k - 1], M[k + 1] / H[k + 1] - u);
   };
+  // Coulomb resistance per unit width; Voellmy's drag is applied implicitly (turbulent_factor).
   auto resistance = [&](double h, double u, double zeta, double kappa) {
-    return h * (mu * std::max(0.0, g * std::cos(zeta) + curv * kappa * u * u) + g * ixi * u * u);
+    return h * mu * std::max(0.0, g * std::cos(zeta) + curv * kappa * u * u);
+  };
+  auto drag = [&](double& m, double h, double span) {
+    if (ixi > 0 && h > hdry) m *= turbulent_factor(std::abs(m) / h, h, span * g * ixi);
   };
 
   double t = 0, ke_peak = 0;
@@ -211,6 +215,7 @@ Sh1dResult run_sh1d(const Channel1D& ch, const Sh1dConfig& cfg, Sh1dState init) 
                   0.5 * dt * h * g * std::sin(w.zeta[k]);
       double dummy = 0;
       apply_friction(mp, dummy, std::abs(mp), 0.5 * dt * resistance(h, u, w.zeta[k], w.kappa[k]));
+      drag(mp, h, 0.5 * dt);
       w.mp[k] = mp;
     }
     auto flux_m = [&](int k) {
@@ -251,6 +256,7 @@ Sh1dResult run_sh1d(const Channel1D& ch, const Sh1dConfig& cfg, Sh1dState init) 
                               resistance(hq3, uq3, w.zeta[k + 1], w.kappa[k + 1]));
       double dummy = 0;
       apply_friction(Sm, dummy, std::abs(Sm), dt * R);
+      drag(Sm, Sh, dt);
       w.Sh[k] = Sh;
       w.Sm[k] = Sm;
     }

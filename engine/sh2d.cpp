@@ -93,6 +93,7 @@ void validate(const Terrain2D& t, const Sh2dConfig& cfg, const Sh2dState& s) {
   if (!(cfg.time.cfl > 0 && cfg.time.cfl <= 0.5)) bad("CFL number must lie in (0, 0.5]");
   if (!(cfg.time.t_end >= 0)) bad("end time must be >= 0");
   if (cfg.tile < 4) bad("tile size must be >= 4 cells");
+  if (!(cfg.curvature_cap >= 0)) bad("curvature cap must be >= 0");
   cfg.material.validate();
 }
 
@@ -181,6 +182,7 @@ class Solver {
       : t_(t), cfg_(cfg), geo_(SurfaceGeometry::from(t)), nx_(t.nx), ny_(t.ny), n_(t.cells()),
         T_(cfg.tile), ntx_((nx_ + T_ - 1) / T_), nty_((ny_ + T_ - 1) / T_), ntiles_(ntx_ * nty_) {
     g_ = cfg.gravity;
+    qcap_ = cfg.curvature_cap * cfg.gravity;
     mu_ = cfg.material.coulomb_coefficient();
     ixi_ = cfg.material.inv_xi();
     kap_ = cfg.material.earth_pressure == EarthPressure::active_passive;
@@ -280,14 +282,14 @@ class Solver {
   // in curved terrain without loss of energy. The option `curvature` only decides whether the
   // centrifugal part raises the basal friction (as in eq. 3.48), as in the 1D solver.
   double normal_g(std::size_t k, double U, double V) const {
-    const double Q = U * U * geo_.hxx[k] + 2 * U * V * geo_.hxy[k] + V * V * geo_.hyy[k];
+    const double Q = std::min(qcap_, U * U * geo_.hxx[k] + 2 * U * V * geo_.hxy[k] + V * V * geo_.hyy[k]);
     return std::max(0.0, g_ + Q);
   }
-  // Resistance per horizontal area (magnitude of the friction force, 3D); gn = (g + Q)_+.
-  double resistance(std::size_t k, double H, double U, double V, double gn) const {
-    const double w = geo_.bx[k] * U + geo_.by[k] * V;
+  // Coulomb resistance per horizontal area (magnitude of the basal friction force, 3D):
+  // mu N / cos(theta) with N / rho = h c (g + Q)_+ = H c^2 (g + Q)_+; gn = (g + Q)_+.
+  double resistance(std::size_t k, double H, double gn) const {
     const double load = cfg_.curvature ? gn : g_;
-    return H * (mu_ * geo_.c[k] * load + g_ * ixi_ * (U * U + V * V + w * w));
+    return H * mu_ * geo_.c[k] * load;
   }
   // sqrt(Pxx)/dx + sqrt(Pyy)/dy: the gravity-wave part of the CFL rate, per sqrt(H).
   double wave_factor(double pxx, double pyy) const { return std::sqrt(pxx) / t_.dx + std::sqrt(pyy) / t_.dy; }
@@ -316,7 +318,7 @@ class Solver {
   int nx_, ny_;
   std::size_t n_;
   int T_, ntx_, nty_, ntiles_;
-  double g_ = 9.81, mu_ = 0, ixi_ = 0;
+  double g_ = 9.81, mu_ = 0, ixi_ = 0, qcap_ = 9.81;
   bool kap_ = false;
   double kx_[2] = {1, 1}, ky_[2][2] = {{1, 1}, {1, 1}};
   // State at t (index cur_) and t + dt (1 - cur_); U, V the velocity (zero where dry).
@@ -485,7 +487,13 @@ void Solver::predictor(TileWork& w, double dt) const {
         Up = H > dry ? U + 0.5 * dt * acc * geo_.bx[k] : 0.0;
         Vp = H > dry ? V + 0.5 * dt * acc * geo_.by[k] : 0.0;
       }
-      const bool rest = apply_friction(Up, Vp, m3(k, Up, Vp), 0.5 * dt * resistance(k, 1.0, U, V, gn));
+      const double M3 = m3(k, Up, Vp), imp = 0.5 * dt * resistance(k, 1.0, gn);
+      const bool rest = apply_friction(Up, Vp, M3, imp);
+      if (ixi_ > 0 && H > dry) {  // Voellmy drag over the half step, implicit
+        const double f = turbulent_factor(std::max(M3 - imp, 0.0), H * geo_.c[k], 0.5 * dt * g_ * ixi_);
+        Up *= f;
+        Vp *= f;
+      }
       w.held[q] = rest && MU == 0.0 && MV == 0.0 ? 1.0 : 0.0;
       w.sHx[q] = sHx;
       w.sux[q] = sux;
@@ -579,6 +587,7 @@ RUNOUT_SIMD_CLONES void Solver::predictor_row(TileWork& w, int j, int ia, int ib
   double *__restrict oPxx = &w.Pxx[q0], *__restrict oPxy = &w.Pxy[q0], *__restrict oPyy = &w.Pyy[q0];
   double *__restrict oPs = &w.Ps[q0], *__restrict oheld = &w.held[q0];
   const double hx = 0.5 * dt / t_.dx, hy = 0.5 * dt / t_.dy, dry = cfg_.dry_depth, g = g_, mu = mu_, ixi = ixi_;
+  const double qcap = qcap_;
   const double curv = cfg_.curvature ? 1.0 : 0.0;
   const std::ptrdiff_t N = nx_;
   auto mm = [](double a, double b) { return limited_slope(lim, a, b); };
@@ -594,7 +603,7 @@ RUNOUT_SIMD_CLONES void Solver::predictor_row(TileWork& w, int j, int ia, int ib
     double sHy = mm(H - Hs[k - N], Hs[k + N] - H);
     double suy = wy * mm(U - Us[k - N], Us[k + N] - U), svy = wy * mm(V - Vs[k - N], Vs[k + N] - V);
     const double pxx = Pxx[k], pxy = Pxy[k], pyy = Pyy[k];
-    const double gn = std::max(0.0, g + U * U * hxx[k] + 2 * U * V * hxy[k] + V * V * hyy[k]);
+    const double gn = std::max(0.0, g + std::min(qcap, U * U * hxx[k] + 2 * U * V * hxy[k] + V * V * hyy[k]));
     const double c = cc[k], acc = -c * c * gn, wet = H > dry ? 1.0 : 0.0;
     const double Hp1 = H - hx * (U * sHx + H * sux) - hy * (V * sHy + H * svy);
     const double Up1 = wet * (U - hx * (U * sux + pxx * sHx) - hy * (V * suy + pxy * sHy) + 0.5 * dt * acc * bx[k]);
@@ -610,16 +619,18 @@ RUNOUT_SIMD_CLONES void Solver::predictor_row(TileWork& w, int j, int ia, int ib
     const double Hp = good * Hp1 + bad * H;
     double Up = good * Up1 + bad * (wet * (U + 0.5 * dt * acc * bx[k]));
     double Vp = good * Vp1 + bad * (wet * (V + 0.5 * dt * acc * by[k]));
-    // Friction over the half step, bounded: the same numbers as apply_friction.
-    const double wv = bx[k] * U + by[k] * V;
+    // Friction over the half step, bounded: the same numbers as apply_friction, then Voellmy's
+    // drag implicitly (turbulent_factor; 1 without it).
     const double load = curv * gn + (1.0 - curv) * g;
-    const double imp = 0.5 * dt * (mu * c * load + g * ixi * (U * U + V * V + wv * wv));
+    const double imp = 0.5 * dt * (mu * c * load);
     const double wp = bx[k] * Up + by[k] * Vp;
     const double M3 = std::sqrt(Up * Up + Vp * Vp + wp * wp);
     const double f = std::max(0.0, 1.0 - imp / std::max(M3, 1e-300));
     const double rest = M3 <= imp ? 1.0 : 0.0;
-    Up *= f;
-    Vp *= f;
+    const double ft = 2.0 / (1.0 + std::sqrt(1.0 + 4.0 * (0.5 * dt * g * ixi / std::max(H * c, 1e-300)) *
+                                                       std::max(M3 - imp, 0.0)));
+    Up *= f * ft;
+    Vp *= f * ft;
     oheld[t] = std::abs(HUs[k]) + std::abs(HVs[k]) == 0.0 ? rest : 0.0;
     oHx[t] = sHx;
     oux[t] = sux;
@@ -742,12 +753,18 @@ void Solver::update(int tt, const TileWork& w, double t, double dt) {
       double U = 0, V = 0, sp = 0;
       if (H > dry) {
         // Friction at the half step (midpoint rule), as a bounded impulse that never reverses u.
-        const double M3 = m3(k, MU, MV), impulse = dt * resistance(k, Hp, Up, Vp, gn);
+        const double M3 = m3(k, MU, MV), impulse = dt * resistance(k, Hp, gn);
         apply_friction(MU, MV, M3, impulse);
         const double inv = 1.0 / H;
+        sp = std::max(M3 - impulse, 0.0) * inv;  // surface speed after Coulomb friction
+        if (ixi_ > 0) {  // Voellmy drag, implicit in the speed
+          const double f = turbulent_factor(sp, H * geo_.c[k], dt * g_ * ixi_);
+          MU *= f;
+          MV *= f;
+          sp *= f;
+        }
         U = MU * inv;
         V = MV * inv;
-        sp = std::max(M3 - impulse, 0.0) * inv;  // surface speed after friction
       } else {
         MU = MV = 0;
       }

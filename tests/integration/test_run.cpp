@@ -360,3 +360,16 @@ TEST(Scenarios, InDenArelenReachesTheValleyFloor) {
   ASSERT_EQ(md->GetRasterBand(1)->RasterIO(GF_Read, i, rr, 1, 1, &v, 1, 1, GDT_Float32, 0, 0), CE_None);
   EXPECT_GT(v, 0.01f);
 }
+
+TEST(Scenarios, WolfsgrubenRunsInTheDemCrs) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/wolfsgruben.json");
+  r.dem.resolution = 20;  // coarser than the scenario's 5 m, to stay fast
+  r.timeseries_interval = 0;
+  TempDir d;
+  const auto sum = jobs::run_scenario(r, d.p.string());
+  EXPECT_EQ(sum.crs, "MGI / Austria Lambert");
+  EXPECT_LT(sum.volume_error, 1e-12);
+  EXPECT_NEAR(sum.release_area_m2, 135185, 0.05 * 135185);  // AvaFrame's projected release area
+  EXPECT_GT(sum.runout_m, 1000);
+  EXPECT_LT(sum.max_speed, 150);  // bounded (the curvature bound; without it this terrain ran away)
+}

@@ -97,6 +97,21 @@ TEST(Sh1d, KineticEnergyStopRule) {
   EXPECT_NEAR(r.mass_final, r.mass_initial, 1e-12 * r.mass_initial);
 }
 
+TEST(Sh1d, VoellmyLayerReachesItsTerminalSpeed) {
+  // Uniform 0.5 m layer on a 35 degree chute: u = sqrt(xi h (sin - mu cos)).
+  const int n = 40;
+  auto ch = Channel1D::uniform(n, 2.0, 0.0, 35 * kDeg);
+  Sh1dConfig cfg;
+  cfg.material.rheology = Rheology::voellmy;
+  cfg.material.mu = 0.25;
+  cfg.material.xi = 2000;
+  cfg.time.t_end = 200.0;
+  Sh1dState s{std::vector<double>(n, 0.5), std::vector<double>(n, 0.0)};
+  const auto r = run_sh1d(ch, cfg, s);
+  const double expect = std::sqrt(2000 * 0.5 * (std::sin(35 * kDeg) - 0.25 * std::cos(35 * kDeg)));
+  EXPECT_NEAR(r.state.m[n / 2] / r.state.h[n / 2], expect, 0.002 * expect);
+}
+
 TEST(Sh1d, ProgressHookCanCancel) {
   auto ch = Channel1D::uniform(50, 1.0, 0.0, 30 * kDeg);
   auto cfg = coulomb(20, 100.0);

@@ -118,7 +118,7 @@ TEST(Sh2d, OutflowIsAccountedFor) {
 }
 
 TEST(Sh2d, VoellmyLayerReachesItsTerminalSpeed) {
-  // Uniform 1 m layer on an infinite 30 degree slope: g sin - mu g cos - g u^2 / (xi h) = 0.
+  // Uniform 2 m layer on an infinite 30 degree slope: g sin - mu g cos - g u^2 / (xi h) = 0.
   Terrain2D t;
   t.nx = t.ny = 12;
   t.dx = t.dy = 5.0;
@@ -133,11 +133,11 @@ TEST(Sh2d, VoellmyLayerReachesItsTerminalSpeed) {
   cfg.time.t_end = 120.0;
   cfg.south = cfg.north = Boundary2D::wall;
   // An infinite slope: the outflow ghosts copy the state, so the uniform layer stays uniform.
-  const auto r = run_sh2d(t, cfg, state_from_normal_depth(t, std::vector<double>(t.cells(), 1.0)));
-  const double expect = std::sqrt(1000.0 * 1.0 * (std::sin(th) - 0.2 * std::cos(th)));
+  const auto r = run_sh2d(t, cfg, state_from_normal_depth(t, std::vector<double>(t.cells(), 2.0)));
+  const double expect = std::sqrt(1000.0 * 2.0 * (std::sin(th) - 0.2 * std::cos(th)));
   const std::size_t k = std::size_t(6) * t.nx + 6;
   EXPECT_NEAR(r.hazard.max_speed[k], expect, 0.005 * expect);
-  EXPECT_NEAR(r.hazard.final_depth[k], 1.0, 1e-9);
+  EXPECT_NEAR(r.hazard.final_depth[k], 2.0, 1e-9);
 }
 
 TEST(Sh2d, HazardMapsAreConsistent) {
@@ -313,6 +313,40 @@ TEST(Sh2d, OutsideMaskIsChecked) {
   t.outside.resize(3);
   s.H.assign(t.cells(), 0.0);
   EXPECT_THROW(run_sh2d(t, coulomb(20, 1.0), s), std::invalid_argument);
+}
+
+TEST(Sh2d, CurvatureBoundKeepsFlowsOnRoughTerrainWithinTheirEnergy) {
+  // A 35 degree slope corrugated at the grid scale (wavelength 3 cells, amplitude 1.5 m). Without
+  // friction a flow can never be faster than free fall from its highest point allows.
+  Terrain2D t;
+  t.nx = 160;
+  t.ny = 40;
+  t.dx = t.dy = 5.0;
+  t.z.resize(t.cells());
+  for (int j = 0; j < t.ny; ++j)
+    for (int i = 0; i < t.nx; ++i)
+      t.z[std::size_t(j) * t.nx + i] = -std::tan(35 * kDeg) * i * t.dx + 1.5 * std::sin(2 * M_PI * i / 3.0) * std::cos(2 * M_PI * j / 3.0);
+  const auto h0 = blob(t, 20, 20, 8, 2.0);
+  double zmax = -1e9, zmin = 1e9;
+  for (std::size_t k = 0; k < t.cells(); ++k) {
+    if (h0[k] > 0) zmax = std::max(zmax, t.z[k] + h0[k]);
+    zmin = std::min(zmin, t.z[k]);
+  }
+  const double bound = std::sqrt(2 * 9.81 * (zmax - zmin));
+  auto cfg = coulomb(0, 10.0);
+  cfg.south = cfg.north = Boundary2D::wall;
+  cfg.flow_threshold = 0.05;
+  cfg.time.max_steps = 3000;
+  const auto capped = run_sh2d(t, cfg, state_from_normal_depth(t, h0));
+  double vmax = 0;
+  for (double v : capped.hazard.max_speed) vmax = std::max(vmax, v);
+  // The bound leaves a few per cent of energy gain on this extreme corrugation (bumps of 3 m every 15 m).
+  EXPECT_LT(vmax, 1.10 * bound) << "bound " << bound;
+  cfg.curvature_cap = 1e9;  // unbounded: the explicit turns pump energy into the flow
+  const auto free = run_sh2d(t, cfg, state_from_normal_depth(t, h0));
+  double vfree = 0;
+  for (double v : free.hazard.max_speed) vfree = std::max(vfree, v);
+  EXPECT_GT(vfree, 1.5 * vmax) << "bound " << bound;
 }
 
 TEST(Sh2d, NormalDepthConventionOnASlope) {
