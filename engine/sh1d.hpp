@@ -5,12 +5,13 @@
 //
 //   dh/dt + d(h u)/dxi = 0
 //   d(h u)/dt + d(h u^2 + beta h^2 / 2)/dxi
-//       = h g sin(zeta) - sgn(u) h [ mu (g cos(zeta) + kappa u^2) + g u^2 / xi_V ],
+//       = h g sin(zeta) - sgn(u) [ h mu (g cos(zeta) + kappa u^2) + g u^2 / xi_V ],
 //   beta = K g cos(zeta),
 //
 // zeta(xi) the local inclination (positive where the bed falls in +xi), kappa = -dzeta/dxi the
 // bed curvature (positive where the channel flattens: concave), mu = tan(delta) (Coulomb) or the
-// Voellmy mu, and 1/xi_V = 0 for pure Coulomb friction. K = 1 or K_act/pass from phi and delta by
+// Voellmy mu, and 1/xi_V = 0 for pure Coulomb friction (Voellmy's drag is a stress, independent of
+// the depth; it is integrated implicitly, engine/rheology.hpp turbulent_factor). K = 1 or K_act/pass from phi and delta by
 // the sign of du/dxi.
 //
 // Scheme: the NOC (non-oscillatory central) predictor-corrector of Tai et al. (2002) and the

@@ -16,7 +16,7 @@
 // horizontal momentum balance per horizontal area is
 //
 //   d(H U)/dt + div(H U (x) U + Pi) = -H c^2 (g + Q)_+ grad(b)                      (gravity + normal reaction)
-//                                      - [mu H c (g + Q)_+ + H g |u|^2 / xi] u_h / |u|   (basal friction)
+//                                      - [mu H c (g + Q)_+ + g |u|^2 / (xi c)] u_h / |u| (basal friction)
 //
 // with |u|^2 = |U|^2 + (grad b . U)^2, u_h / |u| the horizontal part of the unit velocity, and the
 // depth-averaged pressure (earth pressure K in the downslope direction d and K_y across it)
