@@ -183,7 +183,14 @@ Grid prepare_grid(const DemRequest& req, DemReport* report) {
   if (!dst.IsProjected())
     throw TerrainError("grid.crs: the computation needs a projected CRS in metres, got " + crs_name(dst));
 
-  const double res = req.resolution > 0 ? req.resolution : std::max(1.0, std::round(rep.source_resolution_m));
+  // The DEM's own grid is used as it is (no resampling) when the computation CRS is the DEM's, its
+  // raster is north-up with square cells and the resolution is the DEM's (or not given).
+  const bool north_up = gt[2] == 0 && gt[4] == 0 && gt[5] < 0 && std::abs(gt[1] + gt[5]) <= 1e-9 * gt[1];
+  const bool native = north_up && dst.IsSame(&src) &&
+                      (req.resolution <= 0 || std::abs(req.resolution - gt[1]) <= 1e-6 * gt[1]);
+  const double res = native ? gt[1]
+                     : req.resolution > 0 ? req.resolution
+                                          : std::max(1.0, std::round(rep.source_resolution_m));
   if (rep.source_resolution_m > 0 && res < rep.source_resolution_m / 10.0)
     throw TerrainError("grid.resolution_m = " + fmt(res, 2) + " m is finer than a tenth of the DEM's resolution (" +
                        fmt(rep.source_resolution_m, 1) + " m)");
@@ -230,31 +237,60 @@ Grid prepare_grid(const DemRequest& req, DemReport* report) {
                          " m exceeds the memory budget of " + fmt(req.memory_budget_bytes / (1u << 30), 1) +
                          " GiB: choose a coarser grid.resolution_m or a smaller area of interest");
   }
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> wopt(
-      GDALWarpAppOptionsNew(argv.data(), nullptr), GDALWarpAppOptionsFree);
-  if (!wopt) throw TerrainError("internal: warp options rejected" + gdal_message());
-  GDALDatasetH srch = GDALDataset::ToHandle(dem.get());
-  int usage_error = 0;
-  GDALDatasetUniquePtr warped(GDALDataset::FromHandle(GDALWarp("", nullptr, 1, &srch, wopt.get(), &usage_error)));
-  if (!warped) throw TerrainError("DEM '" + req.dem_path + "': reprojection failed" + gdal_message());
-
   Grid g;
-  g.nx = warped->GetRasterXSize();
-  g.ny = warped->GetRasterYSize();
-  double wgt[6];
-  warped->GetGeoTransform(wgt);
-  g.dx = wgt[1];
-  g.x_min = wgt[0];
-  g.y_min = wgt[3] + wgt[5] * g.ny;
   g.crs_wkt = wkt(dst);
   g.crs_name = crs_name(dst);
-  if (g.nx < 3 || g.ny < 3) throw TerrainError("the area of interest covers fewer than 3 x 3 cells at " + fmt(res, 2) + " m");
-  std::vector<double> rows(g.cells());
-  if (warped->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, g.nx, g.ny, rows.data(), g.nx, g.ny, GDT_Float64, 0, 0) != CE_None)
-    throw TerrainError("DEM '" + req.dem_path + "': reading the reprojected raster failed" + gdal_message());
+  std::vector<double> rows;
+  if (native) {
+    // A window of whole DEM cells covering the area (or the whole DEM), values as they are.
+    int c0 = 0, r0 = 0, c1 = dem->GetRasterXSize(), r1 = dem->GetRasterYSize();
+    if (aoi) {
+      const std::size_t k = std::find(args.begin(), args.end(), "-te") - args.begin();
+      const double ex0 = std::stod(args[k + 1]), ey0 = std::stod(args[k + 2]), ex1 = std::stod(args[k + 3]),
+                   ey1 = std::stod(args[k + 4]);
+      c0 = std::max(c0, int(std::floor((ex0 - gt[0]) / gt[1])));
+      c1 = std::min(c1, int(std::ceil((ex1 - gt[0]) / gt[1])));
+      r0 = std::max(r0, int(std::floor((ey1 - gt[3]) / gt[5])));
+      r1 = std::min(r1, int(std::ceil((ey0 - gt[3]) / gt[5])));
+    }
+    g.nx = c1 - c0;
+    g.ny = r1 - r0;
+    g.dx = gt[1];
+    g.x_min = gt[0] + c0 * gt[1];
+    g.y_min = gt[3] + r1 * gt[5];
+    if (g.nx < 3 || g.ny < 3) throw TerrainError("the area of interest covers fewer than 3 x 3 cells of the DEM");
+    rows.resize(g.cells());
+    auto* band = dem->GetRasterBand(1);
+    if (band->RasterIO(GF_Read, c0, r0, g.nx, g.ny, rows.data(), g.nx, g.ny, GDT_Float64, 0, 0) != CE_None)
+      throw TerrainError("DEM '" + req.dem_path + "': reading the raster failed" + gdal_message());
+    int has = 0;
+    const double nd = band->GetNoDataValue(&has);
+    if (has)
+      for (double& v : rows)
+        if (v == nd || std::isnan(nd) != std::isnan(v)) v = -99999.0;
+  } else {
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> wopt(
+        GDALWarpAppOptionsNew(argv.data(), nullptr), GDALWarpAppOptionsFree);
+    if (!wopt) throw TerrainError("internal: warp options rejected" + gdal_message());
+    GDALDatasetH srch = GDALDataset::ToHandle(dem.get());
+    int usage_error = 0;
+    GDALDatasetUniquePtr warped(GDALDataset::FromHandle(GDALWarp("", nullptr, 1, &srch, wopt.get(), &usage_error)));
+    if (!warped) throw TerrainError("DEM '" + req.dem_path + "': reprojection failed" + gdal_message());
+    g.nx = warped->GetRasterXSize();
+    g.ny = warped->GetRasterYSize();
+    double wgt[6];
+    warped->GetGeoTransform(wgt);
+    g.dx = wgt[1];
+    g.x_min = wgt[0];
+    g.y_min = wgt[3] + wgt[5] * g.ny;
+    if (g.nx < 3 || g.ny < 3) throw TerrainError("the area of interest covers fewer than 3 x 3 cells at " + fmt(res, 2) + " m");
+    rows.resize(g.cells());
+    if (warped->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, g.nx, g.ny, rows.data(), g.nx, g.ny, GDT_Float64, 0, 0) != CE_None)
+      throw TerrainError("DEM '" + req.dem_path + "': reading the reprojected raster failed" + gdal_message());
+  }
   g.z.resize(g.cells());
   g.outside.assign(g.cells(), 0);
   for (int r = 0; r < g.ny; ++r)

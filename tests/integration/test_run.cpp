@@ -318,6 +318,31 @@ TEST(Terrain, DemGapsAndTheAreaPolygonAreOutsideTheDomain) {
   EXPECT_EQ(v, -9999.0f);
 }
 
+TEST(Terrain, TheDemsOwnGridIsUsedAsItIs) {
+  TempDir d;
+  make_dem(d / "dem.tif", 90, 7.5, 30);  // cells of 7.5 m: not a round size
+  terrain::DemRequest rq;
+  rq.dem_path = d / "dem.tif";
+  rq.target_crs = "dem";
+  const auto g = terrain::prepare_grid(rq);
+  EXPECT_EQ(g.nx, 90);
+  EXPECT_EQ(g.ny, 90);
+  EXPECT_EQ(g.dx, 7.5);
+  EXPECT_EQ(g.x_min, 500000.0);
+  GDALDatasetUniquePtr ds(GDALDataset::Open((d / "dem.tif").c_str(), GDAL_OF_RASTER));
+  float z = 0;
+  ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 10, 20, 1, 1, &z, 1, 1, GDT_Float32, 0, 0), CE_None);
+  EXPECT_EQ(g.z[std::size_t(90 - 1 - 20) * 90 + 10], double(z));  // values unchanged (no resampling)
+  // With an area of interest: a window of whole DEM cells.
+  make_polygons(d / "aoi.geojson", {square(500100, 5200100, 300)}, "EPSG:32632");
+  rq.aoi_path = d / "aoi.geojson";
+  const auto w = terrain::prepare_grid(rq);
+  EXPECT_EQ(w.dx, 7.5);
+  EXPECT_NEAR(std::fmod(w.x_min - 500000.0, 7.5), 0.0, 1e-9);
+  EXPECT_LE(w.x_min, 500100.0);
+  EXPECT_GE(w.x_min + w.nx * w.dx, 500400.0);
+}
+
 TEST(Terrain, GridOverTheMemoryBudgetIsRefused) {
   TempDir d;
   make_dem(d / "dem.tif", 400, 100.0, 20);  // 40 km square
@@ -363,7 +388,7 @@ TEST(Scenarios, InDenArelenReachesTheValleyFloor) {
 
 TEST(Scenarios, WolfsgrubenRunsInTheDemCrs) {
   auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/wolfsgruben.json");
-  r.dem.resolution = 20;  // coarser than the scenario's 5 m, to stay fast
+  r.dem.resolution = 20;  // coarser than the DEM's 5 m, to stay fast
   r.timeseries_interval = 0;
   TempDir d;
   const auto sum = jobs::run_scenario(r, d.p.string());
