@@ -137,6 +137,7 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
     if (q.has_max_slope && !(q.max_slope > 0 && q.max_slope <= 90)) bad(f + ".max_slope_deg", "must lie in (0, 90]");
     if (q.has_min_slope && q.has_max_slope && !(q.min_slope < q.max_slope))
       bad(f, "min_slope_deg must be below max_slope_deg");
+    q.crs = rl.crs();
     q.min_slope_attribute = rl.min_slope_attribute();
     q.max_slope_attribute = rl.max_slope_attribute();
     r.releases.push_back(q);

@@ -431,9 +431,15 @@ std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseR
     int n = 0;
     for (auto* layer : ds->GetLayers()) {
       const OGRSpatialReference* ls = layer->GetSpatialRef();
-      if (!ls) throw TerrainError("release '" + rq.path + "': the file has no CRS");
-      OGRSpatialReference src = *ls;
-      src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+      OGRSpatialReference src;
+      if (ls && !ls->IsEmpty()) {
+        src = *ls;
+        src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+      } else if (!rq.crs.empty()) {
+        src = srs_from(rq.crs, "release '" + rq.path + "'");
+      } else {
+        throw TerrainError("release '" + rq.path + "' has no CRS and none is given: set the release's crs (e.g. \"EPSG:2056\")");
+      }
       auto ct = transform(src, dst, "release '" + rq.path + "'");
       for (auto& f : layer) {
         ++n;

@@ -61,6 +61,7 @@ std::vector<double> slope_deg(const Grid& g);
 
 struct ReleaseRequest {
   std::string path;
+  std::string crs;  ///< used when the file has none
   bool has_thickness = false;
   double thickness = 0;
   std::string thickness_attribute;

@@ -343,6 +343,43 @@ TEST(Terrain, TheDemsOwnGridIsUsedAsItIs) {
   EXPECT_GE(w.x_min + w.nx * w.dx, 500400.0);
 }
 
+TEST(Terrain, ReleaseWithoutCrsNeedsOne) {
+  TempDir d;
+  make_dem(d / "dem.tif", 80, 25.0, 30);
+  // A shapefile without .prj.
+  {
+    auto* drv = GetGDALDriverManager()->GetDriverByName("ESRI Shapefile");
+    GDALDatasetUniquePtr ds(drv->Create((d / "rel.shp").c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+    auto* layer = ds->CreateLayer("rel", nullptr, wkbPolygon, nullptr);
+    OGRFeature f(layer->GetLayerDefn());
+    OGRPolygon p;
+    OGRLinearRing ring;
+    for (const auto& v : square(500300, 5200500, 300)) ring.addPoint(v.first, v.second);
+    p.addRing(&ring);
+    f.SetGeometry(&p);
+    ASSERT_EQ(layer->CreateFeature(&f), OGRERR_NONE);
+  }
+  ASSERT_FALSE(fs::exists(d / "rel.prj"));
+  terrain::DemRequest rq;
+  rq.dem_path = d / "dem.tif";
+  rq.resolution = 25;
+  const auto g = terrain::prepare_grid(rq);
+  terrain::ReleaseRequest r;
+  r.path = d / "rel.shp";
+  r.has_thickness = true;
+  r.thickness = 1;
+  try {
+    terrain::rasterize_releases(g, {r});
+    ADD_FAILURE();
+  } catch (const terrain::TerrainError& e) {
+    EXPECT_NE(std::string(e.what()).find("has no CRS and none is given"), std::string::npos) << e.what();
+  }
+  r.crs = "EPSG:32632";
+  terrain::ReleaseReport rep;
+  terrain::rasterize_releases(g, {r}, &rep);
+  EXPECT_EQ(rep.cells, 12 * 12);
+}
+
 TEST(Terrain, GridOverTheMemoryBudgetIsRefused) {
   TempDir d;
   make_dem(d / "dem.tif", 400, 100.0, 20);  // 40 km square
