@@ -153,7 +153,8 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
     sum.files.push_back(name + ".tif");
   }
   const auto outline = terrain::write_outline(out("outline.geojson"), out("outline.gpkg"), grid, hz.max_depth, s.outline_threshold);
-  sum.files.push_back("outline.geojson");
+  if (outline.geojson) sum.files.push_back("outline.geojson");
+  else sum.notes.push_back("outline.geojson not written: the grid's CRS is local (no geographic coordinates)");
   sum.files.push_back("outline.gpkg");
   terrain::MapRequest mreq;
   mreq.title = s.scenario.name().empty() ? "runout" : s.scenario.name();

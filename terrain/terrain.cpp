@@ -43,6 +43,11 @@ std::string fmt(double v, int prec = 1) {
 
 OGRSpatialReference srs_from(const std::string& text, const std::string& what) {
   OGRSpatialReference s;
+  if (text == "local") {  // local Cartesian metres: synthetic terrain, surveys without georeference
+    s.SetLocalCS("local metres");
+    s.SetLinearUnits(SRS_UL_METER, 1.0);
+    return s;
+  }
   if (s.SetFromUserInput(text.c_str()) != OGRERR_NONE)
     throw TerrainError(what + ": unknown CRS '" + text + "' (use e.g. EPSG:2056 or a WKT/PROJ string)");
   s.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
@@ -56,13 +61,6 @@ OGRSpatialReference wgs84() {
   return s;
 }
 
-std::unique_ptr<OGRCoordinateTransformation> transform(const OGRSpatialReference& from, const OGRSpatialReference& to,
-                                                       const std::string& what) {
-  std::unique_ptr<OGRCoordinateTransformation> t(OGRCreateCoordinateTransformation(&from, &to));
-  if (!t) throw TerrainError(what + ": no coordinate transformation between the CRSs" + gdal_message());
-  return t;
-}
-
 std::string wkt(const OGRSpatialReference& s) {
   char* w = nullptr;
   s.exportToWkt(&w);
@@ -72,11 +70,25 @@ std::string wkt(const OGRSpatialReference& s) {
 }
 
 std::string crs_name(const OGRSpatialReference& s) {
+  if (s.IsLocal()) return "local metres";
   const char* auth = s.GetAuthorityName(nullptr);
   const char* code = s.GetAuthorityCode(nullptr);
   if (auth && code) return std::string(auth) + ":" + code;
   const char* n = s.GetName();
   return n ? n : "unnamed CRS";
+}
+
+// A coordinate transformation; nullptr for two local CRSs (the identity: they have no datum to relate).
+std::unique_ptr<OGRCoordinateTransformation> transform(const OGRSpatialReference& from, const OGRSpatialReference& to,
+                                                       const std::string& what) {
+  if (from.IsLocal() || to.IsLocal()) {
+    if (from.IsLocal() && to.IsLocal()) return nullptr;
+    throw TerrainError(what + ": a local CRS cannot be related to " + (from.IsLocal() ? crs_name(to) : crs_name(from)) +
+                       "; give every input in the same local CRS");
+  }
+  std::unique_ptr<OGRCoordinateTransformation> t(OGRCreateCoordinateTransformation(&from, &to));
+  if (!t) throw TerrainError(what + ": no coordinate transformation between the CRSs" + gdal_message());
+  return t;
 }
 
 // Union of the polygons of every layer of a vector file, with its CRS.
@@ -156,22 +168,30 @@ Grid prepare_grid(const DemRequest& req, DemReport* report) {
     rep.used_aoi = true;
   }
   const auto ll = wgs84();
-  double clon, clat;
-  if (aoi) {
+  double clon = 0, clat = 0;
+  if (src.IsLocal()) {
+    // No geographic position: the grid stays in the local CRS.
+  } else if (aoi) {
     OGREnvelope e;
     aoi->getEnvelope(&e);
     clon = 0.5 * (e.MinX + e.MaxX);
     clat = 0.5 * (e.MinY + e.MaxY);
-    transform(aoi_srs, ll, "area of interest")->Transform(1, &clon, &clat);
+    auto ct = transform(aoi_srs, ll, "area of interest");
+    if (ct) ct->Transform(1, &clon, &clat);
   } else {
     clon = gt[0] + gt[1] * dem->GetRasterXSize() / 2.0 + gt[2] * dem->GetRasterYSize() / 2.0;
     clat = gt[3] + gt[4] * dem->GetRasterXSize() / 2.0 + gt[5] * dem->GetRasterYSize() / 2.0;
-    transform(src, ll, "DEM")->Transform(1, &clon, &clat);
+    auto ct = transform(src, ll, "DEM");
+    if (ct) ct->Transform(1, &clon, &clat);
   }
 
   // Computation CRS.
   OGRSpatialReference dst;
-  if (req.target_crs.empty() || req.target_crs == "utm") {
+  if (src.IsLocal()) {
+    if (!(req.target_crs.empty() || req.target_crs == "dem"))
+      throw TerrainError("grid.crs: a DEM in a local CRS is computed in it (\"dem\"), not in " + req.target_crs);
+    dst = src;
+  } else if (req.target_crs.empty() || req.target_crs == "utm") {
     const int zone = std::clamp(int(std::floor((clon + 180.0) / 6.0)) + 1, 1, 60);
     dst.importFromEPSG((clat >= 0 ? 32600 : 32700) + zone);
   } else if (req.target_crs == "dem") {
@@ -180,7 +200,7 @@ Grid prepare_grid(const DemRequest& req, DemReport* report) {
     dst = srs_from(req.target_crs, "grid.crs");
   }
   dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  if (!dst.IsProjected())
+  if (!dst.IsProjected() && !dst.IsLocal())
     throw TerrainError("grid.crs: the computation needs a projected CRS in metres, got " + crs_name(dst));
 
   // The DEM's own grid is used as it is (no resampling) when the computation CRS is the DEM's, its
@@ -188,6 +208,9 @@ Grid prepare_grid(const DemRequest& req, DemReport* report) {
   const bool north_up = gt[2] == 0 && gt[4] == 0 && gt[5] < 0 && std::abs(gt[1] + gt[5]) <= 1e-9 * gt[1];
   const bool native = north_up && dst.IsSame(&src) &&
                       (req.resolution <= 0 || std::abs(req.resolution - gt[1]) <= 1e-6 * gt[1]);
+  if (src.IsLocal() && !native)
+    throw TerrainError("grid: a DEM in a local CRS is used on its own cells (leave grid.resolution_m unset or equal to " +
+                       fmt(gt[1], 4) + " m; its raster must be north-up with square cells)");
   const double res = native ? gt[1]
                      : req.resolution > 0 ? req.resolution
                                           : std::max(1.0, std::round(rep.source_resolution_m));
@@ -205,7 +228,8 @@ Grid prepare_grid(const DemRequest& req, DemReport* report) {
   }
   if (aoi) {
     auto g = std::unique_ptr<OGRGeometry>(aoi->clone());
-    if (g->transform(transform(aoi_srs, dst, "area of interest").get()) != OGRERR_NONE)
+    auto ct = transform(aoi_srs, dst, "area of interest");
+    if (ct && g->transform(ct.get()) != OGRERR_NONE)
       throw TerrainError("area of interest '" + req.aoi_path + "': cannot transform it to " + crs_name(dst));
     OGREnvelope e;
     g->getEnvelope(&e);
@@ -306,7 +330,7 @@ Grid prepare_grid(const DemRequest& req, DemReport* report) {
   // Cells outside the area-of-interest polygon are outside the domain too.
   if (aoi) {
     auto poly = std::unique_ptr<OGRGeometry>(aoi->clone());
-    poly->transform(transform(aoi_srs, dst, "area of interest").get());
+    if (auto ct = transform(aoi_srs, dst, "area of interest")) poly->transform(ct.get());
     GDALDatasetUniquePtr mask(GetGDALDriverManager()->GetDriverByName("MEM")->Create("", g.nx, g.ny, 1, GDT_Byte, nullptr));
     double mgt[6] = {g.x_min, g.dx, 0, g.y_min + g.ny * g.dx, 0, -g.dx};
     mask->SetGeoTransform(mgt);
@@ -466,7 +490,7 @@ std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseR
           geom = std::move(fixed);
           rep.notes.push_back(what + ": invalid geometry (e.g. self-intersecting) repaired with GEOS MakeValid");
         }
-        if (geom->transform(ct.get()) != OGRERR_NONE) throw TerrainError(what + ": cannot transform it to " + g.crs_name);
+        if (ct && geom->transform(ct.get()) != OGRERR_NONE) throw TerrainError(what + ": cannot transform it to " + g.crs_name);
         auto mask_ds = mem_raster(g, GDT_Byte);
         int band = 1;
         double burn = 1;
@@ -554,6 +578,14 @@ OutlineReport write_outline(const std::string& geojson_path, const std::string& 
   layer->CreateField(&fd);
   if (GDALPolygonize(mask->GetRasterBand(1), mask->GetRasterBand(1), layer, 0, nullptr, nullptr, nullptr) != CE_None)
     throw TerrainError("outline: polygonising failed" + gdal_message());
+  layer->ResetReading();
+  for (auto& f : layer) {
+    if (const OGRGeometry* geom = f->GetGeometryRef()) {
+      rep.area_m2 += geom->toPolygon()->get_Area();
+      ++rep.polygons;
+    }
+  }
+  if (srs.IsLocal()) return rep;  // no geographic coordinates: no GeoJSON (RFC 7946 is WGS84)
   // GeoJSON in WGS84 (RFC 7946) from the same polygons.
   auto* gj = GetGDALDriverManager()->GetDriverByName("GeoJSON");
   const char* gjopts[] = {"RFC7946=YES", nullptr};
@@ -568,16 +600,14 @@ OutlineReport write_outline(const std::string& geojson_path, const std::string& 
   for (auto& f : layer) {
     const OGRGeometry* geom = f->GetGeometryRef();
     if (!geom) continue;
-    const double a = geom->toPolygon()->get_Area();
-    rep.area_m2 += a;
-    ++rep.polygons;
     std::unique_ptr<OGRGeometry> w(geom->clone());
     w->transform(ct.get());
     OGRFeature out(jl->GetLayerDefn());
-    out.SetField("area_m2", a);
+    out.SetField("area_m2", geom->toPolygon()->get_Area());
     out.SetGeometry(w.get());
     if (jl->CreateFeature(&out) != OGRERR_NONE) throw TerrainError("writing '" + geojson_path + "' failed" + gdal_message());
   }
+  rep.geojson = true;
   return rep;
 }
 

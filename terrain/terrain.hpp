@@ -89,8 +89,10 @@ void write_cog(const std::string& path, const Grid& g, const std::vector<double>
 struct OutlineReport {
   int polygons = 0;
   double area_m2 = 0;
+  bool geojson = false;  ///< written (not for a grid in a local CRS)
 };
-/// Outline of the cells where values > threshold: GeoJSON in WGS84 lon/lat and GeoPackage in the grid's CRS.
+/// Outline of the cells where values > threshold: GeoJSON in WGS84 lon/lat (unless the grid's CRS is
+/// local) and GeoPackage in the grid's CRS.
 OutlineReport write_outline(const std::string& geojson_path, const std::string& gpkg_path, const Grid& g,
                             const std::vector<double>& values, double threshold);
 

@@ -93,6 +93,17 @@ v1::Scenario base_scenario(const std::string& dem, const std::string& release, d
   return s;
 }
 
+void expect_error(const v1::Scenario& s, const TempDir& d, const std::string& needle) {
+  try {
+    auto r = jobs::resolve_scenario(s, d.p.string());
+    fs::create_directories(d.p / "err");
+    jobs::run_scenario(r, (d.p / "err").string());
+    ADD_FAILURE() << "no error, expected one containing: " << needle;
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 
 TEST(Terrain, SyntheticSlopeRunsAndWritesEveryOutput) {
@@ -343,22 +354,51 @@ TEST(Terrain, TheDemsOwnGridIsUsedAsItIs) {
   EXPECT_GE(w.x_min + w.nx * w.dx, 500400.0);
 }
 
+// A shapefile without .prj holding one polygon.
+void make_shapefile(const std::string& path, const std::vector<std::pair<double, double>>& ring_pts) {
+  auto* drv = GetGDALDriverManager()->GetDriverByName("ESRI Shapefile");
+  GDALDatasetUniquePtr ds(drv->Create(path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+  auto* layer = ds->CreateLayer("rel", nullptr, wkbPolygon, nullptr);
+  OGRFeature f(layer->GetLayerDefn());
+  OGRPolygon p;
+  OGRLinearRing ring;
+  for (const auto& v : ring_pts) ring.addPoint(v.first, v.second);
+  p.addRing(&ring);
+  f.SetGeometry(&p);
+  ASSERT_EQ(layer->CreateFeature(&f), OGRERR_NONE);
+}
+
+TEST(Terrain, LocalCrsForTerrainWithoutGeoreference) {
+  TempDir d;
+  make_dem(d / "dem.asc", 80, 5.0, 30, "", false);  // synthetic, no CRS at all
+  make_shapefile(d / "rel.shp", square(500050, 5200250, 60));
+  auto sc = base_scenario(d / "dem.asc", d / "rel.shp");
+  sc.mutable_grid()->set_resolution_m(0);
+  sc.mutable_dem()->set_crs("local");
+  sc.mutable_releases(0)->set_crs("local");
+  auto r = jobs::resolve_scenario(sc, d.p.string());
+  fs::create_directories(d / "out");
+  const auto sum = jobs::run_scenario(r, d / "out");
+  EXPECT_EQ(sum.crs, "local metres");
+  EXPECT_EQ(sum.nx, 80);
+  EXPECT_EQ(sum.dx, 5.0);
+  EXPECT_LT(sum.volume_error, 1e-12);
+  EXPECT_TRUE(fs::exists(d / "out/max_depth.tif"));
+  EXPECT_TRUE(fs::exists(d / "out/outline.gpkg"));
+  EXPECT_FALSE(fs::exists(d / "out/outline.geojson"));
+  ASSERT_EQ(sum.notes.size(), 1u);
+  // A local DEM cannot be resampled or related to a georeferenced release.
+  sc.mutable_grid()->set_resolution_m(10);
+  expect_error(sc, d, "used on its own cells");
+  sc.mutable_grid()->set_resolution_m(0);
+  sc.mutable_releases(0)->set_crs("EPSG:32632");
+  expect_error(sc, d, "a local CRS cannot be related to EPSG:32632");
+}
+
 TEST(Terrain, ReleaseWithoutCrsNeedsOne) {
   TempDir d;
   make_dem(d / "dem.tif", 80, 25.0, 30);
-  // A shapefile without .prj.
-  {
-    auto* drv = GetGDALDriverManager()->GetDriverByName("ESRI Shapefile");
-    GDALDatasetUniquePtr ds(drv->Create((d / "rel.shp").c_str(), 0, 0, 0, GDT_Unknown, nullptr));
-    auto* layer = ds->CreateLayer("rel", nullptr, wkbPolygon, nullptr);
-    OGRFeature f(layer->GetLayerDefn());
-    OGRPolygon p;
-    OGRLinearRing ring;
-    for (const auto& v : square(500300, 5200500, 300)) ring.addPoint(v.first, v.second);
-    p.addRing(&ring);
-    f.SetGeometry(&p);
-    ASSERT_EQ(layer->CreateFeature(&f), OGRERR_NONE);
-  }
+  make_shapefile(d / "rel.shp", square(500300, 5200500, 300));
   ASSERT_FALSE(fs::exists(d / "rel.prj"));
   terrain::DemRequest rq;
   rq.dem_path = d / "dem.tif";
