@@ -94,7 +94,9 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
     cfg.snapshot = [&](double time, const engine::Sh2dStateView& v) { series->write(time, v); };
   }
   const auto t1 = std::chrono::steady_clock::now();
+  const std::clock_t cpu0 = std::clock();
   const auto res = engine::run_sh2d(t, cfg, engine::state_from_normal_depth(t, h0));
+  sum.cpu_seconds = double(std::clock() - cpu0) / CLOCKS_PER_SEC;
   int frames = 0;
   if (series) frames = series->finish();
   sum.seconds_run = since(t1);
@@ -168,6 +170,20 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
     sum.files.push_back("timeseries.xmf");
   }
   sum.seconds_write = since(t2);
+
+  // ISeeSnow export: peak flow thickness and velocity on the input DEM's grid, and the result row.
+  if (!opt.iseesnow_id.empty()) {
+    const std::string stem = fs::path(s.releases.front().path).stem().string() + "_" + opt.iseesnow_id + "_null_runout";
+    terrain::write_ascii_on(out(stem + "_pft.asc"), s.dem.dem_path, grid, masked(hz.max_depth));
+    terrain::write_ascii_on(out(stem + "_pfv.asc"), s.dem.dem_path, grid, masked(hz.max_speed));
+    std::ofstream csv(out("iseesnow_" + opt.iseesnow_id + ".csv"));
+    csv << "simulationID,modelName,cpuTime_s,flowTime_s,initialVolume_m3,finalVolume_m3,resolution_m\n";
+    csv << opt.iseesnow_id << ",runout," << jnum(sum.cpu_seconds) << "," << jnum(d.t) << "," << jnum(d.volume_initial) << ","
+        << jnum(d.volume_final) << "," << jnum(grid.dx) << "\n";
+    if (!csv) throw std::runtime_error("writing the ISeeSnow CSV failed");
+    for (const char* suffix : {"_pft.asc", "_pfv.asc"}) sum.files.push_back(stem + suffix);
+    sum.files.push_back("iseesnow_" + opt.iseesnow_id + ".csv");
+  }
 
   // Run record.
   std::string scenario_json;

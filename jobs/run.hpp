@@ -13,6 +13,10 @@ namespace runout::jobs {
 struct RunOptions {
   engine::ProgressHook progress;  ///< optional; returning false cancels the run
   long progress_every = 50;
+  /// ISeeSnow benchmark export (validation.md A8) when not empty: the simulation id (e.g.
+  /// "03CoulombOnly"). Writes <release>_<id>_null_runout_pft.asc / _pfv.asc on the DEM's grid and
+  /// iseesnow_<id>.csv.
+  std::string iseesnow_id;
 };
 
 struct RunSummary {
@@ -26,6 +30,7 @@ struct RunSummary {
   long steps = 0;
   std::string stop;
   double seconds_prepare = 0, seconds_run = 0, seconds_write = 0;
+  double cpu_seconds = 0;  ///< processor time of the solve (all threads)
   std::vector<std::string> files;  ///< written, relative to the output directory
   std::vector<std::string> notes;
 };

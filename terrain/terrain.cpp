@@ -611,6 +611,56 @@ OutlineReport write_outline(const std::string& geojson_path, const std::string& 
   return rep;
 }
 
+void write_ascii_on(const std::string& path, const std::string& template_path, const Grid& g,
+                    const std::vector<double>& values) {
+  init_gdal();
+  GDALDatasetUniquePtr tpl(GDALDataset::Open(template_path.c_str(), GDAL_OF_RASTER));
+  if (!tpl) throw TerrainError("'" + template_path + "': cannot read it as a raster" + gdal_message());
+  auto src = mem_raster(g, GDT_Float32);
+  const float nodata = -9999.0f;
+  src->GetRasterBand(1)->SetNoDataValue(nodata);
+  std::vector<float> rows(g.cells());
+  for (int r = 0; r < g.ny; ++r)
+    for (int i = 0; i < g.nx; ++i) {
+      const double v = values[std::size_t(g.ny - 1 - r) * g.nx + i];
+      rows[std::size_t(r) * g.nx + i] = std::isfinite(v) ? float(v) : nodata;
+    }
+  if (src->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, g.nx, g.ny, rows.data(), g.nx, g.ny, GDT_Float32, 0, 0) != CE_None)
+    throw TerrainError("writing '" + path + "' failed");
+  auto* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  GDALDatasetUniquePtr dst(mem->Create("", tpl->GetRasterXSize(), tpl->GetRasterYSize(), 1, GDT_Float32, nullptr));
+  double gt[6];
+  tpl->GetGeoTransform(gt);
+  dst->SetGeoTransform(gt);
+  // The template's CRS, or the grid's when the template has none (a DEM whose CRS the scenario gave).
+  const OGRSpatialReference* ts = tpl->GetSpatialRef();
+  dst->SetProjection(ts && !ts->IsEmpty() ? wkt(*ts).c_str() : g.crs_wkt.c_str());
+  dst->GetRasterBand(1)->SetNoDataValue(nodata);
+  dst->GetRasterBand(1)->Fill(nodata);
+  std::vector<std::string> args = {"-r", "bilinear", "-srcnodata", "-9999", "-dstnodata", "-9999"};
+  OGRSpatialReference gs;
+  gs.importFromWkt(g.crs_wkt.c_str());
+  if (gs.IsLocal()) {  // identical local frames: no CRS to transform between
+    args.push_back("-to");
+    args.push_back("SRC_METHOD=GEOTRANSFORM");
+    args.push_back("-to");
+    args.push_back("DST_METHOD=GEOTRANSFORM");
+  }
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> wopt(GDALWarpAppOptionsNew(argv.data(), nullptr),
+                                                                               GDALWarpAppOptionsFree);
+  GDALDatasetH s = GDALDataset::ToHandle(src.get());
+  int usage = 0;
+  if (!GDALWarp(nullptr, GDALDataset::ToHandle(dst.get()), 1, &s, wopt.get(), &usage))
+    throw TerrainError("writing '" + path + "': resampling to the DEM's grid failed" + gdal_message());
+  auto* asc = GetGDALDriverManager()->GetDriverByName("AAIGrid");
+  const char* opts[] = {"DECIMAL_PRECISION=4", nullptr};
+  GDALDatasetUniquePtr out(asc->CreateCopy(path.c_str(), dst.get(), FALSE, const_cast<char**>(opts), nullptr, nullptr));
+  if (!out) throw TerrainError("writing '" + path + "' failed" + gdal_message());
+}
+
 std::string sha256_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw TerrainError("cannot read '" + path + "' to hash it");

@@ -96,6 +96,11 @@ struct OutlineReport {
 OutlineReport write_outline(const std::string& geojson_path, const std::string& gpkg_path, const Grid& g,
                             const std::vector<double>& values, double threshold);
 
+/// ESRI ASCII grid of `values` (computed on `g`) on the raster grid of the file `template_path` (its
+/// size, extent and CRS; resampled bilinearly where the grids differ), nodata -9999. For benchmark
+/// exports that demand the input DEM's grid (ISeeSnow).
+void write_ascii_on(const std::string& path, const std::string& template_path, const Grid& g, const std::vector<double>& values);
+
 /// SHA-256 of a file, hex.
 std::string sha256_file(const std::string& path);
 

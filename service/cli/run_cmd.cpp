@@ -25,11 +25,17 @@ extern "C" void on_interrupt(int) { g_interrupted = true; }
 }  // namespace
 
 int run(const std::vector<std::string>& args) {
-  std::string scenario, out;
+  std::string scenario, out, iseesnow;
   bool force = false, quiet = false;
   for (std::size_t k = 0; k < args.size(); ++k) {
     const auto& a = args[k];
-    if (a == "--out" || a == "--threads") {
+    if (a == "--iseesnow") {
+      if (k + 1 >= args.size()) {
+        std::cerr << "runout run: --iseesnow needs the simulation id (e.g. 03CoulombOnly)\n";
+        return kUsage;
+      }
+      iseesnow = args[++k];
+    } else if (a == "--out" || a == "--threads") {
       if (k + 1 >= args.size()) {
         std::cerr << "runout run: " << a << " needs a value\n";
         return kUsage;
@@ -100,6 +106,7 @@ int run(const std::vector<std::string>& args) {
   const auto wall0 = std::chrono::steady_clock::now();
   const bool tty = isatty(fileno(stderr));
   jobs::RunOptions opt;
+  opt.iseesnow_id = iseesnow;
   const double t_end = resolved.config.time.t_end;
   opt.progress = [&](const engine::Progress& p) {
     if (!quiet) {

@@ -387,6 +387,32 @@ TEST(Terrain, LocalCrsForTerrainWithoutGeoreference) {
   EXPECT_TRUE(fs::exists(d / "out/outline.gpkg"));
   EXPECT_FALSE(fs::exists(d / "out/outline.geojson"));
   ASSERT_EQ(sum.notes.size(), 1u);
+  // The ISeeSnow export: on the DEM's own grid, named after the release and the simulation id.
+  fs::create_directories(d / "out2");
+  jobs::RunOptions opt;
+  opt.iseesnow_id = "03CoulombOnly";
+  jobs::run_scenario(r, d / "out2", opt);
+  for (const char* f : {"rel_03CoulombOnly_null_runout_pft.asc", "rel_03CoulombOnly_null_runout_pfv.asc", "iseesnow_03CoulombOnly.csv"})
+    EXPECT_TRUE(fs::exists(fs::path(d / "out2") / f)) << f;
+  GDALDatasetUniquePtr pft(GDALDataset::Open((d / "out2/rel_03CoulombOnly_null_runout_pft.asc").c_str(), GDAL_OF_RASTER));
+  GDALDatasetUniquePtr dem(GDALDataset::Open((d / "dem.asc").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(pft && dem);
+  EXPECT_EQ(pft->GetRasterXSize(), dem->GetRasterXSize());
+  double a[6], b[6];
+  pft->GetGeoTransform(a);
+  dem->GetGeoTransform(b);
+  for (int q = 0; q < 6; ++q) EXPECT_NEAR(a[q], b[q], 1e-6);
+  double mx = 0;
+  std::vector<float> v(std::size_t(80) * 80);
+  ASSERT_EQ(pft->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, 80, 80, v.data(), 80, 80, GDT_Float32, 0, 0), CE_None);
+  for (float x : v) mx = std::max(mx, double(x));
+  EXPECT_NEAR(mx, sum.max_depth, 1e-3);  // the same cells: nothing resampled
+  std::ifstream csv(d / "out2/iseesnow_03CoulombOnly.csv");
+  std::string header, row;
+  std::getline(csv, header);
+  std::getline(csv, row);
+  EXPECT_EQ(header, "simulationID,modelName,cpuTime_s,flowTime_s,initialVolume_m3,finalVolume_m3,resolution_m");
+  EXPECT_EQ(row.rfind("03CoulombOnly,runout,", 0), 0u) << row;
   // A local DEM cannot be resampled or related to a georeferenced release.
   sc.mutable_grid()->set_resolution_m(10);
   expect_error(sc, d, "used on its own cells");
