@@ -41,11 +41,24 @@ void fill_orders(std::vector<Row>& rows, const std::string& metric) {
   }
 }
 
-/// Orders from `metric`, and the finest pair's order checked against `min_order` as `name`.
+/// Orders from `metric` between neighbouring rows, and the observed order over all rows (least-squares
+/// slope of log(error) against log(dx): pairwise orders of tiny errors scatter) checked against
+/// `min_order` as `name` on the finest row.
 void check_order(std::vector<Row>& rows, const std::string& metric, const std::string& name, double min_order) {
   fill_orders(rows, metric);
-  if (rows.size() >= 2 && std::isfinite(rows.back().order))
-    rows.back().metrics.push_back({name, rows.back().order, min_order, false});
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  int n = 0;
+  for (const auto& r : rows) {
+    const Metric* m = r.metric(metric);
+    if (!m || !(m->value > 0)) continue;
+    const double x = std::log(r.dx), y = std::log(m->value);
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
+    ++n;
+  }
+  if (n >= 2) rows.back().metrics.push_back({name, (n * sxy - sx * sy) / (n * sxx - sx * sx), min_order, false});
 }
 
 /// An inclined plane in map coordinates with cells of size ds along the slope (dx = ds cos zeta),
