@@ -349,9 +349,7 @@ void Solver::tile_scan(int tt) {
       mass += h;
       ke += 0.5 * h * sp2;
       vmax = std::max(vmax, std::sqrt(sp2));
-      const double Hs = std::max(h, 0.0);
-      rate = std::max(rate, (std::abs(U) + std::sqrt(Pxx_[k] * Hs)) / t_.dx +
-                                (std::abs(V) + std::sqrt(Pyy_[k] * Hs)) / t_.dy);
+      rate = std::max(rate, std::abs(U) / t_.dx + std::abs(V) / t_.dy + Ps_[k] * std::sqrt(std::max(h, 0.0)));
       wet = wet || h > cfg_.activation_depth;
     }
   tile_mass_[tt] = mass;

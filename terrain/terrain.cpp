@@ -227,12 +227,12 @@ Grid prepare_grid(const DemRequest& req, DemReport* report) {
     args.push_back(wkt(src));
   }
   if (aoi) {
-    auto g = std::unique_ptr<OGRGeometry>(aoi->clone());
+    // From here on the area is used in the computation CRS (bounding box here, mask below).
     auto ct = transform(aoi_srs, dst, "area of interest");
-    if (ct && g->transform(ct.get()) != OGRERR_NONE)
+    if (ct && aoi->transform(ct.get()) != OGRERR_NONE)
       throw TerrainError("area of interest '" + req.aoi_path + "': cannot transform it to " + crs_name(dst));
     OGREnvelope e;
-    g->getEnvelope(&e);
+    aoi->getEnvelope(&e);
     const double x0 = std::floor(e.MinX / res) * res, y0 = std::floor(e.MinY / res) * res;
     const double x1 = std::ceil(e.MaxX / res) * res, y1 = std::ceil(e.MaxY / res) * res;
     args.push_back("-te");
@@ -329,14 +329,12 @@ Grid prepare_grid(const DemRequest& req, DemReport* report) {
     }
   // Cells outside the area-of-interest polygon are outside the domain too.
   if (aoi) {
-    auto poly = std::unique_ptr<OGRGeometry>(aoi->clone());
-    if (auto ct = transform(aoi_srs, dst, "area of interest")) poly->transform(ct.get());
     GDALDatasetUniquePtr mask(GetGDALDriverManager()->GetDriverByName("MEM")->Create("", g.nx, g.ny, 1, GDT_Byte, nullptr));
     double mgt[6] = {g.x_min, g.dx, 0, g.y_min + g.ny * g.dx, 0, -g.dx};
     mask->SetGeoTransform(mgt);
     int band = 1;
     double burn = 1;
-    OGRGeometryH gh = OGRGeometry::ToHandle(poly.get());
+    OGRGeometryH gh = OGRGeometry::ToHandle(aoi.get());
     std::vector<unsigned char> m(g.cells());
     if (GDALRasterizeGeometries(GDALDataset::ToHandle(mask.get()), 1, &band, 1, &gh, nullptr, nullptr, &burn, nullptr,
                                 nullptr, nullptr) != CE_None ||
