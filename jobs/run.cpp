@@ -176,11 +176,36 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
     const std::string stem = fs::path(s.releases.front().path).stem().string() + "_" + opt.iseesnow_id + "_null_runout";
     terrain::write_ascii_on(out(stem + "_pft.asc"), s.dem.dem_path, grid, masked(hz.max_depth));
     terrain::write_ascii_on(out(stem + "_pfv.asc"), s.dem.dem_path, grid, masked(hz.max_speed));
+    // The benchmark's result table (simulationResultTable.csv): one row per simulation; the
+    // leading digits of the id are the row index, the rest the test case.
+    std::size_t digits = 0;
+    while (digits < opt.iseesnow_id.size() && std::isdigit(static_cast<unsigned char>(opt.iseesnow_id[digits]))) ++digits;
+    const std::string index = digits ? std::to_string(std::stoi(opt.iseesnow_id.substr(0, digits))) : "";
     std::ofstream csv(out("iseesnow_" + opt.iseesnow_id + ".csv"));
-    csv << "simulationID,modelName,cpuTime_s,flowTime_s,initialVolume_m3,finalVolume_m3,resolution_m\n";
-    csv << opt.iseesnow_id << ",runout," << jnum(sum.cpu_seconds) << "," << jnum(d.t) << "," << jnum(d.volume_initial) << ","
-        << jnum(d.volume_final) << "," << jnum(grid.dx) << "\n";
+    csv << ",testCase,computation duration (CPU) [s],avalanche flow time [s],volume at t0 [m3],"
+           "volume at tFinal [m3],spatial resolution x [m],spatial resolution y [m],number of particles\n";
+    csv << index << "," << opt.iseesnow_id.substr(digits) << "," << jnum(sum.cpu_seconds) << "," << jnum(d.t) << ","
+        << jnum(d.volume_initial) << "," << jnum(d.volume_final) << "," << jnum(grid.dx) << "," << jnum(grid.dx) << ",\n";
     if (!csv) throw std::runtime_error("writing the ISeeSnow CSV failed");
+    // The model configuration file the benchmark asks for, named like the peak fields.
+    std::ofstream cfg(out(stem + ".txt"));
+    const auto& m = s.scenario.material();
+    cfg << "runout " << RUNOUT_VERSION << ": depth-averaged Savage-Hutter model (NOC-TVD scheme, "
+        << "curvature in the bed friction " << (s.scenario.numerics().curvature_off() ? "off" : "on") << ")\n"
+        << "scenario = " << s.scenario.name() << "\n"
+        << "rheology = " << (m.rheology().empty() ? "coulomb" : m.rheology()) << "\n";
+    if (m.has_voellmy_mu()) cfg << "mu = " << jnum(m.voellmy_mu()) << "\n";
+    if (m.has_voellmy_xi()) cfg << "xi_m_s2 = " << jnum(m.voellmy_xi()) << "\n";
+    if (m.has_bed_friction_deg()) cfg << "bed_friction_deg = " << jnum(m.bed_friction_deg()) << "\n";
+    if (m.has_internal_friction_deg()) cfg << "internal_friction_deg = " << jnum(m.internal_friction_deg()) << "\n";
+    cfg << "earth_pressure = " << (m.earth_pressure().empty() ? "unity" : m.earth_pressure()) << "\n"
+        << "limiter = " << (s.scenario.numerics().limiter().empty() ? "minmod" : s.scenario.numerics().limiter()) << "\n"
+        << "cfl = " << jnum(s.config.time.cfl) << "\n"
+        << "cell_size_m = " << jnum(grid.dx) << "\n"
+        << "release_volume_m3 = " << jnum(d.volume_initial) << "\n"
+        << "stop = " << engine::to_string(d.stop) << " at t = " << jnum(d.t) << " s\n";
+    if (!cfg) throw std::runtime_error("writing the ISeeSnow configuration file failed");
+    sum.files.push_back(stem + ".txt");
     for (const char* suffix : {"_pft.asc", "_pfv.asc"}) sum.files.push_back(stem + suffix);
     sum.files.push_back("iseesnow_" + opt.iseesnow_id + ".csv");
   }

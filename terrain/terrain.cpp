@@ -208,9 +208,6 @@ Grid prepare_grid(const DemRequest& req, DemReport* report) {
   const bool north_up = gt[2] == 0 && gt[4] == 0 && gt[5] < 0 && std::abs(gt[1] + gt[5]) <= 1e-9 * gt[1];
   const bool native = north_up && dst.IsSame(&src) &&
                       (req.resolution <= 0 || std::abs(req.resolution - gt[1]) <= 1e-6 * gt[1]);
-  if (src.IsLocal() && !native)
-    throw TerrainError("grid: a DEM in a local CRS is used on its own cells (leave grid.resolution_m unset or equal to " +
-                       fmt(gt[1], 4) + " m; its raster must be north-up with square cells)");
   const double res = native ? gt[1]
                      : req.resolution > 0 ? req.resolution
                                           : std::max(1.0, std::round(rep.source_resolution_m));
@@ -219,10 +216,17 @@ Grid prepare_grid(const DemRequest& req, DemReport* report) {
                        fmt(rep.source_resolution_m, 1) + " m)");
 
   // Warp options.
-  std::vector<std::string> args = {"-of", "MEM", "-t_srs", wkt(dst), "-tr", fmt(res, 6), fmt(res, 6),
+  std::vector<std::string> args = {"-of", "MEM", "-tr", fmt(res, 6), fmt(res, 6),
                                    "-r", req.resampling.empty() ? "cubic" : req.resampling, "-dstnodata", "-99999",
                                    "-ot", "Float64"};
-  if (!req.dem_crs.empty() && !(dem->GetSpatialRef() && !dem->GetSpatialRef()->IsEmpty())) {
+  if (src.IsLocal()) {
+    // One local frame: resampling only, through the geotransforms (there is no CRS to transform).
+    for (const char* o : {"-to", "SRC_METHOD=GEOTRANSFORM", "-to", "DST_METHOD=GEOTRANSFORM"}) args.push_back(o);
+  } else {
+    args.push_back("-t_srs");
+    args.push_back(wkt(dst));
+  }
+  if (!src.IsLocal() && !req.dem_crs.empty() && !(dem->GetSpatialRef() && !dem->GetSpatialRef()->IsEmpty())) {
     args.push_back("-s_srs");
     args.push_back(wkt(src));
   }

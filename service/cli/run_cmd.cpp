@@ -35,6 +35,12 @@ int run(const std::vector<std::string>& args) {
         return kUsage;
       }
       iseesnow = args[++k];
+      if (iseesnow.empty() || iseesnow.find_first_of("_/\\ .") != std::string::npos) {
+        std::cerr << "runout run: --iseesnow '" << iseesnow
+                  << "': the simulation id names files and may not be empty or hold '_', '/', '\\', '.' or spaces"
+                     " (the benchmark's ids: 01IdealizedTopo, 02RealTopo, 03CoulombOnly)\n";
+        return kUsage;
+      }
     } else if (a == "--out" || a == "--threads") {
       if (k + 1 >= args.size()) {
         std::cerr << "runout run: " << a << " needs a value\n";

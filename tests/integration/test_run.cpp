@@ -10,6 +10,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <sstream>
 
 #include "jobs/run.hpp"
 #include "jobs/scenario.hpp"
@@ -102,6 +104,106 @@ void expect_error(const v1::Scenario& s, const TempDir& d, const std::string& ne
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
   }
+}
+
+// What every bundled scenario's output directory must hold: the rasters as Float32 COGs on the
+// computation grid with its CRS and nodata, and a valid runout outline whose area is the affected area.
+void check_outputs(const TempDir& d, const jobs::RunSummary& sum, const std::string& crs_name) {
+  for (const char* f : {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "arrival_time.tif"}) {
+    GDALDatasetUniquePtr t(GDALDataset::Open((d / f).c_str(), GDAL_OF_RASTER));
+    ASSERT_TRUE(t) << f;
+    EXPECT_EQ(t->GetRasterXSize(), sum.nx) << f;
+    EXPECT_EQ(t->GetRasterYSize(), sum.ny) << f;
+    double gt[6];
+    t->GetGeoTransform(gt);
+    EXPECT_NEAR(gt[1], sum.dx, 1e-9 * sum.dx) << f;
+    EXPECT_NEAR(gt[5], -sum.dx, 1e-9 * sum.dx) << f;
+    EXPECT_EQ(t->GetRasterBand(1)->GetRasterDataType(), GDT_Float32) << f;
+    int has = 0;
+    EXPECT_EQ(t->GetRasterBand(1)->GetNoDataValue(&has), -9999.0) << f;
+    EXPECT_TRUE(has) << f;
+    ASSERT_TRUE(t->GetSpatialRef()) << f;
+    if (crs_name == "local metres")  // GeoTIFF keeps a local frame as an unnamed engineering CRS in metres
+      EXPECT_TRUE(t->GetSpatialRef()->IsLocal()) << f;
+    else
+      EXPECT_EQ(std::string(t->GetSpatialRef()->GetName()), crs_name) << f;
+    EXPECT_STREQ(t->GetMetadataItem("LAYOUT", "IMAGE_STRUCTURE"), "COG") << f;
+  }
+  GDALDatasetUniquePtr ol(GDALDataset::Open((d / "outline.gpkg").c_str(), GDAL_OF_VECTOR));
+  ASSERT_TRUE(ol);
+  double area = 0;
+  int n = 0;
+  for (auto& f : ol->GetLayer(0)) {
+    ASSERT_TRUE(f->GetGeometryRef()->IsValid());
+    EXPECT_EQ(wkbFlatten(f->GetGeometryRef()->getGeometryType()), wkbPolygon);
+    area += OGR_G_Area(OGRGeometry::ToHandle(f->GetGeometryRef()));
+    ++n;
+  }
+  EXPECT_GE(n, 1);
+  EXPECT_NEAR(area, sum.affected_area_m2, 1e-6 * area);
+  EXPECT_TRUE(fs::exists(d / "run.json"));
+  EXPECT_TRUE(fs::exists(d / "map.png"));
+}
+
+// The first lines of an ESRI ASCII grid as key -> value.
+std::map<std::string, double> ascii_header(const std::string& path) {
+  std::ifstream in(path);
+  std::map<std::string, double> h;
+  std::string k;
+  double v;
+  for (int i = 0; i < 6 && (in >> k >> v); ++i) {
+    for (auto& c : k) c = char(std::tolower(static_cast<unsigned char>(c)));
+    h[k] = v;
+  }
+  return h;
+}
+
+// An ISeeSnow export: both peak fields with the benchmark's names on the DEM's grid, the
+// configuration file and the result-table row.
+void check_iseesnow(const TempDir& d, const std::string& release, const std::string& id, const std::string& dem,
+                    double volume) {
+  const std::string stem = release + "_" + id + "_null_runout";
+  GDALDatasetUniquePtr z(GDALDataset::Open(dem.c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(z);
+  double gz[6];
+  z->GetGeoTransform(gz);
+  for (const char* suffix : {"_pft.asc", "_pfv.asc"}) {
+    const auto h = ascii_header(d / (stem + suffix));
+    ASSERT_EQ(h.size(), 6u) << stem << suffix;
+    EXPECT_EQ(h.at("ncols"), z->GetRasterXSize());
+    EXPECT_EQ(h.at("nrows"), z->GetRasterYSize());
+    EXPECT_NEAR(h.at("cellsize"), gz[1], 1e-9);
+    EXPECT_NEAR(h.at("xllcorner"), gz[0], 1e-6);
+    EXPECT_NEAR(h.at("yllcorner"), gz[3] + gz[5] * z->GetRasterYSize(), 1e-6);
+    EXPECT_EQ(h.at("nodata_value"), -9999.0);
+    // No NaN anywhere, and a flow somewhere.
+    std::ifstream in(d / (stem + suffix));
+    std::string line;
+    for (int i = 0; i < 6; ++i) std::getline(in, line);
+    double mx = 0, v;
+    std::size_t count = 0;
+    while (in >> v) {
+      EXPECT_TRUE(std::isfinite(v));
+      mx = std::max(mx, v);
+      ++count;
+    }
+    EXPECT_EQ(count, std::size_t(z->GetRasterXSize()) * z->GetRasterYSize());
+    EXPECT_GT(mx, 0.5) << stem << suffix;
+  }
+  EXPECT_TRUE(fs::exists(d / (stem + ".txt")));
+  std::ifstream csv(d / ("iseesnow_" + id + ".csv"));
+  std::string header, row;
+  std::getline(csv, header);
+  std::getline(csv, row);
+  EXPECT_EQ(header.rfind(",testCase,computation duration (CPU) [s],", 0), 0u) << header;
+  std::stringstream rs(row);
+  std::vector<std::string> cells;
+  for (std::string c; std::getline(rs, c, ',');) cells.push_back(c);
+  ASSERT_GE(cells.size(), 6u) << row;
+  EXPECT_EQ(cells[0], std::to_string(std::stoi(id.substr(0, 2))));  // "03CoulombOnly": row 3,
+  EXPECT_EQ(cells[1], id.substr(2));                                 // test case CoulombOnly
+  EXPECT_NEAR(std::stod(cells[4]), volume, 1e-6 * volume);  // volume at t0
+  EXPECT_NEAR(std::stod(cells[5]), volume, 1e-6 * volume);  // closed: nothing left the grid
 }
 
 }  // namespace
@@ -383,7 +485,8 @@ TEST(Terrain, LocalCrsForTerrainWithoutGeoreference) {
   jobs::RunOptions opt;
   opt.iseesnow_id = "03CoulombOnly";
   jobs::run_scenario(r, d / "out2", opt);
-  for (const char* f : {"rel_03CoulombOnly_null_runout_pft.asc", "rel_03CoulombOnly_null_runout_pfv.asc", "iseesnow_03CoulombOnly.csv"})
+  for (const char* f : {"rel_03CoulombOnly_null_runout_pft.asc", "rel_03CoulombOnly_null_runout_pfv.asc",
+                        "rel_03CoulombOnly_null_runout.txt", "iseesnow_03CoulombOnly.csv"})
     EXPECT_TRUE(fs::exists(fs::path(d / "out2") / f)) << f;
   GDALDatasetUniquePtr pft(GDALDataset::Open((d / "out2/rel_03CoulombOnly_null_runout_pft.asc").c_str(), GDAL_OF_RASTER));
   GDALDatasetUniquePtr dem(GDALDataset::Open((d / "dem.asc").c_str(), GDAL_OF_RASTER));
@@ -402,11 +505,19 @@ TEST(Terrain, LocalCrsForTerrainWithoutGeoreference) {
   std::string header, row;
   std::getline(csv, header);
   std::getline(csv, row);
-  EXPECT_EQ(header, "simulationID,modelName,cpuTime_s,flowTime_s,initialVolume_m3,finalVolume_m3,resolution_m");
-  EXPECT_EQ(row.rfind("03CoulombOnly,runout,", 0), 0u) << row;
-  // A local DEM cannot be resampled or related to a georeferenced release.
+  EXPECT_EQ(header, ",testCase,computation duration (CPU) [s],avalanche flow time [s],volume at t0 [m3],"
+                    "volume at tFinal [m3],spatial resolution x [m],spatial resolution y [m],number of particles");
+  EXPECT_EQ(row.rfind("3,CoulombOnly,", 0), 0u) << row;
+  EXPECT_NE(row.find(",5,5,"), std::string::npos) << row;
+  // A local DEM is resampled in its own frame, and cannot be related to a georeferenced release.
   sc.mutable_grid()->set_resolution_m(10);
-  expect_error(sc, d, "used on its own cells");
+  auto coarse = jobs::resolve_scenario(sc, d.p.string());
+  fs::create_directories(d / "out3");
+  const auto sum10 = jobs::run_scenario(coarse, d / "out3");
+  EXPECT_EQ(sum10.nx, 40);
+  EXPECT_EQ(sum10.dx, 10.0);
+  EXPECT_EQ(sum10.crs, "local metres");
+  EXPECT_NEAR(sum10.release_area_m2, sum.release_area_m2, 0.35 * sum.release_area_m2);
   sc.mutable_grid()->set_resolution_m(0);
   sc.mutable_releases(0)->set_crs("EPSG:32632");
   expect_error(sc, d, "a local CRS cannot be related to EPSG:32632");
@@ -460,6 +571,8 @@ TEST(Scenarios, InDenArelenReachesTheValleyFloor) {
   EXPECT_EQ(sum.crs, "EPSG:32632");
   EXPECT_LT(sum.volume_error, 1e-12);
   EXPECT_NEAR(sum.release_volume_m3, 2.9e5, 0.5e5);
+  check_outputs(d, sum, "WGS 84 / UTM zone 32N");
+  EXPECT_TRUE(fs::exists(d / "outline.geojson"));
   // (Pure Coulomb friction with delta = 15 deg lets thin layers slide on over the long slopes above
   // 15 deg, so at 30 m the run may end by the end time rather than the kinetic-energy rule.)
   // The flow reaches the farmhouse (46.8367 N, 9.8539 E).
@@ -488,7 +601,69 @@ TEST(Scenarios, WolfsgrubenRunsInTheDemCrs) {
   const auto sum = jobs::run_scenario(r, d.p.string());
   EXPECT_EQ(sum.crs, "MGI / Austria Lambert");
   EXPECT_LT(sum.volume_error, 1e-12);
+  check_outputs(d, sum, "MGI / Austria Lambert");
   EXPECT_NEAR(sum.release_area_m2, 135185, 0.05 * 135185);  // AvaFrame's projected release area
   EXPECT_GT(sum.runout_m, 1000);
   EXPECT_LT(sum.max_speed, 150);  // bounded (the curvature bound; without it this terrain ran away)
+}
+
+// The three ISeeSnow cases (validation.md A8), computed coarser than their 5 m DEMs to stay fast; the
+// export is still on the DEM's own 5 m grid and extent.
+TEST(Scenarios, IseesnowIdealizedTopo) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/iseesnow-idealized.json");
+  r.dem.resolution = 10;
+  TempDir d;
+  jobs::RunOptions opt;
+  opt.iseesnow_id = "01IdealizedTopo";
+  const auto sum = jobs::run_scenario(r, d.p.string(), opt);
+  EXPECT_EQ(sum.crs, "local metres");
+  EXPECT_EQ(sum.nx, 502);
+  EXPECT_LT(sum.volume_error, 1e-12);
+  EXPECT_EQ(sum.volume_outflow, 0);
+  EXPECT_EQ(sum.stop, "kinetic-energy");
+  // 1.5 m normal to the surface over the 296.5 m x 139.8 m release rectangle (mean slope about 34 deg):
+  // 71,960 m3 on the DEM's 5 m cells.
+  EXPECT_NEAR(sum.release_volume_m3, 71960, 0.05 * 71960);
+  EXPECT_GT(sum.runout_m, 1500);
+  EXPECT_LT(sum.max_speed, 60);  // Voellmy xi = 2000 bounds the speed well below free fall
+  check_outputs(d, sum, "local metres");
+  EXPECT_FALSE(fs::exists(d / "outline.geojson"));  // no geographic position
+  check_iseesnow(d, "release1HS", "01IdealizedTopo",
+                 std::string(RUNOUT_SOURCE_DIR) + "/scenarios/data/iseesnow/idealized/DEM_IdealizedTopo.tif",
+                 sum.volume_initial);
+}
+
+TEST(Scenarios, IseesnowCoulombOnlyRunsFurtherThanVoellmy) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/iseesnow-coulomb.json");
+  r.dem.resolution = 10;
+  TempDir d;
+  jobs::RunOptions opt;
+  opt.iseesnow_id = "03CoulombOnly";
+  const auto sum = jobs::run_scenario(r, d.p.string(), opt);
+  EXPECT_LT(sum.volume_error, 1e-12);
+  // Without turbulent drag the flow is faster and longer than IdealizedTopo's (same terrain and release):
+  // the energy line of mu = 0.4 from about 1400 m of drop.
+  EXPECT_GT(sum.max_speed, 80);
+  EXPECT_GT(sum.runout_m, 2500);
+  check_outputs(d, sum, "local metres");
+  check_iseesnow(d, "release1HS", "03CoulombOnly",
+                 std::string(RUNOUT_SOURCE_DIR) + "/scenarios/data/iseesnow/idealized/DEM_IdealizedTopo.tif",
+                 sum.volume_initial);
+}
+
+TEST(Scenarios, IseesnowRealTopo) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/iseesnow-realtopo.json");
+  r.dem.resolution = 15;
+  TempDir d;
+  jobs::RunOptions opt;
+  opt.iseesnow_id = "02RealTopo";
+  const auto sum = jobs::run_scenario(r, d.p.string(), opt);
+  EXPECT_EQ(sum.crs, "MGI / Austria Lambert");
+  EXPECT_LT(sum.volume_error, 1e-12);
+  EXPECT_NEAR(sum.release_area_m2, 135185, 0.1 * 135185);
+  EXPECT_GT(sum.runout_m, 1000);
+  check_outputs(d, sum, "MGI / Austria Lambert");
+  check_iseesnow(d, "relWog", "02RealTopo",
+                 std::string(RUNOUT_SOURCE_DIR) + "/scenarios/data/iseesnow/realtopo/DEM_RealTopo.tif",
+                 sum.volume_initial);
 }
