@@ -175,6 +175,9 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
 
   // Numerics.
   auto* nm = s.mutable_numerics();
+  if (nm->scheme().empty()) nm->set_scheme("noc-tvd");
+  if (nm->scheme() != "noc-tvd")
+    bad("numerics.scheme", "unknown value '" + nm->scheme() + "' (valid: noc-tvd)");
   r.config.limiter = enum_of(engine::kLimiterNames, "numerics.limiter", nm->limiter(), "minmod");
   if (nm->limiter().empty()) nm->set_limiter("minmod");
   if (!nm->has_cfl()) nm->set_cfl(0.45);

@@ -381,6 +381,9 @@ TEST(Terrain, BadInputNamesWhatIsWrong) {
   s.mutable_numerics()->set_limiter("vanLeer");
   expect(s, "numerics.limiter: unknown value 'vanLeer' (valid: minmod, vanleer, superbee)");
   s = base_scenario("dem.tif", "rel.geojson");
+  s.mutable_numerics()->set_scheme("weno5");
+  expect(s, "numerics.scheme: unknown value 'weno5' (valid: noc-tvd)");
+  s = base_scenario("dem.tif", "rel.geojson");
   s.mutable_material()->set_rheology("bingham");
   expect(s, "valid: coulomb, voellmy");
   s = base_scenario("dem.tif", "rel.geojson", 1.0);
