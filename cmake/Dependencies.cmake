@@ -1,9 +1,10 @@
-# Every dependency comes from Debian packages (scripts/install-deps lists them).
+# Every dependency comes from Debian packages (scripts/deps.sh lists them).
 # Each is found here even where no module uses it yet, so that a missing package
 # fails at configure time, not in a later issue.
 find_package(PkgConfig REQUIRED)
 find_package(OpenMP REQUIRED COMPONENTS CXX)
 find_package(Threads REQUIRED)
+find_package(OpenSSL REQUIRED)
 find_package(MPI REQUIRED COMPONENTS C)
 find_package(GDAL CONFIG QUIET)
 if(NOT GDAL_FOUND)

@@ -1,5 +1,10 @@
 #include "jobs/scenario.hpp"
 
+#include <google/protobuf/io/coded_stream.h>
+#include <google/protobuf/io/zero_copy_stream_impl_lite.h>
+
+#include "jobs/sha256.hpp"
+
 #include <google/protobuf/util/json_util.h>
 
 #include <algorithm>
@@ -214,6 +219,27 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   r.timeseries_interval = o->timeseries_interval_s();
   r.scenario = std::move(s);
   return r;
+}
+
+std::string scenario_hash(const ResolvedScenario& r) {
+  v1::Scenario s = r.scenario;
+  s.mutable_dem()->clear_path();
+  s.mutable_area_of_interest()->clear_path();
+  for (auto& rel : *s.mutable_releases()) rel.clear_path();
+  std::string bytes;
+  {
+    google::protobuf::io::StringOutputStream so(&bytes);
+    google::protobuf::io::CodedOutputStream co(&so);
+    co.SetSerializationDeterministic(true);
+    s.SerializeToCodedStream(&co);
+  }
+  Sha256 h;
+  h.update("runout.v1.Scenario\n");
+  h.update(bytes);
+  for (const auto& f : r.input_files) {
+    h.update("\n" + fs::path(f).extension().string() + " " + sha256_of_file(f));
+  }
+  return h.hex();
 }
 
 }  // namespace runout::jobs

@@ -28,6 +28,10 @@ struct ResolvedScenario {
   std::vector<std::string> input_files;  ///< for hashing
 };
 
+/// SHA-256 of a resolved scenario: its message with the input paths left out, and the content of
+/// every input file. Two scenarios with the same hash compute the same result.
+std::string scenario_hash(const ResolvedScenario& r);
+
 /// The raster names an output list may hold.
 const std::vector<std::string>& raster_names();
 

@@ -5,9 +5,19 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <mutex>
 #include <stdexcept>
 
 namespace runout::jobs {
+
+namespace {
+// The HDF5 library Debian builds with MPI (the one PETSc uses) is not thread-safe: the service runs
+// several jobs in one process, so every HDF5 call of this file holds this lock.
+std::mutex& hdf5_mutex() {
+  static std::mutex m;
+  return m;
+}
+}  // namespace
 
 struct TimeSeriesWriter::Impl {
   std::string dir;
@@ -44,6 +54,7 @@ TimeSeriesWriter::TimeSeriesWriter(const std::string& dir, const terrain::Grid& 
   m.x0 = grid.x_min;
   m.y0 = grid.y_min;
   m.geo = engine::SurfaceGeometry::from(t);
+  std::lock_guard lk(hdf5_mutex());
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported by us
   m.file = H5Fcreate((dir + "/timeseries.h5").c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
   if (m.file < 0) throw std::runtime_error("time series: cannot create " + dir + "/timeseries.h5");
@@ -55,6 +66,7 @@ TimeSeriesWriter::TimeSeriesWriter(const std::string& dir, const terrain::Grid& 
 }
 
 TimeSeriesWriter::~TimeSeriesWriter() {
+  std::lock_guard lk(hdf5_mutex());
   if (impl_ && impl_->file >= 0) H5Fclose(impl_->file);
 }
 
@@ -72,6 +84,7 @@ void TimeSeriesWriter::write(double t, const engine::Sh2dStateView& s) {
   }
   char name[32];
   std::snprintf(name, sizeof name, "frames/%05zu", m.times.size());
+  std::lock_guard lk(hdf5_mutex());
   hid_t g = H5Gcreate2(m.file, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   if (g < 0) throw std::runtime_error("time series: cannot create group");
   m.dataset(g, "depth", h);
@@ -88,6 +101,7 @@ void TimeSeriesWriter::write(double t, const engine::Sh2dStateView& s) {
 int TimeSeriesWriter::finish() {
   auto& m = *impl_;
   if (m.file >= 0) {
+    std::lock_guard lk(hdf5_mutex());
     H5Fclose(m.file);
     m.file = -1;
   }

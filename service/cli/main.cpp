@@ -24,19 +24,48 @@ commands:
         (or CSV). Cases: A1 A2 A3 A4 A5 A6 A7 STRESS (default: all). --full adds the finest
         resolutions. --resolutions overrides a case's cell sizes in metres (A2: cells across the cap).
         Limiters: minmod (default), vanleer, superbee.
+  serve [--config FILE] [--listen HOST:PORT] [--state-dir DIR] [--data-root DIR]... [--tokens FILE]
+        [--tls-cert FILE --tls-key FILE] [--workers N] [--threads-per-run N] [--log-file FILE]
+        Run the gRPC batch server (runout.v1.Runout, health checking, reflection) until SIGINT or
+        SIGTERM; options override the JSON configuration file (deploy/README.md lists every key).
+        Jobs left running by a killed server are queued again at the next start.
+  submit SCENARIO.json [--wait] [--quiet] [--request-id ID] [--server-paths]
+        Upload the scenario's input files and queue it; prints the job id and state. --wait follows
+        the job to its end (progress on standard error). --server-paths sends the input paths as
+        they are, for files inside the server's data roots.
+  status [JOB] [--state STATE]...
+        One job in detail (state history, error), or the list of this client's jobs and their disk use.
+  watch JOB
+        Follow a job's progress until it ends.
+  cancel JOB
+        Cancel a queued or running job.
+  fetch JOB --out DIR [--force]
+        Download a job's results (checksums verified) into DIR; for a failed job, its log.
+  health
+        Ask the server's standard health service (no token needed); exit 0 when serving.
+  regress [--server HOST:PORT] [--out DIR] [--scenario FILE] [--reference DIR] [--accept --reason TEXT]
+        The In den Arelen regression: run the scenario through the service (an embedded server on
+        127.0.0.1 unless --server), compare with the accepted reference, write report.md with the
+        map and a difference map; exit 1 on a regression. --accept makes this run the reference.
   version
         Print the program version and the versions of the libraries it links.
   help
         Print this text.
+
+  The client commands (submit, status, watch, cancel, fetch, health, regress) take
+  --server HOST:PORT (default $RUNOUT_SERVER or 127.0.0.1:50051), --token TOKEN or --token-file FILE
+  (default $RUNOUT_TOKEN), and --tls-ca FILE or --tls for a server with TLS.
 
 exit codes:
   0  success (verify: every checked figure within its tolerance)
   1  verify: at least one figure outside its tolerance
   2  bad command line (unknown command, option or name)
   3  internal error
-  4  run: invalid scenario or input data (the message names the field or file)
-  5  run: output directory exists (use --force) or cannot be written
-  6  run: cancelled (interrupt)
+  4  invalid scenario or input data (the message names the field or file); unknown job
+  5  run, fetch: output directory exists (use --force) or cannot be written
+  6  run: cancelled (interrupt); submit --wait, watch: the job was cancelled
+  7  the server cannot be reached or refused the call (unknown token, queue limit, ...)
+  8  submit --wait, watch, fetch: the job failed (its error is printed)
 )";
 
 }  // namespace
@@ -53,7 +82,16 @@ int main(int argc, char** argv) {
     if (cmd == "run") return runout::cli::run(args);
     if (cmd == "verify") return runout::cli::verify(args);
     if (cmd == "version" || cmd == "--version") return runout::cli::version(args);
-    std::cerr << "runout: unknown command '" << cmd << "' (valid: run, verify, version, help)\n";
+    if (cmd == "serve") return runout::cli::serve(args);
+    if (cmd == "submit") return runout::cli::submit(args);
+    if (cmd == "status") return runout::cli::status(args);
+    if (cmd == "watch") return runout::cli::watch(args);
+    if (cmd == "cancel") return runout::cli::cancel(args);
+    if (cmd == "fetch") return runout::cli::fetch(args);
+    if (cmd == "health") return runout::cli::health(args);
+    if (cmd == "regress") return runout::cli::regress(args);
+    std::cerr << "runout: unknown command '" << cmd
+              << "' (valid: run, verify, serve, submit, status, watch, cancel, fetch, health, regress, version, help)\n";
     return runout::cli::kUsage;
   } catch (const std::exception& e) {
     std::cerr << "runout: internal error: " << e.what() << "\n";

@@ -1,0 +1,88 @@
+#pragma once
+// Workers that take queued jobs from the store and run them with the same run driver as `runout run`.
+// Results are written to results/<hash>.tmp-<job> and renamed to results/<hash> only when complete,
+// so a folder under results/ without ".tmp-" is always a whole result. Each job has a log
+// (logs/<job>.log) that keeps its progress and, when it fails, the error.
+//
+// Stopping: stop() interrupts running jobs through the run driver's progress hook and records them
+// as queued again; a server killed outright leaves them "running" in the store, and start() queues
+// them again. Runs are deterministic, so a job run again gives the result an uninterrupted run gives.
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "jobs/store.hpp"
+
+namespace runout::jobs {
+
+struct SchedulerConfig {
+  std::string state_dir;            ///< holds results/ and logs/
+  int workers = 1;                  ///< concurrent runs
+  int threads_per_run = 0;          ///< OpenMP threads of each run; 0: cores / workers (at least 1)
+  double retention_days = 0;        ///< finished results older than this are deleted; 0: kept
+  std::int64_t retention_max_bytes = 0;  ///< oldest results deleted beyond this total; 0: no limit
+  std::function<void(const std::string&)> log;  ///< server log lines (optional)
+};
+
+class Scheduler {
+ public:
+  Scheduler(JobStore& store, SchedulerConfig cfg);
+  ~Scheduler();
+  Scheduler(const Scheduler&) = delete;
+  Scheduler& operator=(const Scheduler&) = delete;
+
+  /// Queue again what a dead server left running, apply the retention policy, start the workers.
+  void start();
+  /// Interrupt running jobs (they are queued again) and join the workers.
+  void stop();
+  /// A job was queued.
+  void notify();
+  /// Ask a running job to stop; it ends as cancelled. false when it is not running here.
+  bool cancel_running(const std::string& id);
+
+  /// Live progress of a running job (newer than the store's copy) and a change counter.
+  struct Live {
+    v1::Progress progress;
+    std::uint64_t version = 0;
+    bool running = false;
+  };
+  Live live(const std::string& id) const;
+  /// Wait until the job's state or progress changes after `version`, or the timeout passes.
+  void wait_change(const std::string& id, std::uint64_t version, std::chrono::milliseconds timeout) const;
+  /// Bumped on every state change of any job (watchers re-read the store).
+  void touch(const std::string& id);
+
+  std::string results_dir(const std::string& hash) const;
+  std::string log_path(const std::string& id) const;
+  /// Delete results per the retention policy now.
+  void apply_retention();
+
+ private:
+  void worker_loop(int index);
+  void run_job(StoredJob job);
+  void log(const std::string& line) const;
+
+  JobStore& store_;
+  SchedulerConfig cfg_;
+  std::vector<std::thread> threads_;
+  std::atomic<bool> stopping_{false};
+  mutable std::mutex mu_;
+  mutable std::condition_variable work_cv_;     // workers wait for jobs
+  mutable std::condition_variable change_cv_;   // watchers wait for changes
+  std::map<std::string, Live> live_;
+  std::map<std::string, std::uint64_t> versions_;
+  std::set<std::string> cancel_;
+  std::uint64_t counter_ = 0;
+  std::uint64_t work_seq_ = 0;  // bumped by notify(): work may be waiting
+  std::chrono::steady_clock::time_point last_retention_{};
+};
+
+}  // namespace runout::jobs

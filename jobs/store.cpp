@@ -1,0 +1,443 @@
+#include "jobs/store.hpp"
+
+#include <sqlite3.h>
+
+#include <chrono>
+#include <ctime>
+#include <random>
+
+namespace runout::jobs {
+
+namespace {
+
+// A prepared statement that finalises itself.
+class Stmt {
+ public:
+  Stmt(sqlite3* db, const char* sql) : db_(db) {
+    if (sqlite3_prepare_v2(db, sql, -1, &s_, nullptr) != SQLITE_OK)
+      throw StoreError(std::string("job store: ") + sqlite3_errmsg(db) + " in: " + sql);
+  }
+  ~Stmt() { sqlite3_finalize(s_); }
+  Stmt(const Stmt&) = delete;
+  Stmt& operator=(const Stmt&) = delete;
+  Stmt& bind(int k, const std::string& v) {
+    sqlite3_bind_text(s_, k, v.data(), int(v.size()), SQLITE_TRANSIENT);
+    return *this;
+  }
+  Stmt& blob(int k, const std::string& v) {
+    sqlite3_bind_blob(s_, k, v.data(), int(v.size()), SQLITE_TRANSIENT);
+    return *this;
+  }
+  Stmt& bind(int k, std::int64_t v) {
+    sqlite3_bind_int64(s_, k, v);
+    return *this;
+  }
+  Stmt& null(int k) {
+    sqlite3_bind_null(s_, k);
+    return *this;
+  }
+  /// true while rows come.
+  bool step() {
+    const int rc = sqlite3_step(s_);
+    if (rc == SQLITE_ROW) return true;
+    if (rc == SQLITE_DONE) return false;
+    throw StoreError(std::string("job store: ") + sqlite3_errmsg(db_));
+  }
+  std::string text(int c) const {
+    const auto* p = reinterpret_cast<const char*>(sqlite3_column_blob(s_, c));
+    return p ? std::string(p, std::size_t(sqlite3_column_bytes(s_, c))) : std::string();
+  }
+  std::int64_t i64(int c) const { return sqlite3_column_int64(s_, c); }
+  sqlite3_stmt* get() const { return s_; }
+
+ private:
+  sqlite3* db_;
+  sqlite3_stmt* s_ = nullptr;
+};
+
+// BEGIN IMMEDIATE ... COMMIT, rolled back when an exception leaves the scope.
+class Transaction {
+ public:
+  explicit Transaction(sqlite3* db) : db_(db) { run("BEGIN IMMEDIATE"); }
+  ~Transaction() {
+    if (!done_) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+  }
+  void commit() {
+    run("COMMIT");
+    done_ = true;
+  }
+
+ private:
+  void run(const char* sql) {
+    char* err = nullptr;
+    if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
+      std::string m = err ? err : "?";
+      sqlite3_free(err);
+      throw StoreError("job store: " + m);
+    }
+  }
+  sqlite3* db_;
+  bool done_ = false;
+};
+
+constexpr const char* kColumns =
+    "id, owner, name, hash, request_id, state, created, updated, error, attempts, scenario, progress, result_bytes, "
+    "results_removed";
+
+void add_transition(sqlite3* db, const std::string& id, v1::JobState s, const std::string& when, const std::string& reason) {
+  Stmt(db, "INSERT INTO transitions(job, time, state, reason) VALUES (?, ?, ?, ?)")
+      .bind(1, id)
+      .bind(2, when)
+      .bind(3, std::int64_t(s))
+      .bind(4, reason)
+      .step();
+}
+
+}  // namespace
+
+std::string utc_now() {
+  const auto now = std::chrono::system_clock::now();
+  const std::time_t t = std::chrono::system_clock::to_time_t(now);
+  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char b[64];
+  std::snprintf(b, sizeof b, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday, tm.tm_hour,
+                tm.tm_min, tm.tm_sec, int(ms));
+  return b;
+}
+
+std::string new_job_id() {
+  static thread_local std::mt19937_64 rng{std::random_device{}() ^
+                                          std::uint64_t(std::chrono::steady_clock::now().time_since_epoch().count())};
+  char b[24];
+  std::snprintf(b, sizeof b, "j%016llx", static_cast<unsigned long long>(rng()));
+  return b;
+}
+
+std::string state_name(v1::JobState s) {
+  switch (s) {
+    case v1::QUEUED: return "queued";
+    case v1::RUNNING: return "running";
+    case v1::SUCCEEDED: return "succeeded";
+    case v1::FAILED: return "failed";
+    case v1::CANCELLED: return "cancelled";
+    default: return "unknown";
+  }
+}
+
+bool is_final(v1::JobState s) { return s == v1::SUCCEEDED || s == v1::FAILED || s == v1::CANCELLED; }
+
+JobStore::JobStore(const std::string& path) {
+  if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX, nullptr) !=
+      SQLITE_OK) {
+    const std::string m = db_ ? sqlite3_errmsg(db_) : "out of memory";
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw StoreError("job store '" + path + "': " + m);
+  }
+  sqlite3_busy_timeout(db_, 10000);
+  exec("PRAGMA journal_mode=WAL");
+  exec("PRAGMA synchronous=NORMAL");
+  exec("PRAGMA foreign_keys=ON");
+  exec(R"(CREATE TABLE IF NOT EXISTS jobs(
+           seq INTEGER PRIMARY KEY AUTOINCREMENT,
+           id TEXT UNIQUE NOT NULL,
+           owner TEXT NOT NULL,
+           name TEXT NOT NULL,
+           hash TEXT NOT NULL,
+           request_id TEXT,
+           state INTEGER NOT NULL,
+           created TEXT NOT NULL,
+           updated TEXT NOT NULL,
+           error TEXT NOT NULL DEFAULT '',
+           attempts INTEGER NOT NULL DEFAULT 0,
+           scenario BLOB NOT NULL,
+           progress BLOB,
+           result_bytes INTEGER NOT NULL DEFAULT 0,
+           results_removed INTEGER NOT NULL DEFAULT 0);
+         CREATE UNIQUE INDEX IF NOT EXISTS jobs_request ON jobs(owner, request_id) WHERE request_id IS NOT NULL;
+         CREATE INDEX IF NOT EXISTS jobs_owner_hash ON jobs(owner, hash);
+         CREATE INDEX IF NOT EXISTS jobs_state ON jobs(state, seq);
+         CREATE TABLE IF NOT EXISTS transitions(
+           job TEXT NOT NULL REFERENCES jobs(id),
+           time TEXT NOT NULL,
+           state INTEGER NOT NULL,
+           reason TEXT NOT NULL);
+         CREATE INDEX IF NOT EXISTS transitions_job ON transitions(job);)");
+}
+
+JobStore::~JobStore() { sqlite3_close(db_); }
+
+void JobStore::exec(const char* sql) const {
+  char* err = nullptr;
+  if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
+    std::string m = err ? err : "?";
+    sqlite3_free(err);
+    throw StoreError("job store: " + m);
+  }
+}
+
+StoredJob JobStore::read_row(void* p) const {
+  auto* st = static_cast<Stmt*>(p);
+  StoredJob j;
+  j.job.set_id(st->text(0));
+  j.owner = st->text(1);
+  j.job.set_name(st->text(2));
+  j.job.set_scenario_hash(st->text(3));
+  j.job.set_request_id(st->text(4));
+  j.job.set_state(v1::JobState(st->i64(5)));
+  j.job.set_created_utc(st->text(6));
+  j.job.set_updated_utc(st->text(7));
+  j.job.set_error(st->text(8));
+  j.job.set_attempts(int(st->i64(9)));
+  if (!j.scenario.ParseFromString(st->text(10))) throw StoreError("job store: job " + j.job.id() + " holds an unreadable scenario");
+  const std::string prog = st->text(11);
+  if (!prog.empty()) (void)j.job.mutable_progress()->ParseFromString(prog);
+  j.job.set_result_bytes(st->i64(12));
+  j.results_removed = st->i64(13) != 0;
+  return j;
+}
+
+void JobStore::load_transitions(StoredJob& j) const {
+  Stmt st(db_, "SELECT time, state, reason FROM transitions WHERE job = ? ORDER BY rowid");
+  st.bind(1, j.job.id());
+  while (st.step()) {
+    auto* t = j.job.add_transitions();
+    t->set_time_utc(st.text(0));
+    t->set_state(v1::JobState(st.i64(1)));
+    t->set_reason(st.text(2));
+  }
+}
+
+SubmitOutcome JobStore::submit(const std::string& owner, const std::string& hash, const std::string& request_id,
+                               const v1::Scenario& scenario, int max_queued) {
+  std::lock_guard lk(mu_);
+  Transaction tx(db_);
+  SubmitOutcome out;
+  auto existing = [&](Stmt& st) {
+    if (!st.step()) return false;
+    out.job = read_row(&st);
+    load_transitions(out.job);
+    return true;
+  };
+  if (!request_id.empty()) {
+    Stmt st(db_, (std::string("SELECT ") + kColumns + " FROM jobs WHERE owner = ? AND request_id = ?").c_str());
+    st.bind(1, owner).bind(2, request_id);
+    if (existing(st)) {
+      tx.commit();
+      return out;
+    }
+  }
+  {
+    Stmt st(db_, (std::string("SELECT ") + kColumns +
+                  " FROM jobs WHERE owner = ? AND hash = ? AND state IN (1, 2, 3) AND results_removed = 0 "
+                  "ORDER BY seq DESC LIMIT 1")
+                     .c_str());
+    st.bind(1, owner).bind(2, hash);
+    if (existing(st)) {
+      tx.commit();
+      return out;
+    }
+  }
+  {
+    Stmt st(db_, "SELECT COUNT(*) FROM jobs WHERE owner = ? AND state IN (1, 2)");
+    st.bind(1, owner);
+    st.step();
+    if (st.i64(0) >= max_queued)
+      throw QueueFull("this client already has " + std::to_string(st.i64(0)) + " queued or running jobs (the server's limit is " +
+                      std::to_string(max_queued) + ")");
+  }
+  const std::string id = new_job_id(), now = utc_now();
+  std::string blob;
+  scenario.SerializeToString(&blob);
+  Stmt ins(db_,
+           "INSERT INTO jobs(id, owner, name, hash, request_id, state, created, updated, scenario) "
+           "VALUES (?, ?, ?, ?, ?, 1, ?, ?, ?)");
+  ins.bind(1, id).bind(2, owner).bind(3, scenario.name()).bind(4, hash);
+  if (request_id.empty())
+    ins.null(5);
+  else
+    ins.bind(5, request_id);
+  ins.bind(6, now).bind(7, now).blob(8, blob);
+  ins.step();
+  add_transition(db_, id, v1::QUEUED, now, "submitted");
+  tx.commit();
+  out.created = true;
+  out.job.owner = owner;
+  out.job.scenario = scenario;
+  auto& j = out.job.job;
+  j.set_id(id);
+  j.set_state(v1::QUEUED);
+  j.set_name(scenario.name());
+  j.set_scenario_hash(hash);
+  j.set_created_utc(now);
+  j.set_updated_utc(now);
+  j.set_request_id(request_id);
+  auto* t = j.add_transitions();
+  t->set_state(v1::QUEUED);
+  t->set_time_utc(now);
+  t->set_reason("submitted");
+  return out;
+}
+
+std::optional<StoredJob> JobStore::get(const std::string& id, const std::string& owner) const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_, (std::string("SELECT ") + kColumns + " FROM jobs WHERE id = ?").c_str());
+  st.bind(1, id);
+  if (!st.step()) return std::nullopt;
+  StoredJob j = read_row(&st);
+  if (!owner.empty() && j.owner != owner) return std::nullopt;
+  load_transitions(j);
+  return j;
+}
+
+std::vector<StoredJob> JobStore::list(const std::string& owner, const std::vector<v1::JobState>& states, int page_size,
+                                      const std::string& page_token, std::string* next_page_token) const {
+  std::lock_guard lk(mu_);
+  std::string sql = std::string("SELECT ") + kColumns + ", seq FROM jobs WHERE owner = ? AND seq < ?";
+  if (!states.empty()) {
+    sql += " AND state IN (";
+    for (std::size_t k = 0; k < states.size(); ++k) sql += (k ? ", " : "") + std::to_string(int(states[k]));
+    sql += ")";
+  }
+  sql += " ORDER BY seq DESC LIMIT ?";
+  std::int64_t before = INT64_MAX;
+  if (!page_token.empty()) {
+    try {
+      before = std::stoll(page_token);
+    } catch (...) {
+      throw std::invalid_argument("page_token: not a token this server gave out");
+    }
+  }
+  Stmt st(db_, sql.c_str());
+  st.bind(1, owner).bind(2, before).bind(3, std::int64_t(page_size) + 1);
+  std::vector<StoredJob> out;
+  std::int64_t last_seq = 0;
+  if (next_page_token) next_page_token->clear();
+  while (st.step()) {
+    if (int(out.size()) == page_size) {
+      if (next_page_token) *next_page_token = std::to_string(last_seq);
+      break;
+    }
+    out.push_back(read_row(&st));
+    last_seq = st.i64(14);
+  }
+  for (auto& j : out) load_transitions(j);
+  return out;
+}
+
+std::optional<StoredJob> JobStore::claim_next() {
+  std::lock_guard lk(mu_);
+  Transaction tx(db_);
+  Stmt st(db_, (std::string("SELECT ") + kColumns + " FROM jobs WHERE state = 1 ORDER BY seq LIMIT 1").c_str());
+  if (!st.step()) {
+    tx.commit();
+    return std::nullopt;
+  }
+  StoredJob j = read_row(&st);
+  const std::string now = utc_now();
+  Stmt up(db_, "UPDATE jobs SET state = 2, attempts = attempts + 1, updated = ? WHERE id = ?");
+  up.bind(1, now).bind(2, j.job.id()).step();
+  j.job.set_attempts(j.job.attempts() + 1);
+  add_transition(db_, j.job.id(), v1::RUNNING, now, "started (attempt " + std::to_string(j.job.attempts()) + ")");
+  tx.commit();
+  j.job.set_state(v1::RUNNING);
+  j.job.set_updated_utc(now);
+  load_transitions(j);
+  return j;
+}
+
+void JobStore::transition(const std::string& id, v1::JobState state, const std::string& reason, const std::string& error,
+                          std::int64_t result_bytes) {
+  std::lock_guard lk(mu_);
+  Transaction tx(db_);
+  const std::string now = utc_now();
+  Stmt up(db_,
+          "UPDATE jobs SET state = ?, updated = ?, error = ?, result_bytes = CASE WHEN ? >= 0 THEN ? ELSE result_bytes END "
+          "WHERE id = ?");
+  up.bind(1, std::int64_t(state)).bind(2, now).bind(3, error).bind(4, result_bytes).bind(5, result_bytes).bind(6, id).step();
+  add_transition(db_, id, state, now, reason);
+  tx.commit();
+}
+
+std::optional<StoredJob> JobStore::cancel(const std::string& id, const std::string& owner) {
+  {
+    std::lock_guard lk(mu_);
+    Transaction tx(db_);
+    Stmt st(db_, "SELECT state FROM jobs WHERE id = ? AND owner = ?");
+    st.bind(1, id).bind(2, owner);
+    if (!st.step()) return std::nullopt;
+    if (v1::JobState(st.i64(0)) == v1::QUEUED) {
+      const std::string now = utc_now();
+      Stmt up(db_, "UPDATE jobs SET state = 5, updated = ? WHERE id = ?");
+      up.bind(1, now).bind(2, id).step();
+      add_transition(db_, id, v1::CANCELLED, now, "cancelled by the client before it started");
+    }
+    tx.commit();
+  }
+  return get(id, owner);
+}
+
+int JobStore::requeue_running(const std::string& reason) {
+  std::lock_guard lk(mu_);
+  Transaction tx(db_);
+  std::vector<std::string> ids;
+  {
+    Stmt st(db_, "SELECT id FROM jobs WHERE state = 2");
+    while (st.step()) ids.push_back(st.text(0));
+  }
+  const std::string now = utc_now();
+  for (const auto& id : ids) {
+    Stmt(db_, "UPDATE jobs SET state = 1, updated = ? WHERE id = ?").bind(1, now).bind(2, id).step();
+    add_transition(db_, id, v1::QUEUED, now, reason);
+  }
+  tx.commit();
+  return int(ids.size());
+}
+
+void JobStore::save_progress(const std::string& id, const v1::Progress& p) {
+  std::lock_guard lk(mu_);
+  std::string blob;
+  p.SerializeToString(&blob);
+  Stmt(db_, "UPDATE jobs SET progress = ? WHERE id = ?").blob(1, blob).bind(2, id).step();
+}
+
+std::int64_t JobStore::result_bytes_total(const std::string& owner) const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_,
+          "SELECT COALESCE(SUM(b), 0) FROM (SELECT MAX(result_bytes) AS b FROM jobs WHERE owner = ? AND state = 3 "
+          "AND results_removed = 0 GROUP BY hash)");
+  st.bind(1, owner);
+  st.step();
+  return st.i64(0);
+}
+
+std::vector<JobStore::Finished> JobStore::finished_results() const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_,
+          "SELECT hash, MAX(updated), MAX(result_bytes) FROM jobs WHERE state = 3 AND results_removed = 0 GROUP BY hash "
+          "ORDER BY MAX(updated)");
+  std::vector<Finished> out;
+  while (st.step()) out.push_back({st.text(0), st.text(1), st.i64(2)});
+  return out;
+}
+
+void JobStore::mark_results_removed(const std::string& hash, const std::string& reason) {
+  std::lock_guard lk(mu_);
+  Transaction tx(db_);
+  std::vector<std::string> ids;
+  {
+    Stmt st(db_, "SELECT id FROM jobs WHERE hash = ? AND state = 3 AND results_removed = 0");
+    st.bind(1, hash);
+    while (st.step()) ids.push_back(st.text(0));
+  }
+  const std::string now = utc_now();
+  for (const auto& id : ids) {
+    Stmt(db_, "UPDATE jobs SET results_removed = 1, result_bytes = 0, updated = ? WHERE id = ?").bind(1, now).bind(2, id).step();
+    add_transition(db_, id, v1::SUCCEEDED, now, reason);
+  }
+  tx.commit();
+}
+
+}  // namespace runout::jobs

@@ -1,0 +1,96 @@
+#pragma once
+// The job store: every job, its state, its transitions (time and reason) and its last progress, in a
+// SQLite file (WAL mode) in the server's state directory. One connection, serialised by a mutex;
+// every state change is one transaction, so a process killed at any point leaves a consistent store.
+// States: queued -> running -> succeeded | failed | cancelled; running -> queued when the server stops
+// or restarts during a run.
+#include <cstdint>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "runout/v1/scenario.pb.h"
+#include "runout/v1/service.pb.h"
+
+struct sqlite3;
+
+namespace runout::jobs {
+
+struct StoreError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+/// The client already has as many queued and running jobs as the server allows.
+struct QueueFull : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct StoredJob {
+  v1::Job job;            ///< id, state, name, hash, times, error, progress, transitions, attempts
+  std::string owner;      ///< the client (token) that submitted it
+  v1::Scenario scenario;  ///< as resolved on the server (absolute input paths)
+  bool results_removed = false;  ///< results deleted by the retention policy
+};
+
+struct SubmitOutcome {
+  StoredJob job;
+  bool created = false;  ///< false: an existing job answered (same request id or identical scenario)
+};
+
+class JobStore {
+ public:
+  /// Opens (creating when needed) the store at `path`.
+  explicit JobStore(const std::string& path);
+  ~JobStore();
+  JobStore(const JobStore&) = delete;
+  JobStore& operator=(const JobStore&) = delete;
+
+  /// Queue a job, or return the existing one: the same owner's job with this request id, else the
+  /// same owner's newest job with this scenario hash that did not fail or get cancelled. Throws
+  /// QueueFull when the owner already has `max_queued` queued or running jobs.
+  SubmitOutcome submit(const std::string& owner, const std::string& hash, const std::string& request_id,
+                       const v1::Scenario& scenario, int max_queued);
+  /// The job with this id; with a non-empty owner only if it is that owner's.
+  std::optional<StoredJob> get(const std::string& id, const std::string& owner = "") const;
+  /// The owner's jobs, newest first, filtered by state (empty: all); `page_token` from the previous page.
+  std::vector<StoredJob> list(const std::string& owner, const std::vector<v1::JobState>& states, int page_size,
+                              const std::string& page_token, std::string* next_page_token) const;
+  /// The oldest queued job, now running (attempts + 1); nothing when the queue is empty.
+  std::optional<StoredJob> claim_next();
+  /// Record a state change with its reason (and the error for failures).
+  void transition(const std::string& id, v1::JobState state, const std::string& reason, const std::string& error = "",
+                  std::int64_t result_bytes = -1);
+  /// Queued jobs become cancelled here; running ones are left for the worker (returns their state).
+  std::optional<StoredJob> cancel(const std::string& id, const std::string& owner);
+  /// Jobs left running by a server that died: queued again. Returns how many.
+  int requeue_running(const std::string& reason);
+  void save_progress(const std::string& id, const v1::Progress& p);
+  /// Disk used by the owner's results (each result folder counted once).
+  std::int64_t result_bytes_total(const std::string& owner) const;
+  /// Succeeded jobs whose results still exist, oldest first: (hash, updated time, bytes).
+  struct Finished {
+    std::string hash, updated;
+    std::int64_t bytes = 0;
+  };
+  std::vector<Finished> finished_results() const;
+  /// The results of this scenario hash were deleted (retention): every job with it says so.
+  void mark_results_removed(const std::string& hash, const std::string& reason);
+
+ private:
+  StoredJob read_row(void* stmt) const;
+  void load_transitions(StoredJob& j) const;
+  void exec(const char* sql) const;
+  sqlite3* db_ = nullptr;
+  mutable std::mutex mu_;
+};
+
+/// "2026-11-23T06:30:04.123Z"
+std::string utc_now();
+/// A new random job id ("j" + 16 hex digits).
+std::string new_job_id();
+/// "queued", "running", ...
+std::string state_name(v1::JobState s);
+bool is_final(v1::JobState s);
+
+}  // namespace runout::jobs

@@ -1,0 +1,161 @@
+// runout regress: the nightly In den Arelen regression through the service (validation.md C1).
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "jobs/regression.hpp"
+#include "jobs/scenario.hpp"
+#include "service/cli/commands.hpp"
+#include "service/client/client.hpp"
+#include "service/server/server.hpp"
+
+namespace fs = std::filesystem;
+
+namespace runout::cli {
+
+int regress(const std::vector<std::string>& args) {
+  service::ClientOptions opt;
+  bool remote = false, accept = false;
+  std::string out, reason, scenario = std::string(RUNOUT_SOURCE_DIR) + "/scenarios/in-den-arelen.json",
+                           reference = std::string(RUNOUT_SOURCE_DIR) + "/regression/in-den-arelen";
+  if (const char* t = std::getenv("RUNOUT_TOKEN")) opt.token = t;
+  for (std::size_t k = 0; k < args.size(); ++k) {
+    const auto& a = args[k];
+    if (a == "--accept") {
+      accept = true;
+      continue;
+    }
+    if (a == "--tls") {
+      opt.tls = true;
+      continue;
+    }
+    if (k + 1 >= args.size()) {
+      std::cerr << "runout regress: " << (a[0] == '-' ? a + " needs a value" : "unknown argument '" + a + "'") << "\n";
+      return kUsage;
+    }
+    const std::string v = args[++k];
+    if (a == "--server") {
+      opt.server = v;
+      remote = true;
+    } else if (a == "--token") {
+      opt.token = v;
+    } else if (a == "--token-file") {
+      std::ifstream in(v);
+      if (!in || !std::getline(in, opt.token)) {
+        std::cerr << "runout regress: --token-file '" << v << "': cannot read a token from it\n";
+        return kUsage;
+      }
+    } else if (a == "--tls-ca") {
+      opt.tls_ca = v;
+    } else if (a == "--out") {
+      out = v;
+    } else if (a == "--scenario") {
+      scenario = v;
+    } else if (a == "--reference") {
+      reference = v;
+    } else if (a == "--reason") {
+      reason = v;
+    } else {
+      std::cerr << "runout regress: unknown option '" << a << "' (see runout help)\n";
+      return kUsage;
+    }
+  }
+  if (accept && reason.empty()) {
+    std::cerr << "runout regress: --accept needs --reason TEXT (why this run becomes the reference)\n";
+    return kUsage;
+  }
+  if (out.empty()) {
+    char b[64];
+    const std::time_t now = std::time(nullptr);
+    std::strftime(b, sizeof b, "runs/regress-%Y%m%d-%H%M%S", std::gmtime(&now));
+    out = b;
+  }
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec) {
+    std::cerr << "runout regress: cannot create '" << out << "': " << ec.message() << "\n";
+    return kOutput;
+  }
+
+  // The service: the given server, or one started here on a free loopback port.
+  std::unique_ptr<service::Server> embedded;
+  const fs::path state = fs::path(out) / ".service-state";
+  try {
+    if (!remote) {
+      v1::ServerConfig cfg;
+      cfg.set_listen("127.0.0.1:0");
+      cfg.set_state_dir(state.string());
+      cfg.set_log_file((fs::path(out) / "server.log").string());
+      embedded = std::make_unique<service::Server>(cfg);
+      embedded->start();
+      opt.server = embedded->address();
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    service::Client client(opt);
+    std::ifstream in(scenario);
+    if (!in) throw jobs::ScenarioError("cannot read scenario '" + scenario + "'");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    auto s = jobs::parse_scenario_json(ss.str());
+    s = service::upload_inputs(client, s, fs::absolute(scenario).parent_path().string());
+    const auto job = client.submit(s, "");
+    std::fprintf(stderr, "runout regress: job %s on %s\n", job.id().c_str(), opt.server.c_str());
+    const auto fin = client.watch(job.id());
+    if (fin.state() != v1::SUCCEEDED) {
+      std::cerr << "runout regress: the job " << service::state_word(fin.state()) << (fin.error().empty() ? "" : ": " + fin.error())
+                << "\n";
+      return kFailed;
+    }
+    const fs::path results = fs::path(out) / "run";
+    fs::remove_all(results, ec);
+    fs::create_directories(results);
+    const auto listing = client.results(job.id());
+    for (const auto& f : listing.files()) client.download(job.id(), f.name(), (results / f.name()).string());
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    fs::copy_file(results / "map.png", fs::path(out) / "map.png", fs::copy_options::overwrite_existing);
+    if (embedded) {
+      embedded->shutdown();
+      embedded.reset();
+      fs::remove_all(state, ec);
+    }
+
+    const auto figures = jobs::measure_run(results.string());
+    if (accept) {
+      jobs::accept_reference(reference, figures, (results / "max_depth.tif").string(), reason, fin.scenario_hash(), RUNOUT_VERSION);
+      std::printf("accepted as the reference in %s: runout %.0f m, affected area %.0f m2, max depth %.2f m, max speed %.1f m/s, "
+                  "farmhouse %s\n",
+                  reference.c_str(), figures.runout_m, figures.affected_area_m2, figures.max_depth_m, figures.max_speed_m_s,
+                  figures.farmhouse_distance_m == 0 ? "reached" : "not reached");
+    }
+    const auto ref = jobs::read_reference(reference);
+    const auto o = jobs::compare_run(figures, ref, (results / "max_depth.tif").string(), reference, out);
+    jobs::write_report(out, o, ref, job.id(), fin.scenario_hash(), wall);
+    for (const auto& r : o.rows)
+      std::printf("%-48s %14.6g %14.6g  %s\n", r.name.c_str(), r.reference, r.value, r.ok ? "ok" : "FAIL");
+    std::printf("%s: report in %s\n", o.ok ? "PASS" : "REGRESSION", (fs::path(out) / "report.md").string().c_str());
+    return o.ok ? kOk : kFailed;
+  } catch (const service::RpcError& e) {
+    std::cerr << "runout regress: " << e.what() << "\n";
+    return kService;
+  } catch (const service::ConfigError& e) {
+    std::cerr << "runout regress: embedded server: " << e.what() << "\n";
+    return kInternal;
+  } catch (const jobs::ScenarioError& e) {
+    std::cerr << "runout regress: " << e.what() << "\n";
+    return kBadInput;
+  } catch (const std::exception& e) {
+    std::cerr << "runout regress: " << e.what() << "\n";
+    return kFailed;
+  }
+}
+
+}  // namespace runout::cli

@@ -1,0 +1,591 @@
+#include "service/server/server.hpp"
+
+#include <google/protobuf/util/json_util.h>
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <openssl/crypto.h>
+#include <unistd.h>
+
+#include <array>
+#include <condition_variable>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <sstream>
+
+#include "jobs/run.hpp"
+#include "jobs/scenario.hpp"
+#include "jobs/scheduler.hpp"
+#include "jobs/sha256.hpp"
+#include "jobs/store.hpp"
+#include "runout/v1/service.grpc.pb.h"
+#include "terrain/terrain.hpp"
+
+namespace fs = std::filesystem;
+
+namespace runout::service {
+
+namespace {
+
+using grpc::Status;
+using grpc::StatusCode;
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw ConfigError("cannot read '" + path + "'");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::array<unsigned char, 32> digest_of(const std::string& hex) {
+  std::array<unsigned char, 32> d{};
+  for (std::size_t k = 0; k < 32; ++k) d[k] = static_cast<unsigned char>(std::stoi(hex.substr(2 * k, 2), nullptr, 16));
+  return d;
+}
+
+bool is_hex64(const std::string& s) {
+  return s.size() == 64 && s.find_first_not_of("0123456789abcdefABCDEF") == std::string::npos;
+}
+
+// Bearer tokens from a file: one per line, the token itself or "sha256:HEX"; '#' starts a comment
+// line. Only digests are kept; a presented token is hashed and compared with every digest in
+// constant time. The file is read again when it changes (token rotation without a restart).
+class Tokens {
+ public:
+  explicit Tokens(std::string path) : path_(std::move(path)) {
+    if (!path_.empty()) load();
+  }
+  bool enabled() const { return !path_.empty(); }
+  /// The owner id of a token ("t" + 16 hex digits of its digest), or "" when it is not known.
+  std::string owner_of(const std::string& token) {
+    std::lock_guard lk(mu_);
+    std::error_code ec;
+    const auto mt = fs::last_write_time(path_, ec);
+    if (!ec && mt != mtime_) {
+      try {
+        load_locked();
+      } catch (const std::exception&) {
+        // keep the tokens we have; the server log says why on the next start
+      }
+    }
+    const auto d = digest_of(jobs::sha256_hex(token));
+    bool found = false;
+    for (const auto& k : digests_) found |= CRYPTO_memcmp(k.data(), d.data(), d.size()) == 0;
+    if (!found) return "";
+    static const char* hex = "0123456789abcdef";
+    std::string o = "t";
+    for (int k = 0; k < 8; ++k) {
+      o += hex[d[k] >> 4];
+      o += hex[d[k] & 15];
+    }
+    return o;
+  }
+
+ private:
+  void load() {
+    std::lock_guard lk(mu_);
+    load_locked();
+  }
+  void load_locked() {
+    std::ifstream in(path_);
+    if (!in) throw ConfigError("tokens_file '" + path_ + "': cannot read it");
+    std::vector<std::array<unsigned char, 32>> ds;
+    std::string line;
+    int n = 0;
+    while (std::getline(in, line)) {
+      ++n;
+      while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.pop_back();
+      std::size_t b = line.find_first_not_of(" \t");
+      if (b == std::string::npos || line[b] == '#') continue;
+      line = line.substr(b);
+      if (line.rfind("sha256:", 0) == 0) {
+        const std::string h = line.substr(7);
+        if (!is_hex64(h))
+          throw ConfigError("tokens_file '" + path_ + "' line " + std::to_string(n) + ": sha256: needs 64 hex digits");
+        std::string lower = h;
+        for (auto& c : lower) c = char(std::tolower(static_cast<unsigned char>(c)));
+        ds.push_back(digest_of(lower));
+      } else {
+        ds.push_back(digest_of(jobs::sha256_hex(line)));
+      }
+    }
+    if (ds.empty()) throw ConfigError("tokens_file '" + path_ + "' holds no token");
+    digests_ = std::move(ds);
+    std::error_code ec;
+    mtime_ = fs::last_write_time(path_, ec);
+  }
+  std::string path_;
+  std::vector<std::array<unsigned char, 32>> digests_;
+  fs::file_time_type mtime_{};
+  std::mutex mu_;
+};
+
+bool plain_name(const std::string& n) {
+  if (n.empty() || n.size() > 200 || n[0] == '.') return false;
+  return n.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789._-") == std::string::npos;
+}
+
+bool inside(const fs::path& p, const fs::path& root) {
+  auto r = root.begin(), q = p.begin();
+  for (; r != root.end(); ++r, ++q) {
+    if (r->empty()) continue;  // a trailing separator
+    if (q == p.end() || *q != *r) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+v1::ServerConfig resolve_config(v1::ServerConfig c) {
+  if (c.listen().empty()) c.set_listen("127.0.0.1:50051");
+  if (c.listen().find(':') == std::string::npos) throw ConfigError("listen: '" + c.listen() + "' is not HOST:PORT");
+  if (c.state_dir().empty()) c.set_state_dir("runout-state");
+  if (c.workers() == 0) c.set_workers(1);
+  if (c.workers() < 0 || c.workers() > 256) throw ConfigError("workers: must lie in 1..256, got " + std::to_string(c.workers()));
+  if (c.threads_per_run() < 0) throw ConfigError("threads_per_run: must be >= 0 (0: cores / workers)");
+  if (c.max_queued_per_client() == 0) c.set_max_queued_per_client(100);
+  if (c.max_queued_per_client() < 0) throw ConfigError("max_queued_per_client: must be > 0");
+  if (c.max_upload_bytes() == 0) c.set_max_upload_bytes(std::int64_t(2) << 30);
+  if (c.max_upload_bytes() < 0) throw ConfigError("max_upload_bytes: must be > 0");
+  if (c.max_message_bytes() == 0) c.set_max_message_bytes(16 << 20);
+  if (c.max_message_bytes() < (1 << 20)) throw ConfigError("max_message_bytes: must be at least 1048576");
+  if (c.retention_days() < 0) throw ConfigError("retention_days: must be >= 0 (0: keep)");
+  if (c.retention_max_bytes() < 0) throw ConfigError("retention_max_bytes: must be >= 0 (0: no limit)");
+  if (c.tls_cert().empty() != c.tls_key().empty()) throw ConfigError("tls_cert and tls_key: give both or neither");
+  std::error_code ec;
+  fs::create_directories(c.state_dir(), ec);
+  if (ec) throw ConfigError("state_dir '" + c.state_dir() + "': " + ec.message());
+  c.set_state_dir(fs::canonical(c.state_dir()).string());
+  for (int k = 0; k < c.data_roots_size(); ++k) {
+    const fs::path p = c.data_roots(k);
+    if (!fs::is_directory(p, ec)) throw ConfigError("data_roots: '" + p.string() + "' is not a folder");
+    c.set_data_roots(k, fs::canonical(p).string());
+  }
+  for (const auto* f : {&c.tokens_file(), &c.tls_cert(), &c.tls_key()})
+    if (!f->empty() && !fs::is_regular_file(*f, ec)) throw ConfigError("'" + *f + "' does not exist or is not a file");
+  return c;
+}
+
+v1::ServerConfig read_config_file(const std::string& path) {
+  v1::ServerConfig c;
+  google::protobuf::util::JsonParseOptions o;
+  o.ignore_unknown_fields = false;
+  const auto st = google::protobuf::util::JsonStringToMessage(read_text(path), &c, o);
+  if (!st.ok()) throw ConfigError("configuration '" + path + "': " + std::string(st.message()));
+  return c;
+}
+
+struct Server::Impl final : v1::Runout::Service {
+  v1::ServerConfig cfg;
+  std::unique_ptr<Tokens> tokens;
+  std::unique_ptr<jobs::JobStore> store;
+  std::unique_ptr<jobs::Scheduler> sched;
+  std::unique_ptr<grpc::Server> server;
+  int bound_port = 0;
+  std::mutex log_mu;
+  std::ofstream log_file;
+  std::mutex stop_mu;
+  std::condition_variable stop_cv;
+  bool stopped = false;
+
+  void log(const std::string& line) {
+    std::lock_guard lk(log_mu);
+    std::ostream& o = log_file.is_open() ? static_cast<std::ostream&>(log_file) : std::cerr;
+    o << jobs::utc_now() << " " << line << std::endl;
+  }
+
+  Status authenticate(grpc::ServerContext* ctx, std::string* owner) {
+    if (!tokens->enabled()) {
+      *owner = "local";
+      return Status::OK;
+    }
+    const auto& md = ctx->client_metadata();
+    const auto it = md.find("authorization");
+    if (it == md.end()) return {StatusCode::UNAUTHENTICATED, "missing bearer token (metadata 'authorization: Bearer TOKEN')"};
+    const std::string v(it->second.data(), it->second.size());
+    if (v.rfind("Bearer ", 0) != 0) return {StatusCode::UNAUTHENTICATED, "the authorization metadata must read 'Bearer TOKEN'"};
+    *owner = tokens->owner_of(v.substr(7));
+    if (owner->empty()) return {StatusCode::UNAUTHENTICATED, "unknown bearer token"};
+    return Status::OK;
+  }
+
+  // A scenario's input path on this server: an uploaded file or a file inside a data root.
+  Status resolve_input(const std::string& field, std::string* path) {
+    const std::string p = *path;
+    if (p.empty()) return Status::OK;  // the scenario's own check names what is missing
+    if (p.rfind("upload:", 0) == 0) {
+      const std::string ref = p.substr(7);
+      const auto slash = ref.find('/');
+      const std::string id = ref.substr(0, slash), name = slash == std::string::npos ? "" : ref.substr(slash + 1);
+      if (!is_hex64(id) || !plain_name(name))
+        return {StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' is not an upload reference (upload:ID/NAME)"};
+      const fs::path f = fs::path(cfg.state_dir()) / "uploads" / id / name;
+      if (!fs::is_regular_file(f)) return {StatusCode::INVALID_ARGUMENT, field + ": no upload '" + p + "' on this server"};
+      *path = f.string();
+      return Status::OK;
+    }
+    for (const auto& part : fs::path(p))
+      if (part == "..") return {StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' may not contain '..'"};
+    if (cfg.data_roots().empty())
+      return {StatusCode::INVALID_ARGUMENT,
+              field + ": '" + p + "': this server has no data roots; upload the file (runout submit does) and use its upload: reference"};
+    std::error_code ec;
+    for (const auto& root : cfg.data_roots()) {
+      const fs::path cand = fs::path(p).is_absolute() ? fs::path(p) : fs::path(root) / p;
+      if (!fs::exists(cand, ec)) continue;
+      const fs::path real = fs::canonical(cand, ec);  // symbolic links resolved
+      if (ec) continue;
+      bool ok = false;
+      for (const auto& r : cfg.data_roots()) ok |= inside(real, r);
+      if (!ok)
+        return {StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' lies outside the server's data roots (after links are followed)"};
+      *path = real.string();
+      return Status::OK;
+    }
+    return {StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' is in none of the server's data roots"};
+  }
+
+  v1::Job with_live(const jobs::StoredJob& j) {
+    v1::Job out = j.job;
+    const auto l = sched->live(j.job.id());
+    if (l.running && out.state() == v1::RUNNING) *out.mutable_progress() = l.progress;
+    return out;
+  }
+
+  Status SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRequest* req, v1::Job* resp) override {
+    std::string owner;
+    if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
+    if (!req->has_scenario()) return {StatusCode::INVALID_ARGUMENT, "scenario: missing"};
+    if (req->request_id().size() > 200) return {StatusCode::INVALID_ARGUMENT, "request_id: longer than 200 characters"};
+    v1::Scenario s = req->scenario();
+    if (auto st = resolve_input("dem.path", s.mutable_dem()->mutable_path()); !st.ok()) return st;
+    if (s.has_area_of_interest())
+      if (auto st = resolve_input("area_of_interest.path", s.mutable_area_of_interest()->mutable_path()); !st.ok()) return st;
+    for (int k = 0; k < s.releases_size(); ++k)
+      if (auto st = resolve_input("releases[" + std::to_string(k) + "].path", s.mutable_releases(k)->mutable_path()); !st.ok())
+        return st;
+    std::string hash;
+    try {
+      const auto r = jobs::resolve_scenario(s, "/");
+      hash = jobs::scenario_hash(r);
+    } catch (const jobs::ScenarioError& e) {
+      return {StatusCode::INVALID_ARGUMENT, e.what()};
+    } catch (const terrain::TerrainError& e) {
+      return {StatusCode::INVALID_ARGUMENT, e.what()};
+    } catch (const std::exception& e) {
+      return {StatusCode::INTERNAL, std::string("validating the scenario failed: ") + e.what()};
+    }
+    try {
+      const auto out = store->submit(owner, hash, req->request_id(), s, cfg.max_queued_per_client());
+      *resp = with_live(out.job);
+      if (out.created) {
+        log("job " + resp->id() + ": queued (" + owner + ", scenario " + hash.substr(0, 12) + ")");
+        sched->touch(resp->id());
+        sched->notify();
+      }
+    } catch (const jobs::QueueFull& e) {
+      return {StatusCode::RESOURCE_EXHAUSTED, e.what()};
+    } catch (const std::exception& e) {
+      return {StatusCode::INTERNAL, e.what()};
+    }
+    return Status::OK;
+  }
+
+  Status GetJob(grpc::ServerContext* ctx, const v1::GetJobRequest* req, v1::Job* resp) override {
+    std::string owner;
+    if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
+    const auto j = store->get(req->id(), owner);
+    if (!j) return {StatusCode::NOT_FOUND, "no job '" + req->id() + "'"};
+    *resp = with_live(*j);
+    return Status::OK;
+  }
+
+  Status ListJobs(grpc::ServerContext* ctx, const v1::ListJobsRequest* req, v1::ListJobsResponse* resp) override {
+    std::string owner;
+    if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
+    int n = req->page_size() <= 0 ? 50 : std::min(req->page_size(), 500);
+    std::vector<v1::JobState> states;
+    for (int s : req->states()) states.push_back(v1::JobState(s));
+    try {
+      std::string next;
+      for (const auto& j : store->list(owner, states, n, req->page_token(), &next)) *resp->add_jobs() = with_live(j);
+      resp->set_next_page_token(next);
+      resp->set_result_bytes_total(store->result_bytes_total(owner));
+    } catch (const std::invalid_argument& e) {
+      return {StatusCode::INVALID_ARGUMENT, e.what()};
+    }
+    return Status::OK;
+  }
+
+  Status CancelJob(grpc::ServerContext* ctx, const v1::CancelJobRequest* req, v1::Job* resp) override {
+    std::string owner;
+    if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
+    auto j = store->cancel(req->id(), owner);
+    if (!j) return {StatusCode::NOT_FOUND, "no job '" + req->id() + "'"};
+    if (j->job.state() == v1::RUNNING) {
+      sched->cancel_running(req->id());
+      log("job " + req->id() + ": cancel requested");
+    }
+    sched->touch(req->id());
+    *resp = with_live(*j);
+    return Status::OK;
+  }
+
+  Status WatchJob(grpc::ServerContext* ctx, const v1::WatchJobRequest* req, grpc::ServerWriter<v1::JobEvent>* w) override {
+    std::string owner;
+    if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
+    std::uint64_t sent = ~std::uint64_t(0);
+    auto last = std::chrono::steady_clock::now();
+    for (;;) {
+      const auto l = sched->live(req->id());
+      const auto j = store->get(req->id(), owner);
+      if (!j) return {StatusCode::NOT_FOUND, "no job '" + req->id() + "'"};
+      const auto now = std::chrono::steady_clock::now();
+      if (l.version != sent || now - last > std::chrono::seconds(10) || jobs::is_final(j->job.state())) {
+        v1::JobEvent ev;
+        *ev.mutable_job() = with_live(*j);
+        if (!w->Write(ev)) return {StatusCode::CANCELLED, "the client went away"};
+        sent = l.version;
+        last = now;
+      }
+      if (jobs::is_final(j->job.state())) return Status::OK;
+      if (ctx->IsCancelled()) return {StatusCode::CANCELLED, "the client cancelled the watch"};
+      {
+        std::lock_guard lk(stop_mu);
+        if (stopped) return {StatusCode::UNAVAILABLE, "the server is stopping"};
+      }
+      sched->wait_change(req->id(), l.version, std::chrono::milliseconds(500));
+    }
+  }
+
+  // The files of a job the client may download: the results of a succeeded job, and its log.
+  std::vector<v1::ResultFile> result_files(const jobs::StoredJob& j) {
+    std::vector<v1::ResultFile> out;
+    std::error_code ec;
+    if (j.job.state() == v1::SUCCEEDED && !j.results_removed) {
+      const fs::path d = sched->results_dir(j.job.scenario_hash());
+      for (const auto& e : fs::directory_iterator(d, ec)) {
+        if (!e.is_regular_file(ec)) continue;
+        v1::ResultFile f;
+        f.set_name(e.path().filename().string());
+        f.set_bytes(std::int64_t(e.file_size(ec)));
+        out.push_back(f);
+      }
+      std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.name() < b.name(); });
+    }
+    const fs::path lg = sched->log_path(j.job.id());
+    if (fs::exists(lg, ec)) {
+      v1::ResultFile f;
+      f.set_name("job.log");
+      f.set_bytes(std::int64_t(fs::file_size(lg, ec)));
+      out.push_back(f);
+    }
+    return out;
+  }
+
+  Status ListResults(grpc::ServerContext* ctx, const v1::ListResultsRequest* req, v1::ListResultsResponse* resp) override {
+    std::string owner;
+    if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
+    const auto j = store->get(req->job_id(), owner);
+    if (!j) return {StatusCode::NOT_FOUND, "no job '" + req->job_id() + "'"};
+    for (auto& f : result_files(*j)) *resp->add_files() = f;
+    if (j->job.state() == v1::SUCCEEDED && j->results_removed)
+      return {StatusCode::FAILED_PRECONDITION, "the results of job " + j->job.id() + " were removed by the retention policy"};
+    return Status::OK;
+  }
+
+  Status DownloadResult(grpc::ServerContext* ctx, const v1::DownloadResultRequest* req, grpc::ServerWriter<v1::DataChunk>* w) override {
+    std::string owner;
+    if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
+    const auto j = store->get(req->job_id(), owner);
+    if (!j) return {StatusCode::NOT_FOUND, "no job '" + req->job_id() + "'"};
+    const auto files = result_files(*j);
+    const bool listed = std::any_of(files.begin(), files.end(), [&](const auto& f) { return f.name() == req->name(); });
+    if (!listed) {
+      if (j->job.state() != v1::SUCCEEDED && req->name() != "job.log")
+        return {StatusCode::FAILED_PRECONDITION,
+                "job " + j->job.id() + " is " + jobs::state_name(j->job.state()) + ": only job.log can be fetched"};
+      return {StatusCode::NOT_FOUND, "job " + j->job.id() + " has no result '" + req->name() + "'"};
+    }
+    const fs::path p = req->name() == "job.log" ? fs::path(sched->log_path(j->job.id()))
+                                                : fs::path(sched->results_dir(j->job.scenario_hash())) / req->name();
+    std::ifstream in(p, std::ios::binary);
+    if (!in) return {StatusCode::INTERNAL, "cannot read result '" + req->name() + "'"};
+    std::error_code ec;
+    const auto total = std::int64_t(fs::file_size(p, ec));
+    jobs::Sha256 h;
+    std::string buf(1 << 20, '\0');
+    std::int64_t offset = 0;
+    bool first = true;
+    for (;;) {
+      in.read(buf.data(), std::streamsize(buf.size()));
+      const auto n = std::size_t(in.gcount());
+      const bool last = !in || offset + std::int64_t(n) >= total;
+      v1::DataChunk c;
+      c.set_data(buf.data(), n);
+      c.set_offset(offset);
+      h.update(std::string_view(buf.data(), n));
+      if (first) c.set_total_bytes(total);
+      if (last) c.set_sha256(h.hex());
+      if (!w->Write(c)) return {StatusCode::CANCELLED, "the client went away"};
+      offset += std::int64_t(n);
+      first = false;
+      if (last) break;
+    }
+    return Status::OK;
+  }
+
+  Status UploadInput(grpc::ServerContext* ctx, grpc::ServerReader<v1::UploadChunk>* r, v1::UploadResponse* resp) override {
+    std::string owner;
+    if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
+    const fs::path up = fs::path(cfg.state_dir()) / "uploads";
+    const fs::path tmp = up / (".tmp-" + jobs::new_job_id());
+    std::error_code ec;
+    fs::create_directories(tmp, ec);
+    if (ec) return {StatusCode::INTERNAL, "cannot create an upload folder: " + ec.message()};
+    auto fail = [&](StatusCode c, const std::string& m) {
+      fs::remove_all(tmp, ec);
+      return Status(c, m);
+    };
+    v1::UploadChunk c;
+    std::string current;
+    std::ofstream out;
+    std::vector<std::string> names;
+    jobs::Sha256 set_hash;
+    std::unique_ptr<jobs::Sha256> file_hash;
+    std::int64_t bytes = 0;
+    auto close_file = [&] {
+      if (!current.empty()) {
+        out.close();
+        set_hash.update(current + "\n" + file_hash->hex() + "\n");
+      }
+    };
+    while (r->Read(&c)) {
+      if (c.file_name() != current && !c.file_name().empty()) {
+        if (!plain_name(c.file_name()))
+          return fail(StatusCode::INVALID_ARGUMENT, "file_name: '" + c.file_name() + "' must be a plain file name (letters, digits, . _ -)");
+        if (std::find(names.begin(), names.end(), c.file_name()) != names.end())
+          return fail(StatusCode::INVALID_ARGUMENT, "file_name: '" + c.file_name() + "' sent twice in one upload");
+        close_file();
+        current = c.file_name();
+        names.push_back(current);
+        out.open(tmp / current, std::ios::binary);
+        file_hash = std::make_unique<jobs::Sha256>();
+      }
+      if (current.empty()) return fail(StatusCode::INVALID_ARGUMENT, "file_name: the first chunk must name its file");
+      bytes += std::int64_t(c.data().size());
+      if (bytes > cfg.max_upload_bytes())
+        return fail(StatusCode::RESOURCE_EXHAUSTED, "upload larger than the server's limit of " + std::to_string(cfg.max_upload_bytes()) + " bytes");
+      out.write(c.data().data(), std::streamsize(c.data().size()));
+      file_hash->update(c.data());
+      if (!out) return fail(StatusCode::INTERNAL, "writing the upload failed");
+    }
+    if (names.empty()) return fail(StatusCode::INVALID_ARGUMENT, "empty upload");
+    close_file();
+    const std::string id = set_hash.hex();
+    const fs::path dest = up / id;
+    if (fs::exists(dest, ec)) {
+      fs::remove_all(tmp, ec);  // the same files were uploaded before
+    } else {
+      fs::rename(tmp, dest, ec);
+      if (ec && !fs::exists(dest)) return fail(StatusCode::INTERNAL, "storing the upload failed: " + ec.message());
+      fs::remove_all(tmp, ec);
+    }
+    resp->set_ref("upload:" + id + "/" + names.front());
+    for (const auto& n : names) resp->add_files(n);
+    resp->set_bytes(bytes);
+    log("upload " + id.substr(0, 12) + " (" + owner + "): " + std::to_string(names.size()) + " file(s), " + std::to_string(bytes) + " bytes");
+    return Status::OK;
+  }
+};
+
+Server::Server(const v1::ServerConfig& cfg) : impl_(std::make_unique<Impl>()) { impl_->cfg = resolve_config(cfg); }
+
+Server::~Server() { shutdown(); }
+
+void Server::start() {
+  auto& m = *impl_;
+  if (!m.cfg.log_file().empty()) {
+    m.log_file.open(m.cfg.log_file(), std::ios::app);
+    if (!m.log_file) throw ConfigError("log_file '" + m.cfg.log_file() + "': cannot open it");
+  }
+  m.tokens = std::make_unique<Tokens>(m.cfg.tokens_file());
+  fs::create_directories(fs::path(m.cfg.state_dir()) / "uploads");
+  try {
+    m.store = std::make_unique<jobs::JobStore>((fs::path(m.cfg.state_dir()) / "jobs.db").string());
+  } catch (const std::exception& e) {
+    throw ConfigError(e.what());
+  }
+  jobs::SchedulerConfig sc;
+  sc.state_dir = m.cfg.state_dir();
+  sc.workers = m.cfg.workers();
+  sc.threads_per_run = m.cfg.threads_per_run();
+  sc.retention_days = m.cfg.retention_days();
+  sc.retention_max_bytes = m.cfg.retention_max_bytes();
+  sc.log = [&m](const std::string& s) { m.log(s); };
+  m.sched = std::make_unique<jobs::Scheduler>(*m.store, sc);
+
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  grpc::ServerBuilder b;
+  std::shared_ptr<grpc::ServerCredentials> creds;
+  if (!m.cfg.tls_cert().empty()) {
+    grpc::SslServerCredentialsOptions o;
+    o.pem_key_cert_pairs.push_back({read_text(m.cfg.tls_key()), read_text(m.cfg.tls_cert())});
+    creds = grpc::SslServerCredentials(o);
+  } else {
+    creds = grpc::InsecureServerCredentials();
+    if (!m.tokens->enabled() && m.cfg.listen().rfind("127.0.0.1:", 0) != 0 && m.cfg.listen().rfind("localhost:", 0) != 0)
+      m.log("warning: listening on " + m.cfg.listen() + " without tokens_file: anyone who reaches the port can submit jobs");
+  }
+  b.AddListeningPort(m.cfg.listen(), creds, &m.bound_port);
+  b.SetMaxReceiveMessageSize(m.cfg.max_message_bytes());
+  b.SetMaxSendMessageSize(m.cfg.max_message_bytes());
+  b.RegisterService(&m);
+  m.server = b.BuildAndStart();
+  if (!m.server || m.bound_port == 0) throw ConfigError("listen: cannot listen on " + m.cfg.listen());
+  m.server->GetHealthCheckService()->SetServingStatus(true);
+  m.sched->start();
+  std::ofstream sj(fs::path(m.cfg.state_dir()) / "server.json.tmp");
+  sj << "{\"listen\": \"" << address() << "\", \"pid\": " << getpid() << ", \"started_utc\": \"" << jobs::utc_now() << "\"}\n";
+  sj.close();
+  fs::rename(fs::path(m.cfg.state_dir()) / "server.json.tmp", fs::path(m.cfg.state_dir()) / "server.json");
+  m.log("runout server listening on " + address() + " (state " + m.cfg.state_dir() + ", " + std::to_string(m.cfg.workers()) +
+        " worker(s), " + (m.tokens->enabled() ? "tokens" : "no authentication") + (m.cfg.tls_cert().empty() ? "" : ", TLS") + ")");
+}
+
+int Server::port() const { return impl_->bound_port; }
+
+std::string Server::address() const {
+  const std::string& l = impl_->cfg.listen();
+  return l.substr(0, l.rfind(':')) + ":" + std::to_string(impl_->bound_port);
+}
+
+void Server::shutdown() {
+  auto& m = *impl_;
+  {
+    std::lock_guard lk(m.stop_mu);
+    if (m.stopped) return;
+    m.stopped = true;
+  }
+  if (m.server) {
+    m.server->GetHealthCheckService()->SetServingStatus(false);
+    m.log("stopping: interrupting running jobs (they run again at the next start)");
+    if (m.sched) m.sched->stop();
+    m.server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(5));
+    std::error_code ec;
+    fs::remove(fs::path(m.cfg.state_dir()) / "server.json", ec);
+    m.log("stopped");
+  }
+  m.stop_cv.notify_all();
+}
+
+void Server::wait() {
+  std::unique_lock lk(impl_->stop_mu);
+  impl_->stop_cv.wait(lk, [&] { return impl_->stopped; });
+}
+
+}  // namespace runout::service

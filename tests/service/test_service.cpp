@@ -1,0 +1,355 @@
+// The batch service end to end: the real `runout serve` process on 127.0.0.1 with an ephemeral port
+// and a temporary state directory, driven through the client library.
+#include <gdal_priv.h>
+#include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "jobs/scenario.hpp"
+#include "jobs/sha256.hpp"
+#include "service/client/client.hpp"
+
+namespace fs = std::filesystem;
+using namespace runout;
+using namespace std::chrono_literals;
+
+namespace {
+
+struct TempDir {
+  fs::path p;
+  TempDir() {
+    static int n = 0;
+    p = fs::temp_directory_path() / ("runout-svc-" + std::to_string(getpid()) + "-" + std::to_string(n++));
+    fs::create_directories(p);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(p, ec);
+  }
+};
+
+// `runout serve` as a child process.
+class ServerProcess {
+ public:
+  ServerProcess(const fs::path& state, std::vector<std::string> extra) : state_(state), extra_(std::move(extra)) { start(); }
+  ~ServerProcess() { stop(SIGTERM); }
+  void start() {
+    fs::remove(state_ / "server.json");
+    std::vector<std::string> args = {RUNOUT_BIN, "serve", "--listen", "127.0.0.1:0", "--state-dir", state_.string(),
+                                     "--log-file", (state_.parent_path() / "server.log").string()};
+    args.insert(args.end(), extra_.begin(), extra_.end());
+    pid_ = fork();
+    if (pid_ == 0) {
+      std::vector<char*> argv;
+      for (auto& a : args) argv.push_back(a.data());
+      argv.push_back(nullptr);
+      std::freopen("/dev/null", "w", stdout);
+      execv(argv[0], argv.data());
+      _exit(127);
+    }
+    // The server writes server.json (atomically) once it listens.
+    for (int k = 0; k < 300 && !fs::exists(state_ / "server.json"); ++k) std::this_thread::sleep_for(50ms);
+    std::ifstream in(state_ / "server.json");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const std::string s = ss.str();
+    const auto a = s.find("\"listen\": \"") + 11;
+    address_ = s.substr(a, s.find('"', a) - a);
+  }
+  void stop(int sig) {
+    if (pid_ <= 0) return;
+    kill(pid_, sig);
+    int st = 0;
+    waitpid(pid_, &st, 0);
+    pid_ = -1;
+  }
+  const std::string& address() const { return address_; }
+
+ private:
+  fs::path state_;
+  std::vector<std::string> extra_;
+  pid_t pid_ = -1;
+  std::string address_;
+};
+
+service::ClientOptions client_options(const std::string& address, const std::string& token) {
+  service::ClientOptions o;
+  o.server = address;
+  o.token = token;
+  return o;
+}
+
+// The In den Arelen test scenario (30 m) with its inputs named relative to the scenarios folder.
+v1::Scenario arelen(double end_time = 600, double stop_fraction = 0.01) {
+  std::ifstream in(std::string(RUNOUT_SOURCE_DIR) + "/tests/data/arelen-30m.json");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  auto s = jobs::parse_scenario_json(ss.str());
+  s.mutable_dem()->set_path("data/arelen/davos_srtm3.tif");
+  s.mutable_area_of_interest()->set_path("data/arelen/aoi.geojson");
+  s.mutable_releases(0)->set_path("data/arelen/release.geojson");
+  s.mutable_numerics()->set_end_time_s(end_time);
+  s.mutable_numerics()->set_stop_fraction(stop_fraction);
+  return s;
+}
+
+void write_tokens(const fs::path& p) {
+  std::ofstream t(p);
+  t << "# test tokens\nalpha-token\nsha256:" << jobs::sha256_hex("beta-token") << "\n";
+}
+
+std::vector<float> raster(const fs::path& p) {
+  GDALAllRegister();
+  GDALDatasetUniquePtr d(GDALDataset::Open(p.c_str(), GDAL_OF_RASTER));
+  if (!d) return {};
+  std::vector<float> v(std::size_t(d->GetRasterXSize()) * d->GetRasterYSize());
+  if (d->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, d->GetRasterXSize(), d->GetRasterYSize(), v.data(), d->GetRasterXSize(),
+                                    d->GetRasterYSize(), GDT_Float32, 0, 0) != CE_None)
+    return {};
+  return v;
+}
+
+int code_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const service::RpcError& e) {
+    return e.code;
+  }
+  return 0;
+}
+
+const std::string kScenarios = std::string(RUNOUT_SOURCE_DIR) + "/scenarios";
+
+}  // namespace
+
+TEST(Service, SubmitWatchFetchWithUploadsAndServerPaths) {
+  TempDir d;
+  write_tokens(d.p / "tokens");
+  ServerProcess srv(d.p / "state", {"--tokens", (d.p / "tokens").string(), "--data-root", kScenarios, "--workers", "2"});
+  ASSERT_FALSE(srv.address().empty());
+  service::Client c(client_options(srv.address(), "alpha-token"));
+  EXPECT_TRUE(c.healthy());
+  // Inputs uploaded from the client side.
+  auto s = service::upload_inputs(c, arelen(), kScenarios);
+  EXPECT_EQ(s.dem().path().rfind("upload:", 0), 0u);
+  const auto j = c.submit(s);
+  std::vector<v1::JobState> seen;
+  int with_progress = 0;
+  const auto fin = c.watch(j.id(), [&](const v1::Job& ev) {
+    if (seen.empty() || seen.back() != ev.state()) seen.push_back(ev.state());
+    if (ev.state() == v1::RUNNING && ev.progress().steps() > 0) ++with_progress;
+  });
+  EXPECT_EQ(fin.state(), v1::SUCCEEDED) << fin.error();
+  EXPECT_EQ(seen.back(), v1::SUCCEEDED);
+  EXPECT_GE(with_progress, 1);
+  ASSERT_GE(fin.transitions_size(), 3);  // submitted, started, completed
+  EXPECT_GT(fin.result_bytes(), 0);
+  const auto files = c.results(j.id());
+  std::set<std::string> names;
+  for (const auto& f : files.files()) names.insert(f.name());
+  for (const char* n : {"max_depth.tif", "max_speed.tif", "outline.geojson", "map.png", "run.json", "job.log"})
+    EXPECT_TRUE(names.count(n)) << n;
+  c.download(j.id(), "max_depth.tif", (d.p / "max_depth.tif").string());
+  const auto v = raster(d.p / "max_depth.tif");
+  ASSERT_FALSE(v.empty());
+  EXPECT_GT(*std::max_element(v.begin(), v.end()), 1.0f);
+  // The same scenario named by server paths has the same hash: the same job answers.
+  const auto again = c.submit(arelen());
+  EXPECT_EQ(again.id(), j.id());
+  EXPECT_EQ(again.scenario_hash(), j.scenario_hash());
+  // A result name outside the list is refused (no path tricks).
+  EXPECT_EQ(code_of([&] { c.download(j.id(), "../jobs.db", (d.p / "x").string()); }), int(grpc::StatusCode::NOT_FOUND));
+}
+
+TEST(Service, IdempotentResubmissionAndRequestIds) {
+  TempDir d;
+  ServerProcess srv(d.p / "state", {"--data-root", kScenarios});
+  service::Client c(client_options(srv.address(), ""));
+  // Held in the queue behind a long job, so that nothing finishes during the checks.
+  const auto blocker = c.submit(arelen(1e6, 0));
+  const auto a = c.submit(arelen(500));
+  const auto b = c.submit(arelen(500));
+  EXPECT_EQ(a.id(), b.id());
+  const auto r1 = c.submit(arelen(400), "client-key-1");
+  const auto r2 = c.submit(arelen(400), "client-key-1");
+  EXPECT_EQ(r1.id(), r2.id());
+  EXPECT_NE(r1.id(), a.id());
+  const auto list = c.list();
+  EXPECT_EQ(list.jobs_size(), 3);
+  // Paging: one job per page, every job once.
+  std::set<std::string> ids;
+  std::string token;
+  do {
+    const auto page = c.list({}, 1, token);
+    for (const auto& j : page.jobs()) ids.insert(j.id());
+    token = page.next_page_token();
+  } while (!token.empty());
+  EXPECT_EQ(ids.size(), 3u);
+  EXPECT_EQ(c.list({v1::RUNNING}).jobs_size() + c.list({v1::QUEUED}).jobs_size(), 3);
+  // Cancelled jobs end so; a new identical submission is a new job.
+  EXPECT_EQ(c.cancel(a.id()).state(), v1::CANCELLED);
+  EXPECT_NE(c.submit(arelen(500)).id(), a.id());
+  c.cancel(blocker.id());
+}
+
+TEST(Service, CancelWhileRunning) {
+  TempDir d;
+  ServerProcess srv(d.p / "state", {"--data-root", kScenarios});
+  service::Client c(client_options(srv.address(), ""));
+  const auto j = c.submit(arelen(1e6, 0));  // runs until cancelled
+  for (int k = 0; k < 200; ++k) {
+    const auto g = c.get(j.id());
+    if (g.state() == v1::RUNNING && g.progress().steps() > 0) break;
+    std::this_thread::sleep_for(50ms);
+  }
+  const auto r = c.cancel(j.id());
+  EXPECT_EQ(r.state(), v1::RUNNING);  // asked; the run stops at its next progress point
+  const auto fin = c.watch(j.id());
+  EXPECT_EQ(fin.state(), v1::CANCELLED);
+  const auto files = c.results(j.id());
+  ASSERT_EQ(files.files_size(), 1);  // the log only
+  EXPECT_EQ(files.files(0).name(), "job.log");
+  EXPECT_EQ(code_of([&] { c.download(j.id(), "max_depth.tif", (d.p / "x").string()); }),
+            int(grpc::StatusCode::FAILED_PRECONDITION));
+  // Nothing half-written is left under results/.
+  for (const auto& e : fs::directory_iterator(d.p / "state/results")) ADD_FAILURE() << e.path();
+}
+
+TEST(Service, BadScenariosTokensAndPathsGetTheRightCodes) {
+  TempDir d;
+  write_tokens(d.p / "tokens");
+  fs::create_directories(d.p / "root");
+  fs::create_symlink("/etc/hostname", d.p / "root/escape.tif");
+  ServerProcess srv(d.p / "state", {"--tokens", (d.p / "tokens").string(), "--data-root", kScenarios, "--data-root",
+                                    (d.p / "root").string(), "--log-file", (d.p / "log").string()});
+  service::Client alpha(client_options(srv.address(), "alpha-token"));
+  service::Client beta(client_options(srv.address(), "beta-token"));  // listed by its SHA-256
+  service::Client none(client_options(srv.address(), ""));
+  service::Client wrong(client_options(srv.address(), "gamma-token"));
+  EXPECT_EQ(code_of([&] { none.list(); }), int(grpc::StatusCode::UNAUTHENTICATED));
+  EXPECT_EQ(code_of([&] { wrong.submit(arelen()); }), int(grpc::StatusCode::UNAUTHENTICATED));
+  EXPECT_TRUE(none.healthy());  // health checking needs no token
+  // Bad scenarios: INVALID_ARGUMENT naming the field.
+  auto s = arelen();
+  s.mutable_material()->set_bed_friction_deg(95);
+  try {
+    alpha.submit(s);
+    FAIL();
+  } catch (const service::RpcError& e) {
+    EXPECT_EQ(e.code, int(grpc::StatusCode::INVALID_ARGUMENT));
+    EXPECT_NE(std::string(e.what()).find("material.bed_friction_deg"), std::string::npos) << e.what();
+  }
+  s = arelen();
+  s.mutable_numerics()->set_limiter("vanLeer");
+  EXPECT_EQ(code_of([&] { alpha.submit(s); }), int(grpc::StatusCode::INVALID_ARGUMENT));
+  // Paths outside the data roots: '..', absolute paths elsewhere, links that leave a root.
+  for (const std::string p : {"../tests/data/arelen-30m.json", "/etc/hostname", "escape.tif", "data/arelen/missing.tif"}) {
+    s = arelen();
+    s.mutable_dem()->set_path(p);
+    try {
+      alpha.submit(s);
+      ADD_FAILURE() << p << " was accepted";
+    } catch (const service::RpcError& e) {
+      EXPECT_EQ(e.code, int(grpc::StatusCode::INVALID_ARGUMENT)) << p;
+      EXPECT_NE(std::string(e.what()).find("dem.path"), std::string::npos) << e.what();
+    }
+  }
+  s = arelen();
+  s.mutable_dem()->set_path("upload:" + std::string(64, 'a') + "/dem.tif");
+  EXPECT_EQ(code_of([&] { alpha.submit(s); }), int(grpc::StatusCode::INVALID_ARGUMENT));
+  // A token sees only its own jobs.
+  const auto j = alpha.submit(arelen(300));
+  EXPECT_EQ(code_of([&] { beta.get(j.id()); }), int(grpc::StatusCode::NOT_FOUND));
+  EXPECT_EQ(code_of([&] { beta.cancel(j.id()); }), int(grpc::StatusCode::NOT_FOUND));
+  EXPECT_EQ(beta.list().jobs_size(), 0);
+  EXPECT_EQ(code_of([&] { alpha.get("jdoesnotexist"); }), int(grpc::StatusCode::NOT_FOUND));
+  alpha.watch(j.id());
+}
+
+TEST(Service, QueueLimitPerClient) {
+  TempDir d;
+  std::ofstream(d.p / "server.json") << R"({"max_queued_per_client": 2, "data_roots": [")" << kScenarios << R"("]})";
+  ServerProcess srv(d.p / "state", {"--config", (d.p / "server.json").string()});
+  service::Client c(client_options(srv.address(), ""));
+  const auto a = c.submit(arelen(1e6, 0));
+  const auto b = c.submit(arelen(1e6 + 1, 0));
+  EXPECT_EQ(code_of([&] { c.submit(arelen(1e6 + 2, 0)); }), int(grpc::StatusCode::RESOURCE_EXHAUSTED));
+  c.cancel(a.id());
+  c.cancel(b.id());
+}
+
+TEST(Service, KilledServerFinishesEveryJobAfterRestart) {
+  TempDir d;
+  const std::vector<double> ends = {300, 301, 302};
+  std::vector<std::string> ids;
+  {
+    ServerProcess srv(d.p / "state", {"--data-root", kScenarios, "--workers", "1"});
+    service::Client c(client_options(srv.address(), ""));
+    for (double e : ends) ids.push_back(c.submit(arelen(e)).id());
+    // Kill -9 while the first job is in the middle of its run.
+    for (int k = 0; k < 400; ++k) {
+      const auto g = c.get(ids[0]);
+      if (g.state() == v1::RUNNING && g.progress().steps() > 0) break;
+      std::this_thread::sleep_for(25ms);
+    }
+    EXPECT_EQ(c.get(ids[0]).state(), v1::RUNNING);
+    srv.stop(SIGKILL);
+  }
+  // Restart on the same state directory: every job finishes.
+  ServerProcess srv(d.p / "state", {"--data-root", kScenarios, "--workers", "1"});
+  service::Client c(client_options(srv.address(), ""));
+  for (const auto& id : ids) {
+    const auto fin = c.watch(id);
+    EXPECT_EQ(fin.state(), v1::SUCCEEDED) << id << " " << fin.error();
+  }
+  const auto first = c.get(ids[0]);
+  EXPECT_EQ(first.attempts(), 2);
+  bool requeued = false;
+  for (const auto& t : first.transitions()) requeued |= t.reason().find("queued to run again") != std::string::npos;
+  EXPECT_TRUE(requeued);
+  // The results equal an uninterrupted run's, value for value.
+  TempDir ref;
+  ServerProcess other(ref.p / "state", {"--data-root", kScenarios, "--workers", "2"});
+  service::Client c2(client_options(other.address(), ""));
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const auto j = c2.watch(c2.submit(arelen(ends[k])).id());
+    ASSERT_EQ(j.state(), v1::SUCCEEDED);
+    const fs::path fa = d.p / "a.tif", fb = d.p / "b.tif";
+    fs::remove(fa);
+    fs::remove(fb);
+    c.download(ids[k], "max_depth.tif", fa.string());
+    c2.download(j.id(), "max_depth.tif", fb.string());
+    const auto va = raster(fa), vb = raster(fb);
+    ASSERT_FALSE(va.empty());
+    EXPECT_EQ(va, vb) << "job " << ids[k];
+  }
+}
+
+TEST(Service, TerminatedServerRequeuesItsRunningJob) {
+  TempDir d;
+  std::string id;
+  {
+    ServerProcess srv(d.p / "state", {"--data-root", kScenarios});
+    service::Client c(client_options(srv.address(), ""));
+    id = c.submit(arelen(1e6, 0)).id();
+    for (int k = 0; k < 200 && c.get(id).state() != v1::RUNNING; ++k) std::this_thread::sleep_for(25ms);
+    srv.stop(SIGTERM);
+  }
+  ServerProcess srv(d.p / "state", {"--data-root", kScenarios});
+  service::Client c(client_options(srv.address(), ""));
+  const auto j = c.get(id);
+  bool interrupted = false;
+  for (const auto& t : j.transitions()) interrupted |= t.reason().find("interrupted by the server stopping") != std::string::npos;
+  EXPECT_TRUE(interrupted);
+  EXPECT_NE(j.state(), v1::FAILED);
+  c.cancel(id);
+}
