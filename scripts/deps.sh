@@ -7,7 +7,7 @@ RUNOUT_PACKAGES=(
   libgdal-dev gdal-bin libproj-dev proj-bin
   petsc-dev libhdf5-openmpi-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
-  libsqlite3-dev libssl-dev
+  libsqlite3-dev libssl-dev openssl
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 

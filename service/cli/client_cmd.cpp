@@ -225,9 +225,11 @@ int status(const std::vector<std::string>& args) {
     std::string token;
     std::int64_t bytes = 0;
     int n = 0;
-    std::printf("%-18s %-10s %-24s %s\n", "job", "state", "updated", "name");
+    bool header = false;
     do {
       const auto r = client.list(states, 200, token);
+      if (!header) std::printf("%-18s %-10s %-24s %s\n", "job", "state", "updated", "name");
+      header = true;
       for (const auto& j : r.jobs()) {
         std::printf("%-18s %-10s %-24s %s\n", j.id().c_str(), service::state_word(j.state()).c_str(), j.updated_utc().c_str(),
                     j.name().c_str());

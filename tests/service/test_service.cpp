@@ -353,3 +353,77 @@ TEST(Service, TerminatedServerRequeuesItsRunningJob) {
   EXPECT_NE(j.state(), v1::FAILED);
   c.cancel(id);
 }
+
+TEST(Service, TlsWithTheServersCertificate) {
+  TempDir d;
+  const std::string cmd = "openssl req -x509 -newkey rsa:2048 -nodes -days 2 -subj /CN=localhost -addext "
+                          "subjectAltName=IP:127.0.0.1,DNS:localhost -keyout " +
+                          (d.p / "key.pem").string() + " -out " + (d.p / "cert.pem").string() + " 2>/dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << "openssl could not make a test certificate";
+  write_tokens(d.p / "tokens");
+  ServerProcess srv(d.p / "state", {"--tls-cert", (d.p / "cert.pem").string(), "--tls-key", (d.p / "key.pem").string(),
+                                    "--tokens", (d.p / "tokens").string(), "--data-root", kScenarios});
+  auto o = client_options(srv.address(), "alpha-token");
+  o.tls_ca = (d.p / "cert.pem").string();
+  service::Client tls(o);
+  EXPECT_TRUE(tls.healthy());
+  const auto j = tls.submit(arelen(200));
+  EXPECT_EQ(tls.watch(j.id()).state(), v1::SUCCEEDED);
+  // A plaintext client does not get through.
+  auto p = client_options(srv.address(), "alpha-token");
+  p.timeout_s = 5;
+  service::Client plain(p);
+  EXPECT_EQ(code_of([&] { plain.list(); }), int(grpc::StatusCode::UNAVAILABLE));
+}
+
+TEST(Service, UploadLimitAndTokenRotation) {
+  TempDir d;
+  write_tokens(d.p / "tokens");
+  std::ofstream(d.p / "server.json") << R"({"max_upload_bytes": 20000, "tokens_file": ")" << (d.p / "tokens").string() << R"("})";
+  ServerProcess srv(d.p / "state", {"--config", (d.p / "server.json").string()});
+  service::Client alpha(client_options(srv.address(), "alpha-token"));
+  // The 14 kB DEM fits, a 40 kB file does not.
+  EXPECT_EQ(alpha.upload({kScenarios + "/data/arelen/davos_srtm3.tif"}).ref().rfind("upload:", 0), 0u);
+  {
+    std::ofstream big(d.p / "big.tif", std::ios::binary);
+    big << std::string(40000, 'x');
+  }
+  EXPECT_EQ(code_of([&] { alpha.upload({(d.p / "big.tif").string()}); }), int(grpc::StatusCode::RESOURCE_EXHAUSTED));
+  // Rotation: a new token works without a restart once it is in the file, an old one stops working.
+  service::Client gamma(client_options(srv.address(), "gamma-token"));
+  EXPECT_EQ(code_of([&] { gamma.list(); }), int(grpc::StatusCode::UNAUTHENTICATED));
+  std::this_thread::sleep_for(20ms);  // a distinct modification time
+  {
+    std::ofstream t(d.p / "tokens.new");
+    t << "gamma-token\n";
+  }
+  fs::rename(d.p / "tokens.new", d.p / "tokens");
+  EXPECT_EQ(code_of([&] { gamma.list(); }), 0);
+  EXPECT_EQ(code_of([&] { alpha.list(); }), int(grpc::StatusCode::UNAUTHENTICATED));
+}
+
+TEST(Service, RetentionRemovesOldResultsAndSaysSo) {
+  TempDir d;
+  std::string id;
+  {
+    ServerProcess srv(d.p / "state", {"--data-root", kScenarios});
+    service::Client c(client_options(srv.address(), ""));
+    id = c.submit(arelen(200)).id();
+    ASSERT_EQ(c.watch(id).state(), v1::SUCCEEDED);
+    EXPECT_GT(c.list().result_bytes_total(), 0);
+  }
+  // Restarted with a disk limit of one byte: the results go at start, the job record stays.
+  std::ofstream(d.p / "server.json") << R"({"retention_max_bytes": 1, "data_roots": [")" << kScenarios << R"("]})";
+  ServerProcess srv(d.p / "state", {"--config", (d.p / "server.json").string()});
+  service::Client c(client_options(srv.address(), ""));
+  const auto j = c.get(id);
+  EXPECT_EQ(j.state(), v1::SUCCEEDED);
+  EXPECT_EQ(j.result_bytes(), 0);
+  EXPECT_NE(j.transitions(j.transitions_size() - 1).reason().find("retention"), std::string::npos);
+  EXPECT_EQ(code_of([&] { c.results(id); }), int(grpc::StatusCode::FAILED_PRECONDITION));
+  EXPECT_EQ(c.list().result_bytes_total(), 0);
+  // Submitting the scenario again computes it again.
+  const auto again = c.submit(arelen(200));
+  EXPECT_NE(again.id(), id);
+  EXPECT_EQ(c.watch(again.id()).state(), v1::SUCCEEDED);
+}
