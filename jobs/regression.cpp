@@ -292,7 +292,11 @@ void accept_reference(const std::string& reference_dir, const RegressionFigures&
   std::ofstream j(fs::path(reference_dir) / "reference.json");
   j.precision(12);
   j << "{\n  \"accepted_utc\": \"" << now << "\",\n  \"reason\": \"";
-  for (char c : reason) j << (c == '"' || c == '\\' ? std::string("\\") + c : std::string(1, c));
+  for (char c : reason) {
+    if (c == '"' || c == '\\') j << '\\' << c;
+    else if (static_cast<unsigned char>(c) < 0x20) j << ' ';  // no control characters in the JSON string
+    else j << c;
+  }
   j << "\",\n  \"software_version\": \"" << version << "\",\n  \"scenario_hash\": \"" << scenario_hash << "\",\n";
   j << "  \"figures\": {\"runout_m\": " << f.runout_m << ", \"affected_area_m2\": " << f.affected_area_m2
     << ", \"max_depth_m\": " << f.max_depth_m << ", \"max_speed_m_s\": " << f.max_speed_m_s << ", \"volume_error\": " << f.volume_error

@@ -92,10 +92,11 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   r.dem.dem_crs = s.dem().crs();
   r.input_files.push_back(r.dem.dem_path);
   // Companion files that change how the DEM reads (ESRI ASCII .prj) are part of the input.
-  for (const char* ext : {".prj", ".aux.xml"}) {
+  for (const char* ext : {".prj", ".hdr", ".tfw"}) {
     fs::path side = fs::path(r.dem.dem_path).replace_extension(ext);
     if (fs::exists(side)) r.input_files.push_back(side.string());
   }
+  if (fs::exists(r.dem.dem_path + ".aux.xml")) r.input_files.push_back(r.dem.dem_path + ".aux.xml");  // GDAL's PAM file
   if (!s.area_of_interest().path().empty()) {
     r.dem.aoi_path = path_in(base, s.area_of_interest().path(), "area_of_interest.path");
     r.input_files.push_back(r.dem.aoi_path);
@@ -237,7 +238,10 @@ std::string scenario_hash(const ResolvedScenario& r) {
   h.update("runout.v1.Scenario\n");
   h.update(bytes);
   for (const auto& f : r.input_files) {
-    h.update("\n" + fs::path(f).extension().string() + " " + sha256_of_file(f));
+    h.update("\n");
+    h.update(fs::path(f).extension().string());
+    h.update(" ");
+    h.update(sha256_of_file(f));
   }
   return h.hex();
 }

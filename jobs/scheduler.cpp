@@ -93,10 +93,9 @@ void Scheduler::notify() {
 
 bool Scheduler::cancel_running(const std::string& id) {
   std::lock_guard lk(mu_);
+  cancel_.insert(id);  // also when the worker has claimed the job but not yet started it
   const auto it = live_.find(id);
-  if (it == live_.end() || !it->second.running) return false;
-  cancel_.insert(id);
-  return true;
+  return it != live_.end() && it->second.running;
 }
 
 Scheduler::Live Scheduler::live(const std::string& id) const {
@@ -124,7 +123,11 @@ void Scheduler::touch(const std::string& id) {
 }
 
 void Scheduler::apply_retention() {
-  last_retention_ = std::chrono::steady_clock::now();
+  std::lock_guard once(retention_mu_);  // one pass at a time
+  {
+    std::lock_guard lk(mu_);
+    last_retention_ = std::chrono::steady_clock::now();
+  }
   if (cfg_.retention_days <= 0 && cfg_.retention_max_bytes <= 0) return;
   auto finished = store_.finished_results();  // oldest first
   const double now = double(std::time(nullptr));
@@ -163,10 +166,9 @@ void Scheduler::worker_loop(int index) {
       std::unique_lock lk(mu_);
       // Woken by notify() (also one that came during the claim above) or stop().
       work_cv_.wait_for(lk, std::chrono::seconds(2), [&] { return stopping_.load() || work_seq_ != seen; });
-      if (std::chrono::steady_clock::now() - last_retention_ > std::chrono::hours(1)) {
-        lk.unlock();
-        apply_retention();
-      }
+      const bool due = std::chrono::steady_clock::now() - last_retention_ > std::chrono::hours(1);
+      lk.unlock();
+      if (due) apply_retention();
       continue;
     }
     run_job(std::move(*job));
@@ -217,6 +219,15 @@ void Scheduler::run_job(StoredJob sj) {
   }
   const fs::path tmp = fs::path(final_dir.string() + ".tmp-" + id);
   fs::remove_all(tmp, ec);
+  bool cancelled_early = store_.cancel_requested(id);
+  {
+    std::lock_guard lk(mu_);
+    cancelled_early = cancelled_early || cancel_.count(id) > 0;
+  }
+  if (cancelled_early) {
+    finish(v1::CANCELLED, "cancelled by the client before the run started", "", 0);
+    return;
+  }
   try {
     ResolvedScenario r = resolve_scenario(sj.scenario, "/");
     fs::create_directories(tmp);
@@ -250,6 +261,14 @@ void Scheduler::run_job(StoredJob sj) {
       change_cv_.notify_all();
       if (now - last_save > std::chrono::seconds(1)) {
         last_save = now;
+        try {
+          if (store_.cancel_requested(id)) {
+            std::lock_guard lk(mu_);
+            cancel_.insert(id);
+            go = false;
+          }
+        } catch (...) {
+        }
         try {
           store_.save_progress(id, pr);
         } catch (...) {

@@ -82,7 +82,8 @@ class Scheduler {
   std::set<std::string> cancel_;
   std::uint64_t counter_ = 0;
   std::uint64_t work_seq_ = 0;  // bumped by notify(): work may be waiting
-  std::chrono::steady_clock::time_point last_retention_{};
+  std::chrono::steady_clock::time_point last_retention_{};  // guarded by mu_
+  std::mutex retention_mu_;
 };
 
 }  // namespace runout::jobs

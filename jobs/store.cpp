@@ -155,7 +155,8 @@ JobStore::JobStore(const std::string& path) {
            scenario BLOB NOT NULL,
            progress BLOB,
            result_bytes INTEGER NOT NULL DEFAULT 0,
-           results_removed INTEGER NOT NULL DEFAULT 0);
+           results_removed INTEGER NOT NULL DEFAULT 0,
+           cancel_requested INTEGER NOT NULL DEFAULT 0);
          CREATE UNIQUE INDEX IF NOT EXISTS jobs_request ON jobs(owner, request_id) WHERE request_id IS NOT NULL;
          CREATE INDEX IF NOT EXISTS jobs_owner_hash ON jobs(owner, hash);
          CREATE INDEX IF NOT EXISTS jobs_state ON jobs(state, seq);
@@ -373,27 +374,54 @@ std::optional<StoredJob> JobStore::cancel(const std::string& id, const std::stri
       Stmt up(db_, "UPDATE jobs SET state = 5, updated = ? WHERE id = ?");
       up.bind(1, now).bind(2, id).step();
       add_transition(db_, id, v1::CANCELLED, now, "cancelled by the client before it started");
+    } else if (v1::JobState(st.i64(0)) == v1::RUNNING) {
+      // Kept in the store, so that neither a worker that has just claimed the job nor a restart
+      // after a crash loses it.
+      Stmt(db_, "UPDATE jobs SET cancel_requested = 1 WHERE id = ?").bind(1, id).step();
     }
     tx.commit();
   }
   return get(id, owner);
 }
 
-int JobStore::requeue_running(const std::string& reason) {
+int JobStore::requeue_running(const std::string& reason, int max_attempts) {
   std::lock_guard lk(mu_);
   Transaction tx(db_);
-  std::vector<std::string> ids;
+  struct Row {
+    std::string id;
+    std::int64_t attempts, cancel;
+  };
+  std::vector<Row> rows;
   {
-    Stmt st(db_, "SELECT id FROM jobs WHERE state = 2");
-    while (st.step()) ids.push_back(st.text(0));
+    Stmt st(db_, "SELECT id, attempts, cancel_requested FROM jobs WHERE state = 2");
+    while (st.step()) rows.push_back({st.text(0), st.i64(1), st.i64(2)});
   }
   const std::string now = utc_now();
-  for (const auto& id : ids) {
-    Stmt(db_, "UPDATE jobs SET state = 1, updated = ? WHERE id = ?").bind(1, now).bind(2, id).step();
-    add_transition(db_, id, v1::QUEUED, now, reason);
+  int queued = 0;
+  for (const auto& r : rows) {
+    if (r.cancel) {
+      Stmt(db_, "UPDATE jobs SET state = 5, updated = ? WHERE id = ?").bind(1, now).bind(2, r.id).step();
+      add_transition(db_, r.id, v1::CANCELLED, now, "cancelled by the client; the server stopped before the run did");
+    } else if (r.attempts >= max_attempts) {
+      // A job that takes the server down with it must not do so for ever.
+      const std::string e = "the server stopped during each of " + std::to_string(r.attempts) + " attempts of this job";
+      Stmt(db_, "UPDATE jobs SET state = 4, updated = ?, error = ? WHERE id = ?").bind(1, now).bind(2, e).bind(3, r.id).step();
+      add_transition(db_, r.id, v1::FAILED, now, e);
+    } else {
+      Stmt(db_, "UPDATE jobs SET state = 1, updated = ? WHERE id = ?").bind(1, now).bind(2, r.id).step();
+      add_transition(db_, r.id, v1::QUEUED, now, reason);
+      ++queued;
+    }
   }
   tx.commit();
-  return int(ids.size());
+  return queued;
+}
+
+bool JobStore::cancel_requested(const std::string& id) const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_, "SELECT cancel_requested FROM jobs WHERE id = ?");
+  st.bind(1, id);
+  return st.step() && st.i64(0) != 0;
 }
 
 void JobStore::save_progress(const std::string& id, const v1::Progress& p) {

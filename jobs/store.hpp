@@ -63,8 +63,12 @@ class JobStore {
                   std::int64_t result_bytes = -1);
   /// Queued jobs become cancelled here; running ones are left for the worker (returns their state).
   std::optional<StoredJob> cancel(const std::string& id, const std::string& owner);
-  /// Jobs left running by a server that died: queued again. Returns how many.
-  int requeue_running(const std::string& reason);
+  /// Jobs left running by a server that died: queued again (cancelled when the client had asked;
+  /// failed after `max_attempts` runs, so that a job that kills the server cannot do so for ever).
+  /// Returns how many were queued again.
+  int requeue_running(const std::string& reason, int max_attempts = 3);
+  /// Whether the client asked to cancel this (running) job.
+  bool cancel_requested(const std::string& id) const;
   void save_progress(const std::string& id, const v1::Progress& p);
   /// Disk used by the owner's results (each result folder counted once).
   std::int64_t result_bytes_total(const std::string& owner) const;

@@ -50,7 +50,7 @@ bool parse_common(const std::string& cmd, const std::vector<std::string>& args, 
           std::cerr << "runout " << cmd << ": --token-file '" << v << "': cannot read a token from it\n";
           return false;
         }
-        while (!t.empty() && (t.back() == '\r' || t.back() == ' ')) t.pop_back();
+        while (!t.empty() && (t.back() == '\r' || t.back() == ' ' || t.back() == '\t')) t.pop_back();
         c->opt.token = t;
       }
     } else if (a == "--tls") {
@@ -333,6 +333,8 @@ int fetch(const std::vector<std::string>& args) {
     }
     std::int64_t bytes = 0;
     for (const auto& f : files.files()) {
+      if (f.name().empty() || f.name()[0] == '.' || f.name().find_first_of("/\\") != std::string::npos)
+        throw service::RpcError(int(grpc::StatusCode::DATA_LOSS), "the server named a result '" + f.name() + "': not a plain file name");
       client.download(id, f.name(), (tmp / f.name()).string());
       bytes += f.bytes();
     }

@@ -54,6 +54,7 @@ int regress(const std::vector<std::string>& args) {
         std::cerr << "runout regress: --token-file '" << v << "': cannot read a token from it\n";
         return kUsage;
       }
+      while (!opt.token.empty() && (opt.token.back() == '\r' || opt.token.back() == ' ')) opt.token.pop_back();
     } else if (a == "--tls-ca") {
       opt.tls_ca = v;
     } else if (a == "--out") {

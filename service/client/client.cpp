@@ -65,7 +65,7 @@ v1::UploadResponse Client::upload(const std::vector<std::string>& files) {
   impl_->prepare(ctx, false);
   v1::UploadResponse resp;
   auto w = impl_->stub->UploadInput(&ctx, &resp);
-  std::string buf(1 << 20, '\0');
+  std::string buf(256 << 10, '\0');  // well below the server's smallest message limit
   for (const auto& f : files) {
     std::ifstream in(f, std::ios::binary);
     if (!in) throw RpcError(int(grpc::StatusCode::INVALID_ARGUMENT), "cannot read '" + f + "' to upload it");
@@ -131,6 +131,8 @@ v1::Job Client::cancel(const std::string& id) {
 v1::Job Client::watch(const std::string& id, const std::function<void(const v1::Job&)>& on_event) {
   grpc::ClientContext ctx;
   impl_->prepare(ctx, false);
+  if (impl_->opt.watch_timeout_s > 0)
+    ctx.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(long(impl_->opt.watch_timeout_s * 1000)));
   v1::WatchJobRequest req;
   req.set_id(id);
   auto r = impl_->stub->WatchJob(&ctx, req);

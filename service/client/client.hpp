@@ -23,6 +23,7 @@ struct ClientOptions {
   std::string tls_ca;   ///< PEM file of the CA that signed the server's certificate: TLS
   bool tls = false;     ///< TLS with the system's roots
   double timeout_s = 60;  ///< deadline of unary calls
+  double watch_timeout_s = 0;  ///< deadline of a whole watch; 0: none
 };
 
 class Client {

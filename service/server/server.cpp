@@ -4,6 +4,7 @@
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
+#include <gdal.h>
 #include <openssl/crypto.h>
 #include <unistd.h>
 
@@ -223,29 +224,42 @@ struct Server::Impl final : v1::Runout::Service {
       if (!is_hex64(id) || !plain_name(name))
         return {StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' is not an upload reference (upload:ID/NAME)"};
       const fs::path f = fs::path(cfg.state_dir()) / "uploads" / id / name;
-      if (!fs::is_regular_file(f)) return {StatusCode::INVALID_ARGUMENT, field + ": no upload '" + p + "' on this server"};
+      if (!fs::is_regular_file(f)) return {StatusCode::NOT_FOUND, field + ": no upload '" + p + "' on this server"};
       *path = f.string();
-      return Status::OK;
+      return allowed_format(field, *path);
     }
     for (const auto& part : fs::path(p))
       if (part == "..") return {StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' may not contain '..'"};
     if (cfg.data_roots().empty())
       return {StatusCode::INVALID_ARGUMENT,
               field + ": '" + p + "': this server has no data roots; upload the file (runout submit does) and use its upload: reference"};
+    // One answer for every refusal, so that it tells nothing about files outside the roots.
+    const Status refused{StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' is not a readable file inside the server's data roots"};
     std::error_code ec;
     for (const auto& root : cfg.data_roots()) {
-      const fs::path cand = fs::path(p).is_absolute() ? fs::path(p) : fs::path(root) / p;
-      if (!fs::exists(cand, ec)) continue;
+      const fs::path cand = (fs::path(p).is_absolute() ? fs::path(p) : fs::path(root) / p).lexically_normal();
+      if (!inside(cand, root)) continue;  // checked before the file system is asked anything
       const fs::path real = fs::canonical(cand, ec);  // symbolic links resolved
       if (ec) continue;
       bool ok = false;
       for (const auto& r : cfg.data_roots()) ok |= inside(real, r);
-      if (!ok)
-        return {StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' lies outside the server's data roots (after links are followed)"};
+      if (!ok || !fs::is_regular_file(real, ec)) return refused;
       *path = real.string();
-      return Status::OK;
+      return allowed_format(field, *path);
     }
-    return {StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' is in none of the server's data roots"};
+    return refused;
+  }
+
+  // Only formats that cannot point at other files or URLs (no VRT, no /vsi paths inside).
+  Status allowed_format(const std::string& field, const std::string& path) {
+    static const char* const kAllowed[] = {"GTiff", "COG", "AAIGrid", "SRTMHGT", "EHdr", "GeoJSON", "ESRI Shapefile", "GPKG", nullptr};
+    GDALAllRegister();
+    GDALDriverH d = GDALIdentifyDriverEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_VECTOR, kAllowed, nullptr);
+    if (!d)
+      return {StatusCode::INVALID_ARGUMENT, field + ": '" + fs::path(path).filename().string() +
+                                                "' is not in a format this server reads (GeoTIFF, ESRI ASCII grid, SRTM .hgt, "
+                                                "EHdr, GeoJSON, Shapefile, GeoPackage)"};
+    return Status::OK;
   }
 
   v1::Job with_live(const jobs::StoredJob& j) {
@@ -391,9 +405,7 @@ struct Server::Impl final : v1::Runout::Service {
     if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
     const auto j = store->get(req->job_id(), owner);
     if (!j) return {StatusCode::NOT_FOUND, "no job '" + req->job_id() + "'"};
-    for (auto& f : result_files(*j)) *resp->add_files() = f;
-    if (j->job.state() == v1::SUCCEEDED && j->results_removed)
-      return {StatusCode::FAILED_PRECONDITION, "the results of job " + j->job.id() + " were removed by the retention policy"};
+    for (auto& f : result_files(*j)) *resp->add_files() = f;  // after retention: the log only
     return Status::OK;
   }
 
@@ -405,6 +417,8 @@ struct Server::Impl final : v1::Runout::Service {
     const auto files = result_files(*j);
     const bool listed = std::any_of(files.begin(), files.end(), [&](const auto& f) { return f.name() == req->name(); });
     if (!listed) {
+      if (j->job.state() == v1::SUCCEEDED && j->results_removed && req->name() != "job.log")
+        return {StatusCode::FAILED_PRECONDITION, "the results of job " + j->job.id() + " were removed by the retention policy"};
       if (j->job.state() != v1::SUCCEEDED && req->name() != "job.log")
         return {StatusCode::FAILED_PRECONDITION,
                 "job " + j->job.id() + " is " + jobs::state_name(j->job.state()) + ": only job.log can be fetched"};
@@ -417,7 +431,7 @@ struct Server::Impl final : v1::Runout::Service {
     std::error_code ec;
     const auto total = std::int64_t(fs::file_size(p, ec));
     jobs::Sha256 h;
-    std::string buf(1 << 20, '\0');
+    std::string buf(256 << 10, '\0');  // well below the smallest message limit
     std::int64_t offset = 0;
     bool first = true;
     for (;;) {
@@ -464,6 +478,8 @@ struct Server::Impl final : v1::Runout::Service {
       }
     };
     while (r->Read(&c)) {
+      if (c.file_name() != current && !c.file_name().empty() && names.size() >= 16)
+        return fail(StatusCode::INVALID_ARGUMENT, "an upload holds at most 16 files (one input and its companions)");
       if (c.file_name() != current && !c.file_name().empty()) {
         if (!plain_name(c.file_name()))
           return fail(StatusCode::INVALID_ARGUMENT, "file_name: '" + c.file_name() + "' must be a plain file name (letters, digits, . _ -)");
@@ -483,6 +499,7 @@ struct Server::Impl final : v1::Runout::Service {
       file_hash->update(c.data());
       if (!out) return fail(StatusCode::INTERNAL, "writing the upload failed");
     }
+    if (ctx->IsCancelled()) return fail(StatusCode::CANCELLED, "the client went away during the upload");
     if (names.empty()) return fail(StatusCode::INVALID_ARGUMENT, "empty upload");
     close_file();
     const std::string id = set_hash.hex();
@@ -527,6 +544,12 @@ void Server::start() {
   sc.retention_max_bytes = m.cfg.retention_max_bytes();
   sc.log = [&m](const std::string& s) { m.log(s); };
   m.sched = std::make_unique<jobs::Scheduler>(*m.store, sc);
+  {
+    std::error_code ec;  // uploads cut off by a dead process
+    for (const auto& e : fs::directory_iterator(fs::path(m.cfg.state_dir()) / "uploads", ec))
+      if (e.path().filename().string().rfind(".tmp-", 0) == 0) fs::remove_all(e.path(), ec);
+  }
+  m.sched->start();  // before listening: requeue and cancel decisions are made before any call
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
@@ -548,7 +571,6 @@ void Server::start() {
   m.server = b.BuildAndStart();
   if (!m.server || m.bound_port == 0) throw ConfigError("listen: cannot listen on " + m.cfg.listen());
   m.server->GetHealthCheckService()->SetServingStatus(true);
-  m.sched->start();
   std::ofstream sj(fs::path(m.cfg.state_dir()) / "server.json.tmp");
   sj << "{\"listen\": \"" << address() << "\", \"pid\": " << getpid() << ", \"started_utc\": \"" << jobs::utc_now() << "\"}\n";
   sj.close();

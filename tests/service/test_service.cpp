@@ -85,6 +85,7 @@ service::ClientOptions client_options(const std::string& address, const std::str
   service::ClientOptions o;
   o.server = address;
   o.token = token;
+  o.watch_timeout_s = 240;  // a broken requeue fails the test instead of hanging it
   return o;
 }
 
@@ -149,6 +150,7 @@ TEST(Service, SubmitWatchFetchWithUploadsAndServerPaths) {
     if (ev.state() == v1::RUNNING && ev.progress().steps() > 0) ++with_progress;
   });
   EXPECT_EQ(fin.state(), v1::SUCCEEDED) << fin.error();
+  ASSERT_FALSE(seen.empty());
   EXPECT_EQ(seen.back(), v1::SUCCEEDED);
   EXPECT_GE(with_progress, 1);
   ASSERT_GE(fin.transitions_size(), 3);  // submitted, started, completed
@@ -180,7 +182,8 @@ TEST(Service, IdempotentResubmissionAndRequestIds) {
   const auto b = c.submit(arelen(500));
   EXPECT_EQ(a.id(), b.id());
   const auto r1 = c.submit(arelen(400), "client-key-1");
-  const auto r2 = c.submit(arelen(400), "client-key-1");
+  // A retry is recognised by its request id alone, whatever it carries.
+  const auto r2 = c.submit(arelen(450), "client-key-1");
   EXPECT_EQ(r1.id(), r2.id());
   EXPECT_NE(r1.id(), a.id());
   const auto list = c.list();
@@ -195,6 +198,9 @@ TEST(Service, IdempotentResubmissionAndRequestIds) {
   } while (!token.empty());
   EXPECT_EQ(ids.size(), 3u);
   EXPECT_EQ(c.list({v1::RUNNING}).jobs_size() + c.list({v1::QUEUED}).jobs_size(), 3);
+  // Even after it was cancelled, the request id names that job.
+  c.cancel(r1.id());
+  EXPECT_EQ(c.submit(arelen(400), "client-key-1").id(), r1.id());
   // Cancelled jobs end so; a new identical submission is a new job.
   EXPECT_EQ(c.cancel(a.id()).state(), v1::CANCELLED);
   EXPECT_NE(c.submit(arelen(500)).id(), a.id());
@@ -265,6 +271,15 @@ TEST(Service, BadScenariosTokensAndPathsGetTheRightCodes) {
   }
   s = arelen();
   s.mutable_dem()->set_path("upload:" + std::string(64, 'a') + "/dem.tif");
+  EXPECT_EQ(code_of([&] { alpha.submit(s); }), int(grpc::StatusCode::NOT_FOUND));
+  // Formats that can point at other files (a VRT naming a file outside the roots) are refused.
+  {
+    std::ofstream v(d.p / "dem.vrt");
+    v << "<VRTDataset rasterXSize=\"10\" rasterYSize=\"10\"><VRTRasterBand dataType=\"Float32\" band=\"1\"><SimpleSource>"
+         "<SourceFilename relativeToVRT=\"0\">/etc/hostname</SourceFilename></SimpleSource></VRTRasterBand></VRTDataset>\n";
+  }
+  s = arelen();
+  s.mutable_dem()->set_path(alpha.upload({(d.p / "dem.vrt").string()}).ref());
   EXPECT_EQ(code_of([&] { alpha.submit(s); }), int(grpc::StatusCode::INVALID_ARGUMENT));
   // A token sees only its own jobs.
   const auto j = alpha.submit(arelen(300));
@@ -277,12 +292,18 @@ TEST(Service, BadScenariosTokensAndPathsGetTheRightCodes) {
 
 TEST(Service, QueueLimitPerClient) {
   TempDir d;
-  std::ofstream(d.p / "server.json") << R"({"max_queued_per_client": 2, "data_roots": [")" << kScenarios << R"("]})";
+  write_tokens(d.p / "tokens");
+  std::ofstream(d.p / "server.json") << R"({"max_queued_per_client": 2, "data_roots": [")" << kScenarios << R"("], "tokens_file": ")"
+                                      << (d.p / "tokens").string() << R"("})";
   ServerProcess srv(d.p / "state", {"--config", (d.p / "server.json").string()});
-  service::Client c(client_options(srv.address(), ""));
+  service::Client c(client_options(srv.address(), "alpha-token"));
+  service::Client other(client_options(srv.address(), "beta-token"));
   const auto a = c.submit(arelen(1e6, 0));
   const auto b = c.submit(arelen(1e6 + 1, 0));
   EXPECT_EQ(code_of([&] { c.submit(arelen(1e6 + 2, 0)); }), int(grpc::StatusCode::RESOURCE_EXHAUSTED));
+  // The limit is per client: another token still gets in.
+  const auto o = other.submit(arelen(1e6 + 3, 0));
+  other.cancel(o.id());
   c.cancel(a.id());
   c.cancel(b.id());
 }
@@ -420,7 +441,10 @@ TEST(Service, RetentionRemovesOldResultsAndSaysSo) {
   EXPECT_EQ(j.state(), v1::SUCCEEDED);
   EXPECT_EQ(j.result_bytes(), 0);
   EXPECT_NE(j.transitions(j.transitions_size() - 1).reason().find("retention"), std::string::npos);
-  EXPECT_EQ(code_of([&] { c.results(id); }), int(grpc::StatusCode::FAILED_PRECONDITION));
+  const auto left = c.results(id);  // the log stays
+  ASSERT_EQ(left.files_size(), 1);
+  EXPECT_EQ(left.files(0).name(), "job.log");
+  EXPECT_EQ(code_of([&] { c.download(id, "max_depth.tif", (d.p / "x.tif").string()); }), int(grpc::StatusCode::FAILED_PRECONDITION));
   EXPECT_EQ(c.list().result_bytes_total(), 0);
   // Submitting the scenario again computes it again.
   const auto again = c.submit(arelen(200));
