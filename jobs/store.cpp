@@ -166,6 +166,11 @@ JobStore::JobStore(const std::string& path) {
            state INTEGER NOT NULL,
            reason TEXT NOT NULL);
          CREATE INDEX IF NOT EXISTS transitions_job ON transitions(job);)");
+  // Stores written before the cancel flag existed get the column.
+  sqlite3_stmt* probe = nullptr;
+  if (sqlite3_prepare_v2(db_, "SELECT cancel_requested FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
+    exec("ALTER TABLE jobs ADD COLUMN cancel_requested INTEGER NOT NULL DEFAULT 0");
+  sqlite3_finalize(probe);
 }
 
 JobStore::~JobStore() { sqlite3_close(db_); }
