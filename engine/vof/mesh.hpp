@@ -1,0 +1,70 @@
+#pragma once
+// Face-addressed finite-volume mesh for the VOF engine: cells (centre, volume), faces (owner,
+// neighbour, area vector, centre), internal faces first, then the boundary faces grouped into named
+// patches. Plane (one cell thick) meshes carry no front/back faces: those would be "empty" patches
+// that contribute nothing. The numerics use only this addressing, so channel meshes, terrain-following
+// meshes and imported meshes all work the same way.
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace runout::engine::vof {
+
+struct Vec {
+  double x = 0, y = 0, z = 0;
+};
+inline Vec operator+(Vec a, Vec b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline Vec operator-(Vec a, Vec b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline Vec operator*(double s, Vec a) { return {s * a.x, s * a.y, s * a.z}; }
+inline double dot(Vec a, Vec b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline double norm(Vec a) { return std::sqrt(dot(a, a)); }
+
+struct Patch {
+  std::string name;
+  int start = 0;  ///< first face
+  int size = 0;
+};
+
+struct Mesh {
+  std::vector<Vec> centre;     ///< per cell
+  std::vector<double> volume;  ///< per cell
+  std::vector<int> owner, neighbour;  ///< per face; neighbour only for internal faces
+  std::vector<Vec> Sf, Cf;     ///< per face: area vector (out of the owner), centre
+  int n_internal = 0;          ///< faces [0, n_internal) are internal
+  std::vector<Patch> patches;  ///< boundary faces in order, each patch contiguous
+  double thickness = 0;        ///< plane meshes: the one cell's depth [m]; 0 for 3D meshes
+  /// Derived per face: |Sf|, 1/|d . n| (d: owner centre to neighbour centre, or to the face centre on
+  /// the boundary), and the owner's interpolation weight.
+  std::vector<double> magSf, delta_coeff, weight;
+
+  int cells() const { return int(volume.size()); }
+  int faces() const { return int(owner.size()); }
+  const Patch& patch(const std::string& name) const;
+  int patch_index(const std::string& name) const;  ///< -1 when absent
+  /// Compute the derived face data; checks that every cell is closed (sum of Sf = 0).
+  void finish();
+};
+
+/// A rectangular block in the x-y plane (x along the channel, y normal to its bottom), one cell of
+/// `thickness` deep, with optional geometric grading in y (ratio of the last to the first cell
+/// height). Patches: "bottom", "top", "left" (x = x0), "right" (x = x1). Cells whose centre lies
+/// inside `blocked` (a closed polygon, counter-clockwise) are left out, and the faces they shared
+/// with kept cells form the patch "obstacle" (cut-out, stair-stepped obstacles).
+struct BlockSpec {
+  double x0 = 0, x1 = 1, y0 = 0, y1 = 1;
+  int nx = 10, ny = 10;
+  double thickness = 0.01;
+  double y_grading = 1.0;
+  std::vector<std::array<double, 2>> blocked;
+};
+Mesh block_mesh(const BlockSpec& s);
+
+/// Rename the part of a patch whose face centres satisfy `pick` into a new patch (e.g. the top
+/// boundary above x > 0 becomes "atmosphere"). Faces are reordered so that patches stay contiguous.
+template <class Pick>
+void split_patch(Mesh& m, const std::string& from, const std::string& to, Pick pick);
+
+}  // namespace runout::engine::vof
+
+#include "engine/vof/mesh_impl.hpp"

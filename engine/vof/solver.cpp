@@ -1,0 +1,764 @@
+#include "engine/vof/solver.hpp"
+
+#include <petscksp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+
+namespace runout::engine::vof {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kSmall = 1e-300;
+
+void petsc_check(PetscErrorCode e, const char* what) {
+  if (e) throw VofError(std::string("PETSc: ") + what + " failed (error " + std::to_string(int(e)) + ")");
+}
+
+// PETSc (and with it MPI) is started once per process, on first use.
+void petsc_init() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    PetscBool started = PETSC_FALSE;
+    PetscInitialized(&started);
+    if (!started) {
+      petsc_check(PetscInitializeNoArguments(), "PetscInitialize");
+      PetscPopSignalHandler();  // signals stay the program's business (a server, a CLI run)
+    }
+  });
+}
+
+struct Grad {  // a 2x2 (plane) or 3x3 velocity gradient, row i = d/dx_i
+  double g[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+};
+
+double comp(const Vec& v, int i) { return i == 0 ? v.x : i == 1 ? v.y : v.z; }
+void add_comp(Vec& v, int i, double a) { (i == 0 ? v.x : i == 1 ? v.y : v.z) += a; }
+
+}  // namespace
+
+struct VofSolver::Impl {
+  VofSolver& s;
+  const Mesh& m;
+  int nc = 0, nf = 0, dims = 2;
+  std::vector<Bc> face_bc;             // per boundary face (index f - n_internal)
+  std::vector<const PatchBc*> face_pbc;
+  std::vector<std::vector<int>> cell_faces;  // faces of each cell
+  bool has_dirichlet = false;
+  // Pressure system.
+  Mat A = nullptr;
+  ::Vec x = nullptr, b = nullptr, r = nullptr, dx = nullptr;
+  KSP ksp = nullptr;
+  // Work arrays.
+  std::vector<double> rho, rho_old, mu, A_D, rAU, rAUf, gh, ghf, alpha_phi, rho_phi;
+  std::vector<Vec> H, HbyA, bsrc;
+  std::vector<double> cO, cN;
+  Mat Mu = nullptr;
+  KSP kspU = nullptr;
+  std::vector<std::array<double, 3>> recon_inv;  // inverse of sum Sf Sf / |Sf| (plane: 2x2 packed)
+
+  explicit Impl(VofSolver& solver) : s(solver), m(solver.mesh_) {}
+  ~Impl() {
+    if (ksp) KSPDestroy(&ksp);
+    if (kspU) KSPDestroy(&kspU);
+    if (Mu) MatDestroy(&Mu);
+    if (A) MatDestroy(&A);
+    if (x) VecDestroy(&x);
+    if (b) VecDestroy(&b);
+    if (r) VecDestroy(&r);
+    if (dx) VecDestroy(&dx);
+  }
+
+  const PatchBc& bc_of(int f) const { return *face_pbc[std::size_t(f - m.n_internal)]; }
+  Bc kind_of(int f) const { return face_bc[std::size_t(f - m.n_internal)]; }
+
+  void setup() {
+    nc = m.cells();
+    nf = m.faces();
+    dims = m.thickness > 0 ? 2 : 3;
+    face_bc.resize(std::size_t(nf - m.n_internal));
+    face_pbc.resize(face_bc.size());
+    for (const auto& p : m.patches) {
+      const auto it = s.cfg_.bc.find(p.name);
+      if (it == s.cfg_.bc.end()) throw VofError("boundary conditions: patch '" + p.name + "' has none");
+      if (it->second.kind == Bc::inflow && (!it->second.inflow_velocity || !it->second.inflow_alpha))
+        throw VofError("boundary conditions: inflow patch '" + p.name + "' needs a velocity and a phase-fraction profile");
+      if (it->second.kind == Bc::atmosphere) has_dirichlet = true;
+      for (int f = p.start; f < p.start + p.size; ++f) {
+        face_bc[std::size_t(f - m.n_internal)] = it->second.kind;
+        face_pbc[std::size_t(f - m.n_internal)] = &it->second;
+      }
+    }
+    for (const auto& [name, _] : s.cfg_.bc)
+      if (m.patch_index(name) < 0) throw VofError("boundary conditions: the mesh has no patch '" + name + "'");
+    if (s.cfg_.rheology != "coulomb") throw VofError("rheology: unknown '" + s.cfg_.rheology + "' (valid: coulomb)");
+    if (!(s.cfg_.phi_deg > 0 && s.cfg_.phi_deg < 90)) throw VofError("phi_deg must lie in (0, 90)");
+    cell_faces.assign(std::size_t(nc), {});
+    for (int f = 0; f < nf; ++f) {
+      cell_faces[std::size_t(m.owner[std::size_t(f)])].push_back(f);
+      if (f < m.n_internal) cell_faces[std::size_t(m.neighbour[std::size_t(f)])].push_back(f);
+    }
+    // Reconstruction tensors.
+    recon_inv.resize(static_cast<std::size_t>(nc));
+    for (int c = 0; c < nc; ++c) {
+      double t00 = 0, t01 = 0, t11 = 0;
+      for (int f : cell_faces[std::size_t(c)]) {
+        const Vec& S = m.Sf[std::size_t(f)];
+        const double a = m.magSf[std::size_t(f)];
+        t00 += S.x * S.x / a;
+        t01 += S.x * S.y / a;
+        t11 += S.y * S.y / a;
+      }
+      const double det = t00 * t11 - t01 * t01;
+      recon_inv[std::size_t(c)] = {t11 / det, -t01 / det, t00 / det};
+    }
+    if (dims == 3) throw VofError("3D meshes: not supported by this build of the VOF engine yet (plane meshes only)");
+    // Pressure matrix with the sparsity of the mesh.
+    petsc_init();
+    std::vector<PetscInt> nnz(std::size_t(nc), 1);
+    for (int f = 0; f < m.n_internal; ++f) {
+      ++nnz[std::size_t(m.owner[std::size_t(f)])];
+      ++nnz[std::size_t(m.neighbour[std::size_t(f)])];
+    }
+    petsc_check(MatCreateSeqAIJ(PETSC_COMM_SELF, nc, nc, 0, nnz.data(), &A), "MatCreateSeqAIJ");
+    petsc_check(MatSetOption(A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+    petsc_check(VecCreateSeq(PETSC_COMM_SELF, nc, &x), "VecCreateSeq");
+    petsc_check(VecDuplicate(x, &b), "VecDuplicate");
+    petsc_check(VecDuplicate(x, &r), "VecDuplicate");
+    petsc_check(VecDuplicate(x, &dx), "VecDuplicate");
+    petsc_check(KSPCreate(PETSC_COMM_SELF, &ksp), "KSPCreate");
+    petsc_check(KSPSetType(ksp, KSPCG), "KSPSetType");
+    PC pc;
+    petsc_check(KSPGetPC(ksp, &pc), "KSPGetPC");
+    if (s.cfg_.pressure_pc == "gamg") {
+      petsc_check(PCSetType(pc, PCGAMG), "PCSetType gamg");
+      // The 1/A of the two phases differ a thousandfold: GAMG's default Chebyshev smoothers, with their
+      // estimated eigenvalue bounds, then made the preconditioner indefinite for CG now and then.
+      // Damped Jacobi smoothing (Richardson, scale 0.6) is symmetric and stays positive definite.
+      petsc_check(KSPSetOptionsPrefix(ksp, "runout_p_"), "KSPSetOptionsPrefix");
+      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_ksp_type", "richardson");
+      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_pc_type", "jacobi");
+      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_ksp_richardson_scale", "0.6");
+      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_ksp_max_it", "2");
+      petsc_check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
+    } else if (s.cfg_.pressure_pc == "hypre") {
+      if (PCSetType(pc, PCHYPRE)) throw VofError("pressure_pc: this PETSc has no hypre (valid here: gamg)");
+      petsc_check(PCHYPRESetType(pc, "boomeramg"), "PCHYPRESetType");
+    } else {
+      throw VofError("pressure_pc: unknown '" + s.cfg_.pressure_pc + "' (valid: gamg, hypre)");
+    }
+    petsc_check(KSPSetTolerances(ksp, s.cfg_.pressure_rtol, 1e-300, PETSC_DEFAULT, 2000), "KSPSetTolerances");
+    petsc_check(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
+    rho.assign(std::size_t(nc), 0);
+    rho_old = rho;
+    mu = rho;
+    A_D = rho;
+    rAU = rho;
+    gh = rho;
+    rAUf.assign(std::size_t(nf), 0);
+    ghf = rAUf;
+    alpha_phi = rAUf;
+    rho_phi = rAUf;
+    H.assign(std::size_t(nc), Vec{});
+    HbyA = H;
+    bsrc = H;
+    cO.assign(std::size_t(nf), 0);
+    cN = cO;
+    petsc_check(MatCreateSeqAIJ(PETSC_COMM_SELF, nc, nc, 0, nnz.data(), &Mu), "MatCreateSeqAIJ");
+    petsc_check(KSPCreate(PETSC_COMM_SELF, &kspU), "KSPCreate");
+    petsc_check(KSPSetType(kspU, KSPBCGS), "KSPSetType");
+    PC pcu;
+    petsc_check(KSPGetPC(kspU, &pcu), "KSPGetPC");
+    petsc_check(PCSetType(pcu, PCILU), "PCSetType ilu");
+    petsc_check(KSPSetTolerances(kspU, 1e-10, 1e-300, PETSC_DEFAULT, 2000), "KSPSetTolerances");
+    petsc_check(KSPSetInitialGuessNonzero(kspU, PETSC_TRUE), "KSPSetInitialGuessNonzero");
+  }
+
+  void update_gravity(double t) {
+    const Vec g = s.cfg_.gravity(t);
+    for (int c = 0; c < nc; ++c) gh[std::size_t(c)] = dot(g, m.centre[std::size_t(c)]);
+    for (int f = 0; f < nf; ++f) ghf[std::size_t(f)] = dot(g, m.Cf[std::size_t(f)]);
+  }
+
+  void update_rho(std::vector<double>& r) const {
+    const auto& a = s.alpha_;
+    for (int c = 0; c < nc; ++c) {
+      const double al = std::clamp(a[std::size_t(c)], 0.0, 1.0);
+      r[std::size_t(c)] = al * s.cfg_.rho1 + (1 - al) * s.cfg_.rho2;
+    }
+  }
+
+  // Boundary value of alpha on face f (zero gradient; air enters through the atmosphere).
+  double alpha_b(int f) const {
+    const int o = m.owner[std::size_t(f)];
+    switch (kind_of(f)) {
+      case Bc::inflow: return bc_of(f).inflow_alpha(m.Cf[std::size_t(f)]);
+      case Bc::atmosphere: return s.phi_[std::size_t(f)] < 0 ? 0.0 : s.alpha_[std::size_t(o)];
+      default: return s.alpha_[std::size_t(o)];
+    }
+  }
+
+  // Gauss gradient of the velocity per cell (boundary values from the conditions).
+  std::vector<Grad> velocity_gradient() const {
+    std::vector<Grad> G(static_cast<std::size_t>(nc));
+    for (int f = 0; f < nf; ++f) {
+      const int o = m.owner[std::size_t(f)];
+      const Vec S = m.Sf[std::size_t(f)];
+      Vec Uf;
+      if (f < m.n_internal) {
+        const double w = m.weight[std::size_t(f)];
+        Uf = w * s.U_[std::size_t(o)] + (1 - w) * s.U_[std::size_t(m.neighbour[std::size_t(f)])];
+      } else {
+        Uf = boundary_velocity(f);
+      }
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+          const double v = comp(S, i) * comp(Uf, j);
+          G[std::size_t(o)].g[i][j] += v;
+          if (f < m.n_internal) G[std::size_t(m.neighbour[std::size_t(f)])].g[i][j] -= v;
+        }
+    }
+    for (int c = 0; c < nc; ++c)
+      for (auto& row : G[std::size_t(c)].g)
+        for (double& v : row) v /= m.volume[std::size_t(c)];
+    return G;
+  }
+
+  // The velocity on a boundary face.
+  Vec boundary_velocity(int f) const {
+    const int o = m.owner[std::size_t(f)];
+    const Vec Up = s.U_[std::size_t(o)];
+    const Vec n = (1.0 / m.magSf[std::size_t(f)]) * m.Sf[std::size_t(f)];
+    switch (kind_of(f)) {
+      case Bc::wall: return {};
+      case Bc::inflow: return bc_of(f).inflow_velocity(m.Cf[std::size_t(f)]);
+      case Bc::outflow: return Up;
+      case Bc::atmosphere: {
+        // pressureInletOutletVelocity: zero gradient out, the flux's normal velocity in.
+        const double ph = s.phi_[std::size_t(f)];
+        return ph >= 0 ? Up : (ph / m.magSf[std::size_t(f)]) * n;
+      }
+      case Bc::coulomb_slip: {
+        const Vec ut = Up - dot(Up, n) * n;
+        const double mag = norm(ut);
+        double vf = 1.0;  // stick
+        if (s.alpha_[std::size_t(o)] >= 0.5) {
+          const double mub = mu[std::size_t(o)];
+          const double pb = s.p_[std::size_t(o)];
+          vf = std::clamp(bc_of(f).tan_delta / m.delta_coeff[std::size_t(f)] * pb / std::max(1e-300, mub * mag), 0.0, 1.0);
+        }
+        return (1 - vf) * ut;
+      }
+    }
+    return {};
+  }
+
+  void update_viscosity() {
+    const auto G = velocity_gradient();
+    const double tanphi = std::tan(s.cfg_.phi_deg * kPi / 180);
+    for (int c = 0; c < nc; ++c) {
+      const auto& g = G[std::size_t(c)].g;
+      double dd = 0;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+          const double d = 0.5 * (g[i][j] + g[j][i]);
+          dd += d * d;
+        }
+      const double sr = std::sqrt(2 * dd);
+      const double nu = tanphi * s.p_[std::size_t(c)] / (s.cfg_.rho1 * std::max(sr, 1e-300));
+      s.nu1_[std::size_t(c)] = std::clamp(std::isfinite(nu) ? nu : s.cfg_.nu_max, s.cfg_.nu_min, s.cfg_.nu_max);
+      const double al = std::clamp(s.alpha_[std::size_t(c)], 0.0, 1.0);
+      mu[std::size_t(c)] = al * s.cfg_.rho1 * s.nu1_[std::size_t(c)] + (1 - al) * s.cfg_.rho2 * s.cfg_.nu2;
+    }
+  }
+
+  // Phase fraction: explicit, upwind plus a limited correction toward central differencing with
+  // interface compression (Zalesak FCT keeps every cell within its neighbours' bounds and [0, 1]).
+  void solve_alpha(double dt) {
+    auto& a = s.alpha_;
+    const int n = std::max(1, s.cfg_.alpha_subcycles);
+    const double dts = dt / n;
+    std::fill(alpha_phi.begin(), alpha_phi.end(), 0.0);
+    std::vector<double> FL(static_cast<std::size_t>(nf)), AF(static_cast<std::size_t>(nf)), amax(static_cast<std::size_t>(nc)), amin(static_cast<std::size_t>(nc)),
+        Pp(static_cast<std::size_t>(nc)), Pm(static_cast<std::size_t>(nc)), Rp(static_cast<std::size_t>(nc)), Rm(static_cast<std::size_t>(nc)), aL(static_cast<std::size_t>(nc));
+    for (int sub = 0; sub < n; ++sub) {
+      // Interface normal per cell (Gauss gradient of alpha).
+      std::vector<Vec> ga(static_cast<std::size_t>(nc));
+      for (int f = 0; f < nf; ++f) {
+        const int o = m.owner[std::size_t(f)];
+        const double af = f < m.n_internal ? m.weight[std::size_t(f)] * a[std::size_t(o)] +
+                                                 (1 - m.weight[std::size_t(f)]) * a[std::size_t(m.neighbour[std::size_t(f)])]
+                                           : alpha_b(f);
+        ga[std::size_t(o)] = ga[std::size_t(o)] + af * m.Sf[std::size_t(f)];
+        if (f < m.n_internal) ga[std::size_t(m.neighbour[std::size_t(f)])] = ga[std::size_t(m.neighbour[std::size_t(f)])] - af * m.Sf[std::size_t(f)];
+      }
+      for (int c = 0; c < nc; ++c) ga[std::size_t(c)] = (1.0 / m.volume[std::size_t(c)]) * ga[std::size_t(c)];
+      for (int c = 0; c < nc; ++c) amax[std::size_t(c)] = amin[std::size_t(c)] = a[std::size_t(c)];
+      for (int f = 0; f < nf; ++f) {
+        const int o = m.owner[std::size_t(f)];
+        const double ph = s.phi_[std::size_t(f)];
+        if (f < m.n_internal) {
+          const int nb = m.neighbour[std::size_t(f)];
+          const double ao = a[std::size_t(o)], an = a[std::size_t(nb)];
+          FL[std::size_t(f)] = ph * (ph >= 0 ? ao : an);
+          // Central value and compression flux.
+          const double w = m.weight[std::size_t(f)];
+          const double ac = w * ao + (1 - w) * an;
+          Vec gf = w * ga[std::size_t(o)] + (1 - w) * ga[std::size_t(nb)];
+          const double dn = 1e-8 * std::cbrt(m.volume[std::size_t(o)]);
+          const double nS = dot(gf, m.Sf[std::size_t(f)]) / (norm(gf) + 1e-8 / std::max(dn, 1e-30));
+          const double phir = s.cfg_.c_alpha * std::abs(ph) / m.magSf[std::size_t(f)] * nS;
+          const double a_up = phir >= 0 ? ao : an, b_up = phir >= 0 ? 1 - an : 1 - ao;
+          const double FH = ph * ac + phir * a_up * b_up;
+          AF[std::size_t(f)] = FH - FL[std::size_t(f)];
+          amax[std::size_t(o)] = std::max(amax[std::size_t(o)], an);
+          amin[std::size_t(o)] = std::min(amin[std::size_t(o)], an);
+          amax[std::size_t(nb)] = std::max(amax[std::size_t(nb)], ao);
+          amin[std::size_t(nb)] = std::min(amin[std::size_t(nb)], ao);
+        } else {
+          const double ab = ph >= 0 ? a[std::size_t(o)] : alpha_b(f);
+          FL[std::size_t(f)] = ph * ab;
+          AF[std::size_t(f)] = 0;
+          if (ph < 0) {
+            amax[std::size_t(o)] = std::max(amax[std::size_t(o)], ab);
+            amin[std::size_t(o)] = std::min(amin[std::size_t(o)], ab);
+          }
+        }
+      }
+      // Low-order update and the limiter.
+      for (int c = 0; c < nc; ++c) aL[std::size_t(c)] = a[std::size_t(c)] * m.volume[std::size_t(c)];
+      std::fill(Pp.begin(), Pp.end(), 0.0);
+      std::fill(Pm.begin(), Pm.end(), 0.0);
+      for (int f = 0; f < nf; ++f) {
+        const int o = m.owner[std::size_t(f)];
+        aL[std::size_t(o)] -= dts * FL[std::size_t(f)];
+        if (f < m.n_internal) {
+          const int nb = m.neighbour[std::size_t(f)];
+          aL[std::size_t(nb)] += dts * FL[std::size_t(f)];
+          const double A = AF[std::size_t(f)];
+          // A > 0 takes from the owner, gives to the neighbour.
+          if (A > 0) {
+            Pm[std::size_t(o)] += A;
+            Pp[std::size_t(nb)] += A;
+          } else {
+            Pp[std::size_t(o)] -= A;
+            Pm[std::size_t(nb)] -= A;
+          }
+        }
+      }
+      for (int c = 0; c < nc; ++c) {
+        const double V = m.volume[std::size_t(c)];
+        const double lo = aL[std::size_t(c)] / V;
+        const double up = std::clamp(amax[std::size_t(c)], 0.0, 1.0), dn = std::clamp(amin[std::size_t(c)], 0.0, 1.0);
+        const double Qp = std::max(0.0, (up - lo) * V / dts), Qm = std::max(0.0, (lo - dn) * V / dts);
+        Rp[std::size_t(c)] = Pp[std::size_t(c)] > 0 ? std::min(1.0, Qp / Pp[std::size_t(c)]) : 1.0;
+        Rm[std::size_t(c)] = Pm[std::size_t(c)] > 0 ? std::min(1.0, Qm / Pm[std::size_t(c)]) : 1.0;
+      }
+      for (int f = 0; f < nf; ++f) {
+        double F = FL[std::size_t(f)];
+        if (f < m.n_internal) {
+          const int o = m.owner[std::size_t(f)], nb = m.neighbour[std::size_t(f)];
+          const double A = AF[std::size_t(f)];
+          const double lam = A > 0 ? std::min(Rm[std::size_t(o)], Rp[std::size_t(nb)]) : std::min(Rp[std::size_t(o)], Rm[std::size_t(nb)]);
+          F += lam * A;
+          const double dA = lam * A * dts;
+          aL[std::size_t(o)] -= dA;
+          aL[std::size_t(nb)] += dA;
+        }
+        alpha_phi[std::size_t(f)] += F / n;
+      }
+      for (int c = 0; c < nc; ++c) a[std::size_t(c)] = aL[std::size_t(c)] / m.volume[std::size_t(c)];
+    }
+    for (int f = 0; f < nf; ++f)
+      rho_phi[std::size_t(f)] = alpha_phi[std::size_t(f)] * (s.cfg_.rho1 - s.cfg_.rho2) + s.phi_[std::size_t(f)] * s.cfg_.rho2;
+  }
+
+  // Momentum matrix (both velocity components share it): diagonal A_D, the neighbour coefficients of
+  // each internal face (cO: owner row, cN: neighbour row; A_D U_P - sum c U_nb = bsrc) and the
+  // sources. Boundary values and the transpose viscous part are taken from the current velocity.
+  void build_momentum(double dt) {
+    for (int c = 0; c < nc; ++c) {
+      const double V = m.volume[std::size_t(c)];
+      A_D[std::size_t(c)] = rho[std::size_t(c)] * V / dt;
+      bsrc[std::size_t(c)] = (rho_old[std::size_t(c)] * V / dt) * U_old[std::size_t(c)];
+    }
+    // Transpose part of the viscous stress, explicit: V (grad U) . grad mu.
+    {
+      const auto& G = grad_cache;
+      std::vector<Vec> gm(static_cast<std::size_t>(nc));
+      for (int f = 0; f < nf; ++f) {
+        const int o = m.owner[std::size_t(f)];
+        const double muf = f < m.n_internal
+                               ? m.weight[std::size_t(f)] * mu[std::size_t(o)] + (1 - m.weight[std::size_t(f)]) * mu[std::size_t(m.neighbour[std::size_t(f)])]
+                               : mu[std::size_t(o)];
+        gm[std::size_t(o)] = gm[std::size_t(o)] + muf * m.Sf[std::size_t(f)];
+        if (f < m.n_internal) gm[std::size_t(m.neighbour[std::size_t(f)])] = gm[std::size_t(m.neighbour[std::size_t(f)])] - muf * m.Sf[std::size_t(f)];
+      }
+      for (int c = 0; c < nc; ++c) {
+        const Vec g = (1.0 / m.volume[std::size_t(c)]) * gm[std::size_t(c)];
+        for (int i = 0; i < 3; ++i) {
+          double v = 0;
+          for (int j = 0; j < 3; ++j) v += G[std::size_t(c)].g[i][j] * comp(g, j);
+          add_comp(bsrc[std::size_t(c)], i, m.volume[std::size_t(c)] * v);
+        }
+      }
+    }
+    for (int f = 0; f < nf; ++f) {
+      const int o = m.owner[std::size_t(f)];
+      const double F = rho_phi[std::size_t(f)];
+      if (f < m.n_internal) {
+        const int nb = m.neighbour[std::size_t(f)];
+        const double w = m.weight[std::size_t(f)];
+        const double muf = w * mu[std::size_t(o)] + (1 - w) * mu[std::size_t(nb)];
+        const double D = muf * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+        // Row o: + max(F,0) U_o + min(F,0) U_nb + D (U_o - U_nb); row nb: the flux out of nb is -F.
+        A_D[std::size_t(o)] += std::max(F, 0.0) + D;
+        cO[std::size_t(f)] = D - std::min(F, 0.0);
+        A_D[std::size_t(nb)] += std::max(-F, 0.0) + D;
+        cN[std::size_t(f)] = D - std::min(-F, 0.0);
+      } else {
+        const Bc k = kind_of(f);
+        const Vec Ub = boundary_velocity(f);
+        const double D = mu[std::size_t(o)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+        if (k == Bc::wall || k == Bc::coulomb_slip || k == Bc::inflow) {
+          A_D[std::size_t(o)] += D;
+          bsrc[std::size_t(o)] = bsrc[std::size_t(o)] + D * Ub;
+        }
+        if (F >= 0) {
+          A_D[std::size_t(o)] += F;  // leaves with the cell's velocity
+        } else {
+          bsrc[std::size_t(o)] = bsrc[std::size_t(o)] + (-F) * Ub;  // brings the boundary's velocity
+        }
+      }
+    }
+    for (int c = 0; c < nc; ++c) rAU[std::size_t(c)] = m.volume[std::size_t(c)] / A_D[std::size_t(c)];  // 1 / A per unit volume [m3 s/kg]
+    for (int f = 0; f < nf; ++f) {
+      const int o = m.owner[std::size_t(f)];
+      rAUf[std::size_t(f)] = f < m.n_internal ? m.weight[std::size_t(f)] * rAU[std::size_t(o)] +
+                                                    (1 - m.weight[std::size_t(f)]) * rAU[std::size_t(m.neighbour[std::size_t(f)])]
+                                              : rAU[std::size_t(o)];
+    }
+  }
+
+  // H = sources + neighbour coefficients x the current velocity; HbyA = H / A_D.
+  void compute_H() {
+    const auto& U = s.U_;
+    H = bsrc;
+    for (int f = 0; f < m.n_internal; ++f) {
+      const int o = m.owner[std::size_t(f)], nb = m.neighbour[std::size_t(f)];
+      H[std::size_t(o)] = H[std::size_t(o)] + cO[std::size_t(f)] * U[std::size_t(nb)];
+      H[std::size_t(nb)] = H[std::size_t(nb)] + cN[std::size_t(f)] * U[std::size_t(o)];
+    }
+    for (int c = 0; c < nc; ++c) HbyA[std::size_t(c)] = (1.0 / A_D[std::size_t(c)]) * H[std::size_t(c)];
+  }
+
+  // Momentum predictor: solve the momentum matrix with the last pressure and buoyancy forces,
+  // so that the viscous coupling (the Coulomb viscosity reaches 1e2 m2/s) is converged every step.
+  int predict() {
+    // Force per cell: V reconstruct(-ghf snGrad(rho) - snGrad(p_rgh)) |Sf|.
+    std::vector<Vec> rec(static_cast<std::size_t>(nc));
+    for (int f = 0; f < nf; ++f) {
+      const int o = m.owner[std::size_t(f)];
+      double q = 0;  // force per area, normal to the face
+      if (f < m.n_internal) {
+        const int nb = m.neighbour[std::size_t(f)];
+        const double dl = m.delta_coeff[std::size_t(f)];
+        q = -ghf[std::size_t(f)] * (rho[std::size_t(nb)] - rho[std::size_t(o)]) * dl - (s.p_rgh_[std::size_t(nb)] - s.p_rgh_[std::size_t(o)]) * dl;
+      } else if (kind_of(f) == Bc::atmosphere) {
+        q = -(-rho[std::size_t(o)] * ghf[std::size_t(f)] - s.p_rgh_[std::size_t(o)]) * m.delta_coeff[std::size_t(f)];
+      } else {
+        continue;  // walls and inflow: the pressure gradient normal to them is balanced (fixed flux)
+      }
+      rec[std::size_t(o)] = rec[std::size_t(o)] + q * m.Sf[std::size_t(f)];
+      if (f < m.n_internal) rec[std::size_t(m.neighbour[std::size_t(f)])] = rec[std::size_t(m.neighbour[std::size_t(f)])] + q * m.Sf[std::size_t(f)];
+    }
+    petsc_check(MatZeroEntries(Mu), "MatZeroEntries");
+    for (int f = 0; f < m.n_internal; ++f) {
+      const PetscInt o = m.owner[std::size_t(f)], nb = m.neighbour[std::size_t(f)];
+      const PetscScalar a = -cO[std::size_t(f)], c = -cN[std::size_t(f)];
+      petsc_check(MatSetValues(Mu, 1, &o, 1, &nb, &a, INSERT_VALUES), "MatSetValues");
+      petsc_check(MatSetValues(Mu, 1, &nb, 1, &o, &c, INSERT_VALUES), "MatSetValues");
+    }
+    for (PetscInt c = 0; c < nc; ++c) {
+      const PetscScalar d = A_D[std::size_t(c)];
+      petsc_check(MatSetValues(Mu, 1, &c, 1, &c, &d, INSERT_VALUES), "MatSetValues");
+    }
+    petsc_check(MatAssemblyBegin(Mu, MAT_FINAL_ASSEMBLY), "MatAssembly");
+    petsc_check(MatAssemblyEnd(Mu, MAT_FINAL_ASSEMBLY), "MatAssembly");
+    petsc_check(KSPSetOperators(kspU, Mu, Mu), "KSPSetOperators");
+    int its_total = 0;
+    for (int comp_i = 0; comp_i < 2; ++comp_i) {
+      for (int c = 0; c < nc; ++c) {
+        const auto& T = recon_inv[std::size_t(c)];
+        const Vec r = rec[std::size_t(c)];
+        const double fx = T[0] * r.x + T[1] * r.y, fy = T[1] * r.x + T[2] * r.y;
+        const double src = comp(bsrc[std::size_t(c)], comp_i) + m.volume[std::size_t(c)] * (comp_i == 0 ? fx : fy);
+        VecSetValue(b, c, src, INSERT_VALUES);
+        VecSetValue(x, c, comp(s.U_[std::size_t(c)], comp_i), INSERT_VALUES);
+      }
+      VecAssemblyBegin(b);
+      VecAssemblyEnd(b);
+      VecAssemblyBegin(x);
+      VecAssemblyEnd(x);
+      petsc_check(KSPSolve(kspU, b, x), "KSPSolve (momentum)");
+      KSPConvergedReason reason;
+      KSPGetConvergedReason(kspU, &reason);
+      PetscInt k = 0;
+      KSPGetIterationNumber(kspU, &k);
+      its_total += int(k);
+      if (reason < 0)
+        throw VofError("momentum solver (BiCGStab + ILU) did not converge at t = " + std::to_string(s.t_) + " s: reason " +
+                       std::to_string(int(reason)));
+      const PetscScalar* xv;
+      VecGetArrayRead(x, &xv);
+      for (int c = 0; c < nc; ++c) (comp_i == 0 ? s.U_[std::size_t(c)].x : s.U_[std::size_t(c)].y) = xv[c];
+      VecRestoreArrayRead(x, &xv);
+    }
+    return its_total;
+  }
+
+  // One pressure correction: solve laplacian(rAUf, p_rgh) = div(phiHbyA) and correct fluxes and
+  // velocities. Returns the iterations.
+  int pressure_correct(bool initial) {
+    std::vector<double> phiHbyA(static_cast<std::size_t>(nf)), phig(static_cast<std::size_t>(nf)), coef(std::size_t(nf), 0.0);
+    for (int f = 0; f < nf; ++f) {
+      const int o = m.owner[std::size_t(f)];
+      if (f < m.n_internal) {
+        const int nb = m.neighbour[std::size_t(f)];
+        const double w = m.weight[std::size_t(f)];
+        const Vec Hf = w * HbyA[std::size_t(o)] + (1 - w) * HbyA[std::size_t(nb)];
+        phiHbyA[std::size_t(f)] = initial ? 0.0 : dot(Hf, m.Sf[std::size_t(f)]);
+        phig[std::size_t(f)] = -ghf[std::size_t(f)] * (rho[std::size_t(nb)] - rho[std::size_t(o)]) * m.delta_coeff[std::size_t(f)] *
+                               m.magSf[std::size_t(f)] * rAUf[std::size_t(f)];
+        coef[std::size_t(f)] = rAUf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+      } else {
+        const Bc k = kind_of(f);
+        if (k == Bc::wall || k == Bc::coulomb_slip) phiHbyA[std::size_t(f)] = 0;
+        else if (k == Bc::inflow) phiHbyA[std::size_t(f)] = dot(bc_of(f).inflow_velocity(m.Cf[std::size_t(f)]), m.Sf[std::size_t(f)]);
+        else phiHbyA[std::size_t(f)] = initial ? 0.0 : dot(HbyA[std::size_t(o)], m.Sf[std::size_t(f)]);
+        if (k == Bc::atmosphere) coef[std::size_t(f)] = rAUf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+      }
+      phiHbyA[std::size_t(f)] += phig[std::size_t(f)];
+    }
+    // Assemble M p = rhs.
+    petsc_check(MatZeroEntries(A), "MatZeroEntries");
+    std::vector<double> diag(std::size_t(nc), 0.0), rhs(std::size_t(nc), 0.0);
+    for (int f = 0; f < nf; ++f) {
+      const int o = m.owner[std::size_t(f)];
+      const double c = coef[std::size_t(f)];
+      rhs[std::size_t(o)] -= phiHbyA[std::size_t(f)];
+      if (f < m.n_internal) {
+        const int nb = m.neighbour[std::size_t(f)];
+        rhs[std::size_t(nb)] += phiHbyA[std::size_t(f)];
+        diag[std::size_t(o)] += c;
+        diag[std::size_t(nb)] += c;
+        const PetscInt r0 = o, c0 = nb;
+        const PetscScalar v = -c;
+        petsc_check(MatSetValues(A, 1, &r0, 1, &c0, &v, INSERT_VALUES), "MatSetValues");
+        petsc_check(MatSetValues(A, 1, &c0, 1, &r0, &v, INSERT_VALUES), "MatSetValues");
+      } else if (kind_of(f) == Bc::atmosphere) {
+        // p = 0 outside: p_rgh_b = -rho_b gh_b.
+        const double pb = -rho[std::size_t(o)] * ghf[std::size_t(f)];
+        diag[std::size_t(o)] += c;
+        rhs[std::size_t(o)] += c * pb;
+      }
+    }
+    for (int c = 0; c < nc; ++c) {
+      const PetscInt r = c;
+      const PetscScalar v = diag[std::size_t(c)];
+      petsc_check(MatSetValues(A, 1, &r, 1, &r, &v, INSERT_VALUES), "MatSetValues");
+      petsc_check(VecSetValue(b, c, rhs[std::size_t(c)], INSERT_VALUES), "VecSetValue");
+      petsc_check(VecSetValue(x, c, s.p_rgh_[std::size_t(c)], INSERT_VALUES), "VecSetValue");
+    }
+    petsc_check(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY), "MatAssembly");
+    petsc_check(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY), "MatAssembly");
+    petsc_check(VecAssemblyBegin(b), "VecAssembly");
+    petsc_check(VecAssemblyEnd(b), "VecAssembly");
+    petsc_check(VecAssemblyBegin(x), "VecAssembly");
+    petsc_check(VecAssemblyEnd(x), "VecAssembly");
+    if (!has_dirichlet) {
+      MatNullSpace ns;
+      petsc_check(MatNullSpaceCreate(PETSC_COMM_SELF, PETSC_TRUE, 0, nullptr, &ns), "MatNullSpaceCreate");
+      petsc_check(MatSetNullSpace(A, ns), "MatSetNullSpace");
+      MatNullSpaceDestroy(&ns);
+    }
+    petsc_check(KSPSetOperators(ksp, A, A), "KSPSetOperators");
+    // Solve for the correction to the last pressure: the tolerance then applies to the change (the
+    // divergence to remove), not to the hydrostatic pressure, whose rounding would otherwise reappear
+    // as fluxes in the light phase (its 1/A is a thousand times the granular phase's).
+    PetscInt its = 0;
+    for (int pass = 0; pass < (initial ? 3 : 1); ++pass) {
+      petsc_check(MatMult(A, x, r), "MatMult");
+      petsc_check(VecAYPX(r, -1.0, b), "VecAYPX");  // r = b - A x
+      if (!has_dirichlet) {
+        MatNullSpace ns;
+        MatGetNullSpace(A, &ns);
+        if (ns) MatNullSpaceRemove(ns, r);
+      }
+      petsc_check(VecSet(dx, 0.0), "VecSet");
+      petsc_check(KSPSolve(ksp, r, dx), "KSPSolve");
+      KSPConvergedReason reason;
+      KSPGetConvergedReason(ksp, &reason);
+      PetscInt k = 0;
+      KSPGetIterationNumber(ksp, &k);
+      its += k;
+      if (reason < 0)
+        throw VofError("pressure solver (CG + " + s.cfg_.pressure_pc + ") did not converge at t = " + std::to_string(s.t_) +
+                       " s: reason " + std::to_string(int(reason)) + " after " + std::to_string(int(k)) + " iterations");
+      petsc_check(VecAXPY(x, 1.0, dx), "VecAXPY");
+    }
+    const PetscScalar* xv;
+    VecGetArrayRead(x, &xv);
+    for (int c = 0; c < nc; ++c) s.p_rgh_[std::size_t(c)] = xv[c];
+    VecRestoreArrayRead(x, &xv);
+    // Fluxes and velocities.
+    std::vector<Vec> rec(static_cast<std::size_t>(nc));
+    for (int f = 0; f < nf; ++f) {
+      const int o = m.owner[std::size_t(f)];
+      double pflux = 0;
+      if (f < m.n_internal) {
+        const int nb = m.neighbour[std::size_t(f)];
+        pflux = -coef[std::size_t(f)] * (s.p_rgh_[std::size_t(nb)] - s.p_rgh_[std::size_t(o)]);
+      } else if (kind_of(f) == Bc::atmosphere) {
+        pflux = -coef[std::size_t(f)] * (-rho[std::size_t(o)] * ghf[std::size_t(f)] - s.p_rgh_[std::size_t(o)]);
+      }
+      s.phi_[std::size_t(f)] = phiHbyA[std::size_t(f)] + pflux;
+      if (rAUf[std::size_t(f)] > 0) {
+        const double q = (phig[std::size_t(f)] + pflux) / rAUf[std::size_t(f)] / m.magSf[std::size_t(f)];
+        rec[std::size_t(o)] = rec[std::size_t(o)] + q * m.Sf[std::size_t(f)];
+        if (f < m.n_internal) rec[std::size_t(m.neighbour[std::size_t(f)])] = rec[std::size_t(m.neighbour[std::size_t(f)])] + q * m.Sf[std::size_t(f)];
+      }
+    }
+    if (!initial)
+      for (int c = 0; c < nc; ++c) {
+        const auto& T = recon_inv[std::size_t(c)];
+        const Vec r = rec[std::size_t(c)];
+        const Vec R{T[0] * r.x + T[1] * r.y, T[1] * r.x + T[2] * r.y, 0};
+        s.U_[std::size_t(c)] = HbyA[std::size_t(c)] + rAU[std::size_t(c)] * R;
+      }
+    for (int c = 0; c < nc; ++c) s.p_[std::size_t(c)] = s.p_rgh_[std::size_t(c)] + rho[std::size_t(c)] * gh[std::size_t(c)];
+    return int(its);
+  }
+
+  std::vector<Vec> U_old;
+  std::vector<Grad> grad_cache;
+};
+
+VofSolver::VofSolver(Mesh mesh, VofConfig cfg) : mesh_(std::move(mesh)), cfg_(std::move(cfg)) {
+  impl_ = std::make_unique<Impl>(*this);
+  impl_->setup();
+  const auto n = std::size_t(mesh_.cells());
+  alpha_.assign(n, 0);
+  p_rgh_.assign(n, 0);
+  p_.assign(n, 0);
+  nu1_.assign(n, cfg_.nu_max);
+  U_.assign(n, Vec{});
+  phi_.assign(std::size_t(mesh_.faces()), 0);
+  dt_ = cfg_.dt_initial;
+}
+
+VofSolver::~VofSolver() = default;
+
+void VofSolver::initialise(const std::vector<double>& alpha, const std::vector<Vec>& U) {
+  auto& I = *impl_;
+  if (alpha.size() != alpha_.size()) throw VofError("initialise: alpha has " + std::to_string(alpha.size()) + " values for " + std::to_string(alpha_.size()) + " cells");
+  alpha_ = alpha;
+  for (double& a : alpha_)
+    if (!(a >= 0 && a <= 1)) throw VofError("initialise: alpha must lie in [0, 1]");
+  if (!U.empty()) {
+    if (U.size() != U_.size()) throw VofError("initialise: velocity size does not match the mesh");
+    U_ = U;
+  }
+  I.update_gravity(t_);
+  I.update_rho(I.rho);
+  // Hydrostatic pressure: the pressure equation with no velocity and unit rAU.
+  std::fill(I.rAUf.begin(), I.rAUf.end(), 1.0);
+  std::fill(I.HbyA.begin(), I.HbyA.end(), Vec{});
+  I.pressure_correct(true);
+  std::fill(phi_.begin(), phi_.end(), 0.0);
+  // Inflow faces carry their flux from the start.
+  for (int f = mesh_.n_internal; f < mesh_.faces(); ++f)
+    if (I.kind_of(f) == Bc::inflow) phi_[std::size_t(f)] = dot(I.bc_of(f).inflow_velocity(mesh_.Cf[std::size_t(f)]), mesh_.Sf[std::size_t(f)]);
+  I.update_viscosity();
+}
+
+StepStats VofSolver::step() {
+  using clk = std::chrono::steady_clock;
+  const auto t0 = clk::now();
+  auto& I = *impl_;
+  const auto& m = mesh_;
+  StepStats st;
+  // 1. Time step from the Courant numbers of the last step (eqs. 4.64-4.65).
+  double co = 0, aco = 0;
+  for (int c = 0; c < m.cells(); ++c) {
+    double sum = 0;
+    for (int f : I.cell_faces[std::size_t(c)]) sum += std::abs(phi_[std::size_t(f)]);
+    const double cc = 0.5 * sum / m.volume[std::size_t(c)] * dt_;
+    co = std::max(co, cc);
+    if (alpha_[std::size_t(c)] > 0.01 && alpha_[std::size_t(c)] < 0.99) aco = std::max(aco, cc);
+  }
+  {
+    const double fac = std::min(cfg_.max_co / std::max(co, 1e-30), cfg_.max_alpha_co / std::max(aco, 1e-30));
+    const double grow = std::min(std::min(fac, 1.0 + 0.1 * fac), 1.2);
+    dt_ = std::min(grow * dt_, cfg_.dt_max);
+  }
+  dt_ = std::min(dt_, std::max(1e-12, t_limit_ - t_));
+  t_ += dt_;
+  st.t = t_;
+  st.dt = dt_;
+  I.update_gravity(t_);
+  I.rho_old = I.rho;
+  I.U_old = U_;
+  // 2-3. Phase fraction (uses the last fluxes), then the mixture density.
+  I.solve_alpha(dt_);
+  I.update_rho(I.rho);
+  // 5-6. Momentum matrix and PISO correctors.
+  I.grad_cache = I.velocity_gradient();
+  double t_p = 0;
+  I.build_momentum(dt_);
+  if (cfg_.momentum_predictor) st.momentum_iterations = I.predict();
+  for (int k = 0; k < std::max(1, cfg_.n_correctors); ++k) {
+    I.compute_H();
+    const auto tp = clk::now();
+    st.pressure_iterations += I.pressure_correct(false);
+    t_p += std::chrono::duration<double>(clk::now() - tp).count();
+  }
+  I.update_viscosity();
+  // Diagnostics.
+  st.alpha_min = 1e300;
+  st.alpha_max = -1e300;
+  std::vector<double> div(std::size_t(m.cells()), 0.0);
+  for (int f = 0; f < m.faces(); ++f) {
+    div[std::size_t(m.owner[std::size_t(f)])] += phi_[std::size_t(f)];
+    if (f < m.n_internal) div[std::size_t(m.neighbour[std::size_t(f)])] -= phi_[std::size_t(f)];
+  }
+  for (int c = 0; c < m.cells(); ++c) {
+    const double a = alpha_[std::size_t(c)];
+    st.alpha_min = std::min(st.alpha_min, a);
+    st.alpha_max = std::max(st.alpha_max, a);
+    st.granular_volume += a * m.volume[std::size_t(c)];
+    if (a > 0.5) st.max_speed = std::max(st.max_speed, norm(U_[std::size_t(c)]));
+    st.divergence = std::max(st.divergence, std::abs(div[std::size_t(c)]) / m.volume[std::size_t(c)]);
+    if (!std::isfinite(a) || !std::isfinite(U_[std::size_t(c)].x) || !std::isfinite(U_[std::size_t(c)].y))
+      throw VofError("the solution is no longer finite at t = " + std::to_string(t_) + " s (cell " + std::to_string(c) + ")");
+  }
+  st.co = co;
+  st.alpha_co = aco;
+  st.seconds_pressure = t_p;
+  st.seconds_total = std::chrono::duration<double>(clk::now() - t0).count();
+  return st;
+}
+
+void VofSolver::run(double t_end, const std::function<bool(const StepStats&)>& hook) {
+  t_limit_ = t_end;
+  while (t_ < t_end - 1e-12) {
+    const auto st = step();
+    if (hook && !hook(st)) break;
+  }
+  t_limit_ = 1e300;
+}
+
+}  // namespace runout::engine::vof

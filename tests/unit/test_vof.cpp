@@ -1,0 +1,148 @@
+// The VOF engine: mesh addressing, configuration errors, and the B9 heaps (validation.md B9) on a
+// coarse plane mesh with the invariants every case must keep.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "engine/vof/solver.hpp"
+
+using namespace runout::engine::vof;
+
+namespace {
+
+Mesh box(int nx = 40, int ny = 20) {
+  BlockSpec b;
+  b.x0 = 0;
+  b.x1 = 0.2;
+  b.y0 = 0;
+  b.y1 = 0.1;
+  b.nx = nx;
+  b.ny = ny;
+  b.thickness = 0.005;
+  return block_mesh(b);
+}
+
+VofConfig box_config() {
+  VofConfig c;
+  c.bc["bottom"].kind = Bc::wall;
+  c.bc["left"].kind = Bc::wall;
+  c.bc["right"].kind = Bc::wall;
+  c.bc["top"].kind = Bc::atmosphere;
+  return c;
+}
+
+struct HeapRun {
+  double max_speed_end = 0, volume0 = 0, volume1 = 0, alpha_min = 1, alpha_max = 0, divergence = 0, angle_deg = 0;
+};
+
+// A heap whose surface falls at `slope` from the left wall; run to t_end; surface angle from the
+// column heights between 80 % and 20 % of the left-wall height.
+HeapRun heap(double top, double slope, double t_end) {
+  Mesh m = box();
+  VofSolver s(m, box_config());
+  std::vector<double> a(std::size_t(m.cells()));
+  for (int k = 0; k < m.cells(); ++k) a[std::size_t(k)] = m.centre[std::size_t(k)].y < top - slope * m.centre[std::size_t(k)].x ? 1 : 0;
+  s.initialise(a);
+  HeapRun r;
+  for (int k = 0; k < m.cells(); ++k) r.volume0 += a[std::size_t(k)] * m.volume[std::size_t(k)];
+  s.run(t_end, [&](const StepStats& st) {
+    r.alpha_min = std::min(r.alpha_min, st.alpha_min);
+    r.alpha_max = std::max(r.alpha_max, st.alpha_max);
+    r.divergence = std::max(r.divergence, st.divergence);
+    r.max_speed_end = st.max_speed;
+    r.volume1 = st.granular_volume;
+    return true;
+  });
+  std::vector<double> h(40, 0.0);
+  for (int k = 0; k < m.cells(); ++k) h[std::size_t(m.centre[std::size_t(k)].x / 0.005)] += s.alpha()[std::size_t(k)] * 0.005;
+  const double hi = 0.8 * h[0], lo = 0.2 * h[0];
+  double xhi = 0, xlo = 0;
+  for (int i = 39; i >= 0; --i) {
+    if (h[std::size_t(i)] < hi) xhi = (i + 0.5) * 0.005;
+    if (h[std::size_t(i)] < lo) xlo = (i + 0.5) * 0.005;
+  }
+  r.angle_deg = std::atan((hi - lo) / std::max(1e-9, xlo - xhi)) * 180 / 3.14159265358979;
+  return r;
+}
+
+}  // namespace
+
+TEST(VofMesh, BlockMeshAddressingAndPatches) {
+  Mesh m = box(4, 3);
+  EXPECT_EQ(m.cells(), 12);
+  EXPECT_EQ(m.n_internal, 3 * 3 + 4 * 2);
+  EXPECT_EQ(m.patch("bottom").size, 4);
+  EXPECT_EQ(m.patch("left").size, 3);
+  for (int f = 0; f < m.n_internal; ++f) EXPECT_GT(dot(m.Sf[std::size_t(f)], m.centre[std::size_t(m.neighbour[std::size_t(f)])] - m.centre[std::size_t(m.owner[std::size_t(f)])]), 0);
+  // The top beyond x = 0.1 becomes its own patch; faces stay grouped.
+  split_patch(m, "top", "atmosphere", [](const Vec& c) { return c.x > 0.1; });
+  EXPECT_EQ(m.patch("top").size, 2);
+  EXPECT_EQ(m.patch("atmosphere").size, 2);
+  for (int f = m.patch("atmosphere").start; f < m.patch("atmosphere").start + 2; ++f) EXPECT_GT(m.Cf[std::size_t(f)].x, 0.1);
+}
+
+TEST(VofMesh, BlockedCellsFormTheObstaclePatch) {
+  BlockSpec b;
+  b.x1 = 1;
+  b.y1 = 1;
+  b.nx = b.ny = 10;
+  b.blocked = {{0.3, 0.0}, {0.7, 0.0}, {0.5, 0.4}};  // a ramp on the floor
+  Mesh m = block_mesh(b);
+  EXPECT_LT(m.cells(), 100);
+  EXPECT_GT(m.patch("obstacle").size, 0);
+  EXPECT_LT(m.patch("bottom").size, 10);
+}
+
+TEST(VofSolver, ConfigurationErrorsNameWhatIsWrong) {
+  auto c = box_config();
+  c.bc.erase("right");
+  try {
+    VofSolver s(box(), c);
+    FAIL();
+  } catch (const VofError& e) {
+    EXPECT_NE(std::string(e.what()).find("'right'"), std::string::npos) << e.what();
+  }
+  c = box_config();
+  c.rheology = "mu(I)";
+  EXPECT_THROW(VofSolver(box(), c), VofError);
+  c = box_config();
+  c.pressure_pc = "ilu";
+  EXPECT_THROW(VofSolver(box(), c), VofError);
+  c = box_config();
+  c.bc["nowhere"].kind = Bc::wall;
+  EXPECT_THROW(VofSolver(box(), c), VofError);
+}
+
+// B9 on a coarse plane mesh (5 mm cells): the invariants must hold exactly; the motion is checked
+// loosely here (the acceptance figures are the VofAcceptance tests, label vof_acceptance,
+// not met yet: see docs/vof.md).
+TEST(VofSolver, B9HeapFlatterThanPhiKeepsItsShape) {
+  const auto r = heap(0.02, -0.3, 1.0);  // surface rising to the right at 0.3, from 2 cm to 8 cm
+  std::printf("flat heap: max speed at 1 s %.2e m/s\n", r.max_speed_end);
+  EXPECT_LT(r.max_speed_end, 0.02);
+  EXPECT_NEAR(r.volume1, r.volume0, 1e-6 * r.volume0);
+  EXPECT_GT(r.alpha_min, -1e-6);
+  EXPECT_LT(r.alpha_max, 1 + 1e-6);
+  EXPECT_LT(r.divergence, 1e-6);
+}
+
+TEST(VofSolver, B9HeapSteeperThanPhiFails) {
+  const auto r = heap(0.075, 1.2, 1.0);
+  std::printf("steep heap: final surface angle %.1f deg (phi 32 deg, initial 50.2 deg), speed at 1 s %.4f m/s\n", r.angle_deg,
+              r.max_speed_end);
+  EXPECT_LT(r.angle_deg, 45);
+  EXPECT_NEAR(r.volume1, r.volume0, 1e-6 * r.volume0);
+  EXPECT_GT(r.alpha_min, -1e-6);
+  EXPECT_LT(r.alpha_max, 1 + 1e-6);
+  EXPECT_LT(r.divergence, 1e-6);
+}
+
+// The B9 figures: below 1 mm/s after 1 s; within 3 deg of phi after failing.
+TEST(VofAcceptance, B9StaticHeapBelowOneMillimetrePerSecond) {
+  EXPECT_LT(heap(0.02, -0.3, 1.0).max_speed_end, 1e-3);
+}
+
+TEST(VofAcceptance, B9FailedHeapWithinThreeDegreesOfPhi) {
+  EXPECT_NEAR(heap(0.075, 1.2, 2.0).angle_deg, 32.0, 3.0);
+}
