@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
   const std::string scenarios = std::string(RUNOUT_SOURCE_DIR) + "/scenarios";
   const pid_t pid = fork();
   if (pid == 0) {
-    std::freopen("/dev/null", "w", stdout);
+    if (!std::freopen("/dev/null", "w", stdout)) _exit(126);
     execl(RUNOUT_BIN, RUNOUT_BIN, "serve", "--listen", "127.0.0.1:0", "--state-dir", (dir / "state").c_str(), "--tokens",
           (dir / "tokens").c_str(), "--data-root", scenarios.c_str(), "--workers", std::to_string(workers).c_str(), "--log-file",
           (dir / "server.log").c_str(), static_cast<char*>(nullptr));

@@ -1,5 +1,7 @@
 #include "jobs/run.hpp"
 
+#include "jobs/lab_run.hpp"
+
 #include <google/protobuf/util/json_util.h>
 
 #include <chrono>
@@ -59,6 +61,7 @@ std::string jnum(double v) {
 }  // namespace
 
 RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt) {
+  if (s.vof) return run_lab(s, out_dir, opt);
   RunSummary sum;
   const auto t0 = std::chrono::steady_clock::now();
   terrain::DemReport dem_rep;

@@ -82,10 +82,49 @@ ResolvedScenario load_scenario(const std::string& path) {
   return r;
 }
 
+// Engine "vof": the laboratory block, checked and completed with its defaults.
+static ResolvedScenario resolve_lab(v1::Scenario s) {
+  if (!s.has_lab()) bad("lab", "engine \"vof\" needs the lab block (domain, cells, fill, boundaries)");
+  auto* l = s.mutable_lab();
+  if (!(l->x_max() > l->x_min())) bad("lab.x_max", "must exceed lab.x_min");
+  if (!(l->y_max() > l->y_min())) bad("lab.y_max", "must exceed lab.y_min");
+  if (l->nx() < 2 || l->ny() < 2) bad("lab.nx", "lab.nx and lab.ny must be at least 2");
+  if (double(l->nx()) * l->ny() > 4e6) bad("lab.nx", "more than 4 million cells");
+  if (!(l->inclination_deg() > -90 && l->inclination_deg() < 90)) bad("lab.inclination_deg", "must lie in (-90, 90)");
+  if (l->fill().empty()) bad("lab.fill", "at least one rectangle of granular material is needed");
+  for (int k = 0; k < l->fill_size(); ++k)
+    if (!(l->fill(k).x_max() > l->fill(k).x_min() && l->fill(k).y_max() > l->fill(k).y_min()))
+      bad("lab.fill[" + std::to_string(k) + "]", "needs x_max > x_min and y_max > y_min");
+  if (l->material().empty()) l->set_material("pvc");
+  if (l->material() != "pvc" && l->material() != "sand") bad("lab.material", "unknown '" + l->material() + "' (valid: pvc, sand)");
+  for (int k = 0; k < l->boundaries_size(); ++k) {
+    const auto& b = l->boundaries(k);
+    const std::string f = "lab.boundaries[" + std::to_string(k) + "]";
+    if (b.side() != "bottom" && b.side() != "top" && b.side() != "left" && b.side() != "right")
+      bad(f + ".side", "unknown '" + b.side() + "' (valid: bottom, top, left, right)");
+    if (b.kind() != "wall" && b.kind() != "coulomb-slip" && b.kind() != "atmosphere" && b.kind() != "outflow")
+      bad(f + ".kind", "unknown '" + b.kind() + "' (valid: wall, coulomb-slip, atmosphere, outflow)");
+    if (b.has_from() && b.has_to() && !(b.to() > b.from())) bad(f + ".to", "must exceed from");
+  }
+  if (l->end_time_s() == 0) l->set_end_time_s(1.0);
+  if (!(l->end_time_s() > 0)) bad("lab.end_time_s", "must be > 0 s");
+  if (l->write_interval_s() == 0) l->set_write_interval_s(0.05);
+  if (l->write_interval_s() < 0) bad("lab.write_interval_s", "must be >= 0 s");
+  if (l->max_courant() == 0) l->set_max_courant(0.2);
+  if (!(l->max_courant() > 0 && l->max_courant() <= 1)) bad("lab.max_courant", "must lie in (0, 1]");
+  if (l->correctors() == 0) l->set_correctors(3);
+  if (l->correctors() < 1 || l->correctors() > 50) bad("lab.correctors", "must lie in 1..50");
+  ResolvedScenario r;
+  r.vof = true;
+  r.scenario = std::move(s);
+  return r;
+}
+
 ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   ResolvedScenario r;
   if (s.engine().empty()) s.set_engine("depth-averaged");
-  if (s.engine() != "depth-averaged") bad("engine", "unknown '" + s.engine() + "' (valid: depth-averaged)");
+  if (s.engine() != "depth-averaged" && s.engine() != "vof") bad("engine", "unknown '" + s.engine() + "' (valid: depth-averaged, vof)");
+  if (s.engine() == "vof") return resolve_lab(std::move(s));
 
   // DEM, area, grid.
   r.dem.dem_path = path_in(base, s.dem().path(), "dem.path");

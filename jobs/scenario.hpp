@@ -26,6 +26,7 @@ struct ResolvedScenario {
   double outline_threshold = 0.1;
   double timeseries_interval = 0;  ///< [s]; 0: no time series
   std::vector<std::string> input_files;  ///< for hashing
+  bool vof = false;  ///< engine "vof": the `lab` block holds the set-up; DEM and releases unused
 };
 
 /// SHA-256 of a resolved scenario: its message with the input paths left out, and the content of

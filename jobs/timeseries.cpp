@@ -10,14 +10,12 @@
 
 namespace runout::jobs {
 
-namespace {
 // The HDF5 library Debian builds with MPI (the one PETSc uses) is not thread-safe: the service runs
-// several jobs in one process, so every HDF5 call of this file holds this lock.
+// several jobs in one process, so every HDF5 call holds this lock.
 std::mutex& hdf5_mutex() {
   static std::mutex m;
   return m;
 }
-}  // namespace
 
 struct TimeSeriesWriter::Impl {
   std::string dir;

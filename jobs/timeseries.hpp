@@ -2,6 +2,7 @@
 // Time series of a run for ParaView and friends: HDF5 (one group per frame: normal depth and speed,
 // Float32) plus an XDMF file that describes them as a temporal collection on a co-rectilinear grid.
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -9,6 +10,9 @@
 #include "terrain/terrain.hpp"
 
 namespace runout::jobs {
+
+/// The process-wide lock every HDF5 call holds (the MPI build of HDF5 is not thread-safe).
+std::mutex& hdf5_mutex();
 
 class TimeSeriesWriter {
  public:

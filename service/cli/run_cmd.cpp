@@ -113,7 +113,7 @@ int run(const std::vector<std::string>& args) {
   const bool tty = isatty(fileno(stderr));
   jobs::RunOptions opt;
   opt.iseesnow_id = iseesnow;
-  const double t_end = resolved.config.time.t_end;
+  const double t_end = resolved.vof ? resolved.scenario.lab().end_time_s() : resolved.config.time.t_end;
   opt.progress = [&](const engine::Progress& p) {
     if (!quiet) {
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
@@ -154,6 +154,19 @@ int run(const std::vector<std::string>& args) {
     std::cerr << "runout run: cannot move the results to '" << dest.string() << "': " << ec.message() << "\n";
     cleanup();
     return kOutput;
+  }
+  if (!quiet && resolved.vof) {
+    std::printf("mesh        %d x %d cells of %.4g m (plane, channel coordinates)\n", sum.nx, sum.ny, sum.dx);
+    std::printf("run         %ld steps to t = %.3f s, %.2f s wall (solve %.2f, write %.2f)\n", sum.steps, sum.t,
+                sum.seconds_prepare + sum.seconds_run + sum.seconds_write, sum.seconds_run, sum.seconds_write);
+    std::printf("granular    %.6g m3 initial, %.6g m3 final (relative error %.1e)\n", sum.volume_initial, sum.volume_final,
+                sum.volume_error);
+    std::printf("flow        peak speed %.3f m/s, front at x = %.4f m, deposit height %.4f m (run.json has the rest)\n",
+                sum.max_speed, sum.runout_m, sum.max_depth);
+    std::printf("results in  %s:", dest.string().c_str());
+    for (const auto& f : sum.files) std::printf(" %s", f.c_str());
+    std::printf("\n");
+    return kOk;
   }
   if (!quiet) {
     for (const auto& n : sum.notes) std::cerr << "note: " << n << "\n";

@@ -670,3 +670,50 @@ TEST(Scenarios, IseesnowRealTopo) {
                  std::string(RUNOUT_SOURCE_DIR) + "/scenarios/data/iseesnow/realtopo/DEM_RealTopo.tif",
                  sum.volume_initial);
 }
+
+// The VOF engine through the same run driver: B2 (validation.md) on a coarse mesh.
+TEST(Scenarios, LabCollapseRunsThroughTheRunDriver) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json");
+  ASSERT_TRUE(r.vof);
+  auto* lab = r.scenario.mutable_lab();
+  lab->set_nx(50);  // 1 cm cells instead of 2.5 mm
+  lab->set_ny(15);
+  lab->set_end_time_s(0.4);
+  TempDir d;
+  const auto sum = jobs::run_scenario(r, d.p.string());
+  EXPECT_EQ(sum.stop, "end-time");
+  EXPECT_NEAR(sum.t, 0.4, 1e-9);
+  for (const char* f : {"fields.h5", "fields.xmf", "figure.png", "run.json"}) EXPECT_TRUE(fs::exists(d / f)) << f;
+  // The column collapses: speeds of the order of the dissertation's 1.1 m/s, a front beyond the gate.
+  EXPECT_GT(sum.max_speed, 0.5);
+  EXPECT_LT(sum.max_speed, 2.0);
+  EXPECT_GT(sum.runout_m, 0.05);
+  // Material leaves only through the open right end (a thin film); no more than 2 % by t = 0.4 s.
+  EXPECT_LE(sum.volume_final, sum.volume_initial * (1 + 1e-9));
+  EXPECT_GT(sum.volume_final, 0.98 * sum.volume_initial);
+  std::ifstream rec(d / "run.json");
+  std::stringstream ss;
+  ss << rec.rdbuf();
+  EXPECT_NE(ss.str().find("\"upper_surface_angle_deg\""), std::string::npos);
+  GDALDatasetUniquePtr fr(GDALDataset::Open(("HDF5:\"" + d / "fields.h5" + "\"://f00000/alpha").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(fr);
+  EXPECT_EQ(fr->GetRasterXSize(), 50);
+}
+
+TEST(Scenarios, LabScenarioErrorsNameTheField) {
+  auto s = jobs::parse_scenario_json(R"({"engine": "vof"})");
+  try {
+    jobs::resolve_scenario(s, ".");
+    FAIL();
+  } catch (const jobs::ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("lab"), std::string::npos) << e.what();
+  }
+  s = jobs::parse_scenario_json(R"({"engine": "vof", "lab": {"x_max": 1, "y_max": 1, "nx": 10, "ny": 10,
+      "fill": [{"x_max": 0.5, "y_max": 0.5}], "boundaries": [{"side": "front", "kind": "wall"}]}})");
+  try {
+    jobs::resolve_scenario(s, ".");
+    FAIL();
+  } catch (const jobs::ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("lab.boundaries[0].side"), std::string::npos) << e.what();
+  }
+}

@@ -1,0 +1,316 @@
+#include "jobs/lab_run.hpp"
+
+#include <gdal_priv.h>
+#include <google/protobuf/util/json_util.h>
+#include <hdf5.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "engine/vof/solver.hpp"
+#include "jobs/timeseries.hpp"
+
+namespace runout::jobs {
+
+namespace {
+
+namespace vof = engine::vof;
+constexpr double kPi = 3.14159265358979323846;
+
+struct Material {
+  double rho, phi_deg, delta_deg;
+};
+Material material(const std::string& name) {  // validation.md part B
+  if (name == "sand") return {1626.67, 37, 18};
+  return {936.17, 32, 20};
+}
+
+std::string num(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream o;
+  o.precision(10);
+  o << v;
+  return o.str();
+}
+
+// Fields of the block mesh (row-major, j = 0 at the bottom) in one HDF5 file, frame by frame.
+class FieldWriter {
+ public:
+  FieldWriter(const std::string& dir, int nx, int ny) : dir_(dir), nx_(nx), ny_(ny) {
+    std::lock_guard lk(hdf5_mutex());
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+    file_ = H5Fcreate((dir + "/fields.h5").c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    if (file_ < 0) throw std::runtime_error("cannot create " + dir + "/fields.h5");
+  }
+  ~FieldWriter() {
+    std::lock_guard lk(hdf5_mutex());
+    if (file_ >= 0) H5Fclose(file_);
+  }
+  void write(double t, const vof::VofSolver& s) {
+    const auto n = std::size_t(nx_) * std::size_t(ny_);
+    std::vector<float> a(n), ux(n), uy(n), p(n), nu(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      a[k] = float(s.alpha()[k]);
+      ux[k] = float(s.velocity()[k].x);
+      uy[k] = float(s.velocity()[k].y);
+      p[k] = float(s.pressure()[k]);
+      nu[k] = float(s.viscosity()[k]);
+    }
+    std::lock_guard lk(hdf5_mutex());
+    char name[32];
+    std::snprintf(name, sizeof name, "/f%05zu", times_.size());
+    hid_t g = H5Gcreate2(file_, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (g < 0) throw std::runtime_error("fields.h5: cannot create a frame");
+    const hsize_t dims[2] = {hsize_t(ny_), hsize_t(nx_)};
+    for (auto [nm, v] : {std::pair<const char*, std::vector<float>*>{"alpha", &a}, {"ux", &ux}, {"uy", &uy}, {"p", &p}, {"nu", &nu}}) {
+      hid_t sp = H5Screate_simple(2, dims, nullptr);
+      hid_t ds = H5Dcreate2(g, nm, H5T_IEEE_F32LE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+      const herr_t st = H5Dwrite(ds, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, v->data());
+      H5Dclose(ds);
+      H5Sclose(sp);
+      if (st < 0) {
+        H5Gclose(g);
+        throw std::runtime_error("fields.h5: writing failed");
+      }
+    }
+    H5Gclose(g);
+    times_.push_back(t);
+  }
+  // fields.xmf: a temporal collection on the cell centres (ORIGIN_DXDY).
+  int finish(double x0, double y0, double dx, double dy) {
+    {
+      std::lock_guard lk(hdf5_mutex());
+      if (file_ >= 0) H5Fclose(file_);
+      file_ = -1;
+    }
+    std::ofstream x(dir_ + "/fields.xmf");
+    x << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n  <Grid Name=\"lab\" GridType=\"Collection\" "
+         "CollectionType=\"Temporal\">\n";
+    for (std::size_t f = 0; f < times_.size(); ++f) {
+      char grp[32];
+      std::snprintf(grp, sizeof grp, "f%05zu", f);
+      x << "   <Grid Name=\"" << grp << "\" GridType=\"Uniform\">\n    <Time Value=\"" << times_[f] << "\"/>\n";
+      x << "    <Topology TopologyType=\"2DCoRectMesh\" Dimensions=\"" << ny_ << " " << nx_ << "\"/>\n";
+      x << "    <Geometry GeometryType=\"ORIGIN_DXDY\">\n     <DataItem Dimensions=\"2\" Format=\"XML\">" << y0 + 0.5 * dy << " "
+        << x0 + 0.5 * dx << "</DataItem>\n     <DataItem Dimensions=\"2\" Format=\"XML\">" << dy << " " << dx
+        << "</DataItem>\n    </Geometry>\n";
+      for (const char* a : {"alpha", "ux", "uy", "p", "nu"})
+        x << "    <Attribute Name=\"" << a << "\" AttributeType=\"Scalar\" Center=\"Node\">\n     <DataItem Dimensions=\"" << ny_ << " "
+          << nx_ << "\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">fields.h5:/" << grp << "/" << a
+          << "</DataItem>\n    </Attribute>\n";
+      x << "   </Grid>\n";
+    }
+    x << "  </Grid>\n </Domain>\n</Xdmf>\n";
+    if (!x) throw std::runtime_error("cannot write fields.xmf");
+    return int(times_.size());
+  }
+
+ private:
+  std::string dir_;
+  int nx_, ny_;
+  hid_t file_ = -1;
+  std::vector<double> times_;
+};
+
+// figure.png: material (alpha > 0.5) coloured by speed (blue slow ... red fast), air white.
+void write_figure(const std::string& path, const vof::VofSolver& s, int nx, int ny, double vmax) {
+  const int sc = std::max(1, 600 / std::max(nx, 1));
+  const int W = nx * sc, H = ny * sc;
+  std::vector<unsigned char> rgb[3];
+  for (auto& c : rgb) c.assign(std::size_t(W) * H, 255);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const std::size_t k = std::size_t(j) * nx + i;
+      const double a = std::clamp(s.alpha()[k], 0.0, 1.0);
+      const double v = std::min(1.0, vof::norm(s.velocity()[k]) / std::max(vmax, 1e-9));
+      const double r = v, g = 1 - std::abs(2 * v - 1), b = 1 - v;  // blue -> green -> red
+      const unsigned char col[3] = {static_cast<unsigned char>(255 * (1 - a + a * r)), static_cast<unsigned char>(255 * (1 - a + a * g)),
+                                    static_cast<unsigned char>(255 * (1 - a + a * b))};
+      for (int q = 0; q < sc; ++q)
+        for (int p = 0; p < sc; ++p) {
+          const std::size_t px = std::size_t(H - 1 - (j * sc + q)) * W + i * sc + p;  // y up
+          for (int c = 0; c < 3; ++c) rgb[c][px] = col[c];
+        }
+    }
+  GDALAllRegister();
+  auto* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  GDALDatasetUniquePtr img(mem->Create("", W, H, 3, GDT_Byte, nullptr));
+  for (int c = 0; c < 3; ++c)
+    if (img->GetRasterBand(c + 1)->RasterIO(GF_Write, 0, 0, W, H, rgb[c].data(), W, H, GDT_Byte, 0, 0) != CE_None)
+      throw std::runtime_error("drawing figure.png failed");
+  GDALDatasetUniquePtr out(GetGDALDriverManager()->GetDriverByName("PNG")->CreateCopy(path.c_str(), img.get(), FALSE, nullptr, nullptr, nullptr));
+  if (!out) throw std::runtime_error("cannot write " + path);
+}
+
+}  // namespace
+
+RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt) {
+  using clk = std::chrono::steady_clock;
+  const auto t0 = clk::now();
+  const auto& L = r.scenario.lab();
+  const Material mat = material(L.material());
+  vof::BlockSpec b;
+  b.x0 = L.x_min();
+  b.x1 = L.x_max();
+  b.y0 = L.y_min();
+  b.y1 = L.y_max();
+  b.nx = L.nx();
+  b.ny = L.ny();
+  const double dx = (b.x1 - b.x0) / b.nx, dy = (b.y1 - b.y0) / b.ny;
+  b.thickness = dx;
+  vof::Mesh m = vof::block_mesh(b);
+  vof::VofConfig c;
+  c.rho1 = mat.rho;
+  c.phi_deg = mat.phi_deg;
+  c.max_co = c.max_alpha_co = L.max_courant();
+  c.n_correctors = L.correctors();
+  const double zeta = L.inclination_deg() * kPi / 180;
+  c.gravity = [zeta](double) { return vof::Vec{9.81 * std::sin(zeta), -9.81 * std::cos(zeta), 0}; };
+  // Conditions: listed parts of sides become their own patches; the rest stays wall.
+  for (const char* side : {"bottom", "top", "left", "right"}) c.bc[side].kind = vof::Bc::wall;
+  for (int k = 0; k < L.boundaries_size(); ++k) {
+    const auto& lb = L.boundaries(k);
+    const std::string name = lb.side() + "-" + std::to_string(k);
+    const bool along_x = lb.side() == "bottom" || lb.side() == "top";
+    const double from = lb.has_from() ? lb.from() : -1e300, to = lb.has_to() ? lb.to() : 1e300;
+    if (m.patch_index(lb.side()) < 0) throw ScenarioError("lab.boundaries[" + std::to_string(k) + "]: side " + lb.side() + " is already taken");
+    vof::split_patch(m, lb.side(), name, [&](const vof::Vec& cf) {
+      const double u = along_x ? cf.x : cf.y;
+      return u >= from && u <= to;
+    });
+    if (m.patch_index(name) < 0) throw ScenarioError("lab.boundaries[" + std::to_string(k) + "]: no face of side " + lb.side() + " lies in [from, to]");
+    vof::PatchBc pb;
+    pb.kind = lb.kind() == "atmosphere" ? vof::Bc::atmosphere
+              : lb.kind() == "outflow"  ? vof::Bc::outflow
+              : lb.kind() == "coulomb-slip" ? vof::Bc::coulomb_slip
+                                        : vof::Bc::wall;
+    pb.tan_delta = std::tan(mat.delta_deg * kPi / 180);
+    c.bc[name] = pb;
+  }
+  for (auto it = c.bc.begin(); it != c.bc.end();)  // sides wholly taken by listed parts
+    it = m.patch_index(it->first) < 0 ? c.bc.erase(it) : std::next(it);
+  vof::VofSolver s(m, c);
+  std::vector<double> alpha(std::size_t(m.cells()), 0.0);
+  for (int k = 0; k < m.cells(); ++k)
+    for (const auto& f : L.fill()) {
+      const auto& p = m.centre[std::size_t(k)];
+      if (p.x >= f.x_min() && p.x <= f.x_max() && p.y >= f.y_min() && p.y <= f.y_max()) alpha[std::size_t(k)] = 1;
+    }
+  s.initialise(alpha);
+  double v0 = 0;
+  for (int k = 0; k < m.cells(); ++k) v0 += alpha[std::size_t(k)] * m.volume[std::size_t(k)];
+  if (v0 <= 0) throw ScenarioError("lab.fill: no cell centre lies in the fill rectangles");
+
+  RunSummary sum;
+  sum.nx = b.nx;
+  sum.ny = b.ny;
+  sum.dx = dx;
+  sum.crs = "channel coordinates";
+  sum.release_volume_m3 = v0;
+  sum.volume_initial = v0;
+  sum.seconds_prepare = std::chrono::duration<double>(clk::now() - t0).count();
+  FieldWriter fields(out_dir, b.nx, b.ny);
+  fields.write(0, s);
+  double next_write = L.write_interval_s() > 0 ? L.write_interval_s() : 1e300;
+  double peak = 0, t_peak = 0, t_rest = -1, pressure_s = 0, alpha_min = 1, alpha_max = 0, div = 0, last_speed = 0;
+  long steps = 0, p_its = 0;
+  bool cancelled = false;
+  const auto t1 = clk::now();
+  s.run(L.end_time_s(), [&](const vof::StepStats& st) {
+    ++steps;
+    p_its += st.pressure_iterations;
+    pressure_s += st.seconds_pressure;
+    alpha_min = std::min(alpha_min, st.alpha_min);
+    alpha_max = std::max(alpha_max, st.alpha_max);
+    div = std::max(div, st.divergence);
+    last_speed = st.max_speed;
+    if (st.max_speed > peak) {
+      peak = st.max_speed;
+      t_peak = st.t;
+    }
+    if (st.max_speed >= 0.01) t_rest = -1;
+    else if (t_rest < 0 && peak >= 0.01) t_rest = st.t;
+    if (st.t >= next_write - 1e-12) {
+      fields.write(st.t, s);
+      next_write += L.write_interval_s();
+    }
+    if (opt.progress && steps % std::max(1L, opt.progress_every) == 0) {
+      engine::Progress p;
+      p.t = st.t;
+      p.dt = st.dt;
+      p.mass = st.granular_volume;
+      p.max_speed = st.max_speed;
+      p.active_fraction = 1.0;
+      p.step = steps;
+      if (!opt.progress(p)) {
+        cancelled = true;
+        return false;
+      }
+    }
+    return true;
+  });
+  sum.seconds_run = std::chrono::duration<double>(clk::now() - t1).count();
+  sum.steps = steps;
+  sum.t = s.time();
+  sum.stop = cancelled ? "cancelled" : "end-time";
+  if (cancelled) return sum;
+  const auto t2 = clk::now();
+  // Deposit figures from the column heights.
+  std::vector<double> h(std::size_t(b.nx), 0.0);
+  double v1 = 0;
+  for (int k = 0; k < m.cells(); ++k) {
+    const auto& p = m.centre[std::size_t(k)];
+    h[std::size_t(std::clamp(int((p.x - b.x0) / dx), 0, b.nx - 1))] += s.alpha()[std::size_t(k)] * dy;
+    v1 += s.alpha()[std::size_t(k)] * m.volume[std::size_t(k)];
+  }
+  double front = b.x0, hmax = 0;
+  for (int i = 0; i < b.nx; ++i) {
+    if (h[std::size_t(i)] >= 0.5 * dy) front = b.x0 + (i + 1) * dx;  // at least half a cell of material
+    hmax = std::max(hmax, h[std::size_t(i)]);
+  }
+  // Upper surface angle: the mean slope between 80 % and 20 % of the highest column, right of it.
+  int imax = int(std::max_element(h.begin(), h.end()) - h.begin());
+  double xh = NAN, xl = NAN;
+  for (int i = imax; i < b.nx; ++i) {
+    if (std::isnan(xh) && h[std::size_t(i)] < 0.8 * hmax) xh = b.x0 + (i + 0.5) * dx;
+    if (std::isnan(xl) && h[std::size_t(i)] < 0.2 * hmax) xl = b.x0 + (i + 0.5) * dx;
+  }
+  const double angle = (std::isnan(xh) || std::isnan(xl) || xl <= xh) ? NAN : std::atan(0.6 * hmax / (xl - xh)) * 180 / kPi;
+  sum.volume_final = v1;
+  sum.volume_error = std::abs(v1 - v0) / v0;
+  sum.max_speed = peak;
+  sum.runout_m = front;
+  sum.max_depth = hmax;
+  const int frames = fields.finish(b.x0, b.y0, dx, dy);
+  write_figure(out_dir + "/figure.png", s, b.nx, b.ny, std::max(peak, 0.01));
+  sum.files = {"fields.h5", "fields.xmf", "figure.png", "run.json"};
+  sum.seconds_write = std::chrono::duration<double>(clk::now() - t2).count();
+
+  std::string scen;
+  google::protobuf::util::JsonPrintOptions po;
+  po.preserve_proto_field_names = true;
+  (void)google::protobuf::util::MessageToJsonString(r.scenario, &scen, po);
+  std::ofstream j(out_dir + "/run.json");
+  j << "{\n  \"software\": {\"name\": \"runout\", \"version\": \"" << RUNOUT_VERSION << "\"},\n";
+  j << "  \"engine\": \"vof\",\n  \"scenario\": " << scen << ",\n";
+  j << "  \"mesh\": {\"cells\": " << m.cells() << ", \"nx\": " << b.nx << ", \"ny\": " << b.ny << ", \"dx_m\": " << num(dx)
+    << ", \"dy_m\": " << num(dy) << "},\n";
+  j << "  \"solver\": {\"steps\": " << steps << ", \"simulated_s\": " << num(s.time()) << ", \"pressure_iterations\": " << p_its
+    << ", \"alpha_min\": " << num(alpha_min) << ", \"alpha_max\": " << num(alpha_max) << ", \"max_divergence_1_s\": " << num(div)
+    << ", \"stop\": \"" << sum.stop << "\"},\n";
+  j << "  \"results\": {\"peak_speed_m_s\": " << num(peak) << ", \"peak_speed_time_s\": " << num(t_peak)
+    << ", \"rest_time_s\": " << num(t_rest >= 0 ? t_rest : NAN) << ", \"final_speed_m_s\": " << num(last_speed)
+    << ", \"front_x_m\": " << num(front) << ", \"deposit_height_m\": " << num(hmax) << ", \"upper_surface_angle_deg\": " << num(angle)
+    << ", \"volume_initial_m3\": " << num(v0) << ", \"volume_final_m3\": " << num(v1) << ", \"volume_relative_error\": " << num(sum.volume_error)
+    << ", \"frames\": " << frames << "},\n";
+  j << "  \"timings_s\": {\"prepare\": " << num(sum.seconds_prepare) << ", \"run\": " << num(sum.seconds_run)
+    << ", \"pressure\": " << num(pressure_s) << ", \"write\": " << num(sum.seconds_write) << ", \"microseconds_per_cell_step\": "
+    << num(steps ? 1e6 * sum.seconds_run / steps / m.cells() : NAN) << "}\n}\n";
+  if (!j) throw std::runtime_error("cannot write run.json");
+  return sum;
+}
+
+}  // namespace runout::jobs
