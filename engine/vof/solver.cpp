@@ -579,27 +579,23 @@ struct VofSolver::Impl {
     petsc_check(VecAssemblyEnd(b), "VecAssembly");
     petsc_check(VecAssemblyBegin(x), "VecAssembly");
     petsc_check(VecAssemblyEnd(x), "VecAssembly");
-    if (!has_dirichlet) {
-      MatNullSpace ns;
-      petsc_check(MatNullSpaceCreate(PETSC_COMM_SELF, PETSC_TRUE, 0, nullptr, &ns), "MatNullSpaceCreate");
-      petsc_check(MatSetNullSpace(A, ns), "MatSetNullSpace");
-      MatNullSpaceDestroy(&ns);
-    }
-    petsc_check(KSPSetOperators(ksp, A, A), "KSPSetOperators");
-    // Solve for the correction to the last pressure: the tolerance then applies to the change (the
-    // divergence to remove), not to the hydrostatic pressure, whose rounding would otherwise reappear
-    // as fluxes in the light phase (its 1/A is a thousand times the granular phase's).
     PetscInt its = 0;
     for (int pass = 0; pass < (initial ? 3 : 1); ++pass) {
       petsc_check(MatMult(A, x, r), "MatMult");
       petsc_check(VecAYPX(r, -1.0, b), "VecAYPX");  // r = b - A x
-      if (!has_dirichlet) {
-        MatNullSpace ns;
-        MatGetNullSpace(A, &ns);
-        if (ns) MatNullSpaceRemove(ns, r);
-      }
       petsc_check(VecSet(dx, 0.0), "VecSet");
+      Mat Ap = A;
+      if (!has_dirichlet) {
+        // A closed domain: the correction is fixed to zero in cell 0 (its row and column replaced
+        // by the diagonal), which leaves a nonsingular system with the same solution up to the
+        // constant that the pressure level below takes care of.
+        petsc_check(MatDuplicate(A, MAT_COPY_VALUES, &Ap), "MatDuplicate");
+        const PetscInt row0 = 0;
+        petsc_check(MatZeroRowsColumns(Ap, 1, &row0, diag[0], dx, r), "MatZeroRowsColumns");
+      }
+      petsc_check(KSPSetOperators(ksp, Ap, Ap), "KSPSetOperators");
       petsc_check(KSPSolve(ksp, r, dx), "KSPSolve");
+      if (Ap != A) MatDestroy(&Ap);
       KSPConvergedReason reason;
       KSPGetConvergedReason(ksp, &reason);
       PetscInt k = 0;
@@ -640,6 +636,20 @@ struct VofSolver::Impl {
         s.U_[std::size_t(c)] = HbyA[std::size_t(c)] + rAU[std::size_t(c)] * R;
       }
     for (int c = 0; c < nc; ++c) s.p_[std::size_t(c)] = s.p_rgh_[std::size_t(c)] + rho[std::size_t(c)] * gh[std::size_t(c)];
+    if (!has_dirichlet) {
+      // A closed domain fixes the pressure only up to a constant, but the Coulomb viscosity needs the
+      // pressure itself: it is zero in the highest cell (along gravity), the top of the air.
+      int top = 0;
+      for (int c = 1; c < nc; ++c)
+        if (gh[std::size_t(c)] < gh[std::size_t(top)]) top = c;
+      const double pmin = s.p_[std::size_t(top)];
+      for (int c = 0; c < nc; ++c) {
+        s.p_[std::size_t(c)] -= pmin;
+        s.p_rgh_[std::size_t(c)] -= pmin;
+      }
+      const PetscScalar shift = -pmin;
+      VecShift(x, shift);
+    }
     return int(its);
   }
 
