@@ -25,6 +25,7 @@ struct Material {
 };
 Material material(const std::string& name) {  // validation.md part B
   if (name == "sand") return {1626.67, 37, 18};
+  if (name == "fine-sand") return {1855, 54.5, 54.5};  // rotating box: side walls raise the effective phi
   return {936.17, 32, 20};
 }
 
@@ -168,7 +169,12 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   c.max_co = c.max_alpha_co = L.max_courant();
   c.n_correctors = L.correctors();
   const double zeta = L.inclination_deg() * kPi / 180;
-  c.gravity = [zeta](double) { return vof::Vec{9.81 * std::sin(zeta), -9.81 * std::cos(zeta), 0}; };
+  const double omega = L.rotation_period_s() > 0 ? 2 * kPi / L.rotation_period_s() : 0.0;
+  c.gravity = [zeta, omega](double t) {
+    // In the frame of a channel turning at omega (counter-clockwise), gravity turns clockwise.
+    const double a = zeta + omega * t;
+    return vof::Vec{9.81 * std::sin(a), -9.81 * std::cos(a), 0};
+  };
   // Conditions: listed parts of sides become their own patches; the rest stays wall.
   for (const char* side : {"bottom", "top", "left", "right"}) c.bc[side].kind = vof::Bc::wall;
   for (int k = 0; k < L.boundaries_size(); ++k) {

@@ -96,7 +96,9 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
     if (!(l->fill(k).x_max() > l->fill(k).x_min() && l->fill(k).y_max() > l->fill(k).y_min()))
       bad("lab.fill[" + std::to_string(k) + "]", "needs x_max > x_min and y_max > y_min");
   if (l->material().empty()) l->set_material("pvc");
-  if (l->material() != "pvc" && l->material() != "sand") bad("lab.material", "unknown '" + l->material() + "' (valid: pvc, sand)");
+  if (l->material() != "pvc" && l->material() != "sand" && l->material() != "fine-sand")
+    bad("lab.material", "unknown '" + l->material() + "' (valid: pvc, sand, fine-sand)");
+  if (l->rotation_period_s() < 0) bad("lab.rotation_period_s", "must be >= 0 s (0: no rotation)");
   for (int k = 0; k < l->boundaries_size(); ++k) {
     const auto& b = l->boundaries(k);
     const std::string f = "lab.boundaries[" + std::to_string(k) + "]";
