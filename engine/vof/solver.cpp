@@ -57,6 +57,7 @@ struct VofSolver::Impl {
   std::vector<Vec> H, HbyA, bsrc;
   std::vector<double> cO, cN;
   Mat Mu = nullptr;
+  Mat Apin = nullptr;  // closed domains: the pressure matrix with cell 0 pinned
   KSP kspU = nullptr;
   std::vector<std::array<double, 3>> recon_inv;  // inverse of sum Sf Sf / |Sf| (plane: 2x2 packed)
 
@@ -65,6 +66,7 @@ struct VofSolver::Impl {
     if (ksp) KSPDestroy(&ksp);
     if (kspU) KSPDestroy(&kspU);
     if (Mu) MatDestroy(&Mu);
+    if (Apin) MatDestroy(&Apin);
     if (A) MatDestroy(&A);
     if (x) VecDestroy(&x);
     if (b) VecDestroy(&b);
@@ -522,7 +524,7 @@ struct VofSolver::Impl {
 
   // One pressure correction: solve laplacian(rAUf, p_rgh) = div(phiHbyA) and correct fluxes and
   // velocities. Returns the iterations.
-  int pressure_correct(bool initial) {
+  int pressure_correct(bool initial, bool reuse = false) {
     std::vector<double> phiHbyA(static_cast<std::size_t>(nf)), phig(static_cast<std::size_t>(nf)), coef(std::size_t(nf), 0.0);
     for (int f = 0; f < nf; ++f) {
       const int o = m.owner[std::size_t(f)];
@@ -543,8 +545,9 @@ struct VofSolver::Impl {
       }
       phiHbyA[std::size_t(f)] += phig[std::size_t(f)];
     }
-    // Assemble M p = rhs.
-    petsc_check(MatZeroEntries(A), "MatZeroEntries");
+    // Assemble M p = rhs. Within a step the matrix does not change (1/A is built once per step):
+    // later correctors keep it and its preconditioner and assemble only the right-hand side.
+    if (!reuse) petsc_check(MatZeroEntries(A), "MatZeroEntries");
     std::vector<double> diag(std::size_t(nc), 0.0), rhs(std::size_t(nc), 0.0);
     for (int f = 0; f < nf; ++f) {
       const int o = m.owner[std::size_t(f)];
@@ -555,10 +558,12 @@ struct VofSolver::Impl {
         rhs[std::size_t(nb)] += phiHbyA[std::size_t(f)];
         diag[std::size_t(o)] += c;
         diag[std::size_t(nb)] += c;
-        const PetscInt r0 = o, c0 = nb;
-        const PetscScalar v = -c;
-        petsc_check(MatSetValues(A, 1, &r0, 1, &c0, &v, INSERT_VALUES), "MatSetValues");
-        petsc_check(MatSetValues(A, 1, &c0, 1, &r0, &v, INSERT_VALUES), "MatSetValues");
+        if (!reuse) {
+          const PetscInt r0 = o, c0 = nb;
+          const PetscScalar v = -c;
+          petsc_check(MatSetValues(A, 1, &r0, 1, &c0, &v, INSERT_VALUES), "MatSetValues");
+          petsc_check(MatSetValues(A, 1, &c0, 1, &r0, &v, INSERT_VALUES), "MatSetValues");
+        }
       } else if (kind_of(f) == Bc::atmosphere) {
         // p = 0 outside: p_rgh_b = -rho_b gh_b.
         const double pb = -rho[std::size_t(o)] * ghf[std::size_t(f)];
@@ -569,12 +574,14 @@ struct VofSolver::Impl {
     for (int c = 0; c < nc; ++c) {
       const PetscInt r = c;
       const PetscScalar v = diag[std::size_t(c)];
-      petsc_check(MatSetValues(A, 1, &r, 1, &r, &v, INSERT_VALUES), "MatSetValues");
+      if (!reuse) petsc_check(MatSetValues(A, 1, &r, 1, &r, &v, INSERT_VALUES), "MatSetValues");
       petsc_check(VecSetValue(b, c, rhs[std::size_t(c)], INSERT_VALUES), "VecSetValue");
       petsc_check(VecSetValue(x, c, s.p_rgh_[std::size_t(c)], INSERT_VALUES), "VecSetValue");
     }
-    petsc_check(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY), "MatAssembly");
-    petsc_check(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY), "MatAssembly");
+    if (!reuse) {
+      petsc_check(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY), "MatAssembly");
+      petsc_check(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY), "MatAssembly");
+    }
     petsc_check(VecAssemblyBegin(b), "VecAssembly");
     petsc_check(VecAssemblyEnd(b), "VecAssembly");
     petsc_check(VecAssemblyBegin(x), "VecAssembly");
@@ -584,18 +591,27 @@ struct VofSolver::Impl {
       petsc_check(MatMult(A, x, r), "MatMult");
       petsc_check(VecAYPX(r, -1.0, b), "VecAYPX");  // r = b - A x
       petsc_check(VecSet(dx, 0.0), "VecSet");
+      const bool same = reuse || pass > 0;  // passes of the initial solve share the matrix too
       Mat Ap = A;
       if (!has_dirichlet) {
         // A closed domain: the correction is fixed to zero in cell 0 (its row and column replaced
         // by the diagonal), which leaves a nonsingular system with the same solution up to the
         // constant that the pressure level below takes care of.
-        petsc_check(MatDuplicate(A, MAT_COPY_VALUES, &Ap), "MatDuplicate");
-        const PetscInt row0 = 0;
-        petsc_check(MatZeroRowsColumns(Ap, 1, &row0, diag[0], dx, r), "MatZeroRowsColumns");
+        if (!same) {
+          if (Apin) MatDestroy(&Apin);
+          petsc_check(MatDuplicate(A, MAT_COPY_VALUES, &Apin), "MatDuplicate");
+          const PetscInt row0 = 0;
+          petsc_check(MatZeroRowsColumns(Apin, 1, &row0, diag[0], dx, r), "MatZeroRowsColumns");
+        } else {
+          petsc_check(VecSetValue(r, 0, 0.0, INSERT_VALUES), "VecSetValue");  // dx_0 = 0
+          VecAssemblyBegin(r);
+          VecAssemblyEnd(r);
+        }
+        Ap = Apin;
       }
+      petsc_check(KSPSetReusePreconditioner(ksp, same ? PETSC_TRUE : PETSC_FALSE), "KSPSetReusePreconditioner");
       petsc_check(KSPSetOperators(ksp, Ap, Ap), "KSPSetOperators");
       petsc_check(KSPSolve(ksp, r, dx), "KSPSolve");
-      if (Ap != A) MatDestroy(&Ap);
       KSPConvergedReason reason;
       KSPGetConvergedReason(ksp, &reason);
       PetscInt k = 0;
@@ -733,7 +749,7 @@ StepStats VofSolver::step() {
   for (int k = 0; k < std::max(1, cfg_.n_correctors); ++k) {
     I.compute_H();
     const auto tp = clk::now();
-    st.pressure_iterations += I.pressure_correct(false);
+    st.pressure_iterations += I.pressure_correct(false, k > 0);
     t_p += std::chrono::duration<double>(clk::now() - tp).count();
   }
   I.update_viscosity();
