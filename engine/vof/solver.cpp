@@ -286,6 +286,9 @@ struct VofSolver::Impl {
     std::fill(alpha_phi.begin(), alpha_phi.end(), 0.0);
     std::vector<double> FL(static_cast<std::size_t>(nf)), AF(static_cast<std::size_t>(nf)), amax(static_cast<std::size_t>(nc)), amin(static_cast<std::size_t>(nc)),
         Pp(static_cast<std::size_t>(nc)), Pm(static_cast<std::size_t>(nc)), Rp(static_cast<std::size_t>(nc)), Rm(static_cast<std::size_t>(nc)), aL(static_cast<std::size_t>(nc));
+    double vsum = 0;
+    for (double v : m.volume) vsum += v;
+    const double delta_n = 1e-8 / std::cbrt(vsum / nc);
     for (int sub = 0; sub < n; ++sub) {
       // Interface normal per cell (Gauss gradient of alpha).
       std::vector<Vec> ga(static_cast<std::size_t>(nc));
@@ -310,8 +313,8 @@ struct VofSolver::Impl {
           const double w = m.weight[std::size_t(f)];
           const double ac = w * ao + (1 - w) * an;
           Vec gf = w * ga[std::size_t(o)] + (1 - w) * ga[std::size_t(nb)];
-          const double dn = 1e-8 * std::cbrt(m.volume[std::size_t(o)]);
-          const double nS = dot(gf, m.Sf[std::size_t(f)]) / (norm(gf) + 1e-8 / std::max(dn, 1e-30));
+          // Unit interface normal; deltaN = 1e-8 / (mean cell size) only keeps the division finite.
+          const double nS = dot(gf, m.Sf[std::size_t(f)]) / (norm(gf) + delta_n);
           const double phir = s.cfg_.c_alpha * std::abs(ph) / m.magSf[std::size_t(f)] * nS;
           const double a_up = phir >= 0 ? ao : an, b_up = phir >= 0 ? 1 - an : 1 - ao;
           const double FH = ph * ac + phir * a_up * b_up;
