@@ -390,25 +390,26 @@ struct VofSolver::Impl {
       A_D[std::size_t(c)] = rho[std::size_t(c)] * V / dt;
       bsrc[std::size_t(c)] = (rho_old[std::size_t(c)] * V / dt) * U_old[std::size_t(c)];
     }
-    // Transpose part of the viscous stress, explicit: V (grad U) . grad mu.
+    // Transpose part of the viscous stress, explicit and in divergence form as interFoam has it:
+    // sum over faces of mu_f (grad U)^T_f . Sf. (The equivalent cell form (grad U) . grad mu, with
+    // mu jumping nine orders of magnitude across the interface, moved a heap that should rest.)
     {
       const auto& G = grad_cache;
-      std::vector<Vec> gm(static_cast<std::size_t>(nc));
       for (int f = 0; f < nf; ++f) {
         const int o = m.owner[std::size_t(f)];
-        const double muf = f < m.n_internal
-                               ? m.weight[std::size_t(f)] * mu[std::size_t(o)] + (1 - m.weight[std::size_t(f)]) * mu[std::size_t(m.neighbour[std::size_t(f)])]
-                               : mu[std::size_t(o)];
-        gm[std::size_t(o)] = gm[std::size_t(o)] + muf * m.Sf[std::size_t(f)];
-        if (f < m.n_internal) gm[std::size_t(m.neighbour[std::size_t(f)])] = gm[std::size_t(m.neighbour[std::size_t(f)])] - muf * m.Sf[std::size_t(f)];
-      }
-      for (int c = 0; c < nc; ++c) {
-        const Vec g = (1.0 / m.volume[std::size_t(c)]) * gm[std::size_t(c)];
+        const bool in = f < m.n_internal;
+        const int nb = in ? m.neighbour[std::size_t(f)] : o;
+        const double w = in ? m.weight[std::size_t(f)] : 1.0;
+        const double muf = w * mu[std::size_t(o)] + (1 - w) * mu[std::size_t(nb)];
+        const Vec& S = m.Sf[std::size_t(f)];
+        Vec t;
         for (int i = 0; i < 3; ++i) {
           double v = 0;
-          for (int j = 0; j < 3; ++j) v += G[std::size_t(c)].g[i][j] * comp(g, j);
-          add_comp(bsrc[std::size_t(c)], i, m.volume[std::size_t(c)] * v);
+          for (int j = 0; j < 3; ++j) v += (w * G[std::size_t(o)].g[i][j] + (1 - w) * G[std::size_t(nb)].g[i][j]) * comp(S, j);
+          add_comp(t, i, muf * v);
         }
+        bsrc[std::size_t(o)] = bsrc[std::size_t(o)] + t;
+        if (in) bsrc[std::size_t(nb)] = bsrc[std::size_t(nb)] - t;
       }
     }
     for (int f = 0; f < nf; ++f) {

@@ -115,8 +115,7 @@ TEST(VofSolver, ConfigurationErrorsNameWhatIsWrong) {
 }
 
 // B9 on a coarse plane mesh (5 mm cells): the invariants must hold exactly; the motion is checked
-// loosely here (the acceptance figures are the VofAcceptance tests, label vof_acceptance,
-// not met yet: see docs/vof.md).
+// loosely here and against the acceptance figures below (VofAcceptance).
 TEST(VofSolver, B9HeapFlatterThanPhiKeepsItsShape) {
   const auto r = heap(0.02, -0.3, 1.0);  // surface rising to the right at 0.3, from 2 cm to 8 cm
   std::printf("flat heap: max speed at 1 s %.2e m/s\n", r.max_speed_end);
