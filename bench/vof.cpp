@@ -2,7 +2,11 @@
 // dissertation timed: OpenFOAM's interFoam with the Coulomb viscosity took 80 s wall for 1677 steps
 // on 12,000 cells (2.5 mm, about 4 microseconds per cell and step, 53 % in the pressure solve).
 //   runout_bench_vof [--full] [--end T]   (default: 5 mm cells; --full: 2.5 mm, the dissertation's)
+//   runout_bench_vof --b10                 B10: column collapse for aspect ratios 0.5-6 (5 mm cells),
+//                                          normalised runout and the exponents of its growth
+#include <cmath>
 #include <cstdio>
+#include <vector>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -20,7 +24,49 @@ static double field(const std::string& json, const std::string& key) {
   return k == std::string::npos ? NAN : std::atof(json.c_str() + k + key.size() + 4);
 }
 
+// B10 (validation.md): a column L = 5 cm wide, H = a L high, against the left wall, released at t = 0.
+static int b10() {
+  std::printf("| a = H/L | cells | (l - L)/L | steps | wall [s] |\n|---:|---:|---:|---:|---:|\n");
+  std::vector<double> as = {0.5, 1, 2, 4, 6}, rs;
+  for (double a : as) {
+    const double L = 0.05, H = a * L, dx = 0.005;
+    const double xmax = L * (2.5 + 2.0 * std::pow(a, 0.9) + 1.5 * a), ymax = H + 0.02;
+    auto s = runout::jobs::parse_scenario_json(R"({"engine": "vof", "lab": {"boundaries": [{"side": "top", "kind": "atmosphere"}, {"side": "right", "kind": "atmosphere"}]}})");
+    auto* lab = s.mutable_lab();
+    lab->set_x_max(xmax);
+    lab->set_y_max(ymax);
+    lab->set_nx(int(std::ceil(xmax / dx)));
+    lab->set_ny(int(std::ceil(ymax / dx)));
+    auto* f = lab->add_fill();
+    f->set_x_max(L);
+    f->set_y_max(H);
+    lab->set_end_time_s(0.6 + 0.25 * std::sqrt(a));
+    lab->set_write_interval_s(0);
+    auto r = runout::jobs::resolve_scenario(s, ".");
+    const fs::path out = fs::temp_directory_path() / ("runout-bench-b10-" + std::to_string(getpid()));
+    fs::create_directories(out);
+    const auto sum = runout::jobs::run_scenario(r, out.string());
+    fs::remove_all(out);
+    const double rel = (sum.runout_m - L) / L;
+    rs.push_back(rel);
+    std::printf("| %.1f | %d | %.2f | %ld | %.1f |\n", a, sum.nx * sum.ny, rel, sum.steps, sum.seconds_run);
+  }
+  // Exponents: log-log slopes over the small (0.5-2) and large (2-6) aspect ratios.
+  auto slope = [&](std::size_t i0, std::size_t i1) {
+    double sx = 0, sy = 0, sxx = 0, sxy = 0, n = 0;
+    for (std::size_t k = i0; k <= i1; ++k) {
+      const double x = std::log(as[k]), y = std::log(std::max(rs[k], 1e-9));
+      sx += x, sy += y, sxx += x * x, sxy += x * y, n += 1;
+    }
+    return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  };
+  std::printf("\nexponent of (l - L)/L in a: %.2f for a = 0.5-2 (expected about 1), %.2f for a = 2-6 (expected about 2/3; 0.9 in wide channels)\n",
+              slope(0, 2), slope(2, 4));
+  return 0;
+}
+
 int main(int argc, char** argv) {
+  if (argc > 1 && std::string(argv[1]) == "--b10") return b10();
   bool full = false;
   double end = 1.0;
   for (int k = 1; k < argc; ++k) {
