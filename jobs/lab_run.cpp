@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <mutex>
 #include <sstream>
 
 #include "engine/vof/solver.hpp"
@@ -149,6 +150,10 @@ void write_figure(const std::string& path, const vof::VofSolver& s, int nx, int 
 }  // namespace
 
 RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt) {
+  // PETSc keeps process-wide state and is not thread-safe: in a server with several workers, VOF
+  // runs take turns (depth-averaged runs are not affected).
+  static std::mutex petsc_turn;
+  std::lock_guard turn(petsc_turn);
   using clk = std::chrono::steady_clock;
   const auto t0 = clk::now();
   const auto& L = r.scenario.lab();
