@@ -21,7 +21,8 @@ namespace fs = std::filesystem;
 
 static double field(const std::string& json, const std::string& key) {
   const auto k = json.find("\"" + key + "\": ");
-  return k == std::string::npos ? NAN : std::atof(json.c_str() + k + key.size() + 4);
+  if (k == std::string::npos || json.compare(k + key.size() + 4, 4, "null") == 0) return NAN;
+  return std::atof(json.c_str() + k + key.size() + 4);
 }
 
 // B10 (validation.md): a column L = 5 cm wide, H = a L high, against the left wall, released at t = 0.
@@ -105,6 +106,8 @@ int main(int argc, char** argv) {
               field(j, "peak_speed_time_s"));
   std::printf("| front, upper surface angle | %.3f m, %.1f deg | 0.19-0.20 m, about 33 deg |\n", field(j, "front_x_m"),
               field(j, "upper_surface_angle_deg"));
+  std::printf("| mean surface angle (80 %% to 20 %% of the height) | %.1f deg | |\n", field(j, "mean_surface_angle_deg"));
+  std::printf("| at rest (below 1 cm/s) from | %.3f s | about 0.6 s |\n", field(j, "rest_time_s"));
   std::printf("| relative volume change (outflow at the open end) | %.2e | |\n", sum.volume_error);
   return 0;
 }

@@ -282,8 +282,17 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     if (h[std::size_t(i)] >= 0.5 * dy) front = b.x0 + (i + 1) * dx;  // at least half a cell of material
     hmax = std::max(hmax, h[std::size_t(i)]);
   }
-  // Upper surface angle: the mean slope between 80 % and 20 % of the highest column, right of it.
+  // Surface angles right of the highest column: the upper surface (least-squares slope of the
+  // column heights between 90 % and 50 % of the highest) and the mean slope from 80 % to 20 %.
   int imax = int(std::max_element(h.begin(), h.end()) - h.begin());
+  while (imax + 1 < b.nx && h[std::size_t(imax) + 1] >= 0.999 * hmax) ++imax;  // the plateau's right end
+  double sx = 0, sy = 0, sxx = 0, sxy = 0, n = 0;
+  for (int i = imax; i < b.nx; ++i)
+    if (h[std::size_t(i)] < 0.9 * hmax && h[std::size_t(i)] > 0.5 * hmax) {
+      const double xx = b.x0 + (i + 0.5) * dx;
+      sx += xx, sy += h[std::size_t(i)], sxx += xx * xx, sxy += xx * h[std::size_t(i)], n += 1;
+    }
+  const double upper = n >= 2 ? std::atan(-(n * sxy - sx * sy) / (n * sxx - sx * sx)) * 180 / kPi : NAN;
   double xh = NAN, xl = NAN;
   for (int i = imax; i < b.nx; ++i) {
     if (std::isnan(xh) && h[std::size_t(i)] < 0.8 * hmax) xh = b.x0 + (i + 0.5) * dx;
@@ -314,7 +323,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     << ", \"stop\": \"" << sum.stop << "\"},\n";
   j << "  \"results\": {\"peak_speed_m_s\": " << num(peak) << ", \"peak_speed_time_s\": " << num(t_peak)
     << ", \"rest_time_s\": " << num(t_rest >= 0 ? t_rest : NAN) << ", \"final_speed_m_s\": " << num(last_speed)
-    << ", \"front_x_m\": " << num(front) << ", \"deposit_height_m\": " << num(hmax) << ", \"upper_surface_angle_deg\": " << num(angle)
+    << ", \"front_x_m\": " << num(front) << ", \"deposit_height_m\": " << num(hmax) << ", \"upper_surface_angle_deg\": " << num(upper) << ", \"mean_surface_angle_deg\": " << num(angle)
     << ", \"volume_initial_m3\": " << num(v0) << ", \"volume_final_m3\": " << num(v1) << ", \"volume_relative_error\": " << num(sum.volume_error)
     << ", \"frames\": " << frames << "},\n";
   j << "  \"timings_s\": {\"prepare\": " << num(sum.seconds_prepare) << ", \"run\": " << num(sum.seconds_run)
