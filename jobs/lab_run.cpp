@@ -205,11 +205,19 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     it = m.patch_index(it->first) < 0 ? c.bc.erase(it) : std::next(it);
   vof::VofSolver s(m, c);
   std::vector<double> alpha(std::size_t(m.cells()), 0.0);
-  for (int k = 0; k < m.cells(); ++k)
-    for (const auto& f : L.fill()) {
-      const auto& p = m.centre[std::size_t(k)];
-      if (p.x >= f.x_min() && p.x <= f.x_max() && p.y >= f.y_min() && p.y <= f.y_max()) alpha[std::size_t(k)] = 1;
+  auto inside = [](const v1::LabRegion& f, double x, double y) {
+    if (f.polygon_xy_size() == 0) return x >= f.x_min() && x <= f.x_max() && y >= f.y_min() && y <= f.y_max();
+    bool in = false;  // even-odd rule
+    const int n = f.polygon_xy_size() / 2;
+    for (int a = 0, b2 = n - 1; a < n; b2 = a++) {
+      const double xa = f.polygon_xy(2 * a), ya = f.polygon_xy(2 * a + 1), xb = f.polygon_xy(2 * b2), yb = f.polygon_xy(2 * b2 + 1);
+      if ((ya > y) != (yb > y) && x < (xb - xa) * (y - ya) / (yb - ya) + xa) in = !in;
     }
+    return in;
+  };
+  for (int k = 0; k < m.cells(); ++k)
+    for (const auto& f : L.fill())
+      if (inside(f, m.centre[std::size_t(k)].x, m.centre[std::size_t(k)].y)) alpha[std::size_t(k)] = 1;
   s.initialise(alpha);
   double v0 = 0;
   for (int k = 0; k < m.cells(); ++k) v0 += alpha[std::size_t(k)] * m.volume[std::size_t(k)];

@@ -92,9 +92,15 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
   if (double(l->nx()) * l->ny() > 4e6) bad("lab.nx", "more than 4 million cells");
   if (!(l->inclination_deg() > -90 && l->inclination_deg() < 90)) bad("lab.inclination_deg", "must lie in (-90, 90)");
   if (l->fill().empty()) bad("lab.fill", "at least one rectangle of granular material is needed");
-  for (int k = 0; k < l->fill_size(); ++k)
-    if (!(l->fill(k).x_max() > l->fill(k).x_min() && l->fill(k).y_max() > l->fill(k).y_min()))
-      bad("lab.fill[" + std::to_string(k) + "]", "needs x_max > x_min and y_max > y_min");
+  for (int k = 0; k < l->fill_size(); ++k) {
+    const auto& f = l->fill(k);
+    if (f.polygon_xy_size() > 0) {
+      if (f.polygon_xy_size() < 6 || f.polygon_xy_size() % 2)
+        bad("lab.fill[" + std::to_string(k) + "].polygon_xy", "needs x, y pairs of at least 3 corners");
+    } else if (!(f.x_max() > f.x_min() && f.y_max() > f.y_min())) {
+      bad("lab.fill[" + std::to_string(k) + "]", "needs x_max > x_min and y_max > y_min (or polygon_xy)");
+    }
+  }
   if (l->material().empty()) l->set_material("pvc");
   if (l->material() != "pvc" && l->material() != "sand" && l->material() != "fine-sand")
     bad("lab.material", "unknown '" + l->material() + "' (valid: pvc, sand, fine-sand)");

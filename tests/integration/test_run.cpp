@@ -717,3 +717,25 @@ TEST(Scenarios, LabScenarioErrorsNameTheField) {
     EXPECT_NE(std::string(e.what()).find("lab.boundaries[0].side"), std::string::npos) << e.what();
   }
 }
+
+// A polygon fill (B3's triangle at 50 deg): the initial volume is the triangle's, to the cell size.
+TEST(Scenarios, LabPolygonFillHoldsTheTriangle) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b3-triangle-pvc.json");
+  auto* lab = r.scenario.mutable_lab();
+  lab->set_nx(80);  // 1 cm cells
+  lab->set_ny(19);
+  lab->set_end_time_s(0.05);
+  TempDir d;
+  const auto sum = jobs::run_scenario(r, d.p.string());
+  const double h = 0.4 * std::tan(18.0 * 3.14159265358979 / 180), area = 0.5 * 0.4 * h, thickness = 0.01;
+  EXPECT_NEAR(sum.volume_initial, area * thickness, 0.1 * area * thickness);
+  EXPECT_GT(sum.max_speed, 0.05);  // steeper than phi on a 50 deg chute: it moves at once
+  auto bad = jobs::parse_scenario_json(R"({"engine": "vof", "lab": {"x_max": 1, "y_max": 1, "nx": 10, "ny": 10,
+      "fill": [{"polygon_xy": [0, 0, 1, 0, 1]}]}})");
+  try {
+    jobs::resolve_scenario(bad, ".");
+    FAIL();
+  } catch (const jobs::ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("lab.fill[0].polygon_xy"), std::string::npos) << e.what();
+  }
+}
