@@ -110,8 +110,10 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
     const std::string f = "lab.boundaries[" + std::to_string(k) + "]";
     if (b.side() != "bottom" && b.side() != "top" && b.side() != "left" && b.side() != "right")
       bad(f + ".side", "unknown '" + b.side() + "' (valid: bottom, top, left, right)");
-    if (b.kind() != "wall" && b.kind() != "coulomb-slip" && b.kind() != "atmosphere" && b.kind() != "outflow")
-      bad(f + ".kind", "unknown '" + b.kind() + "' (valid: wall, coulomb-slip, atmosphere, outflow)");
+    if (b.kind() != "wall" && b.kind() != "coulomb-slip" && b.kind() != "atmosphere" && b.kind() != "outflow" && b.kind() != "inflow")
+      bad(f + ".kind", "unknown '" + b.kind() + "' (valid: wall, coulomb-slip, atmosphere, outflow, inflow)");
+    if (b.kind() == "inflow" && !(b.inflow_height() > 0)) bad(f + ".inflow_height", "an inflow needs a fill height > 0 m");
+    if (b.kind() == "inflow" && b.side() != "left") bad(f + ".side", "inflow is supported on the left side only");
     if (b.has_from() && b.has_to() && !(b.to() > b.from())) bad(f + ".to", "must exceed from");
   }
   if (l->end_time_s() == 0) l->set_end_time_s(1.0);

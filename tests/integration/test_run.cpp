@@ -739,3 +739,28 @@ TEST(Scenarios, LabPolygonFillHoldsTheTriangle) {
     EXPECT_NE(std::string(e.what()).find("lab.fill[0].polygon_xy"), std::string::npos) << e.what();
   }
 }
+
+// An inflow (B4 at 50 deg, coarse): the material enters with the prescribed profile and the stations
+// report depth and velocities.
+TEST(Scenarios, LabInflowFeedsTheChannelAndStationsReport) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b4-steady-pvc.json");
+  auto* lab = r.scenario.mutable_lab();
+  lab->set_nx(175);  // 1 cm cells
+  lab->set_ny(10);
+  lab->set_end_time_s(0.5);
+  TempDir d;
+  const auto sum = jobs::run_scenario(r, d.p.string());
+  EXPECT_GT(sum.volume_final, 20 * sum.volume_initial);  // fed through the inflow
+  std::ifstream rec(d / "run.json");
+  std::stringstream ss;
+  ss << rec.rdbuf();
+  const std::string j = ss.str();
+  const auto at = j.find("\"x_m\": 1,");
+  ASSERT_NE(at, std::string::npos) << j.substr(0, 400);
+  const double depth = std::atof(j.c_str() + j.find("\"depth_m\": ", at) + 11);
+  const double ubar = std::atof(j.c_str() + j.find("\"depth_averaged_u_m_s\": ", at) + 24);
+  EXPECT_GT(depth, 0.01);  // the inflow is 2.96 cm deep
+  EXPECT_LT(depth, 0.05);
+  EXPECT_GT(ubar, 1.5);    // it enters at 1.96 m/s on average and accelerates down the 50 deg chute
+  EXPECT_LT(ubar, 6.0);
+}
