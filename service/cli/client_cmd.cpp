@@ -15,6 +15,7 @@
 
 #include "jobs/scenario.hpp"
 #include "service/cli/commands.hpp"
+#include "service/cli/output_dir.hpp"
 #include "service/client/client.hpp"
 
 namespace fs = std::filesystem;
@@ -311,18 +312,12 @@ int fetch(const std::vector<std::string>& args) {
     std::cerr << "runout fetch: output directory '" << out << "' exists (use --force to replace it)\n";
     return kOutput;
   }
-  std::error_code ec;
-  fs::create_directories(dest.parent_path(), ec);
-  std::string tmp_name = ".";  // (built step by step: GCC 12 warns falsely on "." + string)
-  tmp_name += dest.filename().string();
-  tmp_name += ".tmp-";
-  tmp_name += std::to_string(getpid());
-  const fs::path tmp = dest.parent_path() / tmp_name;
-  fs::remove_all(tmp, ec);
-  if (!fs::create_directory(tmp, ec)) {
-    std::cerr << "runout fetch: cannot create '" << tmp.string() << "': " << ec.message() << "\n";
+  StagedOutput staged(dest);
+  if (!staged.ok()) {
+    std::cerr << "runout fetch: " << staged.error() << "\n";
     return kOutput;
   }
+  const fs::path tmp = staged.path();
   try {
     service::Client client(c.opt);
     const auto j = client.get(id);
@@ -338,18 +333,14 @@ int fetch(const std::vector<std::string>& args) {
       client.download(id, f.name(), (tmp / f.name()).string());
       bytes += f.bytes();
     }
-    if (fs::exists(dest)) fs::remove_all(dest, ec);
-    fs::rename(tmp, dest, ec);
-    if (ec) {
-      std::cerr << "runout fetch: cannot move the results to '" << dest.string() << "': " << ec.message() << "\n";
-      fs::remove_all(tmp, ec);
+    if (!staged.publish()) {
+      std::cerr << "runout fetch: " << staged.error() << "\n";
       return kOutput;
     }
     std::printf("%d file(s), %.2f MiB, checksums verified, in %s\n", files.files_size(), double(bytes) / (1 << 20),
                 dest.string().c_str());
     return j.state() == v1::SUCCEEDED ? kOk : code_of_state(j.state());
   } catch (const service::RpcError& e) {
-    fs::remove_all(tmp, ec);
     std::cerr << "runout fetch: " << e.what() << "\n";
     return code_of(e);
   }

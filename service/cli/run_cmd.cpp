@@ -13,6 +13,7 @@
 
 #include "jobs/run.hpp"
 #include "service/cli/commands.hpp"
+#include "service/cli/output_dir.hpp"
 
 namespace runout::cli {
 namespace fs = std::filesystem;
@@ -93,19 +94,12 @@ int run(const std::vector<std::string>& args) {
   }
 
   // Results go to a temporary sibling directory first and appear under DIR only when complete.
-  std::error_code ec;
-  fs::create_directories(dest.parent_path(), ec);
-  std::string tmp_name = ".";
-  tmp_name += dest.filename().string();
-  tmp_name += ".tmp-";
-  tmp_name += std::to_string(getpid());
-  const fs::path tmp = dest.parent_path() / tmp_name;
-  fs::remove_all(tmp, ec);
-  if (!fs::create_directory(tmp, ec)) {
-    std::cerr << "runout run: cannot create '" << tmp.string() << "': " << ec.message() << "\n";
+  StagedOutput staged(dest);
+  if (!staged.ok()) {
+    std::cerr << "runout run: " << staged.error() << "\n";
     return kOutput;
   }
-  auto cleanup = [&] { fs::remove_all(tmp, ec); };
+  const fs::path tmp = staged.path();
 
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
@@ -127,7 +121,6 @@ int run(const std::vector<std::string>& args) {
   auto fail = [&](const std::string& message, int code) {
     if (!quiet && tty) std::fprintf(stderr, "\n");
     std::cerr << "runout run: " << message << "\n";
-    cleanup();
     return code;
   };
   jobs::RunSummary sum;
@@ -145,14 +138,10 @@ int run(const std::vector<std::string>& args) {
   if (!quiet && tty) std::fprintf(stderr, "\n");
   if (sum.stop == "cancelled") {
     std::cerr << "runout run: cancelled at t = " << sum.t << " s; no results written\n";
-    cleanup();
     return kCancelled;
   }
-  if (fs::exists(dest)) fs::remove_all(dest, ec);
-  fs::rename(tmp, dest, ec);
-  if (ec) {
-    std::cerr << "runout run: cannot move the results to '" << dest.string() << "': " << ec.message() << "\n";
-    cleanup();
+  if (!staged.publish()) {
+    std::cerr << "runout run: " << staged.error() << "\n";
     return kOutput;
   }
   if (!quiet && resolved.vof) {
