@@ -290,7 +290,7 @@ std::string scenario_hash(const ResolvedScenario& r) {
     h.update("\n");
     h.update(fs::path(f).extension().string());
     h.update(" ");
-    h.update(sha256_of_file(f));
+    h.update(terrain::sha256_file(f));
   }
   return h.hex();
 }

@@ -2,7 +2,6 @@
 
 #include <openssl/evp.h>
 
-#include <fstream>
 #include <stdexcept>
 
 namespace runout::jobs {
@@ -37,18 +36,6 @@ std::string Sha256::hex() {
 std::string sha256_hex(std::string_view bytes) {
   Sha256 h;
   h.update(bytes);
-  return h.hex();
-}
-
-std::string sha256_of_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read '" + path + "' to hash it");
-  Sha256 h;
-  char buf[1 << 16];
-  while (in) {
-    in.read(buf, sizeof buf);
-    h.update(std::string_view(buf, std::size_t(in.gcount())));
-  }
   return h.hex();
 }
 

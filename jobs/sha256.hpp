@@ -23,7 +23,6 @@ class Sha256 {
 
 /// Hex SHA-256 of a string.
 std::string sha256_hex(std::string_view bytes);
-/// Hex SHA-256 of a file's bytes; throws std::runtime_error when it cannot be read.
-std::string sha256_of_file(const std::string& path);
+// Files: terrain::sha256_file.
 
 }  // namespace runout::jobs
