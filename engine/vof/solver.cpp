@@ -57,6 +57,7 @@ struct VofSolver::Impl {
   std::vector<Vec> H, HbyA, bsrc;
   std::vector<double> cO, cN;
   Mat Mu = nullptr;
+  ::Vec xu = nullptr, bu = nullptr;  // the momentum predictor's vectors (every cell)
   Mat Apin = nullptr;  // closed domains: the pressure matrix with cell 0 pinned
   KSP kspU = nullptr;
   std::vector<std::array<double, 3>> recon_inv;  // inverse of sum Sf Sf / |Sf| (plane: 2x2 packed)
@@ -72,6 +73,8 @@ struct VofSolver::Impl {
     if (b) VecDestroy(&b);
     if (r) VecDestroy(&r);
     if (dx) VecDestroy(&dx);
+    if (xu) VecDestroy(&xu);
+    if (bu) VecDestroy(&bu);
   }
 
   const PatchBc& bc_of(int f) const { return *face_pbc[std::size_t(f - m.n_internal)]; }
@@ -118,42 +121,13 @@ struct VofSolver::Impl {
       recon_inv[std::size_t(c)] = {t11 / det, -t01 / det, t00 / det};
     }
     if (dims == 3) throw VofError("3D meshes: not supported by this build of the VOF engine yet (plane meshes only)");
-    // Pressure matrix with the sparsity of the mesh.
     petsc_init();
     std::vector<PetscInt> nnz(std::size_t(nc), 1);
     for (int f = 0; f < m.n_internal; ++f) {
       ++nnz[std::size_t(m.owner[std::size_t(f)])];
       ++nnz[std::size_t(m.neighbour[std::size_t(f)])];
     }
-    petsc_check(MatCreateSeqAIJ(PETSC_COMM_SELF, nc, nc, 0, nnz.data(), &A), "MatCreateSeqAIJ");
-    petsc_check(MatSetOption(A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
-    petsc_check(VecCreateSeq(PETSC_COMM_SELF, nc, &x), "VecCreateSeq");
-    petsc_check(VecDuplicate(x, &b), "VecDuplicate");
-    petsc_check(VecDuplicate(x, &r), "VecDuplicate");
-    petsc_check(VecDuplicate(x, &dx), "VecDuplicate");
-    petsc_check(KSPCreate(PETSC_COMM_SELF, &ksp), "KSPCreate");
-    petsc_check(KSPSetType(ksp, KSPCG), "KSPSetType");
-    PC pc;
-    petsc_check(KSPGetPC(ksp, &pc), "KSPGetPC");
-    if (s.cfg_.pressure_pc == "gamg") {
-      petsc_check(PCSetType(pc, PCGAMG), "PCSetType gamg");
-      // The 1/A of the two phases differ a thousandfold: GAMG's default Chebyshev smoothers, with their
-      // estimated eigenvalue bounds, then made the preconditioner indefinite for CG now and then.
-      // Damped Jacobi smoothing (Richardson, scale 0.6) is symmetric and stays positive definite.
-      petsc_check(KSPSetOptionsPrefix(ksp, "runout_p_"), "KSPSetOptionsPrefix");
-      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_ksp_type", "richardson");
-      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_pc_type", "jacobi");
-      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_ksp_richardson_scale", "0.6");
-      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_ksp_max_it", "2");
-      petsc_check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
-    } else if (s.cfg_.pressure_pc == "hypre") {
-      if (PCSetType(pc, PCHYPRE)) throw VofError("pressure_pc: this PETSc has no hypre (valid here: gamg)");
-      petsc_check(PCHYPRESetType(pc, "boomeramg"), "PCHYPRESetType");
-    } else {
-      throw VofError("pressure_pc: unknown '" + s.cfg_.pressure_pc + "' (valid: gamg, hypre)");
-    }
-    petsc_check(KSPSetTolerances(ksp, s.cfg_.pressure_rtol, 1e-300, PETSC_DEFAULT, 2000), "KSPSetTolerances");
-    petsc_check(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
+    make_pressure_ksp();  // checks the preconditioner's name early
     rho.assign(std::size_t(nc), 0);
     rho_old = rho;
     mu = rho;
@@ -170,6 +144,8 @@ struct VofSolver::Impl {
     cO.assign(std::size_t(nf), 0);
     cN = cO;
     petsc_check(MatCreateSeqAIJ(PETSC_COMM_SELF, nc, nc, 0, nnz.data(), &Mu), "MatCreateSeqAIJ");
+    petsc_check(VecCreateSeq(PETSC_COMM_SELF, nc, &xu), "VecCreateSeq");
+    petsc_check(VecDuplicate(xu, &bu), "VecDuplicate");
     petsc_check(KSPCreate(PETSC_COMM_SELF, &kspU), "KSPCreate");
     petsc_check(KSPSetType(kspU, KSPBCGS), "KSPSetType");
     PC pcu;
@@ -183,7 +159,23 @@ struct VofSolver::Impl {
     const Vec g = s.cfg_.gravity(t);
     for (int c = 0; c < nc; ++c) gh[std::size_t(c)] = dot(g, m.centre[std::size_t(c)]);
     for (int f = 0; f < nf; ++f) ghf[std::size_t(f)] = dot(g, m.Cf[std::size_t(f)]);
+    gh_ref = 1e300;
+    for (int f = m.n_internal; f < nf; ++f)
+      if (kind_of(f) == Bc::atmosphere) gh_ref = std::min(gh_ref, ghf[std::size_t(f)]);
+    if (gh_ref == 1e300)  // a closed domain: the level is zero at its highest cell
+      for (int c = 0; c < nc; ++c) gh_ref = std::min(gh_ref, gh[std::size_t(c)]);
   }
+
+  // Outside the domain's openings, and outside the active region, is air at rest: hydrostatic,
+  // p = rho_air g.(x - x_ref), zero at the highest point open to the atmosphere (x_ref). On an
+  // opening next to active cell a, p_rgh_b = p_b - rho_a g.x_b. (Taking p = 0 all along a vertical
+  // opening instead drives air through it: the air inside is hydrostatic, and the 1.5 Pa across a
+  // 15 cm opening set up a circulation that grew to 5 m/s while the material rested.)
+  double outside_p_rgh(int f, int a) const {
+    const double g = ghf[std::size_t(f)];
+    return s.cfg_.rho2 * (g - gh_ref) - rho[std::size_t(a)] * g;
+  }
+  double gh_ref = 0;
 
   void update_rho(std::vector<double>& r) const {
     const auto& a = s.alpha_;
@@ -474,7 +466,7 @@ struct VofSolver::Impl {
         const double dl = m.delta_coeff[std::size_t(f)];
         q = -ghf[std::size_t(f)] * (rho[std::size_t(nb)] - rho[std::size_t(o)]) * dl - (s.p_rgh_[std::size_t(nb)] - s.p_rgh_[std::size_t(o)]) * dl;
       } else if (kind_of(f) == Bc::atmosphere) {
-        q = -(-rho[std::size_t(o)] * ghf[std::size_t(f)] - s.p_rgh_[std::size_t(o)]) * m.delta_coeff[std::size_t(f)];
+        q = -(outside_p_rgh(f, o) - s.p_rgh_[std::size_t(o)]) * m.delta_coeff[std::size_t(f)];
       } else {
         continue;  // walls and inflow: the pressure gradient normal to them is balanced (fixed flux)
       }
@@ -502,14 +494,14 @@ struct VofSolver::Impl {
         const Vec r = rec[std::size_t(c)];
         const double fx = T[0] * r.x + T[1] * r.y, fy = T[1] * r.x + T[2] * r.y;
         const double src = comp(bsrc[std::size_t(c)], comp_i) + m.volume[std::size_t(c)] * (comp_i == 0 ? fx : fy);
-        VecSetValue(b, c, src, INSERT_VALUES);
-        VecSetValue(x, c, comp(s.U_[std::size_t(c)], comp_i), INSERT_VALUES);
+        VecSetValue(bu, c, src, INSERT_VALUES);
+        VecSetValue(xu, c, comp(s.U_[std::size_t(c)], comp_i), INSERT_VALUES);
       }
-      VecAssemblyBegin(b);
-      VecAssemblyEnd(b);
-      VecAssemblyBegin(x);
-      VecAssemblyEnd(x);
-      petsc_check(KSPSolve(kspU, b, x), "KSPSolve (momentum)");
+      VecAssemblyBegin(bu);
+      VecAssemblyEnd(bu);
+      VecAssemblyBegin(xu);
+      VecAssemblyEnd(xu);
+      petsc_check(KSPSolve(kspU, bu, xu), "KSPSolve (momentum)");
       KSPConvergedReason reason;
       KSPGetConvergedReason(kspU, &reason);
       PetscInt k = 0;
@@ -519,91 +511,285 @@ struct VofSolver::Impl {
         throw VofError("momentum solver (BiCGStab + ILU) did not converge at t = " + std::to_string(s.t_) + " s: reason " +
                        std::to_string(int(reason)));
       const PetscScalar* xv;
-      VecGetArrayRead(x, &xv);
+      VecGetArrayRead(xu, &xv);
       for (int c = 0; c < nc; ++c) (comp_i == 0 ? s.U_[std::size_t(c)].x : s.U_[std::size_t(c)].y) = xv[c];
-      VecRestoreArrayRead(x, &xv);
+      VecRestoreArrayRead(xu, &xv);
     }
     return its_total;
   }
 
-  // One pressure correction: solve laplacian(rAUf, p_rgh) = div(phiHbyA) and correct fluxes and
-  // velocities. Returns the iterations.
-  int pressure_correct(bool initial, bool reuse = false) {
-    std::vector<double> phiHbyA(static_cast<std::size_t>(nf)), phig(static_cast<std::size_t>(nf)), coef(std::size_t(nf), 0.0);
+  // The active region (docs/vof.md, "Skipping air far from the material"): cells with material
+  // (alpha > active_alpha), cells with an inflow face, and `active_layers` layers of cells around
+  // them. Only these take part in the pressure equation; the rest is air at rest under the
+  // atmosphere's hydrostatic pressure, and faces to it act as openings. The region is rebuilt when
+  // material comes within two layers of its edge, so it keeps its shape (and the pressure
+  // preconditioner) for many steps. Returns true when it changed.
+  bool update_active(bool force) {
+    const int layers = s.cfg_.active_layers;
+    if (layers <= 0) {
+      if (n_active == nc) return false;
+      active_index.resize(std::size_t(nc));
+      for (int c = 0; c < nc; ++c) active_index[std::size_t(c)] = c;
+      active_cells.resize(std::size_t(nc));
+      for (int c = 0; c < nc; ++c) active_cells[std::size_t(c)] = c;
+      n_active = nc;
+      return true;
+    }
+    // Distance in layers from the material (BFS over faces), up to `layers`.
+    std::vector<int>& d = layer_work;
+    d.assign(std::size_t(nc), -1);
+    std::vector<int> front, next;
+    for (int c = 0; c < nc; ++c)
+      if (s.alpha_[std::size_t(c)] > s.cfg_.active_alpha) {
+        d[std::size_t(c)] = 0;
+        front.push_back(c);
+      }
+    for (int f = m.n_internal; f < nf; ++f)
+      if (kind_of(f) == Bc::inflow) {
+        const int o = m.owner[std::size_t(f)];
+        if (d[std::size_t(o)] < 0) {
+          d[std::size_t(o)] = 0;
+          front.push_back(o);
+        }
+      }
+    for (int k = 1; k <= layers && !front.empty(); ++k) {
+      next.clear();
+      for (int c : front)
+        for (int f : cell_faces[std::size_t(c)]) {
+          if (f >= m.n_internal) continue;
+          const int o = m.owner[std::size_t(f)], nb = m.neighbour[std::size_t(f)];
+          const int other = o == c ? nb : o;
+          if (d[std::size_t(other)] < 0) {
+            d[std::size_t(other)] = k;
+            next.push_back(other);
+          }
+        }
+      front.swap(next);
+    }
+    // Air beyond the layers joins the reservoir only where it connects to an atmosphere opening
+    // through other such cells: an enclosed pocket (under a lid, in a closed box) keeps its volume,
+    // so it stays in the computation.
+    {
+      std::vector<int> stack;
+      std::vector<char> out(std::size_t(nc), 0);
+      for (int f = m.n_internal; f < nf; ++f)
+        if (kind_of(f) == Bc::atmosphere) {
+          const int o = m.owner[std::size_t(f)];
+          if (d[std::size_t(o)] < 0 && !out[std::size_t(o)]) {
+            out[std::size_t(o)] = 1;
+            stack.push_back(o);
+          }
+        }
+      while (!stack.empty()) {
+        const int c = stack.back();
+        stack.pop_back();
+        for (int f : cell_faces[std::size_t(c)]) {
+          if (f >= m.n_internal) continue;
+          const int other = m.owner[std::size_t(f)] == c ? m.neighbour[std::size_t(f)] : m.owner[std::size_t(f)];
+          if (d[std::size_t(other)] < 0 && !out[std::size_t(other)]) {
+            out[std::size_t(other)] = 1;
+            stack.push_back(other);
+          }
+        }
+      }
+      for (int c = 0; c < nc; ++c)
+        if (d[std::size_t(c)] < 0 && !out[std::size_t(c)]) d[std::size_t(c)] = layers + 1;
+    }
+    if (!force && n_active > 0) {
+      bool inside = true;
+      for (int c = 0; c < nc && inside; ++c)
+        if (d[std::size_t(c)] >= 0 && d[std::size_t(c)] <= std::min(2, layers) && active_index[std::size_t(c)] < 0) inside = false;
+      if (inside) return false;
+    }
+    active_index.assign(std::size_t(nc), -1);
+    active_cells.clear();
+    for (int c = 0; c < nc; ++c)
+      if (d[std::size_t(c)] >= 0) {
+        active_index[std::size_t(c)] = int(active_cells.size());
+        active_cells.push_back(c);
+      }
+    n_active = int(active_cells.size());
+    // Air at rest outside the region.
+    for (int c = 0; c < nc; ++c)
+      if (active_index[std::size_t(c)] < 0) {
+        s.U_[std::size_t(c)] = Vec{};
+        s.p_[std::size_t(c)] = s.cfg_.rho2 * (gh[std::size_t(c)] - gh_ref);
+        s.p_rgh_[std::size_t(c)] = s.p_[std::size_t(c)] - rho[std::size_t(c)] * gh[std::size_t(c)];
+      }
+    return true;
+  }
+
+  // The pressure solver: CG with an algebraic multigrid preconditioner. Made anew whenever the
+  // active region changes (GAMG keeps its coarse levels' solvers, whose sizes would not fit).
+  void make_pressure_ksp() {
+    if (ksp) KSPDestroy(&ksp);
+    petsc_check(KSPCreate(PETSC_COMM_SELF, &ksp), "KSPCreate");
+    petsc_check(KSPSetType(ksp, KSPCG), "KSPSetType");
+    PC pc;
+    petsc_check(KSPGetPC(ksp, &pc), "KSPGetPC");
+    if (s.cfg_.pressure_pc == "gamg") {
+      petsc_check(PCSetType(pc, PCGAMG), "PCSetType gamg");
+      // The 1/A of the two phases differ a thousandfold: GAMG's default Chebyshev smoothers, with their
+      // estimated eigenvalue bounds, then made the preconditioner indefinite for CG now and then.
+      // Damped Jacobi smoothing (Richardson, scale 0.6) is symmetric and stays positive definite.
+      petsc_check(KSPSetOptionsPrefix(ksp, "runout_p_"), "KSPSetOptionsPrefix");
+      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_ksp_type", "richardson");
+      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_pc_type", "jacobi");
+      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_ksp_richardson_scale", "0.6");
+      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_ksp_max_it", "2");
+      petsc_check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
+    } else if (s.cfg_.pressure_pc == "hypre") {
+      if (PCSetType(pc, PCHYPRE)) throw VofError("pressure_pc: this PETSc has no hypre (valid here: gamg)");
+      petsc_check(PCHYPRESetType(pc, "boomeramg"), "PCHYPRESetType");
+    } else {
+      throw VofError("pressure_pc: unknown '" + s.cfg_.pressure_pc + "' (valid: gamg, hypre)");
+    }
+    petsc_check(KSPSetTolerances(ksp, s.cfg_.pressure_rtol, 1e-300, PETSC_DEFAULT, 2000), "KSPSetTolerances");
+    petsc_check(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
+  }
+
+  // (Re)create the pressure system for the current active region.
+  void make_pressure_system() {
+    if (A) MatDestroy(&A);
+    if (Apin) MatDestroy(&Apin);
+    for (::Vec* v : {&x, &b, &r, &dx})
+      if (*v) VecDestroy(v);
+    std::vector<PetscInt> nnz(std::size_t(std::max(1, n_active)), 1);
+    for (int f = 0; f < m.n_internal; ++f) {
+      const int io = active_index[std::size_t(m.owner[std::size_t(f)])], in = active_index[std::size_t(m.neighbour[std::size_t(f)])];
+      if (io >= 0 && in >= 0) {
+        ++nnz[std::size_t(io)];
+        ++nnz[std::size_t(in)];
+      }
+    }
+    petsc_check(MatCreateSeqAIJ(PETSC_COMM_SELF, n_active, n_active, 0, nnz.data(), &A), "MatCreateSeqAIJ");
+    petsc_check(MatSetOption(A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+    petsc_check(VecCreateSeq(PETSC_COMM_SELF, n_active, &x), "VecCreateSeq");
+    petsc_check(VecDuplicate(x, &b), "VecDuplicate");
+    petsc_check(VecDuplicate(x, &r), "VecDuplicate");
+    petsc_check(VecDuplicate(x, &dx), "VecDuplicate");
+    make_pressure_ksp();
+    system_fresh = true;
+  }
+
+  // One pressure correction: solve laplacian(rAUf, p_rgh) = div(phiHbyA) on the active region and
+  // correct fluxes and velocities. Returns the iterations.
+  int pressure_correct(bool initial, bool reuse = false, bool final = true) {
+    petsc_check(KSPSetTolerances(ksp, final ? s.cfg_.pressure_rtol : s.cfg_.pressure_rtol_intermediate, 1e-300, PETSC_DEFAULT, 2000),
+                "KSPSetTolerances");
+    const bool closed = !has_dirichlet && n_active == nc;  // no opening anywhere: the level is free
+    const auto& ix = active_index;
+    // Per face: the flux predicted from H/A (oriented with Sf), its buoyancy part, the Laplacian
+    // coefficient and, for an opening (atmosphere patch or the edge of the active region), the
+    // side of the active cell (+1 owner, -1 neighbour) and the pressure outside.
+    std::vector<double> phiHbyA(static_cast<std::size_t>(nf), 0.0), phig(static_cast<std::size_t>(nf), 0.0),
+        coef(std::size_t(nf), 0.0), pout(std::size_t(nf), 0.0);
+    std::vector<signed char> open(std::size_t(nf), 0);
     for (int f = 0; f < nf; ++f) {
       const int o = m.owner[std::size_t(f)];
+      const bool ao = ix[std::size_t(o)] >= 0;
       if (f < m.n_internal) {
         const int nb = m.neighbour[std::size_t(f)];
-        const double w = m.weight[std::size_t(f)];
-        const Vec Hf = w * HbyA[std::size_t(o)] + (1 - w) * HbyA[std::size_t(nb)];
-        phiHbyA[std::size_t(f)] = initial ? 0.0 : dot(Hf, m.Sf[std::size_t(f)]);
-        phig[std::size_t(f)] = -ghf[std::size_t(f)] * (rho[std::size_t(nb)] - rho[std::size_t(o)]) * m.delta_coeff[std::size_t(f)] *
-                               m.magSf[std::size_t(f)] * rAUf[std::size_t(f)];
-        coef[std::size_t(f)] = rAUf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
-      } else {
+        const bool an = ix[std::size_t(nb)] >= 0;
+        if (ao && an) {
+          const double w = m.weight[std::size_t(f)];
+          const Vec Hf = w * HbyA[std::size_t(o)] + (1 - w) * HbyA[std::size_t(nb)];
+          phiHbyA[std::size_t(f)] = initial ? 0.0 : dot(Hf, m.Sf[std::size_t(f)]);
+          phig[std::size_t(f)] = -ghf[std::size_t(f)] * (rho[std::size_t(nb)] - rho[std::size_t(o)]) * m.delta_coeff[std::size_t(f)] *
+                                 m.magSf[std::size_t(f)] * rAUf[std::size_t(f)];
+          coef[std::size_t(f)] = rAUf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+        } else if (ao || an) {
+          const int a = ao ? o : nb;
+          const double sg = ao ? 1.0 : -1.0;
+          open[std::size_t(f)] = ao ? 1 : -1;
+          phiHbyA[std::size_t(f)] = initial ? 0.0 : dot(HbyA[std::size_t(a)], m.Sf[std::size_t(f)]);
+          coef[std::size_t(f)] = rAU[std::size_t(a)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+          pout[std::size_t(f)] = outside_p_rgh(f, a);
+          (void)sg;
+        }
+      } else if (ao) {
         const Bc k = kind_of(f);
-        if (k == Bc::wall || k == Bc::coulomb_slip) phiHbyA[std::size_t(f)] = 0;
-        else if (k == Bc::inflow) phiHbyA[std::size_t(f)] = dot(bc_of(f).inflow_velocity(m.Cf[std::size_t(f)]), m.Sf[std::size_t(f)]);
-        else phiHbyA[std::size_t(f)] = initial ? 0.0 : dot(HbyA[std::size_t(o)], m.Sf[std::size_t(f)]);
-        if (k == Bc::atmosphere) coef[std::size_t(f)] = rAUf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+        if (k == Bc::inflow) phiHbyA[std::size_t(f)] = dot(bc_of(f).inflow_velocity(m.Cf[std::size_t(f)]), m.Sf[std::size_t(f)]);
+        else if (k == Bc::outflow || k == Bc::atmosphere)
+          phiHbyA[std::size_t(f)] = initial ? 0.0 : dot(HbyA[std::size_t(o)], m.Sf[std::size_t(f)]);
+        if (k == Bc::atmosphere) {
+          open[std::size_t(f)] = 1;
+          coef[std::size_t(f)] = rAUf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+          pout[std::size_t(f)] = outside_p_rgh(f, o);
+        }
       }
       phiHbyA[std::size_t(f)] += phig[std::size_t(f)];
     }
     // Assemble M p = rhs. Within a step the matrix does not change (1/A is built once per step):
     // later correctors keep it and its preconditioner and assemble only the right-hand side.
     if (!reuse) petsc_check(MatZeroEntries(A), "MatZeroEntries");
-    std::vector<double> diag(std::size_t(nc), 0.0), rhs(std::size_t(nc), 0.0);
+    std::vector<double> diag(std::size_t(n_active), 0.0), rhs(std::size_t(n_active), 0.0);
     for (int f = 0; f < nf; ++f) {
-      const int o = m.owner[std::size_t(f)];
       const double c = coef[std::size_t(f)];
-      rhs[std::size_t(o)] -= phiHbyA[std::size_t(f)];
+      const int io = ix[std::size_t(m.owner[std::size_t(f)])];
+      if (open[std::size_t(f)] != 0) {
+        const int ia = open[std::size_t(f)] > 0 ? io : ix[std::size_t(m.neighbour[std::size_t(f)])];
+        const double sg = open[std::size_t(f)];
+        rhs[std::size_t(ia)] -= sg * phiHbyA[std::size_t(f)];
+        diag[std::size_t(ia)] += c;
+        rhs[std::size_t(ia)] += c * pout[std::size_t(f)];
+        continue;
+      }
+      if (io < 0) continue;
+      rhs[std::size_t(io)] -= phiHbyA[std::size_t(f)];
       if (f < m.n_internal) {
-        const int nb = m.neighbour[std::size_t(f)];
-        rhs[std::size_t(nb)] += phiHbyA[std::size_t(f)];
-        diag[std::size_t(o)] += c;
-        diag[std::size_t(nb)] += c;
+        const int in = ix[std::size_t(m.neighbour[std::size_t(f)])];
+        rhs[std::size_t(in)] += phiHbyA[std::size_t(f)];
+        diag[std::size_t(io)] += c;
+        diag[std::size_t(in)] += c;
         if (!reuse) {
-          const PetscInt r0 = o, c0 = nb;
+          const PetscInt r0 = io, c0 = in;
           const PetscScalar v = -c;
           petsc_check(MatSetValues(A, 1, &r0, 1, &c0, &v, INSERT_VALUES), "MatSetValues");
           petsc_check(MatSetValues(A, 1, &c0, 1, &r0, &v, INSERT_VALUES), "MatSetValues");
         }
-      } else if (kind_of(f) == Bc::atmosphere) {
-        // p = 0 outside: p_rgh_b = -rho_b gh_b.
-        const double pb = -rho[std::size_t(o)] * ghf[std::size_t(f)];
-        diag[std::size_t(o)] += c;
-        rhs[std::size_t(o)] += c * pb;
       }
     }
-    for (int c = 0; c < nc; ++c) {
-      const PetscInt r = c;
-      const PetscScalar v = diag[std::size_t(c)];
-      if (!reuse) petsc_check(MatSetValues(A, 1, &r, 1, &r, &v, INSERT_VALUES), "MatSetValues");
-      petsc_check(VecSetValue(b, c, rhs[std::size_t(c)], INSERT_VALUES), "VecSetValue");
-      petsc_check(VecSetValue(x, c, s.p_rgh_[std::size_t(c)], INSERT_VALUES), "VecSetValue");
+    {
+      PetscScalar *bv, *xv;
+      petsc_check(VecGetArray(b, &bv), "VecGetArray");
+      petsc_check(VecGetArray(x, &xv), "VecGetArray");
+      for (int k = 0; k < n_active; ++k) {
+        if (!reuse) {
+          const PetscInt r0 = k;
+          const PetscScalar v = diag[std::size_t(k)];
+          petsc_check(MatSetValues(A, 1, &r0, 1, &r0, &v, INSERT_VALUES), "MatSetValues");
+        }
+        bv[k] = rhs[std::size_t(k)];
+        xv[k] = s.p_rgh_[std::size_t(active_cells[std::size_t(k)])];
+      }
+      VecRestoreArray(b, &bv);
+      VecRestoreArray(x, &xv);
     }
     if (!reuse) {
       petsc_check(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY), "MatAssembly");
       petsc_check(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY), "MatAssembly");
     }
-    petsc_check(VecAssemblyBegin(b), "VecAssembly");
-    petsc_check(VecAssemblyEnd(b), "VecAssembly");
-    petsc_check(VecAssemblyBegin(x), "VecAssembly");
-    petsc_check(VecAssemblyEnd(x), "VecAssembly");
     PetscInt its = 0;
     for (int pass = 0; pass < (initial ? 3 : 1); ++pass) {
       petsc_check(MatMult(A, x, r), "MatMult");
       petsc_check(VecAYPX(r, -1.0, b), "VecAYPX");  // r = b - A x
       petsc_check(VecSet(dx, 0.0), "VecSet");
-      const bool same = reuse || pass > 0;  // passes of the initial solve share the matrix too
+      const bool same = (reuse || pass > 0) && !system_fresh;  // passes of the initial solve share the matrix too
+      // The preconditioner (the multigrid hierarchy) is rebuilt every pressure_pc_refresh steps and
+      // whenever the active region changes; in between, the last one preconditions the new matrix
+      // (still symmetric positive definite).
+      bool keep_pc = same;
+      if (!same && !initial && !system_fresh) keep_pc = ++steps_since_pc < std::max(1, s.cfg_.pressure_pc_refresh);
+      if (!keep_pc) steps_since_pc = 0;
       Mat Ap = A;
-      if (!has_dirichlet) {
+      if (closed) {
         // A closed domain: the correction is fixed to zero in cell 0 (its row and column replaced
         // by the diagonal), which leaves a nonsingular system with the same solution up to the
         // constant that the pressure level below takes care of.
         if (!same) {
-          if (Apin) MatDestroy(&Apin);
-          petsc_check(MatDuplicate(A, MAT_COPY_VALUES, &Apin), "MatDuplicate");
+          if (Apin) petsc_check(MatCopy(A, Apin, SAME_NONZERO_PATTERN), "MatCopy");
+          else petsc_check(MatDuplicate(A, MAT_COPY_VALUES, &Apin), "MatDuplicate");
           const PetscInt row0 = 0;
           petsc_check(MatZeroRowsColumns(Apin, 1, &row0, diag[0], dx, r), "MatZeroRowsColumns");
         } else {
@@ -613,7 +799,8 @@ struct VofSolver::Impl {
         }
         Ap = Apin;
       }
-      petsc_check(KSPSetReusePreconditioner(ksp, same ? PETSC_TRUE : PETSC_FALSE), "KSPSetReusePreconditioner");
+      system_fresh = false;
+      petsc_check(KSPSetReusePreconditioner(ksp, keep_pc ? PETSC_TRUE : PETSC_FALSE), "KSPSetReusePreconditioner");
       petsc_check(KSPSetOperators(ksp, Ap, Ap), "KSPSetOperators");
       petsc_check(KSPSolve(ksp, r, dx), "KSPSolve");
       KSPConvergedReason reason;
@@ -621,42 +808,72 @@ struct VofSolver::Impl {
       PetscInt k = 0;
       KSPGetIterationNumber(ksp, &k);
       its += k;
+      if (reason < 0 && keep_pc) {
+        // The kept preconditioner no longer fits the matrix (the viscosity changed by orders of
+        // magnitude somewhere): build it anew and solve again.
+        petsc_check(VecSet(dx, 0.0), "VecSet");
+        petsc_check(KSPSetReusePreconditioner(ksp, PETSC_FALSE), "KSPSetReusePreconditioner");
+        petsc_check(KSPSetOperators(ksp, Ap, Ap), "KSPSetOperators");
+        petsc_check(KSPSolve(ksp, r, dx), "KSPSolve");
+        KSPGetConvergedReason(ksp, &reason);
+        KSPGetIterationNumber(ksp, &k);
+        its += k;
+        steps_since_pc = 0;
+        ++pc_rebuilds_forced;
+      }
       if (reason < 0)
         throw VofError("pressure solver (CG + " + s.cfg_.pressure_pc + ") did not converge at t = " + std::to_string(s.t_) +
                        " s: reason " + std::to_string(int(reason)) + " after " + std::to_string(int(k)) + " iterations");
       petsc_check(VecAXPY(x, 1.0, dx), "VecAXPY");
     }
-    const PetscScalar* xv;
-    VecGetArrayRead(x, &xv);
-    for (int c = 0; c < nc; ++c) s.p_rgh_[std::size_t(c)] = xv[c];
-    VecRestoreArrayRead(x, &xv);
+    {
+      const PetscScalar* xv;
+      VecGetArrayRead(x, &xv);
+      for (int k = 0; k < n_active; ++k) s.p_rgh_[std::size_t(active_cells[std::size_t(k)])] = xv[k];
+      VecRestoreArrayRead(x, &xv);
+    }
     // Fluxes and velocities.
     std::vector<Vec> rec(static_cast<std::size_t>(nc));
     for (int f = 0; f < nf; ++f) {
       const int o = m.owner[std::size_t(f)];
+      const signed char op = open[std::size_t(f)];
+      if (op != 0) {
+        // An opening: the flux out of the active cell a follows its pressure and the outside's.
+        const int a = op > 0 ? o : m.neighbour[std::size_t(f)];
+        const double sg = op;
+        const double pflux_out = -coef[std::size_t(f)] * (pout[std::size_t(f)] - s.p_rgh_[std::size_t(a)]);
+        s.phi_[std::size_t(f)] = phiHbyA[std::size_t(f)] + sg * pflux_out;
+        if (rAU[std::size_t(a)] > 0) {
+          const double q = pflux_out / rAU[std::size_t(a)] / m.magSf[std::size_t(f)];
+          rec[std::size_t(a)] = rec[std::size_t(a)] + (q * sg) * m.Sf[std::size_t(f)];
+        }
+        continue;
+      }
+      if (ix[std::size_t(o)] < 0) {  // outside the active region: no flow
+        s.phi_[std::size_t(f)] = 0;
+        continue;
+      }
       double pflux = 0;
       if (f < m.n_internal) {
         const int nb = m.neighbour[std::size_t(f)];
         pflux = -coef[std::size_t(f)] * (s.p_rgh_[std::size_t(nb)] - s.p_rgh_[std::size_t(o)]);
-      } else if (kind_of(f) == Bc::atmosphere) {
-        pflux = -coef[std::size_t(f)] * (-rho[std::size_t(o)] * ghf[std::size_t(f)] - s.p_rgh_[std::size_t(o)]);
       }
       s.phi_[std::size_t(f)] = phiHbyA[std::size_t(f)] + pflux;
-      if (rAUf[std::size_t(f)] > 0) {
+      if (f < m.n_internal && rAUf[std::size_t(f)] > 0) {
         const double q = (phig[std::size_t(f)] + pflux) / rAUf[std::size_t(f)] / m.magSf[std::size_t(f)];
         rec[std::size_t(o)] = rec[std::size_t(o)] + q * m.Sf[std::size_t(f)];
-        if (f < m.n_internal) rec[std::size_t(m.neighbour[std::size_t(f)])] = rec[std::size_t(m.neighbour[std::size_t(f)])] + q * m.Sf[std::size_t(f)];
+        rec[std::size_t(m.neighbour[std::size_t(f)])] = rec[std::size_t(m.neighbour[std::size_t(f)])] + q * m.Sf[std::size_t(f)];
       }
     }
     if (!initial)
-      for (int c = 0; c < nc; ++c) {
+      for (int c : active_cells) {
         const auto& T = recon_inv[std::size_t(c)];
         const Vec r = rec[std::size_t(c)];
         const Vec R{T[0] * r.x + T[1] * r.y, T[1] * r.x + T[2] * r.y, 0};
         s.U_[std::size_t(c)] = HbyA[std::size_t(c)] + rAU[std::size_t(c)] * R;
       }
-    for (int c = 0; c < nc; ++c) s.p_[std::size_t(c)] = s.p_rgh_[std::size_t(c)] + rho[std::size_t(c)] * gh[std::size_t(c)];
-    if (!has_dirichlet) {
+    for (int c : active_cells) s.p_[std::size_t(c)] = s.p_rgh_[std::size_t(c)] + rho[std::size_t(c)] * gh[std::size_t(c)];
+    if (closed) {
       // A closed domain fixes the pressure only up to a constant, but the Coulomb viscosity needs the
       // pressure itself: it is zero in the highest cell (along gravity), the top of the air.
       int top = 0;
@@ -675,6 +892,13 @@ struct VofSolver::Impl {
 
   std::vector<Vec> U_old;
   std::vector<Grad> grad_cache;
+
+  int steps_since_pc = 0;
+  long pc_rebuilds_forced = 0;  // preconditioners rebuilt because a kept one failed
+  std::vector<int> active_index;  // per cell: its row in the pressure system, -1 outside the active region
+  std::vector<int> active_cells, layer_work;
+  int n_active = 0;
+  bool system_fresh = true;  // the pressure system was just (re)created
 };
 
 VofSolver::VofSolver(Mesh mesh, VofConfig cfg) : mesh_(std::move(mesh)), cfg_(std::move(cfg)) {
@@ -706,7 +930,11 @@ void VofSolver::initialise(const std::vector<double>& alpha, const std::vector<V
   I.update_rho(I.rho);
   // Hydrostatic pressure: the pressure equation with no velocity and unit rAU.
   std::fill(I.rAUf.begin(), I.rAUf.end(), 1.0);
+  std::fill(I.rAU.begin(), I.rAU.end(), 1.0);
   std::fill(I.HbyA.begin(), I.HbyA.end(), Vec{});
+  I.n_active = 0;
+  I.update_active(true);
+  I.make_pressure_system();
   I.pressure_correct(true);
   std::fill(phi_.begin(), phi_.end(), 0.0);
   // Inflow faces carry their flux from the start.
@@ -722,16 +950,22 @@ StepStats VofSolver::step() {
   const auto& m = mesh_;
   StepStats st;
   // 1. Time step from the Courant numbers of the last step (eqs. 4.64-4.65).
-  double co = 0, aco = 0;
-  for (int c = 0; c < m.cells(); ++c) {
+  double co = 0, aco = 0, air_co = 0;
+  for (int c : I.active_cells) {
     double sum = 0;
     for (int f : I.cell_faces[std::size_t(c)]) sum += std::abs(phi_[std::size_t(f)]);
     const double cc = 0.5 * sum / m.volume[std::size_t(c)] * dt_;
-    co = std::max(co, cc);
-    if (alpha_[std::size_t(c)] > 0.01 && alpha_[std::size_t(c)] < 0.99) aco = std::max(aco, cc);
+    const double a = alpha_[std::size_t(c)];
+    if (a > cfg_.material_alpha) {
+      co = std::max(co, cc);
+    } else {
+      air_co = std::max(air_co, cc);
+    }
+    if (a > 0.01 && a < 0.99) aco = std::max(aco, cc);
   }
   {
-    const double fac = std::min(cfg_.max_co / std::max(co, 1e-30), cfg_.max_alpha_co / std::max(aco, 1e-30));
+    const double fac = std::min({cfg_.max_co / std::max(co, 1e-30), cfg_.max_alpha_co / std::max(aco, 1e-30),
+                                 cfg_.max_air_co / std::max(air_co, 1e-30)});
     const double grow = std::min(std::min(fac, 1.0 + 0.1 * fac), 1.2);
     dt_ = std::min(grow * dt_, cfg_.dt_max);
   }
@@ -745,6 +979,8 @@ StepStats VofSolver::step() {
   // 2-3. Phase fraction (uses the last fluxes), then the mixture density.
   I.solve_alpha(dt_);
   I.update_rho(I.rho);
+  if (I.update_active(false)) I.make_pressure_system();
+  st.active_cells = I.n_active;
   // 5-6. Momentum matrix and PISO correctors.
   I.grad_cache = I.velocity_gradient();
   double t_p = 0;
@@ -753,7 +989,7 @@ StepStats VofSolver::step() {
   for (int k = 0; k < std::max(1, cfg_.n_correctors); ++k) {
     I.compute_H();
     const auto tp = clk::now();
-    st.pressure_iterations += I.pressure_correct(false, k > 0);
+    st.pressure_iterations += I.pressure_correct(false, k > 0, k + 1 == std::max(1, cfg_.n_correctors));
     t_p += std::chrono::duration<double>(clk::now() - tp).count();
   }
   I.update_viscosity();
@@ -771,12 +1007,14 @@ StepStats VofSolver::step() {
     st.alpha_max = std::max(st.alpha_max, a);
     st.granular_volume += a * m.volume[std::size_t(c)];
     if (a > 0.5) st.max_speed = std::max(st.max_speed, norm(U_[std::size_t(c)]));
-    st.divergence = std::max(st.divergence, std::abs(div[std::size_t(c)]) / m.volume[std::size_t(c)]);
+    if (I.active_index[std::size_t(c)] >= 0)  // the air at rest outside the active region is a reservoir
+      st.divergence = std::max(st.divergence, std::abs(div[std::size_t(c)]) / m.volume[std::size_t(c)]);
     if (!std::isfinite(a) || !std::isfinite(U_[std::size_t(c)].x) || !std::isfinite(U_[std::size_t(c)].y))
       throw VofError("the solution is no longer finite at t = " + std::to_string(t_) + " s (cell " + std::to_string(c) + ")");
   }
   st.co = co;
   st.alpha_co = aco;
+  st.air_co = air_co;
   st.seconds_pressure = t_p;
   st.seconds_total = std::chrono::duration<double>(clk::now() - t0).count();
   return st;

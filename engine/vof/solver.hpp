@@ -50,15 +50,24 @@ struct VofConfig {
   std::string rheology = "coulomb";  ///< the granular phase's viscosity model, by name
   double nu_min = 1e-15, nu_max = 1e2;  ///< viscosity limits [m2/s]
   std::function<Vec(double)> gravity = [](double) { return Vec{0, -9.81, 0}; };
-  double max_co = 0.2;         ///< target Courant number (velocity)
+  double max_co = 0.2;         ///< target Courant number (velocity) in cells with material
   double max_alpha_co = 0.2;   ///< target Courant number in interface cells
+  double max_air_co = 1.0;     ///< target Courant number in the air (the implicit momentum equation
+                               ///< stays stable; the air's speed does not matter for the material)
+  double material_alpha = 1e-3;  ///< cells with more material than this count as material
   double dt_initial = 1e-4, dt_max = 1e-2;
   double c_alpha = 1.0;        ///< interface compression coefficient
   int n_correctors = 3;        ///< PISO correctors per step
   bool momentum_predictor = false;  ///< solve the momentum matrix before the correctors (see docs/vof.md)
   int alpha_subcycles = 2;
   std::string pressure_pc = "gamg";  ///< "gamg" or "hypre" (BoomerAMG)
-  double pressure_rtol = 1e-8;
+  double pressure_rtol = 1e-8;  ///< relative tolerance of the last corrector's pressure solve
+  double pressure_rtol_intermediate = 1e-2;  ///< of the correctors before it
+  int pressure_pc_refresh = 10;  ///< rebuild the pressure preconditioner every this many steps
+  /// The active region: cells with alpha > active_alpha and this many layers of cells around them
+  /// (0: every cell). Air beyond it is at rest under the atmosphere's pressure and costs nothing.
+  int active_layers = 4;
+  double active_alpha = 1e-6;
   std::map<std::string, PatchBc> bc;  ///< by patch name; every patch needs one
 };
 
@@ -68,7 +77,7 @@ struct VofError : std::runtime_error {
 
 /// Per-step solver statistics.
 struct StepStats {
-  double t = 0, dt = 0, co = 0, alpha_co = 0;
+  double t = 0, dt = 0, co = 0, alpha_co = 0, air_co = 0;  ///< Courant numbers: material, interface, air
   int pressure_iterations = 0;  ///< summed over the correctors
   int momentum_iterations = 0;  ///< of the predictor, both components
   double seconds_pressure = 0, seconds_total = 0;
@@ -76,6 +85,7 @@ struct StepStats {
   double granular_volume = 0;   ///< sum alpha V [m3]
   double max_speed = 0;         ///< in cells with alpha > 0.5
   double divergence = 0;        ///< max |sum of face fluxes| / V over cells [1/s]
+  int active_cells = 0;         ///< cells in the active region (the pressure system's size)
 };
 
 class VofSolver {
