@@ -4,6 +4,9 @@
 //   runout_bench_vof [--full] [--end T]   (default: 5 mm cells; --full: 2.5 mm, the dissertation's)
 //   runout_bench_vof --b10                 B10: column collapse for aspect ratios 0.5-6 (5 mm cells),
 //                                          normalised runout and the exponents of its growth
+//   runout_bench_vof --region              cost per step against the material region: the same failing
+//                                          heap in channels 0.3-2.4 m long, with the active region and
+//                                          with every cell computed
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -66,8 +69,45 @@ static int b10() {
   return 0;
 }
 
+// The same 50 deg heap (6 cm wide, 7 cm high, PVC) failing at the closed left end of channels of
+// growing length (5 mm cells, 10 cm high, open top and right end), to 0.5 s: the active region keeps
+// the cost per step with the material, every cell computed makes it grow with the channel.
+static int region() {
+  std::printf("| channel [m] | cells | active cells (mean) | wall, active region [s] | wall, every cell [s] | "
+              "us per step, active region | us per step, every cell | ratio |\n|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  for (double len : {0.3, 0.6, 1.2, 2.4}) {
+    double wall[2] = {0, 0}, per_step[2] = {0, 0}, active = 0;
+    int cells = 0;
+    for (int mode = 0; mode < 2; ++mode) {
+      auto sc = runout::jobs::parse_scenario_json(
+          R"({"engine": "vof", "lab": {"boundaries": [{"side": "top", "kind": "atmosphere"}, {"side": "right", "kind": "atmosphere"}],
+              "fill": [{"polygon_xy": [0, 0, 0.06, 0, 0, 0.072]}], "y_max": 0.1, "ny": 20, "end_time_s": 0.5, "write_interval_s": 0}})");
+      auto* lab = sc.mutable_lab();
+      lab->set_x_max(len);
+      lab->set_nx(int(std::lround(len / 0.005)));
+      lab->set_active_layers(mode == 0 ? 0 : -1);
+      auto r = runout::jobs::resolve_scenario(sc, ".");
+      const fs::path out = fs::temp_directory_path() / ("runout-bench-region-" + std::to_string(getpid()));
+      fs::create_directories(out);
+      const auto sum = runout::jobs::run_scenario(r, out.string());
+      std::ifstream in(out / "run.json");
+      std::stringstream ss;
+      ss << in.rdbuf();
+      fs::remove_all(out);
+      wall[mode] = sum.seconds_run;
+      per_step[mode] = 1e6 * sum.seconds_run / double(sum.steps);
+      if (mode == 0) active = field(ss.str(), "active_cells_mean");
+      cells = sum.nx * sum.ny;
+    }
+    std::printf("| %.1f | %d | %.0f | %.2f | %.2f | %.0f | %.0f | %.2f |\n", len, cells, active, wall[0], wall[1], per_step[0], per_step[1],
+                per_step[1] / per_step[0]);
+  }
+  return 0;
+}
+
 int main(int argc, char** argv) {
   if (argc > 1 && std::string(argv[1]) == "--b10") return b10();
+  if (argc > 1 && std::string(argv[1]) == "--region") return region();
   bool full = false;
   double end = 1.0;
   for (int k = 1; k < argc; ++k) {

@@ -173,6 +173,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   c.phi_deg = mat.phi_deg;
   c.max_co = c.max_alpha_co = L.max_courant();
   c.n_correctors = L.correctors();
+  c.active_layers = L.active_layers() < 0 ? 0 : L.active_layers();
   const double zeta = L.inclination_deg() * kPi / 180;
   const double omega = L.rotation_period_s() > 0 ? 2 * kPi / L.rotation_period_s() : 0.0;
   c.gravity = [zeta, omega](double t) {
@@ -242,11 +243,15 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   double next_write = L.write_interval_s() > 0 ? L.write_interval_s() : 1e300;
   double peak = 0, t_peak = 0, t_rest = -1, pressure_s = 0, alpha_min = 1, alpha_max = 0, div = 0, last_speed = 0;
   long steps = 0, p_its = 0;
+  double active_sum = 0;
+  int active_max = 0;
   bool cancelled = false;
   const auto t1 = clk::now();
   s.run(L.end_time_s(), [&](const vof::StepStats& st) {
     ++steps;
     p_its += st.pressure_iterations;
+    active_sum += st.active_cells;
+    active_max = std::max(active_max, st.active_cells);
     pressure_s += st.seconds_pressure;
     alpha_min = std::min(alpha_min, st.alpha_min);
     alpha_max = std::max(alpha_max, st.alpha_max);
@@ -268,7 +273,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       p.dt = st.dt;
       p.mass = st.granular_volume;
       p.max_speed = st.max_speed;
-      p.active_fraction = 1.0;
+      p.active_fraction = double(st.active_cells) / m.cells();
       p.step = steps;
       if (!opt.progress(p)) {
         cancelled = true;
@@ -336,6 +341,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     << ", \"dy_m\": " << num(dy) << "},\n";
   j << "  \"solver\": {\"steps\": " << steps << ", \"simulated_s\": " << num(s.time()) << ", \"pressure_iterations\": " << p_its
     << ", \"alpha_min\": " << num(alpha_min) << ", \"alpha_max\": " << num(alpha_max) << ", \"max_divergence_1_s\": " << num(div)
+    << ", \"active_cells_mean\": " << num(steps ? active_sum / steps : NAN) << ", \"active_cells_max\": " << active_max
     << ", \"stop\": \"" << sum.stop << "\"},\n";
   j << "  \"results\": {\"peak_speed_m_s\": " << num(peak) << ", \"peak_speed_time_s\": " << num(t_peak)
     << ", \"rest_time_s\": " << num(t_rest >= 0 ? t_rest : NAN) << ", \"final_speed_m_s\": " << num(last_speed)
@@ -367,7 +373,8 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   j << "],\n";
   j << "  \"timings_s\": {\"prepare\": " << num(sum.seconds_prepare) << ", \"run\": " << num(sum.seconds_run)
     << ", \"pressure\": " << num(pressure_s) << ", \"write\": " << num(sum.seconds_write) << ", \"microseconds_per_cell_step\": "
-    << num(steps ? 1e6 * sum.seconds_run / steps / m.cells() : NAN) << "}\n}\n";
+    << num(steps ? 1e6 * sum.seconds_run / steps / m.cells() : NAN) << ", \"microseconds_per_active_cell_step\": "
+    << num(active_sum > 0 ? 1e6 * sum.seconds_run / active_sum : NAN) << "}\n}\n";
   if (!j) throw std::runtime_error("cannot write run.json");
   return sum;
 }
