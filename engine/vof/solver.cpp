@@ -143,6 +143,18 @@ struct VofSolver::Impl {
     bsrc = H;
     cO.assign(std::size_t(nf), 0);
     cN = cO;
+    G.assign(std::size_t(nc), Grad{});
+    U_old.assign(std::size_t(nc), Vec{});
+    wf1.assign(std::size_t(nf), 0);
+    for (auto* v : {&wf2, &pf_phiHbyA, &pf_phig, &pf_coef, &pf_pout}) *v = wf1;
+    pf_open.assign(std::size_t(nf), 0);
+    wc1.assign(std::size_t(nc), 0);
+    for (auto* v : {&wc2, &wc3, &wc4, &wc5, &wc6, &wc7}) *v = wc1;
+    wv1.assign(std::size_t(nc), Vec{});
+    pf_rec = wv1;
+    double vsum = 0;
+    for (double v : m.volume) vsum += v;
+    mean_cell_size = std::cbrt(vsum / nc);
     petsc_check(MatCreateSeqAIJ(PETSC_COMM_SELF, nc, nc, 0, nnz.data(), &Mu), "MatCreateSeqAIJ");
     petsc_check(VecCreateSeq(PETSC_COMM_SELF, nc, &xu), "VecCreateSeq");
     petsc_check(VecDuplicate(xu, &bu), "VecDuplicate");
@@ -157,6 +169,9 @@ struct VofSolver::Impl {
 
   void update_gravity(double t) {
     const Vec g = s.cfg_.gravity(t);
+    if (gravity_set && g.x == g_last.x && g.y == g_last.y && g.z == g_last.z) return;
+    gravity_set = true;
+    g_last = g;
     for (int c = 0; c < nc; ++c) gh[std::size_t(c)] = dot(g, m.centre[std::size_t(c)]);
     for (int f = 0; f < nf; ++f) ghf[std::size_t(f)] = dot(g, m.Cf[std::size_t(f)]);
     gh_ref = 1e300;
@@ -176,10 +191,12 @@ struct VofSolver::Impl {
     return s.cfg_.rho2 * (g - gh_ref) - rho[std::size_t(a)] * g;
   }
   double gh_ref = 0;
+  Vec g_last;
+  bool gravity_set = false;
 
   void update_rho(std::vector<double>& r) const {
     const auto& a = s.alpha_;
-    for (int c = 0; c < nc; ++c) {
+    for (int c : halo_cells) {
       const double al = std::clamp(a[std::size_t(c)], 0.0, 1.0);
       r[std::size_t(c)] = al * s.cfg_.rho1 + (1 - al) * s.cfg_.rho2;
     }
@@ -196,9 +213,10 @@ struct VofSolver::Impl {
   }
 
   // Gauss gradient of the velocity per cell (boundary values from the conditions).
-  std::vector<Grad> velocity_gradient() const {
-    std::vector<Grad> G(static_cast<std::size_t>(nc));
-    for (int f = 0; f < nf; ++f) {
+  // Only faces of the active region contribute (the air beyond rests); the result is kept in G.
+  void velocity_gradient() {
+    for (int c : halo_cells) G[std::size_t(c)] = Grad{};
+    for (int f : active_faces) {
       const int o = m.owner[std::size_t(f)];
       const Vec S = m.Sf[std::size_t(f)];
       Vec Uf;
@@ -215,10 +233,9 @@ struct VofSolver::Impl {
           if (f < m.n_internal) G[std::size_t(m.neighbour[std::size_t(f)])].g[i][j] -= v;
         }
     }
-    for (int c = 0; c < nc; ++c)
+    for (int c : halo_cells)
       for (auto& row : G[std::size_t(c)].g)
         for (double& v : row) v /= m.volume[std::size_t(c)];
-    return G;
   }
 
   // The velocity on a boundary face.
@@ -251,9 +268,9 @@ struct VofSolver::Impl {
   }
 
   void update_viscosity() {
-    const auto G = velocity_gradient();
+    velocity_gradient();
     const double tanphi = std::tan(s.cfg_.phi_deg * kPi / 180);
-    for (int c = 0; c < nc; ++c) {
+    for (int c : active_cells) {
       const auto& g = G[std::size_t(c)].g;
       double dd = 0;
       for (int i = 0; i < 3; ++i)
@@ -275,16 +292,18 @@ struct VofSolver::Impl {
     auto& a = s.alpha_;
     const int n = std::max(1, s.cfg_.alpha_subcycles);
     const double dts = dt / n;
-    std::fill(alpha_phi.begin(), alpha_phi.end(), 0.0);
-    std::vector<double> FL(static_cast<std::size_t>(nf)), AF(static_cast<std::size_t>(nf)), amax(static_cast<std::size_t>(nc)), amin(static_cast<std::size_t>(nc)),
-        Pp(static_cast<std::size_t>(nc)), Pm(static_cast<std::size_t>(nc)), Rp(static_cast<std::size_t>(nc)), Rm(static_cast<std::size_t>(nc)), aL(static_cast<std::size_t>(nc));
-    double vsum = 0;
-    for (double v : m.volume) vsum += v;
-    const double delta_n = 1e-8 / std::cbrt(vsum / nc);
+    // Only faces of the active region carry flux; alpha changes only in its cells and their
+    // neighbours (halo_cells).
+    for (int f : active_faces) alpha_phi[std::size_t(f)] = 0;
+    auto& FL = wf1;
+    auto& AF = wf2;
+    auto &amax = wc1, &amin = wc2, &Pp = wc3, &Pm = wc4, &Rp = wc5, &Rm = wc6, &aL = wc7;
+    auto& ga = wv1;
+    const double delta_n = 1e-8 / mean_cell_size;
     for (int sub = 0; sub < n; ++sub) {
       // Interface normal per cell (Gauss gradient of alpha).
-      std::vector<Vec> ga(static_cast<std::size_t>(nc));
-      for (int f = 0; f < nf; ++f) {
+      for (int c : halo_cells) ga[std::size_t(c)] = Vec{};
+      for (int f : active_faces) {
         const int o = m.owner[std::size_t(f)];
         const double af = f < m.n_internal ? m.weight[std::size_t(f)] * a[std::size_t(o)] +
                                                  (1 - m.weight[std::size_t(f)]) * a[std::size_t(m.neighbour[std::size_t(f)])]
@@ -292,9 +311,9 @@ struct VofSolver::Impl {
         ga[std::size_t(o)] = ga[std::size_t(o)] + af * m.Sf[std::size_t(f)];
         if (f < m.n_internal) ga[std::size_t(m.neighbour[std::size_t(f)])] = ga[std::size_t(m.neighbour[std::size_t(f)])] - af * m.Sf[std::size_t(f)];
       }
-      for (int c = 0; c < nc; ++c) ga[std::size_t(c)] = (1.0 / m.volume[std::size_t(c)]) * ga[std::size_t(c)];
-      for (int c = 0; c < nc; ++c) amax[std::size_t(c)] = amin[std::size_t(c)] = a[std::size_t(c)];
-      for (int f = 0; f < nf; ++f) {
+      for (int c : halo_cells) ga[std::size_t(c)] = (1.0 / m.volume[std::size_t(c)]) * ga[std::size_t(c)];
+      for (int c : halo_cells) amax[std::size_t(c)] = amin[std::size_t(c)] = a[std::size_t(c)];
+      for (int f : active_faces) {
         const int o = m.owner[std::size_t(f)];
         const double ph = s.phi_[std::size_t(f)];
         if (f < m.n_internal) {
@@ -326,10 +345,11 @@ struct VofSolver::Impl {
         }
       }
       // Low-order update and the limiter.
-      for (int c = 0; c < nc; ++c) aL[std::size_t(c)] = a[std::size_t(c)] * m.volume[std::size_t(c)];
-      std::fill(Pp.begin(), Pp.end(), 0.0);
-      std::fill(Pm.begin(), Pm.end(), 0.0);
-      for (int f = 0; f < nf; ++f) {
+      for (int c : halo_cells) {
+        aL[std::size_t(c)] = a[std::size_t(c)] * m.volume[std::size_t(c)];
+        Pp[std::size_t(c)] = Pm[std::size_t(c)] = 0;
+      }
+      for (int f : active_faces) {
         const int o = m.owner[std::size_t(f)];
         aL[std::size_t(o)] -= dts * FL[std::size_t(f)];
         if (f < m.n_internal) {
@@ -346,7 +366,7 @@ struct VofSolver::Impl {
           }
         }
       }
-      for (int c = 0; c < nc; ++c) {
+      for (int c : halo_cells) {
         const double V = m.volume[std::size_t(c)];
         const double lo = aL[std::size_t(c)] / V;
         const double up = std::clamp(amax[std::size_t(c)], 0.0, 1.0), dn = std::clamp(amin[std::size_t(c)], 0.0, 1.0);
@@ -354,7 +374,7 @@ struct VofSolver::Impl {
         Rp[std::size_t(c)] = Pp[std::size_t(c)] > 0 ? std::min(1.0, Qp / Pp[std::size_t(c)]) : 1.0;
         Rm[std::size_t(c)] = Pm[std::size_t(c)] > 0 ? std::min(1.0, Qm / Pm[std::size_t(c)]) : 1.0;
       }
-      for (int f = 0; f < nf; ++f) {
+      for (int f : active_faces) {
         double F = FL[std::size_t(f)];
         if (f < m.n_internal) {
           const int o = m.owner[std::size_t(f)], nb = m.neighbour[std::size_t(f)];
@@ -367,9 +387,9 @@ struct VofSolver::Impl {
         }
         alpha_phi[std::size_t(f)] += F / n;
       }
-      for (int c = 0; c < nc; ++c) a[std::size_t(c)] = aL[std::size_t(c)] / m.volume[std::size_t(c)];
+      for (int c : halo_cells) a[std::size_t(c)] = aL[std::size_t(c)] / m.volume[std::size_t(c)];
     }
-    for (int f = 0; f < nf; ++f)
+    for (int f : active_faces)
       rho_phi[std::size_t(f)] = alpha_phi[std::size_t(f)] * (s.cfg_.rho1 - s.cfg_.rho2) + s.phi_[std::size_t(f)] * s.cfg_.rho2;
   }
 
@@ -377,7 +397,7 @@ struct VofSolver::Impl {
   // each internal face (cO: owner row, cN: neighbour row; A_D U_P - sum c U_nb = bsrc) and the
   // sources. Boundary values and the transpose viscous part are taken from the current velocity.
   void build_momentum(double dt) {
-    for (int c = 0; c < nc; ++c) {
+    for (int c : halo_cells) {
       const double V = m.volume[std::size_t(c)];
       A_D[std::size_t(c)] = rho[std::size_t(c)] * V / dt;
       bsrc[std::size_t(c)] = (rho_old[std::size_t(c)] * V / dt) * U_old[std::size_t(c)];
@@ -386,8 +406,7 @@ struct VofSolver::Impl {
     // sum over faces of mu_f (grad U)^T_f . Sf. (The equivalent cell form (grad U) . grad mu, with
     // mu jumping nine orders of magnitude across the interface, moved a heap that should rest.)
     {
-      const auto& G = grad_cache;
-      for (int f = 0; f < nf; ++f) {
+      for (int f : active_faces) {
         const int o = m.owner[std::size_t(f)];
         const bool in = f < m.n_internal;
         const int nb = in ? m.neighbour[std::size_t(f)] : o;
@@ -404,7 +423,7 @@ struct VofSolver::Impl {
         if (in) bsrc[std::size_t(nb)] = bsrc[std::size_t(nb)] - t;
       }
     }
-    for (int f = 0; f < nf; ++f) {
+    for (int f : active_faces) {
       const int o = m.owner[std::size_t(f)];
       const double F = rho_phi[std::size_t(f)];
       if (f < m.n_internal) {
@@ -432,8 +451,8 @@ struct VofSolver::Impl {
         }
       }
     }
-    for (int c = 0; c < nc; ++c) rAU[std::size_t(c)] = m.volume[std::size_t(c)] / A_D[std::size_t(c)];  // 1 / A per unit volume [m3 s/kg]
-    for (int f = 0; f < nf; ++f) {
+    for (int c : halo_cells) rAU[std::size_t(c)] = m.volume[std::size_t(c)] / A_D[std::size_t(c)];  // 1 / A per unit volume [m3 s/kg]
+    for (int f : active_faces) {
       const int o = m.owner[std::size_t(f)];
       rAUf[std::size_t(f)] = f < m.n_internal ? m.weight[std::size_t(f)] * rAU[std::size_t(o)] +
                                                     (1 - m.weight[std::size_t(f)]) * rAU[std::size_t(m.neighbour[std::size_t(f)])]
@@ -444,13 +463,14 @@ struct VofSolver::Impl {
   // H = sources + neighbour coefficients x the current velocity; HbyA = H / A_D.
   void compute_H() {
     const auto& U = s.U_;
-    H = bsrc;
-    for (int f = 0; f < m.n_internal; ++f) {
+    for (int c : halo_cells) H[std::size_t(c)] = bsrc[std::size_t(c)];
+    for (int f : active_faces) {
+      if (f >= m.n_internal) break;  // active_faces is sorted: internal faces first
       const int o = m.owner[std::size_t(f)], nb = m.neighbour[std::size_t(f)];
       H[std::size_t(o)] = H[std::size_t(o)] + cO[std::size_t(f)] * U[std::size_t(nb)];
       H[std::size_t(nb)] = H[std::size_t(nb)] + cN[std::size_t(f)] * U[std::size_t(o)];
     }
-    for (int c = 0; c < nc; ++c) HbyA[std::size_t(c)] = (1.0 / A_D[std::size_t(c)]) * H[std::size_t(c)];
+    for (int c : halo_cells) HbyA[std::size_t(c)] = (1.0 / A_D[std::size_t(c)]) * H[std::size_t(c)];
   }
 
   // Momentum predictor: solve the momentum matrix with the last pressure and buoyancy forces,
@@ -525,20 +545,52 @@ struct VofSolver::Impl {
   // material comes within two layers of its edge, so it keeps its shape (and the pressure
   // preconditioner) for many steps. Returns true when it changed.
   bool update_active(bool force) {
-    const int layers = s.cfg_.active_layers;
+    const int layers = s.cfg_.momentum_predictor ? 0 : s.cfg_.active_layers;  // the predictor solves every cell
     if (layers <= 0) {
-      if (n_active == nc) return false;
-      active_index.resize(std::size_t(nc));
-      for (int c = 0; c < nc; ++c) active_index[std::size_t(c)] = c;
-      active_cells.resize(std::size_t(nc));
-      for (int c = 0; c < nc; ++c) active_cells[std::size_t(c)] = c;
-      n_active = nc;
+      if (n_active == nc && !force) return false;
+      std::vector<int> all(std::size_t(nc), 0);
+      set_region(all);
       return true;
     }
+    // Cheap check first: material, and two layers around it, must lie inside the region. Material
+    // can appear only where faces of the region carry flux, so the cells next to it (halo_cells)
+    // are the only candidates; marks carry a stamp instead of being cleared.
+    if (!force && n_active > 0) {
+      if (++stamp == 0) {
+        std::fill(mark.begin(), mark.end(), 0u);
+        stamp = 1;
+      }
+      std::vector<int>& front = bfs_a;
+      std::vector<int>& next = bfs_b;
+      front.clear();
+      for (int c : halo_cells)
+        if (s.alpha_[std::size_t(c)] > s.cfg_.active_alpha) {
+          mark[std::size_t(c)] = stamp;
+          front.push_back(c);
+        }
+      bool inside = true;
+      for (int k = 0; k <= std::min(2, layers) && inside; ++k) {
+        next.clear();
+        for (int c : front) {
+          if (active_index[std::size_t(c)] < 0) {
+            inside = false;
+            break;
+          }
+          for (int f : cell_faces[std::size_t(c)]) {
+            if (f >= m.n_internal) continue;
+            const int other = m.owner[std::size_t(f)] == c ? m.neighbour[std::size_t(f)] : m.owner[std::size_t(f)];
+            if (mark[std::size_t(other)] != stamp) {
+              mark[std::size_t(other)] = stamp;
+              next.push_back(other);
+            }
+          }
+        }
+        front.swap(next);
+      }
+      if (inside) return false;
+    }
     // Distance in layers from the material (BFS over faces), up to `layers`.
-    std::vector<int>& d = layer_work;
-    d.assign(std::size_t(nc), -1);
-    std::vector<int> front, next;
+    std::vector<int> d(std::size_t(nc), -1), front, next;
     for (int c = 0; c < nc; ++c)
       if (s.alpha_[std::size_t(c)] > s.cfg_.active_alpha) {
         d[std::size_t(c)] = 0;
@@ -557,8 +609,7 @@ struct VofSolver::Impl {
       for (int c : front)
         for (int f : cell_faces[std::size_t(c)]) {
           if (f >= m.n_internal) continue;
-          const int o = m.owner[std::size_t(f)], nb = m.neighbour[std::size_t(f)];
-          const int other = o == c ? nb : o;
+          const int other = m.owner[std::size_t(f)] == c ? m.neighbour[std::size_t(f)] : m.owner[std::size_t(f)];
           if (d[std::size_t(other)] < 0) {
             d[std::size_t(other)] = k;
             next.push_back(other);
@@ -595,12 +646,14 @@ struct VofSolver::Impl {
       for (int c = 0; c < nc; ++c)
         if (d[std::size_t(c)] < 0 && !out[std::size_t(c)]) d[std::size_t(c)] = layers + 1;
     }
-    if (!force && n_active > 0) {
-      bool inside = true;
-      for (int c = 0; c < nc && inside; ++c)
-        if (d[std::size_t(c)] >= 0 && d[std::size_t(c)] <= std::min(2, layers) && active_index[std::size_t(c)] < 0) inside = false;
-      if (inside) return false;
-    }
+    set_region(d);
+    return true;
+  }
+
+  // Make the cells with d >= 0 the active region: its cells, the cells next to it, its faces; the
+  // air outside at rest; no flux between resting cells; the material outside the halo, which no
+  // flux can reach, summed once.
+  void set_region(const std::vector<int>& d) {
     active_index.assign(std::size_t(nc), -1);
     active_cells.clear();
     for (int c = 0; c < nc; ++c)
@@ -609,14 +662,52 @@ struct VofSolver::Impl {
         active_cells.push_back(c);
       }
     n_active = int(active_cells.size());
-    // Air at rest outside the region.
+    std::vector<char> in_halo(std::size_t(nc), 0);
+    active_faces.clear();
+    for (int f = 0; f < nf; ++f) {
+      const int o = m.owner[std::size_t(f)];
+      const bool ao = active_index[std::size_t(o)] >= 0;
+      const bool an = f < m.n_internal && active_index[std::size_t(m.neighbour[std::size_t(f)])] >= 0;
+      if (ao || an) {
+        active_faces.push_back(f);
+        in_halo[std::size_t(o)] = 1;
+        if (f < m.n_internal) in_halo[std::size_t(m.neighbour[std::size_t(f)])] = 1;
+      } else {
+        s.phi_[std::size_t(f)] = 0;
+        alpha_phi[std::size_t(f)] = rho_phi[std::size_t(f)] = 0;
+      }
+    }
+    // Cells joining the halo start from their resting state (their old-time values are stale).
+    if (halo_flag.size() != std::size_t(nc)) halo_flag.assign(std::size_t(nc), 0);
     for (int c = 0; c < nc; ++c)
-      if (active_index[std::size_t(c)] < 0) {
+      if (in_halo[std::size_t(c)] && !halo_flag[std::size_t(c)]) {
+        if (active_index[std::size_t(c)] < 0) s.U_[std::size_t(c)] = Vec{};
+        rho_old[std::size_t(c)] = rho[std::size_t(c)];
+        U_old[std::size_t(c)] = s.U_[std::size_t(c)];
+        const double al = std::clamp(s.alpha_[std::size_t(c)], 0.0, 1.0);
+        mu[std::size_t(c)] = al * s.cfg_.rho1 * s.nu1_[std::size_t(c)] + (1 - al) * s.cfg_.rho2 * s.cfg_.nu2;
+      }
+    halo_flag = in_halo;
+    halo_cells.clear();
+    frozen_volume = 0;
+    frozen_min = 1e300;
+    frozen_max = -1e300;
+    for (int c = 0; c < nc; ++c) {
+      if (in_halo[std::size_t(c)]) {
+        halo_cells.push_back(c);
+      } else {
+        const double a = s.alpha_[std::size_t(c)];
+        frozen_volume += a * m.volume[std::size_t(c)];
+        frozen_min = std::min(frozen_min, a);
+        frozen_max = std::max(frozen_max, a);
+      }
+      if (active_index[std::size_t(c)] < 0) {  // air at rest outside the region
         s.U_[std::size_t(c)] = Vec{};
         s.p_[std::size_t(c)] = s.cfg_.rho2 * (gh[std::size_t(c)] - gh_ref);
         s.p_rgh_[std::size_t(c)] = s.p_[std::size_t(c)] - rho[std::size_t(c)] * gh[std::size_t(c)];
       }
-    return true;
+    }
+    if (mark.size() != std::size_t(nc)) mark.assign(std::size_t(nc), 0u);
   }
 
   // The pressure solver: CG with an algebraic multigrid preconditioner. Made anew whenever the
@@ -682,10 +773,11 @@ struct VofSolver::Impl {
     // Per face: the flux predicted from H/A (oriented with Sf), its buoyancy part, the Laplacian
     // coefficient and, for an opening (atmosphere patch or the edge of the active region), the
     // side of the active cell (+1 owner, -1 neighbour) and the pressure outside.
-    std::vector<double> phiHbyA(static_cast<std::size_t>(nf), 0.0), phig(static_cast<std::size_t>(nf), 0.0),
-        coef(std::size_t(nf), 0.0), pout(std::size_t(nf), 0.0);
-    std::vector<signed char> open(std::size_t(nf), 0);
-    for (int f = 0; f < nf; ++f) {
+    auto &phiHbyA = pf_phiHbyA, &phig = pf_phig, &coef = pf_coef, &pout = pf_pout;
+    auto& open = pf_open;
+    for (int f : active_faces) {
+      phiHbyA[std::size_t(f)] = phig[std::size_t(f)] = coef[std::size_t(f)] = pout[std::size_t(f)] = 0;
+      open[std::size_t(f)] = 0;
       const int o = m.owner[std::size_t(f)];
       const bool ao = ix[std::size_t(o)] >= 0;
       if (f < m.n_internal) {
@@ -700,12 +792,10 @@ struct VofSolver::Impl {
           coef[std::size_t(f)] = rAUf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
         } else if (ao || an) {
           const int a = ao ? o : nb;
-          const double sg = ao ? 1.0 : -1.0;
           open[std::size_t(f)] = ao ? 1 : -1;
           phiHbyA[std::size_t(f)] = initial ? 0.0 : dot(HbyA[std::size_t(a)], m.Sf[std::size_t(f)]);
           coef[std::size_t(f)] = rAU[std::size_t(a)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
           pout[std::size_t(f)] = outside_p_rgh(f, a);
-          (void)sg;
         }
       } else if (ao) {
         const Bc k = kind_of(f);
@@ -724,7 +814,7 @@ struct VofSolver::Impl {
     // later correctors keep it and its preconditioner and assemble only the right-hand side.
     if (!reuse) petsc_check(MatZeroEntries(A), "MatZeroEntries");
     std::vector<double> diag(std::size_t(n_active), 0.0), rhs(std::size_t(n_active), 0.0);
-    for (int f = 0; f < nf; ++f) {
+    for (int f : active_faces) {
       const double c = coef[std::size_t(f)];
       const int io = ix[std::size_t(m.owner[std::size_t(f)])];
       if (open[std::size_t(f)] != 0) {
@@ -833,8 +923,9 @@ struct VofSolver::Impl {
       VecRestoreArrayRead(x, &xv);
     }
     // Fluxes and velocities.
-    std::vector<Vec> rec(static_cast<std::size_t>(nc));
-    for (int f = 0; f < nf; ++f) {
+    auto& rec = pf_rec;
+    for (int c : active_cells) rec[std::size_t(c)] = Vec{};
+    for (int f : active_faces) {
       const int o = m.owner[std::size_t(f)];
       const signed char op = open[std::size_t(f)];
       if (op != 0) {
@@ -847,10 +938,6 @@ struct VofSolver::Impl {
           const double q = pflux_out / rAU[std::size_t(a)] / m.magSf[std::size_t(f)];
           rec[std::size_t(a)] = rec[std::size_t(a)] + (q * sg) * m.Sf[std::size_t(f)];
         }
-        continue;
-      }
-      if (ix[std::size_t(o)] < 0) {  // outside the active region: no flow
-        s.phi_[std::size_t(f)] = 0;
         continue;
       }
       double pflux = 0;
@@ -891,13 +978,27 @@ struct VofSolver::Impl {
   }
 
   std::vector<Vec> U_old;
-  std::vector<Grad> grad_cache;
 
   int steps_since_pc = 0;
   long pc_rebuilds_forced = 0;  // preconditioners rebuilt because a kept one failed
   std::vector<int> active_index;  // per cell: its row in the pressure system, -1 outside the active region
-  std::vector<int> active_cells, layer_work;
+  std::vector<int> active_cells;  // the active region
+  std::vector<int> halo_cells;    // the active region and the cells next to it (alpha may change there)
+  std::vector<int> active_faces;  // faces of active cells, in ascending order (internal faces first)
+  double frozen_volume = 0, frozen_min = 0, frozen_max = 0;  // material outside the halo (unchanging)
+  std::vector<unsigned> mark;     // the quick region check's marks
+  std::vector<char> halo_flag;    // membership of halo_cells
+  unsigned stamp = 0;
+  std::vector<int> bfs_a, bfs_b;
   int n_active = 0;
+  double mean_cell_size = 0;
+  // Work arrays (sized once; only entries of the active region are touched).
+  std::vector<Grad> G;            // velocity gradient
+  std::vector<double> wf1, wf2, wc1, wc2, wc3, wc4, wc5, wc6, wc7;
+  std::vector<Vec> wv1;
+  std::vector<double> pf_phiHbyA, pf_phig, pf_coef, pf_pout;  // pressure_correct's per-face values
+  std::vector<signed char> pf_open;
+  std::vector<Vec> pf_rec;
   bool system_fresh = true;  // the pressure system was just (re)created
 };
 
@@ -912,6 +1013,7 @@ VofSolver::VofSolver(Mesh mesh, VofConfig cfg) : mesh_(std::move(mesh)), cfg_(st
   U_.assign(n, Vec{});
   phi_.assign(std::size_t(mesh_.faces()), 0);
   dt_ = cfg_.dt_initial;
+  impl_->set_region(std::vector<int>(n, 0));  // until initialise() finds the material, every cell counts
 }
 
 VofSolver::~VofSolver() = default;
@@ -974,15 +1076,17 @@ StepStats VofSolver::step() {
   st.t = t_;
   st.dt = dt_;
   I.update_gravity(t_);
-  I.rho_old = I.rho;
-  I.U_old = U_;
+  for (int c : I.halo_cells) {
+    I.rho_old[std::size_t(c)] = I.rho[std::size_t(c)];
+    I.U_old[std::size_t(c)] = U_[std::size_t(c)];
+  }
   // 2-3. Phase fraction (uses the last fluxes), then the mixture density.
   I.solve_alpha(dt_);
   I.update_rho(I.rho);
   if (I.update_active(false)) I.make_pressure_system();
   st.active_cells = I.n_active;
   // 5-6. Momentum matrix and PISO correctors.
-  I.grad_cache = I.velocity_gradient();
+  I.velocity_gradient();
   double t_p = 0;
   I.build_momentum(dt_);
   if (cfg_.momentum_predictor) st.momentum_iterations = I.predict();
@@ -996,12 +1100,19 @@ StepStats VofSolver::step() {
   // Diagnostics.
   st.alpha_min = 1e300;
   st.alpha_max = -1e300;
-  std::vector<double> div(std::size_t(m.cells()), 0.0);
-  for (int f = 0; f < m.faces(); ++f) {
+  // Over the halo; the material beyond it does not change (its sums were taken with the region).
+  auto& div = I.wc1;
+  for (int c : I.halo_cells) div[std::size_t(c)] = 0;
+  for (int f : I.active_faces) {
     div[std::size_t(m.owner[std::size_t(f)])] += phi_[std::size_t(f)];
     if (f < m.n_internal) div[std::size_t(m.neighbour[std::size_t(f)])] -= phi_[std::size_t(f)];
   }
-  for (int c = 0; c < m.cells(); ++c) {
+  st.granular_volume = I.frozen_volume;
+  if (I.halo_cells.size() < std::size_t(m.cells())) {
+    st.alpha_min = I.frozen_min;
+    st.alpha_max = I.frozen_max;
+  }
+  for (int c : I.halo_cells) {
     const double a = alpha_[std::size_t(c)];
     st.alpha_min = std::min(st.alpha_min, a);
     st.alpha_max = std::max(st.alpha_max, a);
