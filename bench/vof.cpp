@@ -141,6 +141,8 @@ int main(int argc, char** argv) {
   std::printf("| steps to t = %.2f s | %ld | 1677 (to 1 s) |\n", sum.t, sum.steps);
   std::printf("| wall time of the solve | %.1f s | 80 s (to 1 s) |\n", sum.seconds_run);
   std::printf("| microseconds per cell and step | %.2f | about 4 |\n", 1e6 * sum.seconds_run / sum.steps / cells);
+  std::printf("| cells in the active region, mean | %.0f | (every cell) |\n", field(j, "active_cells_mean"));
+  std::printf("| microseconds per active cell and step | %.2f | |\n", field(j, "microseconds_per_active_cell_step"));
   std::printf("| share of time in the pressure solves | %.0f %% | 53 %% |\n", 100 * pressure / sum.seconds_run);
   std::printf("| peak speed, its time | %.3f m/s at %.3f s | about 1.1 m/s at 0.15 s |\n", field(j, "peak_speed_m_s"),
               field(j, "peak_speed_time_s"));
