@@ -1045,6 +1045,60 @@ void VofSolver::initialise(const std::vector<double>& alpha, const std::vector<V
   I.update_viscosity();
 }
 
+VofState VofSolver::state() {
+  auto& I = *impl_;
+  VofState st;
+  st.t = t_;
+  st.dt = dt_;
+  st.alpha = alpha_;
+  st.p_rgh = p_rgh_;
+  st.p = p_;
+  st.nu1 = nu1_;
+  st.mu = I.mu;
+  st.phi = phi_;
+  st.U = U_;
+  st.active_cells = I.active_cells;
+  I.make_pressure_system();  // as restore() does
+  return st;
+}
+
+void VofSolver::restore(const VofState& st) {
+  auto& I = *impl_;
+  const auto nc = std::size_t(mesh_.cells()), nf = std::size_t(mesh_.faces());
+  if (st.alpha.size() != nc || st.p_rgh.size() != nc || st.p.size() != nc || st.nu1.size() != nc || st.mu.size() != nc ||
+      st.U.size() != nc || st.phi.size() != nf)
+    throw VofError("restore: the checkpoint's fields do not match the mesh (" + std::to_string(nc) + " cells, " + std::to_string(nf) +
+                   " faces)");
+  for (int c : st.active_cells)
+    if (c < 0 || std::size_t(c) >= nc) throw VofError("restore: the checkpoint's active region names a cell outside the mesh");
+  if (!(st.t >= 0 && st.dt > 0)) throw VofError("restore: the checkpoint's time or time step is not valid");
+  t_ = st.t;
+  dt_ = st.dt;
+  alpha_ = st.alpha;
+  p_rgh_ = st.p_rgh;
+  p_ = st.p;
+  nu1_ = st.nu1;
+  phi_ = st.phi;
+  U_ = st.U;
+  I.gravity_set = false;
+  I.update_gravity(t_);
+  {
+    // rho from alpha everywhere (outside the halo it was last computed from the same alpha).
+    std::vector<int> all(nc, 0);
+    I.set_region(all);
+    I.update_rho(I.rho);
+  }
+  std::vector<int> d(nc, -1);
+  for (int c : st.active_cells) d[std::size_t(c)] = 0;
+  I.set_region(d);
+  // The resting air's values as the run left them (they seed the solvers when cells join the region).
+  p_rgh_ = st.p_rgh;
+  p_ = st.p;
+  U_ = st.U;
+  I.mu = st.mu;
+  I.make_pressure_system();
+}
+
 StepStats VofSolver::step() {
   using clk = std::chrono::steady_clock;
   const auto t0 = clk::now();

@@ -88,6 +88,15 @@ struct StepStats {
   int active_cells = 0;         ///< cells in the active region (the pressure system's size)
 };
 
+/// Everything a run needs to continue from a moment (a checkpoint). A run restored from it takes
+/// exactly the steps the original takes after state() (bit for bit on the same build and machine).
+struct VofState {
+  double t = 0, dt = 0;
+  std::vector<double> alpha, p_rgh, p, nu1, mu, phi;
+  std::vector<Vec> U;
+  std::vector<int> active_cells;  ///< the active region (it depends on the run's history)
+};
+
 class VofSolver {
  public:
   VofSolver(Mesh mesh, VofConfig cfg);
@@ -97,6 +106,11 @@ class VofSolver {
 
   /// Initial state: alpha per cell (velocity zero unless set); computes the hydrostatic pressure.
   void initialise(const std::vector<double>& alpha, const std::vector<Vec>& U = {});
+  /// The state for a checkpoint. The next step then starts from freshly built pressure solvers, as a
+  /// restored run's first step does, so that both continue identically.
+  VofState state();
+  /// Continue from a checkpoint (in place of initialise()); sizes must match the mesh.
+  void restore(const VofState& st);
   /// One time step of the length chosen by the Courant control.
   StepStats step();
   /// Step until `t_end`; `hook` is called after every step and may return false to stop.
