@@ -12,6 +12,8 @@
 #include <sstream>
 
 #include "engine/vof/solver.hpp"
+#include "jobs/checkpoint.hpp"
+#include "jobs/sha256.hpp"
 #include "jobs/timeseries.hpp"
 
 namespace runout::jobs {
@@ -147,6 +149,20 @@ void write_figure(const std::string& path, const vof::VofSolver& s, int nx, int 
   if (!out) throw std::runtime_error("cannot write " + path);
 }
 
+// What a checkpoint must match: the scenario without the end time and the write and checkpoint
+// intervals (a run may be continued further than first planned).
+std::string lab_state_hash(const ResolvedScenario& r) {
+  auto sc = r.scenario;
+  sc.mutable_lab()->clear_end_time_s();
+  sc.mutable_lab()->clear_write_interval_s();
+  sc.mutable_lab()->clear_checkpoint_interval_s();
+  std::string json;
+  google::protobuf::util::JsonPrintOptions po;
+  po.preserve_proto_field_names = true;
+  (void)google::protobuf::util::MessageToJsonString(sc, &json, po);
+  return sha256_hex(json);
+}
+
 }  // namespace
 
 RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt) {
@@ -225,10 +241,26 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   for (int k = 0; k < m.cells(); ++k)
     for (const auto& f : L.fill())
       if (inside(f, m.centre[std::size_t(k)].x, m.centre[std::size_t(k)].y)) alpha[std::size_t(k)] = 1;
-  s.initialise(alpha);
   double v0 = 0;
   for (int k = 0; k < m.cells(); ++k) v0 += alpha[std::size_t(k)] * m.volume[std::size_t(k)];
   if (v0 <= 0) throw ScenarioError("lab.fill: no cell centre lies in the fill rectangles");
+  const std::string state_hash = lab_state_hash(r);
+  LabCheckpoint restart;
+  if (!opt.restart_path.empty()) {
+    restart = read_checkpoint(opt.restart_path);
+    if (restart.scenario_hash != state_hash)
+      throw ScenarioError("checkpoint " + opt.restart_path + " belongs to another scenario (only end_time_s, write_interval_s and "
+                          "checkpoint_interval_s may differ)");
+    if (!(restart.state.t < L.end_time_s()))
+      throw ScenarioError("checkpoint " + opt.restart_path + " is at t = " + num(restart.state.t) + " s, not before lab.end_time_s");
+    try {
+      s.restore(restart.state);
+    } catch (const vof::VofError& e) {
+      throw ScenarioError("checkpoint " + opt.restart_path + ": " + e.what());
+    }
+  } else {
+    s.initialise(alpha);
+  }
 
   RunSummary sum;
   sum.nx = b.nx;
@@ -239,12 +271,44 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   sum.volume_initial = v0;
   sum.seconds_prepare = std::chrono::duration<double>(clk::now() - t0).count();
   FieldWriter fields(out_dir, b.nx, b.ny);
-  fields.write(0, s);
   double next_write = L.write_interval_s() > 0 ? L.write_interval_s() : 1e300;
   double peak = 0, t_peak = 0, t_rest = -1, pressure_s = 0, alpha_min = 1, alpha_max = 0, div = 0, last_speed = 0;
   long steps = 0, p_its = 0;
   double active_sum = 0;
   int active_max = 0;
+  // The running figures a checkpoint carries.
+  auto figures = [&] {
+    return std::map<std::string, double>{{"peak", peak},       {"t_peak", t_peak},         {"t_rest", t_rest},
+                                         {"pressure_s", pressure_s}, {"alpha_min", alpha_min}, {"alpha_max", alpha_max},
+                                         {"div", div},         {"last_speed", last_speed}, {"p_its", double(p_its)},
+                                         {"active_sum", active_sum}, {"active_max", double(active_max)}};
+  };
+  if (!opt.restart_path.empty()) {
+    auto f = [&](const char* k) {
+      const auto it = restart.figures.find(k);
+      if (it == restart.figures.end()) throw ScenarioError("checkpoint " + opt.restart_path + ": damaged (no figure '" + k + "')");
+      return it->second;
+    };
+    peak = f("peak"), t_peak = f("t_peak"), t_rest = f("t_rest"), pressure_s = f("pressure_s"), alpha_min = f("alpha_min");
+    alpha_max = f("alpha_max"), div = f("div"), last_speed = f("last_speed"), p_its = long(f("p_its")), active_sum = f("active_sum");
+    active_max = int(f("active_max"));
+    steps = restart.steps;
+    if (L.write_interval_s() > 0)  // the next regular frame after the checkpoint
+      next_write = L.write_interval_s() * (std::floor(restart.state.t / L.write_interval_s() + 1e-9) + 1);
+  } else {
+    fields.write(0, s);
+  }
+  const bool checkpoints = !opt.checkpoint_path.empty();
+  const double cp_every = L.checkpoint_interval_s() > 0 ? L.checkpoint_interval_s() : 1e300;
+  double next_cp = cp_every < 1e300 ? cp_every * (std::floor(s.time() / cp_every + 1e-9) + 1) : 1e300;
+  auto write_cp = [&] {
+    LabCheckpoint cp;
+    cp.scenario_hash = state_hash;
+    cp.steps = steps;
+    cp.figures = figures();
+    cp.state = s.state();
+    write_checkpoint(opt.checkpoint_path, cp);
+  };
   bool cancelled = false;
   const auto t1 = clk::now();
   s.run(L.end_time_s(), [&](const vof::StepStats& st) {
@@ -267,6 +331,10 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       fields.write(st.t, s);
       next_write += L.write_interval_s();
     }
+    if (checkpoints && st.t >= next_cp - 1e-12 && st.t < L.end_time_s() - 1e-12) {
+      write_cp();
+      next_cp += cp_every;
+    }
     if (opt.progress && steps % std::max(1L, opt.progress_every) == 0) {
       engine::Progress p;
       p.t = st.t;
@@ -277,6 +345,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       p.step = steps;
       if (!opt.progress(p)) {
         cancelled = true;
+        if (checkpoints) write_cp();  // the run can continue from here
         return false;
       }
     }
@@ -342,7 +411,8 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   j << "  \"solver\": {\"steps\": " << steps << ", \"simulated_s\": " << num(s.time()) << ", \"pressure_iterations\": " << p_its
     << ", \"alpha_min\": " << num(alpha_min) << ", \"alpha_max\": " << num(alpha_max) << ", \"max_divergence_1_s\": " << num(div)
     << ", \"active_cells_mean\": " << num(steps ? active_sum / steps : NAN) << ", \"active_cells_max\": " << active_max
-    << ", \"stop\": \"" << sum.stop << "\"},\n";
+    << ", \"stop\": \"" << sum.stop << "\", \"continued_from_t_s\": " << num(opt.restart_path.empty() ? NAN : restart.state.t)
+    << "},\n";
   j << "  \"results\": {\"peak_speed_m_s\": " << num(peak) << ", \"peak_speed_time_s\": " << num(t_peak)
     << ", \"rest_time_s\": " << num(t_rest >= 0 ? t_rest : NAN) << ", \"final_speed_m_s\": " << num(last_speed)
     << ", \"front_x_m\": " << num(front) << ", \"deposit_height_m\": " << num(hmax) << ", \"upper_surface_angle_deg\": " << num(upper) << ", \"mean_surface_angle_deg\": " << num(angle)

@@ -17,6 +17,12 @@ struct RunOptions {
   /// "03CoulombOnly"). Writes <release>_<id>_null_runout_pft.asc / _pfv.asc on the DEM's grid and
   /// iseesnow_<id>.csv.
   std::string iseesnow_id;
+  /// VOF runs: write checkpoints to this file (replaced each time) every lab.checkpoint_interval_s
+  /// of simulated time and when the run is cancelled; empty: none.
+  std::string checkpoint_path;
+  /// VOF runs: continue from this checkpoint instead of the initial state (same scenario; the end
+  /// time and the write and checkpoint intervals may differ).
+  std::string restart_path;
 };
 
 struct RunSummary {

@@ -122,6 +122,7 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
   if (l->write_interval_s() < 0) bad("lab.write_interval_s", "must be >= 0 s");
   if (l->active_layers() == 0) l->set_active_layers(4);
   if (l->active_layers() < -1 || l->active_layers() > 1000) bad("lab.active_layers", "must be -1 (every cell) or 1-1000");
+  if (!(l->checkpoint_interval_s() >= 0)) bad("lab.checkpoint_interval_s", "must not be negative");
   if (l->max_courant() == 0) l->set_max_courant(0.2);
   if (!(l->max_courant() > 0 && l->max_courant() <= 1)) bad("lab.max_courant", "must lie in (0, 1]");
   if (l->correctors() == 0) l->set_correctors(3);

@@ -14,11 +14,16 @@ usage: runout <command> [options]
 
 commands:
   run SCENARIO.json --out DIR [--force] [--quiet] [--threads N] [--iseesnow SIMULATION_ID]
+        [--checkpoint FILE] [--restart FILE]
         Run a scenario (JSON form of runout.v1.Scenario, see README) and write the hazard rasters
         (COG GeoTIFF), the runout outline (GeoJSON in WGS84, GeoPackage) and the run record (run.json)
         into DIR. Results appear only when the run succeeded; an existing DIR is replaced only with
         --force. A progress line goes to standard error unless --quiet. --iseesnow also writes the
         ISeeSnow benchmark files (peak thickness/velocity ESRI ASCII on the DEM's grid, result CSV).
+        VOF runs (engine "vof"): --checkpoint writes the run's state to FILE every
+        lab.checkpoint_interval_s and when the run is interrupted (Ctrl-C, SIGTERM); --restart
+        continues from such a file exactly as the run would have gone on (fields.h5 then holds the
+        frames from the restart on).
   verify [CASE...] [--full] [--resolutions R1,R2,...] [--limiter NAME] [--csv] [--threads N]
         Run the verification cases against exact solutions and invariants and print a table
         (or CSV). Cases: A1 A2 A3 A4 A5 A6 A7 STRESS (default: all). --full adds the finest

@@ -26,7 +26,7 @@ extern "C" void on_interrupt(int) { g_interrupted = true; }
 }  // namespace
 
 int run(const std::vector<std::string>& args) {
-  std::string scenario, out, iseesnow;
+  std::string scenario, out, iseesnow, checkpoint, restart;
   bool force = false, quiet = false;
   for (std::size_t k = 0; k < args.size(); ++k) {
     const auto& a = args[k];
@@ -42,6 +42,12 @@ int run(const std::vector<std::string>& args) {
                      " (the benchmark's ids: 01IdealizedTopo, 02RealTopo, 03CoulombOnly)\n";
         return kUsage;
       }
+    } else if (a == "--checkpoint" || a == "--restart") {
+      if (k + 1 >= args.size() || args[k + 1].empty()) {
+        std::cerr << "runout run: " << a << " needs a file\n";
+        return kUsage;
+      }
+      (a == "--checkpoint" ? checkpoint : restart) = fs::absolute(args[++k]).string();
     } else if (a == "--out" || a == "--threads") {
       if (k + 1 >= args.size()) {
         std::cerr << "runout run: " << a << " needs a value\n";
@@ -76,7 +82,8 @@ int run(const std::vector<std::string>& args) {
     }
   }
   if (scenario.empty() || out.empty()) {
-    std::cerr << "runout run: usage: runout run SCENARIO.json --out DIR [--force] [--quiet] [--threads N]\n";
+    std::cerr << "runout run: usage: runout run SCENARIO.json --out DIR [--force] [--quiet] [--threads N]"
+                 " [--checkpoint FILE] [--restart FILE]\n";
     return kUsage;
   }
   const fs::path dest = fs::absolute(out);
@@ -93,6 +100,10 @@ int run(const std::vector<std::string>& args) {
     return kBadInput;
   }
 
+  if (!resolved.vof && !(checkpoint.empty() && restart.empty())) {
+    std::cerr << "runout run: --checkpoint and --restart apply to VOF runs (engine \"vof\") only\n";
+    return kUsage;
+  }
   // Results go to a temporary sibling directory first and appear under DIR only when complete.
   StagedOutput staged(dest);
   if (!staged.ok()) {
@@ -107,6 +118,8 @@ int run(const std::vector<std::string>& args) {
   const bool tty = isatty(fileno(stderr));
   jobs::RunOptions opt;
   opt.iseesnow_id = iseesnow;
+  opt.checkpoint_path = checkpoint;
+  opt.restart_path = restart;
   const double t_end = resolved.vof ? resolved.scenario.lab().end_time_s() : resolved.config.time.t_end;
   opt.progress = [&](const engine::Progress& p) {
     if (!quiet) {
@@ -138,6 +151,8 @@ int run(const std::vector<std::string>& args) {
   if (!quiet && tty) std::fprintf(stderr, "\n");
   if (sum.stop == "cancelled") {
     std::cerr << "runout run: cancelled at t = " << sum.t << " s; no results written\n";
+    if (!checkpoint.empty())
+      std::cerr << "runout run: checkpoint at t = " << sum.t << " s in " << checkpoint << " (continue with --restart " << checkpoint << ")\n";
     return kCancelled;
   }
   if (!staged.publish()) {

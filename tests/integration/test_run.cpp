@@ -764,3 +764,69 @@ TEST(Scenarios, LabInflowFeedsTheChannelAndStationsReport) {
   EXPECT_GT(ubar, 1.5);    // it enters at 1.96 m/s on average and accelerates down the 50 deg chute
   EXPECT_LT(ubar, 6.0);
 }
+
+namespace {
+std::string results_block(const std::string& dir) {
+  std::ifstream rec(dir + "/run.json");
+  std::stringstream ss;
+  ss << rec.rdbuf();
+  const std::string j = ss.str();
+  const auto a = j.find("\"results\"");
+  return a == std::string::npos ? std::string() : j.substr(a, j.find('}', a) - a);
+}
+}  // namespace
+
+// A VOF run continued from its checkpoint ends exactly as the run that wrote it; a run interrupted
+// (Ctrl-C) leaves a checkpoint from which it ends as the uninterrupted run does, to the solver
+// tolerance (the uninterrupted run kept its pressure preconditioner at that step).
+TEST(Scenarios, LabRunContinuesFromItsCheckpoint) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json");
+  auto* lab = r.scenario.mutable_lab();
+  lab->set_nx(50);
+  lab->set_ny(15);
+  lab->set_end_time_s(0.3);
+  lab->set_checkpoint_interval_s(0.1);
+  TempDir whole, first, second, third;
+  jobs::RunOptions o;
+  o.checkpoint_path = whole / "cp.h5";  // at 0.1 s, then replaced at 0.2 s
+  const auto s0 = jobs::run_scenario(r, whole.p.string(), o);
+  ASSERT_EQ(s0.stop, "end-time");
+  auto results = [](const TempDir& d) {
+    const auto b = results_block(d.p.string());
+    return b.substr(0, b.find("\"frames\""));
+  };
+  jobs::RunOptions o2;
+  o2.restart_path = whole / "cp.h5";
+  const auto s2 = jobs::run_scenario(r, second.p.string(), o2);
+  ASSERT_EQ(s2.stop, "end-time");
+  EXPECT_EQ(s2.steps, s0.steps);
+  EXPECT_EQ(s2.volume_final, s0.volume_final);
+  EXPECT_EQ(results(second), results(whole));
+  // Interrupted after 150 steps.
+  jobs::RunOptions o1;
+  o1.checkpoint_path = first / "cp.h5";
+  o1.progress_every = 1;
+  o1.progress = [](const engine::Progress& p) { return p.step < 150; };
+  const auto s1 = jobs::run_scenario(r, first.p.string(), o1);
+  ASSERT_EQ(s1.stop, "cancelled");
+  ASSERT_TRUE(fs::exists(first / "cp.h5"));
+  jobs::RunOptions o3;
+  o3.restart_path = first / "cp.h5";
+  const auto s3 = jobs::run_scenario(r, third.p.string(), o3);
+  ASSERT_EQ(s3.stop, "end-time");
+  EXPECT_NEAR(s3.volume_final, s0.volume_final, 1e-9 * s0.volume_final);
+  EXPECT_NEAR(s3.runout_m, s0.runout_m, 1e-9);
+  EXPECT_NEAR(s3.max_speed, s0.max_speed, 1e-6 * s0.max_speed);
+  // Another scenario's checkpoint, and a file that is none, are refused by name.
+  auto other = r;
+  other.scenario.mutable_lab()->set_nx(40);
+  try {
+    jobs::run_scenario(other, second.p.string(), o2);
+    FAIL() << "a checkpoint of another scenario was accepted";
+  } catch (const jobs::ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("another scenario"), std::string::npos) << e.what();
+  }
+  std::ofstream(first / "junk.h5") << "not a checkpoint";
+  o2.restart_path = first / "junk.h5";
+  EXPECT_THROW(jobs::run_scenario(r, second.p.string(), o2), jobs::ScenarioError);
+}
