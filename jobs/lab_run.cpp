@@ -298,6 +298,52 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   } else {
     fields.write(0, s);
   }
+  // Monitors sampled along the run (validation.md B3): granular outflow through the right end (in
+  // litres per second for the laboratory's 10 cm wide channel), the strain rate du/dy at the gate
+  // (x = 0: the least-squares slope of u over the material cells of the column just downstream),
+  // and the share of the material (alpha > 0.5) moving faster than 1 cm/s.
+  std::vector<int> right_faces;
+  for (const auto& p : m.patches)
+    if (p.name.rfind("right", 0) == 0)
+      for (int f = p.start; f < p.start + p.size; ++f) right_faces.push_back(f);
+  const int gate_i = (0 > b.x0 && 0 < b.x1) ? std::clamp(int((0 - b.x0) / dx + 1e-9), 0, b.nx - 1) : -1;
+  const double mon_every = std::min(0.01, L.end_time_s() / 50);
+  double next_mon = s.time() + mon_every;
+  std::vector<int> gate_faces;  // internal faces on the line x = 0, normal along x
+  for (int f = 0; f < m.n_internal; ++f)
+    if (std::abs(m.Cf[std::size_t(f)].x) < 0.25 * dx && std::abs(m.Sf[std::size_t(f)].x) > 0.5 * m.magSf[std::size_t(f)])
+      gate_faces.push_back(f);
+  std::vector<double> mon_t, mon_q, mon_gate, mon_sr, mon_moving;
+  double t_fluid = -1;
+  auto monitor = [&](double t) {
+    double q = 0;
+    for (int f : right_faces) q += s.granular_flux()[std::size_t(f)];
+    mon_q.push_back(1000 * q / b.thickness * 0.1);
+    double qg = 0;
+    for (int f : gate_faces) qg += (m.Sf[std::size_t(f)].x > 0 ? 1 : -1) * s.granular_flux()[std::size_t(f)];
+    mon_gate.push_back(gate_faces.empty() ? NAN : 1000 * qg / b.thickness * 0.1);
+    double sr = NAN;
+    if (gate_i >= 0) {
+      double sy = 0, su = 0, syy = 0, syu = 0, n = 0;
+      for (int jj = 0; jj < b.ny; ++jj) {
+        const std::size_t k = std::size_t(jj) * b.nx + std::size_t(gate_i);
+        if (s.alpha()[k] <= 0.5) continue;
+        const double y = b.y0 + (jj + 0.5) * dy, u = s.velocity()[k].x;
+        sy += y, su += u, syy += y * y, syu += y * u, n += 1;
+      }
+      if (n >= 3) sr = (n * syu - sy * su) / (n * syy - sy * sy);
+    }
+    mon_sr.push_back(sr);
+    double mat = 0, moving = 0;
+    for (int k = 0; k < m.cells(); ++k)
+      if (s.alpha()[std::size_t(k)] > 0.5) {
+        mat += 1;
+        if (vof::norm(s.velocity()[std::size_t(k)]) > 0.01) moving += 1;
+      }
+    mon_moving.push_back(mat > 0 ? moving / mat : NAN);
+    if (t_fluid < 0 && mat > 0 && moving >= 0.99 * mat) t_fluid = t;
+    mon_t.push_back(t);
+  };
   const bool checkpoints = !opt.checkpoint_path.empty();
   const double cp_every = L.checkpoint_interval_s() > 0 ? L.checkpoint_interval_s() : 1e300;
   double next_cp = cp_every < 1e300 ? cp_every * (std::floor(s.time() / cp_every + 1e-9) + 1) : 1e300;
@@ -330,6 +376,10 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     if (st.t >= next_write - 1e-12) {
       fields.write(st.t, s);
       next_write += L.write_interval_s();
+    }
+    if (st.t >= next_mon - 1e-12) {
+      monitor(st.t);
+      next_mon += mon_every;
     }
     if (checkpoints && st.t >= next_cp - 1e-12 && st.t < L.end_time_s() - 1e-12) {
       write_cp();
@@ -441,6 +491,29 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       << ", \"profile_y_alpha_u\": [" << prof.str() << "]}";
   }
   j << "],\n";
+  {
+    // The outflow's plateau: the median over the second half of the run.
+    std::vector<double> late, late_gate;
+    for (std::size_t q = 0; q < mon_t.size(); ++q)
+      if (mon_t[q] >= 0.5 * L.end_time_s()) late.push_back(mon_q[q]), late_gate.push_back(mon_gate[q]);
+    std::sort(late.begin(), late.end());
+    const double plateau = late.empty() ? NAN : late[late.size() / 2];
+    std::sort(late_gate.begin(), late_gate.end());
+    const double plateau_gate = late_gate.empty() ? NAN : late_gate[late_gate.size() / 2];
+    auto series = [&](const std::vector<double>& v) {
+      std::ostringstream o;
+      for (std::size_t q = 0; q < v.size(); ++q) o << (q ? ", " : "") << num(v[q]);
+      return o.str();
+    };
+    j << "  \"monitors\": {\"fluidised_time_s\": " << num(t_fluid >= 0 ? t_fluid : NAN)
+      << ", \"outflow_median_second_half_l_s_10cm\": " << num(plateau) << ", \"gate_flux_median_second_half_l_s_10cm\": "
+      << num(plateau_gate) << ", \"t_s\": [" << series(mon_t)
+      << "], \"outflow_l_s_10cm\": [" << series(mon_q) << "], \"gate_flux_l_s_10cm\": [" << series(mon_gate)
+      << "], \"gate_strain_rate_1_s\": [" << series(mon_sr)
+      << "], \"moving_share\": [" << series(mon_moving) << "]";
+    if (!opt.restart_path.empty()) j << ", \"note\": \"sampled from the restart at t = " << num(restart.state.t) << " s on\"";
+    j << "},\n";
+  }
   j << "  \"timings_s\": {\"prepare\": " << num(sum.seconds_prepare) << ", \"run\": " << num(sum.seconds_run)
     << ", \"pressure\": " << num(pressure_s) << ", \"write\": " << num(sum.seconds_write) << ", \"microseconds_per_cell_step\": "
     << num(steps ? 1e6 * sum.seconds_run / steps / m.cells() : NAN) << ", \"microseconds_per_active_cell_step\": "

@@ -1045,6 +1045,8 @@ void VofSolver::initialise(const std::vector<double>& alpha, const std::vector<V
   I.update_viscosity();
 }
 
+const std::vector<double>& VofSolver::granular_flux() const { return impl_->alpha_phi; }
+
 VofState VofSolver::state() {
   auto& I = *impl_;
   VofState st;

@@ -123,6 +123,8 @@ class VofSolver {
   const std::vector<double>& pressure() const { return p_; }        ///< full pressure p [Pa]
   const std::vector<double>& viscosity() const { return nu1_; }     ///< granular-phase nu [m2/s]
   const std::vector<double>& face_flux() const { return phi_; }
+  /// Granular volume flux per face [m3/s] over the last step (alpha times the face flux, limited).
+  const std::vector<double>& granular_flux() const;
 
  private:
   struct Impl;

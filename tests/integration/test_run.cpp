@@ -830,3 +830,36 @@ TEST(Scenarios, LabRunContinuesFromItsCheckpoint) {
   o2.restart_path = first / "junk.h5";
   EXPECT_THROW(jobs::run_scenario(r, second.p.string(), o2), jobs::ScenarioError);
 }
+
+// B3 monitors (validation.md B3, coarse): the triangle fluidises, drains through the gate at x = 0
+// with the fastest grains at the surface (a positive strain rate du/dy there), and leaves through the
+// open end once the front arrives; run.json carries the series.
+TEST(Scenarios, LabB3MonitorsFluidisationGateFluxAndStrainRate) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b3-triangle-pvc.json");
+  auto* lab = r.scenario.mutable_lab();
+  lab->set_nx(100);  // 8 mm cells
+  lab->set_ny(24);
+  lab->set_end_time_s(0.3);
+  TempDir d;
+  const auto sum = jobs::run_scenario(r, d.p.string());
+  ASSERT_EQ(sum.stop, "end-time");
+  std::ifstream rec(d / "run.json");
+  std::stringstream ss;
+  ss << rec.rdbuf();
+  const std::string j = ss.str();
+  auto value = [&](const std::string& key) {
+    const auto k = j.find("\"" + key + "\": ");
+    return k == std::string::npos ? NAN : std::atof(j.c_str() + k + key.size() + 4);
+  };
+  const double t_fluid = value("fluidised_time_s");
+  EXPECT_GT(t_fluid, 0.0);
+  EXPECT_LT(t_fluid, 0.3);
+  EXPECT_GT(value("gate_flux_median_second_half_l_s_10cm"), 1.0);  // measured 7.30 l/s at 4 mm cells
+  for (const char* key : {"\"t_s\"", "\"outflow_l_s_10cm\"", "\"gate_flux_l_s_10cm\"", "\"gate_strain_rate_1_s\"", "\"moving_share\""})
+    EXPECT_NE(j.find(key), std::string::npos) << key;
+  // The last strain rate at the gate: positive (fastest grains at the surface).
+  const auto k = j.find("\"gate_strain_rate_1_s\": [");
+  const auto e = j.find(']', k);
+  const auto last = j.rfind(", ", e);
+  EXPECT_GT(std::atof(j.c_str() + last + 2), 1.0);
+}
