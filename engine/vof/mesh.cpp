@@ -1,6 +1,8 @@
 #include "engine/vof/mesh.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <map>
 #include <stdexcept>
 
 namespace runout::engine::vof {
@@ -147,6 +149,97 @@ Mesh block_mesh(const BlockSpec& s) {
   add("top", top);
   add("left", left);
   add("obstacle", obstacle);
+  m.finish();
+  return m;
+}
+
+namespace {
+// Node coordinates of a graded direction: cell sizes h_k = h0 r^k with r^(n-1) = grading.
+std::vector<double> graded_nodes(double a, double b, int n, double grading) {
+  std::vector<double> v(std::size_t(n) + 1);
+  const double r = n > 1 ? std::pow(grading, 1.0 / (n - 1)) : 1.0;
+  double total = 0, h = 1;
+  for (int k = 0; k < n; ++k, h *= r) total += h;
+  h = (b - a) / total;
+  v[0] = a;
+  double y = a;
+  for (int k = 0; k < n; ++k, h *= r) v[std::size_t(k) + 1] = (y += h);
+  v[std::size_t(n)] = b;
+  return v;
+}
+}  // namespace
+
+Mesh block_mesh_3d(const Block3Spec& s) {
+  if (s.nx < 1 || s.ny < 1 || s.nz < 1 || !(s.x1 > s.x0) || !(s.y1 > s.y0) || !(s.z1 > s.z0) || !(s.y_grading > 0))
+    throw std::invalid_argument("block mesh: needs x1 > x0, y1 > y0, z1 > z0, nx, ny, nz >= 1, y_grading > 0");
+  const auto xs = graded_nodes(s.x0, s.x1, s.nx, 1.0), ys = graded_nodes(s.y0, s.y1, s.ny, s.y_grading),
+             zs = graded_nodes(s.z0, s.z1, s.nz, 1.0);
+  Mesh m;
+  m.thickness = 0;
+  const std::size_t NX = std::size_t(s.nx), NY = std::size_t(s.ny), NZ = std::size_t(s.nz);
+  std::vector<int> id(NX * NY * NZ, -1);
+  auto at = [&](std::size_t i, std::size_t j, std::size_t k) { return (k * NY + j) * NX + i; };
+  for (std::size_t k = 0; k < NZ; ++k)
+    for (std::size_t j = 0; j < NY; ++j)
+      for (std::size_t i = 0; i < NX; ++i) {
+        const Vec c{0.5 * (xs[i] + xs[i + 1]), 0.5 * (ys[j] + ys[j + 1]), 0.5 * (zs[k] + zs[k + 1])};
+        if (s.blocked && s.blocked(c)) continue;
+        id[at(i, j, k)] = m.cells();
+        m.centre.push_back(c);
+        m.volume.push_back((xs[i + 1] - xs[i]) * (ys[j + 1] - ys[j]) * (zs[k + 1] - zs[k]));
+      }
+  if (m.cells() == 0) throw std::invalid_argument("block mesh: every cell is blocked");
+  auto cell = [&](long i, long j, long k) {
+    if (i < 0 || j < 0 || k < 0 || i >= s.nx || j >= s.ny || k >= s.nz) return -1;
+    return id[at(std::size_t(i), std::size_t(j), std::size_t(k))];
+  };
+  struct BFace {
+    int owner;
+    Vec Sf, Cf;
+  };
+  std::map<std::string, std::vector<BFace>> bnd;
+  // Faces normal to direction d between cell (.., n-1, ..) and (.., n, ..) along d.
+  for (int d = 0; d < 3; ++d) {
+    const long ni = s.nx + (d == 0), nj = s.ny + (d == 1), nk = s.nz + (d == 2);
+    const char* lo = d == 0 ? "left" : d == 1 ? "bottom" : "back";
+    const char* hi = d == 0 ? "right" : d == 1 ? "top" : "front";
+    for (long k = 0; k < nk; ++k)
+      for (long j = 0; j < nj; ++j)
+        for (long i = 0; i < ni; ++i) {
+          const long ia = i - (d == 0), ja = j - (d == 1), ka = k - (d == 2);
+          const int a = cell(ia, ja, ka), b = cell(i, j, k);
+          if (a < 0 && b < 0) continue;
+          const auto I = std::size_t(i), J = std::size_t(j), K = std::size_t(k);
+          const double ex = d == 0 ? 0 : xs[I + 1] - xs[I], ey = d == 1 ? 0 : ys[J + 1] - ys[J], ez = d == 2 ? 0 : zs[K + 1] - zs[K];
+          const Vec c{d == 0 ? xs[I] : 0.5 * (xs[I] + xs[I + 1]), d == 1 ? ys[J] : 0.5 * (ys[J] + ys[J + 1]),
+                      d == 2 ? zs[K] : 0.5 * (zs[K] + zs[K + 1])};
+          const double area = d == 0 ? ey * ez : d == 1 ? ex * ez : ex * ey;
+          Vec S{d == 0 ? area : 0, d == 1 ? area : 0, d == 2 ? area : 0};
+          if (a >= 0 && b >= 0) {
+            m.owner.push_back(a);
+            m.neighbour.push_back(b);
+            m.Sf.push_back(S);
+            m.Cf.push_back(c);
+          } else if (a >= 0) {
+            const bool edge = (d == 0 ? i : d == 1 ? j : k) == (d == 0 ? s.nx : d == 1 ? s.ny : s.nz);
+            bnd[edge ? hi : "obstacle"].push_back({a, S, c});
+          } else {
+            const bool edge = (d == 0 ? i : d == 1 ? j : k) == 0;
+            bnd[edge ? lo : "obstacle"].push_back({b, (-1.0) * S, c});
+          }
+        }
+  }
+  m.n_internal = int(m.owner.size());
+  for (const char* name : {"bottom", "right", "top", "left", "back", "front", "obstacle"}) {
+    const auto& fs = bnd[name];
+    if (fs.empty()) continue;
+    m.patches.push_back({name, m.faces(), int(fs.size())});
+    for (const auto& f : fs) {
+      m.owner.push_back(f.owner);
+      m.Sf.push_back(f.Sf);
+      m.Cf.push_back(f.Cf);
+    }
+  }
   m.finish();
   return m;
 }

@@ -6,6 +6,7 @@
 // meshes and imported meshes all work the same way.
 #include <array>
 #include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,19 @@ struct BlockSpec {
   std::vector<std::array<double, 2>> blocked;
 };
 Mesh block_mesh(const BlockSpec& s);
+
+/// A box of hexahedral cells (x along the channel, y normal to its bottom, z across it), uniform in
+/// x and z, optionally graded in y. Cells whose centre satisfies `blocked` are left out and the
+/// faces they shared with kept cells form the patch "obstacle" (stair-stepped obstacles: a
+/// tetrahedron or a cylinder standing on the bottom is blocked out cell by cell). Patches:
+/// "bottom" (y0), "top" (y1), "left" (x0), "right" (x1), "back" (z0), "front" (z1), "obstacle".
+struct Block3Spec {
+  double x0 = 0, x1 = 1, y0 = 0, y1 = 1, z0 = 0, z1 = 1;
+  int nx = 10, ny = 10, nz = 10;
+  double y_grading = 1.0;
+  std::function<bool(const Vec&)> blocked;
+};
+Mesh block_mesh_3d(const Block3Spec& s);
 
 /// Rename the part of a patch whose face centres satisfy `pick` into a new patch (e.g. the top
 /// boundary above x > 0 becomes "atmosphere"). Faces are reordered so that patches stay contiguous.

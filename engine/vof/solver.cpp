@@ -60,7 +60,14 @@ struct VofSolver::Impl {
   ::Vec xu = nullptr, bu = nullptr;  // the momentum predictor's vectors (every cell)
   Mat Apin = nullptr;  // closed domains: the pressure matrix with cell 0 pinned
   KSP kspU = nullptr;
-  std::vector<std::array<double, 3>> recon_inv;  // inverse of sum Sf Sf / |Sf| (plane: 2x2 packed)
+  std::vector<std::array<double, 6>> recon_inv;  // inverse of sum Sf Sf / |Sf|: xx, xy, xz, yy, yz, zz
+
+  // fvc::reconstruct: the cell vector whose face projections best match the face values q (sum of
+  // q Sf over the faces in r).
+  Vec reconstruct(int c, const Vec& r) const {
+    const auto& T = recon_inv[std::size_t(c)];
+    return {T[0] * r.x + T[1] * r.y + T[2] * r.z, T[1] * r.x + T[3] * r.y + T[4] * r.z, T[2] * r.x + T[4] * r.y + T[5] * r.z};
+  }
 
   explicit Impl(VofSolver& solver) : s(solver), m(solver.mesh_) {}
   ~Impl() {
@@ -109,18 +116,23 @@ struct VofSolver::Impl {
     // Reconstruction tensors.
     recon_inv.resize(static_cast<std::size_t>(nc));
     for (int c = 0; c < nc; ++c) {
-      double t00 = 0, t01 = 0, t11 = 0;
+      double t[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
       for (int f : cell_faces[std::size_t(c)]) {
         const Vec& S = m.Sf[std::size_t(f)];
         const double a = m.magSf[std::size_t(f)];
-        t00 += S.x * S.x / a;
-        t01 += S.x * S.y / a;
-        t11 += S.y * S.y / a;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) t[i][j] += comp(S, i) * comp(S, j) / a;
       }
-      const double det = t00 * t11 - t01 * t01;
-      recon_inv[std::size_t(c)] = {t11 / det, -t01 / det, t00 / det};
+      if (dims == 2) {  // plane meshes have no front and back faces: invert the x-y block
+        const double det = t[0][0] * t[1][1] - t[0][1] * t[0][1];
+        recon_inv[std::size_t(c)] = {t[1][1] / det, -t[0][1] / det, 0, t[0][0] / det, 0, 0};
+      } else {
+        const double a = t[0][0], b = t[0][1], cc = t[0][2], d = t[1][1], e = t[1][2], f = t[2][2];
+        const double A = d * f - e * e, B = cc * e - b * f, C = b * e - cc * d;
+        const double det = a * A + b * B + cc * C;
+        recon_inv[std::size_t(c)] = {A / det, B / det, C / det, (a * f - cc * cc) / det, (b * cc - a * e) / det, (a * d - b * b) / det};
+      }
     }
-    if (dims == 3) throw VofError("3D meshes: not supported by this build of the VOF engine yet (plane meshes only)");
     petsc_init();
     std::vector<PetscInt> nnz(std::size_t(nc), 1);
     for (int f = 0; f < m.n_internal; ++f) {
@@ -247,6 +259,7 @@ struct VofSolver::Impl {
       case Bc::wall: return {};
       case Bc::inflow: return bc_of(f).inflow_velocity(m.Cf[std::size_t(f)]);
       case Bc::outflow: return Up;
+      case Bc::symmetry: return Up - dot(Up, n) * n;
       case Bc::atmosphere: {
         // pressureInletOutletVelocity: zero gradient out, the flux's normal velocity in.
         const double ph = s.phi_[std::size_t(f)];
@@ -440,6 +453,7 @@ struct VofSolver::Impl {
         const Bc k = kind_of(f);
         const Vec Ub = boundary_velocity(f);
         const double D = mu[std::size_t(o)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+        // A symmetry plane carries no shear: no viscous term (its normal velocity is held by the flux).
         if (k == Bc::wall || k == Bc::coulomb_slip || k == Bc::inflow) {
           A_D[std::size_t(o)] += D;
           bsrc[std::size_t(o)] = bsrc[std::size_t(o)] + D * Ub;
@@ -508,12 +522,10 @@ struct VofSolver::Impl {
     petsc_check(MatAssemblyEnd(Mu, MAT_FINAL_ASSEMBLY), "MatAssembly");
     petsc_check(KSPSetOperators(kspU, Mu, Mu), "KSPSetOperators");
     int its_total = 0;
-    for (int comp_i = 0; comp_i < 2; ++comp_i) {
+    for (int comp_i = 0; comp_i < dims; ++comp_i) {
       for (int c = 0; c < nc; ++c) {
-        const auto& T = recon_inv[std::size_t(c)];
-        const Vec r = rec[std::size_t(c)];
-        const double fx = T[0] * r.x + T[1] * r.y, fy = T[1] * r.x + T[2] * r.y;
-        const double src = comp(bsrc[std::size_t(c)], comp_i) + m.volume[std::size_t(c)] * (comp_i == 0 ? fx : fy);
+        const Vec F = reconstruct(c, rec[std::size_t(c)]);
+        const double src = comp(bsrc[std::size_t(c)], comp_i) + m.volume[std::size_t(c)] * comp(F, comp_i);
         VecSetValue(bu, c, src, INSERT_VALUES);
         VecSetValue(xu, c, comp(s.U_[std::size_t(c)], comp_i), INSERT_VALUES);
       }
@@ -532,7 +544,7 @@ struct VofSolver::Impl {
                        std::to_string(int(reason)));
       const PetscScalar* xv;
       VecGetArrayRead(xu, &xv);
-      for (int c = 0; c < nc; ++c) (comp_i == 0 ? s.U_[std::size_t(c)].x : s.U_[std::size_t(c)].y) = xv[c];
+      for (int c = 0; c < nc; ++c) (comp_i == 0 ? s.U_[std::size_t(c)].x : comp_i == 1 ? s.U_[std::size_t(c)].y : s.U_[std::size_t(c)].z) = xv[c];
       VecRestoreArrayRead(xu, &xv);
     }
     return its_total;
@@ -954,9 +966,7 @@ struct VofSolver::Impl {
     }
     if (!initial)
       for (int c : active_cells) {
-        const auto& T = recon_inv[std::size_t(c)];
-        const Vec r = rec[std::size_t(c)];
-        const Vec R{T[0] * r.x + T[1] * r.y, T[1] * r.x + T[2] * r.y, 0};
+        const Vec R = reconstruct(c, rec[std::size_t(c)]);
         s.U_[std::size_t(c)] = HbyA[std::size_t(c)] + rAU[std::size_t(c)] * R;
       }
     for (int c : active_cells) s.p_[std::size_t(c)] = s.p_rgh_[std::size_t(c)] + rho[std::size_t(c)] * gh[std::size_t(c)];
@@ -1176,7 +1186,7 @@ StepStats VofSolver::step() {
     if (a > 0.5) st.max_speed = std::max(st.max_speed, norm(U_[std::size_t(c)]));
     if (I.active_index[std::size_t(c)] >= 0)  // the air at rest outside the active region is a reservoir
       st.divergence = std::max(st.divergence, std::abs(div[std::size_t(c)]) / m.volume[std::size_t(c)]);
-    if (!std::isfinite(a) || !std::isfinite(U_[std::size_t(c)].x) || !std::isfinite(U_[std::size_t(c)].y))
+    if (!std::isfinite(a) || !std::isfinite(U_[std::size_t(c)].x) || !std::isfinite(U_[std::size_t(c)].y) || !std::isfinite(U_[std::size_t(c)].z))
       throw VofError("the solution is no longer finite at t = " + std::to_string(t_) + " s (cell " + std::to_string(c) + ")");
   }
   st.co = co;

@@ -33,7 +33,10 @@
 
 namespace runout::engine::vof {
 
-enum class Bc { wall, coulomb_slip, atmosphere, inflow, outflow };
+/// wall: stick; coulomb_slip: listing B.2; atmosphere: total pressure of air at rest outside, air in
+/// and anything out; inflow: prescribed velocity and phase fraction; outflow: zero gradient;
+/// symmetry: no flow through it and no shear along it (a plane of symmetry, a frictionless wall).
+enum class Bc { wall, coulomb_slip, atmosphere, inflow, outflow, symmetry };
 
 struct PatchBc {
   Bc kind = Bc::wall;
