@@ -40,10 +40,54 @@ std::string num(double v) {
   return o.str();
 }
 
-// Fields of the block mesh (row-major, j = 0 at the bottom) in one HDF5 file, frame by frame.
+// The lab block as a grid: nx x ny (x nz in 3D) cells, row-major with j = 0 at the bottom and k = 0
+// at z_min; `cell` maps a grid position to the mesh cell, -1 where an obstacle blocks it.
+struct LabGrid {
+  int nx = 0, ny = 0, nz = 1;
+  bool three_d = false;
+  double x0 = 0, y0 = 0, z0 = 0, dx = 0, dy = 0, dz = 0;
+  double width = 0;  ///< across the channel: the modelled width in 3D, the plane mesh's thickness in 2D
+  std::vector<int> cell;
+  std::size_t at(int i, int j, int k) const { return (std::size_t(k) * std::size_t(ny) + std::size_t(j)) * std::size_t(nx) + std::size_t(i); }
+  int id(int i, int j, int k) const { return cell[at(i, j, k)]; }
+  int kc = 0;  ///< the slice along the centre line (stations, gate monitor)
+};
+
+// Obstacles of the lab block (validation.md B5, B7): is the point inside?
+bool in_polygon(const google::protobuf::RepeatedField<double>& xy, double x, double y) {
+  bool in = false;  // even-odd rule
+  const int n = xy.size() / 2;
+  for (int a = 0, b = n - 1; a < n; b = a++) {
+    const double xa = xy.Get(2 * a), ya = xy.Get(2 * a + 1), xb = xy.Get(2 * b), yb = xy.Get(2 * b + 1);
+    if ((ya > y) != (yb > y) && x < (xb - xa) * (y - ya) / (yb - ya) + xa) in = !in;
+  }
+  return in;
+}
+
+bool in_obstacle(const v1::LabObstacle& o, const vof::Vec& c, double y0) {
+  if (o.shape() == "polygon") return in_polygon(o.polygon_xy(), c.x, c.y);
+  if (o.shape() == "cylinder") return std::hypot(c.x - o.x(), c.z - o.z()) < o.radius() && c.y - y0 < o.height();
+  // A regular tetrahedron standing on a face: footprint an equilateral triangle of edge a around
+  // (x, z), apex at height a sqrt(2/3); "edge" puts a corner of the footprint upstream (the flow
+  // meets the edge from it to the apex), "face" a side (the flow meets an inclined face).
+  const double a = o.edge(), R = a / std::sqrt(3.0), H = a * std::sqrt(2.0 / 3.0);
+  const double sgn = o.shape() == "tetrahedron-edge" ? -1 : 1;
+  const vof::Vec v[4] = {{o.x() + sgn * R, y0, o.z()}, {o.x() - sgn * R / 2, y0, o.z() - a / 2}, {o.x() - sgn * R / 2, y0, o.z() + a / 2},
+                         {o.x(), y0 + H, o.z()}};
+  static const int faces[4][4] = {{0, 1, 2, 3}, {0, 1, 3, 2}, {0, 2, 3, 1}, {1, 2, 3, 0}};  // three corners and the opposite one
+  for (const auto& f : faces) {
+    const vof::Vec e1 = v[f[1]] - v[f[0]], e2 = v[f[2]] - v[f[0]];
+    const vof::Vec n{e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x};
+    const double side_opposite = vof::dot(n, v[f[3]] - v[f[0]]), side_c = vof::dot(n, c - v[f[0]]);
+    if (side_c * side_opposite < 0) return false;
+  }
+  return true;
+}
+
+// Fields of the lab grid in one HDF5 file, frame by frame (blocked cells NaN).
 class FieldWriter {
  public:
-  FieldWriter(const std::string& dir, int nx, int ny) : dir_(dir), nx_(nx), ny_(ny) {
+  explicit FieldWriter(const std::string& dir, const LabGrid& g) : dir_(dir), g_(g) {
     std::lock_guard lk(hdf5_mutex());
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
     file_ = H5Fcreate((dir + "/fields.h5").c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
@@ -54,42 +98,52 @@ class FieldWriter {
     if (file_ >= 0) H5Fclose(file_);
   }
   void write(double t, const vof::VofSolver& s) {
-    const auto n = std::size_t(nx_) * std::size_t(ny_);
-    std::vector<float> a(n), ux(n), uy(n), p(n), nu(n);
-    for (std::size_t k = 0; k < n; ++k) {
-      a[k] = float(s.alpha()[k]);
-      ux[k] = float(s.velocity()[k].x);
-      uy[k] = float(s.velocity()[k].y);
-      p[k] = float(s.pressure()[k]);
-      nu[k] = float(s.viscosity()[k]);
+    const auto n = g_.cell.size();
+    std::vector<float> a(n, NAN), ux(n, NAN), uy(n, NAN), uz(n, NAN), p(n, NAN), nu(n, NAN);
+    for (std::size_t q = 0; q < n; ++q) {
+      const int c = g_.cell[q];
+      if (c < 0) continue;
+      const auto k = std::size_t(c);
+      a[q] = float(s.alpha()[k]);
+      ux[q] = float(s.velocity()[k].x);
+      uy[q] = float(s.velocity()[k].y);
+      uz[q] = float(s.velocity()[k].z);
+      p[q] = float(s.pressure()[k]);
+      nu[q] = float(s.viscosity()[k]);
     }
     std::lock_guard lk(hdf5_mutex());
     char name[32];
     std::snprintf(name, sizeof name, "/f%05zu", times_.size());
-    hid_t g = H5Gcreate2(file_, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    if (g < 0) throw std::runtime_error("fields.h5: cannot create a frame");
-    const hsize_t dims[2] = {hsize_t(ny_), hsize_t(nx_)};
-    for (auto [nm, v] : {std::pair<const char*, std::vector<float>*>{"alpha", &a}, {"ux", &ux}, {"uy", &uy}, {"p", &p}, {"nu", &nu}}) {
-      hid_t sp = H5Screate_simple(2, dims, nullptr);
-      hid_t ds = H5Dcreate2(g, nm, H5T_IEEE_F32LE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    hid_t gr = H5Gcreate2(file_, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (gr < 0) throw std::runtime_error("fields.h5: cannot create a frame");
+    const hsize_t dims[3] = {hsize_t(g_.nz), hsize_t(g_.ny), hsize_t(g_.nx)};
+    std::vector<std::pair<const char*, std::vector<float>*>> sets = {{"alpha", &a}, {"ux", &ux}, {"uy", &uy}, {"p", &p}, {"nu", &nu}};
+    if (g_.three_d) sets.push_back({"uz", &uz});
+    for (auto [nm, v] : sets) {
+      hid_t sp = g_.three_d ? H5Screate_simple(3, dims, nullptr) : H5Screate_simple(2, dims + 1, nullptr);
+      hid_t ds = H5Dcreate2(gr, nm, H5T_IEEE_F32LE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
       const herr_t st = H5Dwrite(ds, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, v->data());
       H5Dclose(ds);
       H5Sclose(sp);
       if (st < 0) {
-        H5Gclose(g);
+        H5Gclose(gr);
         throw std::runtime_error("fields.h5: writing failed");
       }
     }
-    H5Gclose(g);
+    H5Gclose(gr);
     times_.push_back(t);
   }
-  // fields.xmf: a temporal collection on the cell centres (ORIGIN_DXDY).
-  int finish(double x0, double y0, double dx, double dy) {
+  // fields.xmf: a temporal collection on the cell centres (ORIGIN_DXDY, ORIGIN_DXDYDZ in 3D).
+  int finish() {
     {
       std::lock_guard lk(hdf5_mutex());
       if (file_ >= 0) H5Fclose(file_);
       file_ = -1;
     }
+    const auto& g = g_;
+    std::ostringstream dims;
+    if (g.three_d) dims << g.nz << " " << g.ny << " " << g.nx;
+    else dims << g.ny << " " << g.nx;
     std::ofstream x(dir_ + "/fields.xmf");
     x << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n  <Grid Name=\"lab\" GridType=\"Collection\" "
          "CollectionType=\"Temporal\">\n";
@@ -97,14 +151,22 @@ class FieldWriter {
       char grp[32];
       std::snprintf(grp, sizeof grp, "f%05zu", f);
       x << "   <Grid Name=\"" << grp << "\" GridType=\"Uniform\">\n    <Time Value=\"" << times_[f] << "\"/>\n";
-      x << "    <Topology TopologyType=\"2DCoRectMesh\" Dimensions=\"" << ny_ << " " << nx_ << "\"/>\n";
-      x << "    <Geometry GeometryType=\"ORIGIN_DXDY\">\n     <DataItem Dimensions=\"2\" Format=\"XML\">" << y0 + 0.5 * dy << " "
-        << x0 + 0.5 * dx << "</DataItem>\n     <DataItem Dimensions=\"2\" Format=\"XML\">" << dy << " " << dx
-        << "</DataItem>\n    </Geometry>\n";
-      for (const char* a : {"alpha", "ux", "uy", "p", "nu"})
-        x << "    <Attribute Name=\"" << a << "\" AttributeType=\"Scalar\" Center=\"Node\">\n     <DataItem Dimensions=\"" << ny_ << " "
-          << nx_ << "\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">fields.h5:/" << grp << "/" << a
-          << "</DataItem>\n    </Attribute>\n";
+      if (g.three_d) {
+        x << "    <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"" << dims.str() << "\"/>\n";
+        x << "    <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n     <DataItem Dimensions=\"3\" Format=\"XML\">" << g.z0 + 0.5 * g.dz << " "
+          << g.y0 + 0.5 * g.dy << " " << g.x0 + 0.5 * g.dx << "</DataItem>\n     <DataItem Dimensions=\"3\" Format=\"XML\">" << g.dz << " "
+          << g.dy << " " << g.dx << "</DataItem>\n    </Geometry>\n";
+      } else {
+        x << "    <Topology TopologyType=\"2DCoRectMesh\" Dimensions=\"" << dims.str() << "\"/>\n";
+        x << "    <Geometry GeometryType=\"ORIGIN_DXDY\">\n     <DataItem Dimensions=\"2\" Format=\"XML\">" << g.y0 + 0.5 * g.dy << " "
+          << g.x0 + 0.5 * g.dx << "</DataItem>\n     <DataItem Dimensions=\"2\" Format=\"XML\">" << g.dy << " " << g.dx
+          << "</DataItem>\n    </Geometry>\n";
+      }
+      std::vector<const char*> names = {"alpha", "ux", "uy", "p", "nu"};
+      if (g.three_d) names.push_back("uz");
+      for (const char* a : names)
+        x << "    <Attribute Name=\"" << a << "\" AttributeType=\"Scalar\" Center=\"Node\">\n     <DataItem Dimensions=\"" << dims.str()
+          << "\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">fields.h5:/" << grp << "/" << a << "</DataItem>\n    </Attribute>\n";
       x << "   </Grid>\n";
     }
     x << "  </Grid>\n </Domain>\n</Xdmf>\n";
@@ -114,28 +176,61 @@ class FieldWriter {
 
  private:
   std::string dir_;
-  int nx_, ny_;
+  const LabGrid& g_;
   hid_t file_ = -1;
   std::vector<double> times_;
 };
 
 // figure.png: material (alpha > 0.5) coloured by speed (blue slow ... red fast), air white.
-void write_figure(const std::string& path, const vof::VofSolver& s, int nx, int ny, double vmax) {
-  const int sc = std::max(1, 600 / std::max(nx, 1));
-  const int W = nx * sc, H = ny * sc;
+void write_figure(const std::string& path, const vof::VofSolver& s, const LabGrid& g, double vmax) {
+  // Plane set-ups: the x-y section, material coloured by speed. 3D: the plan view (x along, z
+  // across), flow depth coloured from blue (thin) to red (the deepest), obstacles grey.
+  const int nrow = g.three_d ? g.nz : g.ny;
+  const int sc = std::max(1, 600 / std::max(g.nx, 1));
+  const int W = g.nx * sc, H = nrow * sc;
   std::vector<unsigned char> rgb[3];
   for (auto& c : rgb) c.assign(std::size_t(W) * H, 255);
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      const std::size_t k = std::size_t(j) * nx + i;
-      const double a = std::clamp(s.alpha()[k], 0.0, 1.0);
-      const double v = std::min(1.0, vof::norm(s.velocity()[k]) / std::max(vmax, 1e-9));
-      const double r = v, g = 1 - std::abs(2 * v - 1), b = 1 - v;  // blue -> green -> red
-      const unsigned char col[3] = {static_cast<unsigned char>(255 * (1 - a + a * r)), static_cast<unsigned char>(255 * (1 - a + a * g)),
-                                    static_cast<unsigned char>(255 * (1 - a + a * b))};
+  std::vector<double> depth;
+  double dmax = 1e-9;
+  if (g.three_d) {
+    depth.assign(std::size_t(g.nx) * g.nz, -1);
+    for (int k = 0; k < g.nz; ++k)
+      for (int i = 0; i < g.nx; ++i) {
+        double d = 0;
+        bool blocked = false;
+        for (int j = 0; j < g.ny; ++j) {
+          const int c = g.id(i, j, k);
+          if (c < 0) blocked = true;
+          else d += std::clamp(s.alpha()[std::size_t(c)], 0.0, 1.0) * g.dy;
+        }
+        depth[std::size_t(k) * g.nx + i] = blocked && d < 1e-3 ? -1 : d;  // grey: an obstacle not covered by flow
+        dmax = std::max(dmax, d);
+      }
+  }
+  for (int row = 0; row < nrow; ++row)
+    for (int i = 0; i < g.nx; ++i) {
+      double a = 0, v = 0;
+      bool grey = false;
+      if (g.three_d) {
+        const double d = depth[std::size_t(row) * g.nx + i];
+        grey = d < 0;
+        a = d > 1e-4 ? 1.0 : 0.0;  // white: dry (below 0.1 mm)
+        v = std::max(0.0, d) / dmax;
+      } else {
+        const int c = g.id(i, row, 0);
+        grey = c < 0;
+        if (!grey) {
+          a = std::clamp(s.alpha()[std::size_t(c)], 0.0, 1.0);
+          v = std::min(1.0, vof::norm(s.velocity()[std::size_t(c)]) / std::max(vmax, 1e-9));
+        }
+      }
+      const double r = v, gg = 1 - std::abs(2 * v - 1), b = 1 - v;  // blue -> green -> red
+      unsigned char col[3] = {static_cast<unsigned char>(255 * (1 - a + a * r)), static_cast<unsigned char>(255 * (1 - a + a * gg)),
+                              static_cast<unsigned char>(255 * (1 - a + a * b))};
+      if (grey) col[0] = col[1] = col[2] = 128;
       for (int q = 0; q < sc; ++q)
         for (int p = 0; p < sc; ++p) {
-          const std::size_t px = std::size_t(H - 1 - (j * sc + q)) * W + i * sc + p;  // y up
+          const std::size_t px = std::size_t(H - 1 - (row * sc + q)) * W + i * sc + p;  // y (or z) up
           for (int c = 0; c < 3; ++c) rgb[c][px] = col[c];
         }
     }
@@ -174,16 +269,52 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   const auto t0 = clk::now();
   const auto& L = r.scenario.lab();
   const Material mat = material(L.material());
-  vof::BlockSpec b;
-  b.x0 = L.x_min();
-  b.x1 = L.x_max();
-  b.y0 = L.y_min();
-  b.y1 = L.y_max();
-  b.nx = L.nx();
-  b.ny = L.ny();
-  const double dx = (b.x1 - b.x0) / b.nx, dy = (b.y1 - b.y0) / b.ny;
-  b.thickness = dx;
-  vof::Mesh m = vof::block_mesh(b);
+  // The block: a plane mesh one cell (dx) thick, or a 3D block with nz cells across the channel.
+  LabGrid g;
+  g.three_d = L.nz() > 0;
+  g.nx = L.nx();
+  g.ny = L.ny();
+  g.nz = g.three_d ? L.nz() : 1;
+  g.x0 = L.x_min();
+  g.y0 = L.y_min();
+  g.dx = (L.x_max() - L.x_min()) / g.nx;
+  g.dy = (L.y_max() - L.y_min()) / g.ny;
+  g.z0 = g.three_d ? L.z_min() : 0;
+  g.dz = g.three_d ? (L.z_max() - L.z_min()) / g.nz : g.dx;
+  g.width = g.three_d ? L.z_max() - L.z_min() : g.dx;
+  const double dx = g.dx, dy = g.dy;
+  auto blocked = [&L, y0 = g.y0](const vof::Vec& c) {
+    for (const auto& o : L.obstacles())
+      if (in_obstacle(o, c, y0)) return true;
+    return false;
+  };
+  vof::Mesh m;
+  try {
+    if (g.three_d) {
+      vof::Block3Spec b3;
+      b3.x0 = L.x_min(), b3.x1 = L.x_max(), b3.y0 = L.y_min(), b3.y1 = L.y_max(), b3.z0 = L.z_min(), b3.z1 = L.z_max();
+      b3.nx = g.nx, b3.ny = g.ny, b3.nz = g.nz;
+      b3.blocked = blocked;
+      m = vof::block_mesh_3d(b3);
+    } else {
+      vof::BlockSpec b;
+      b.x0 = L.x_min(), b.x1 = L.x_max(), b.y0 = L.y_min(), b.y1 = L.y_max();
+      b.nx = g.nx, b.ny = g.ny;
+      b.thickness = dx;
+      b.blocked_if = blocked;
+      m = vof::block_mesh(b);
+    }
+  } catch (const std::invalid_argument& e) {
+    throw ScenarioError(std::string("lab.obstacles: ") + e.what());
+  }
+  g.cell.assign(std::size_t(g.nx) * g.ny * g.nz, -1);
+  for (int c = 0; c < m.cells(); ++c) {
+    const auto& p = m.centre[std::size_t(c)];
+    const int i = std::clamp(int((p.x - g.x0) / g.dx), 0, g.nx - 1), j = std::clamp(int((p.y - g.y0) / g.dy), 0, g.ny - 1),
+              k = g.three_d ? std::clamp(int((p.z - g.z0) / g.dz), 0, g.nz - 1) : 0;
+    g.cell[g.at(i, j, k)] = c;
+  }
+  g.kc = g.three_d ? std::clamp(int((0.5 * (L.z_min() + L.z_max()) - g.z0) / g.dz), 0, g.nz - 1) : 0;
   vof::VofConfig c;
   c.rho1 = mat.rho;
   c.phi_deg = mat.phi_deg;
@@ -198,11 +329,12 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     return vof::Vec{9.81 * std::sin(a), -9.81 * std::cos(a), 0};
   };
   // Conditions: listed parts of sides become their own patches; the rest stays wall.
-  for (const char* side : {"bottom", "top", "left", "right"}) c.bc[side].kind = vof::Bc::wall;
+  for (const char* side : {"bottom", "top", "left", "right", "back", "front", "obstacle"})
+    if (m.patch_index(side) >= 0) c.bc[side].kind = vof::Bc::wall;
   for (int k = 0; k < L.boundaries_size(); ++k) {
     const auto& lb = L.boundaries(k);
     const std::string name = lb.side() + "-" + std::to_string(k);
-    const bool along_x = lb.side() == "bottom" || lb.side() == "top";
+    const bool along_x = lb.side() != "left" && lb.side() != "right";
     const double from = lb.has_from() ? lb.from() : -1e300, to = lb.has_to() ? lb.to() : 1e300;
     if (m.patch_index(lb.side()) < 0) throw ScenarioError("lab.boundaries[" + std::to_string(k) + "]: side " + lb.side() + " is already taken");
     vof::split_patch(m, lb.side(), name, [&](const vof::Vec& cf) {
@@ -215,6 +347,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
               : lb.kind() == "outflow"  ? vof::Bc::outflow
               : lb.kind() == "coulomb-slip" ? vof::Bc::coulomb_slip
               : lb.kind() == "inflow"   ? vof::Bc::inflow
+              : lb.kind() == "symmetry" ? vof::Bc::symmetry
                                         : vof::Bc::wall;
     if (pb.kind == vof::Bc::inflow) {
       const double u0 = lb.inflow_u0(), dudy = lb.inflow_dudy(), hin = lb.inflow_height(), ybase = L.y_min();
@@ -230,20 +363,16 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   std::vector<double> alpha(std::size_t(m.cells()), 0.0);
   auto inside = [](const v1::LabRegion& f, double x, double y) {
     if (f.polygon_xy_size() == 0) return x >= f.x_min() && x <= f.x_max() && y >= f.y_min() && y <= f.y_max();
-    bool in = false;  // even-odd rule
-    const int n = f.polygon_xy_size() / 2;
-    for (int a = 0, b2 = n - 1; a < n; b2 = a++) {
-      const double xa = f.polygon_xy(2 * a), ya = f.polygon_xy(2 * a + 1), xb = f.polygon_xy(2 * b2), yb = f.polygon_xy(2 * b2 + 1);
-      if ((ya > y) != (yb > y) && x < (xb - xa) * (y - ya) / (yb - ya) + xa) in = !in;
-    }
-    return in;
+    return in_polygon(f.polygon_xy(), x, y);
   };
+  bool has_inflow = false;
+  for (const auto& lb : L.boundaries()) has_inflow |= lb.kind() == "inflow";
   for (int k = 0; k < m.cells(); ++k)
     for (const auto& f : L.fill())
       if (inside(f, m.centre[std::size_t(k)].x, m.centre[std::size_t(k)].y)) alpha[std::size_t(k)] = 1;
   double v0 = 0;
   for (int k = 0; k < m.cells(); ++k) v0 += alpha[std::size_t(k)] * m.volume[std::size_t(k)];
-  if (v0 <= 0) throw ScenarioError("lab.fill: no cell centre lies in the fill rectangles");
+  if (v0 <= 0 && !has_inflow) throw ScenarioError("lab.fill: no cell centre lies in the fill regions (and no inflow feeds the channel)");
   const std::string state_hash = lab_state_hash(r);
   LabCheckpoint restart;
   if (!opt.restart_path.empty()) {
@@ -263,14 +392,14 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   }
 
   RunSummary sum;
-  sum.nx = b.nx;
-  sum.ny = b.ny;
+  sum.nx = g.nx;
+  sum.ny = g.ny * g.nz;
   sum.dx = dx;
   sum.crs = "channel coordinates";
   sum.release_volume_m3 = v0;
   sum.volume_initial = v0;
   sum.seconds_prepare = std::chrono::duration<double>(clk::now() - t0).count();
-  FieldWriter fields(out_dir, b.nx, b.ny);
+  FieldWriter fields(out_dir, g);
   double next_write = L.write_interval_s() > 0 ? L.write_interval_s() : 1e300;
   double peak = 0, t_peak = 0, t_rest = -1, pressure_s = 0, alpha_min = 1, alpha_max = 0, div = 0, last_speed = 0;
   long steps = 0, p_its = 0;
@@ -306,7 +435,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   for (const auto& p : m.patches)
     if (p.name.rfind("right", 0) == 0)
       for (int f = p.start; f < p.start + p.size; ++f) right_faces.push_back(f);
-  const int gate_i = (0 > b.x0 && 0 < b.x1) ? std::clamp(int((0 - b.x0) / dx + 1e-9), 0, b.nx - 1) : -1;
+  const int gate_i = (0 > L.x_min() && 0 < L.x_max()) ? std::clamp(int((0 - g.x0) / dx + 1e-9), 0, g.nx - 1) : -1;
   const double mon_every = std::min(0.01, L.end_time_s() / 50);
   double next_mon = s.time() + mon_every;
   std::vector<int> gate_faces;  // internal faces on the line x = 0, normal along x
@@ -318,17 +447,20 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   auto monitor = [&](double t) {
     double q = 0;
     for (int f : right_faces) q += s.granular_flux()[std::size_t(f)];
-    mon_q.push_back(1000 * q / b.thickness * 0.1);
+    const double per_width = g.three_d ? 1.0 : 0.1 / g.width;  // plane: as in the 10 cm channel; 3D: the modelled width
+    mon_q.push_back(1000 * q * per_width);
     double qg = 0;
     for (int f : gate_faces) qg += (m.Sf[std::size_t(f)].x > 0 ? 1 : -1) * s.granular_flux()[std::size_t(f)];
-    mon_gate.push_back(gate_faces.empty() ? NAN : 1000 * qg / b.thickness * 0.1);
+    mon_gate.push_back(gate_faces.empty() ? NAN : 1000 * qg * per_width);
     double sr = NAN;
     if (gate_i >= 0) {
       double sy = 0, su = 0, syy = 0, syu = 0, n = 0;
-      for (int jj = 0; jj < b.ny; ++jj) {
-        const std::size_t k = std::size_t(jj) * b.nx + std::size_t(gate_i);
+      for (int jj = 0; jj < g.ny; ++jj) {
+        const int cc = g.id(gate_i, jj, g.kc);
+        if (cc < 0) continue;
+        const auto k = std::size_t(cc);
         if (s.alpha()[k] <= 0.5) continue;
-        const double y = b.y0 + (jj + 0.5) * dy, u = s.velocity()[k].x;
+        const double y = g.y0 + (jj + 0.5) * dy, u = s.velocity()[k].x;
         sy += y, su += u, syy += y * y, syu += y * u, n += 1;
       }
       if (n >= 3) sr = (n * syu - sy * su) / (n * syy - sy * sy);
@@ -408,44 +540,84 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   if (cancelled) return sum;
   const auto t2 = clk::now();
   // Deposit figures from the column heights.
-  std::vector<double> h(std::size_t(b.nx), 0.0);
+  // Column heights (in 3D averaged across the width).
+  std::vector<double> h(std::size_t(g.nx), 0.0);
   double v1 = 0;
   for (int k = 0; k < m.cells(); ++k) {
     const auto& p = m.centre[std::size_t(k)];
-    h[std::size_t(std::clamp(int((p.x - b.x0) / dx), 0, b.nx - 1))] += s.alpha()[std::size_t(k)] * dy;
+    h[std::size_t(std::clamp(int((p.x - g.x0) / dx), 0, g.nx - 1))] += s.alpha()[std::size_t(k)] * dy * g.dz / g.width;
     v1 += s.alpha()[std::size_t(k)] * m.volume[std::size_t(k)];
   }
-  double front = b.x0, hmax = 0;
-  for (int i = 0; i < b.nx; ++i) {
-    if (h[std::size_t(i)] >= 0.5 * dy) front = b.x0 + (i + 1) * dx;  // at least half a cell of material
+  double front = g.x0, hmax = 0;
+  for (int i = 0; i < g.nx; ++i) {
+    if (h[std::size_t(i)] >= 0.5 * dy) front = g.x0 + (i + 1) * dx;  // at least half a cell of material
     hmax = std::max(hmax, h[std::size_t(i)]);
   }
   // Surface angles right of the highest column: the upper surface (least-squares slope of the
   // column heights between 90 % and 50 % of the highest) and the mean slope from 80 % to 20 %.
   int imax = int(std::max_element(h.begin(), h.end()) - h.begin());
-  while (imax + 1 < b.nx && h[std::size_t(imax) + 1] >= 0.999 * hmax) ++imax;  // the plateau's right end
+  while (imax + 1 < g.nx && h[std::size_t(imax) + 1] >= 0.999 * hmax) ++imax;  // the plateau's right end
   double sx = 0, sy = 0, sxx = 0, sxy = 0, n = 0;
-  for (int i = imax; i < b.nx; ++i)
+  for (int i = imax; i < g.nx; ++i)
     if (h[std::size_t(i)] < 0.9 * hmax && h[std::size_t(i)] > 0.5 * hmax) {
-      const double xx = b.x0 + (i + 0.5) * dx;
+      const double xx = g.x0 + (i + 0.5) * dx;
       sx += xx, sy += h[std::size_t(i)], sxx += xx * xx, sxy += xx * h[std::size_t(i)], n += 1;
     }
   const double upper = n >= 2 ? std::atan(-(n * sxy - sx * sy) / (n * sxx - sx * sx)) * 180 / kPi : NAN;
   double xh = NAN, xl = NAN;
-  for (int i = imax; i < b.nx; ++i) {
-    if (std::isnan(xh) && h[std::size_t(i)] < 0.8 * hmax) xh = b.x0 + (i + 0.5) * dx;
-    if (std::isnan(xl) && h[std::size_t(i)] < 0.2 * hmax) xl = b.x0 + (i + 0.5) * dx;
+  for (int i = imax; i < g.nx; ++i) {
+    if (std::isnan(xh) && h[std::size_t(i)] < 0.8 * hmax) xh = g.x0 + (i + 0.5) * dx;
+    if (std::isnan(xl) && h[std::size_t(i)] < 0.2 * hmax) xl = g.x0 + (i + 0.5) * dx;
   }
   const double angle = (std::isnan(xh) || std::isnan(xl) || xl <= xh) ? NAN : std::atan(0.6 * hmax / (xl - xh)) * 180 / kPi;
   sum.volume_final = v1;
-  bool has_inflow = false;
-  for (const auto& lb : L.boundaries()) has_inflow |= lb.kind() == "inflow";
   sum.volume_error = has_inflow ? NAN : std::abs(v1 - v0) / v0;  // material comes in: no conservation figure
   sum.max_speed = peak;
   sum.runout_m = front;
   sum.max_depth = hmax;
-  const int frames = fields.finish(b.x0, b.y0, dx, dy);
-  write_figure(out_dir + "/figure.png", s, b.nx, b.ny, std::max(peak, 0.01));
+  const int frames = fields.finish();
+  write_figure(out_dir + "/figure.png", s, g, std::max(peak, 0.01));
+  // 3D (validation.md B7): the flow depth map at the end; the undisturbed depth (median over the
+  // wetted columns of the first quarter of the chute), the deepest column and its ratio to it, and
+  // per obstacle the dry area (depth below 1 mm) in its shadow: up to 15 cm downstream of its
+  // centre, as wide as the obstacle.
+  std::ostringstream chute;
+  if (g.three_d) {
+    std::vector<double> d(std::size_t(g.nx) * g.nz, 0.0), upstream;
+    std::vector<char> blocked_col(d.size(), 0);
+    for (int k = 0; k < g.nz; ++k)
+      for (int i = 0; i < g.nx; ++i)
+        for (int j = 0; j < g.ny; ++j) {
+          const int c = g.id(i, j, k);
+          if (c < 0) blocked_col[std::size_t(k) * g.nx + i] = 1;
+          else d[std::size_t(k) * g.nx + i] += std::clamp(s.alpha()[std::size_t(c)], 0.0, 1.0) * dy;
+        }
+    double dmax = 0, xm = NAN, zm = NAN;
+    for (int k = 0; k < g.nz; ++k)
+      for (int i = 0; i < g.nx; ++i) {
+        const double v = d[std::size_t(k) * g.nx + i];
+        if (i < g.nx / 4 && v > 0.5 * dy && !blocked_col[std::size_t(k) * g.nx + i]) upstream.push_back(v);
+        if (v > dmax) dmax = v, xm = g.x0 + (i + 0.5) * dx, zm = g.z0 + (k + 0.5) * g.dz;
+      }
+    std::sort(upstream.begin(), upstream.end());
+    const double und = upstream.empty() ? NAN : upstream[upstream.size() / 2];
+    chute << "  \"chute\": {\"undisturbed_depth_m\": " << num(und) << ", \"max_depth_m\": " << num(dmax) << ", \"max_depth_x_m\": " << num(xm)
+          << ", \"max_depth_z_m\": " << num(zm) << ", \"max_depth_ratio\": " << num(und > 0 ? dmax / und : NAN) << ", \"obstacles\": [";
+    for (int q = 0; q < L.obstacles_size(); ++q) {
+      const auto& o = L.obstacles(q);
+      const double half = o.shape() == "cylinder" ? o.radius() : o.shape() == "polygon" ? 0.5 * g.width : 0.5 * o.edge();
+      double dry = 0;
+      for (int k = 0; k < g.nz; ++k)
+        for (int i = 0; i < g.nx; ++i) {
+          const double x = g.x0 + (i + 0.5) * dx, z = g.z0 + (k + 0.5) * g.dz;
+          if (x > o.x() && x < o.x() + 0.15 && std::abs(z - o.z()) < half && !blocked_col[std::size_t(k) * g.nx + i] &&
+              d[std::size_t(k) * g.nx + i] < 1e-3)
+            dry += dx * g.dz;
+        }
+      chute << (q ? ", " : "") << "{\"shape\": \"" << o.shape() << "\", \"sheltered_dry_area_m2\": " << num(dry) << "}";
+    }
+    chute << "]},\n";
+  }
   sum.files = {"fields.h5", "fields.xmf", "figure.png", "run.json"};
   sum.seconds_write = std::chrono::duration<double>(clk::now() - t2).count();
 
@@ -456,8 +628,8 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   std::ofstream j(out_dir + "/run.json");
   j << "{\n  \"software\": {\"name\": \"runout\", \"version\": \"" << RUNOUT_VERSION << "\"},\n";
   j << "  \"engine\": \"vof\",\n  \"scenario\": " << scen << ",\n";
-  j << "  \"mesh\": {\"cells\": " << m.cells() << ", \"nx\": " << b.nx << ", \"ny\": " << b.ny << ", \"dx_m\": " << num(dx)
-    << ", \"dy_m\": " << num(dy) << "},\n";
+  j << "  \"mesh\": {\"cells\": " << m.cells() << ", \"nx\": " << g.nx << ", \"ny\": " << g.ny << ", \"nz\": " << (g.three_d ? g.nz : 0)
+    << ", \"dx_m\": " << num(dx) << ", \"dy_m\": " << num(dy) << ", \"dz_m\": " << num(g.three_d ? g.dz : NAN) << "},\n";
   j << "  \"solver\": {\"steps\": " << steps << ", \"simulated_s\": " << num(s.time()) << ", \"pressure_iterations\": " << p_its
     << ", \"alpha_min\": " << num(alpha_min) << ", \"alpha_max\": " << num(alpha_max) << ", \"max_divergence_1_s\": " << num(div)
     << ", \"active_cells_mean\": " << num(steps ? active_sum / steps : NAN) << ", \"active_cells_max\": " << active_max
@@ -468,26 +640,39 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     << ", \"front_x_m\": " << num(front) << ", \"deposit_height_m\": " << num(hmax) << ", \"upper_surface_angle_deg\": " << num(upper) << ", \"mean_surface_angle_deg\": " << num(angle)
     << ", \"volume_initial_m3\": " << num(v0) << ", \"volume_final_m3\": " << num(v1) << ", \"volume_relative_error\": " << num(sum.volume_error)
     << ", \"frames\": " << frames << "},\n";
-  // Stations: depth, depth-averaged, surface and basal velocity along x, and the profile.
+  // Stations (centre line in 3D): depth, depth-averaged, surface and basal velocity along x, the
+  // basal speed (the slip velocity along the bed, a ramp included), the strain rate du/dy (least
+  // squares over the material cells) and the profile. Cells blocked by an obstacle are skipped: on a
+  // ramp the column starts at the ramp's surface.
   j << "  \"stations\": [";
   for (int q = 0; q < L.stations_x_size(); ++q) {
     const double xs = L.stations_x(q);
-    const int i = std::clamp(int((xs - b.x0) / dx), 0, b.nx - 1);
-    double depth = 0, flux = 0, surface = NAN, basal = NAN;
+    const int i = std::clamp(int((xs - g.x0) / dx), 0, g.nx - 1);
+    double depth = 0, flux = 0, surface = NAN, basal = NAN, basal_speed = NAN, bed = NAN;
+    double sy = 0, su = 0, syy = 0, syu = 0, nn = 0;
     std::ostringstream prof;
-    for (int jj = 0; jj < b.ny; ++jj) {
-      const std::size_t k = std::size_t(jj) * b.nx + i;
+    bool first = true;
+    for (int jj = 0; jj < g.ny; ++jj) {
+      const int c = g.id(i, jj, g.kc);
+      if (c < 0) continue;
+      const auto k = std::size_t(c);
+      const double y = g.y0 + (jj + 0.5) * dy;
+      if (std::isnan(bed)) bed = y - 0.5 * dy;
       const double a = std::clamp(s.alpha()[k], 0.0, 1.0), u = s.velocity()[k].x;
       depth += a * dy;
       flux += a * u * dy;
       if (a > 0.5) {
-        if (std::isnan(basal)) basal = u;
+        if (std::isnan(basal)) basal = u, basal_speed = vof::norm(s.velocity()[k]);
         surface = u;
+        sy += y, su += u, syy += y * y, syu += y * u, nn += 1;
       }
-      prof << (jj ? ", " : "") << "[" << num(b.y0 + (jj + 0.5) * dy) << ", " << num(a) << ", " << num(u) << "]";
+      prof << (first ? "" : ", ") << "[" << num(y) << ", " << num(a) << ", " << num(u) << "]";
+      first = false;
     }
-    j << (q ? ", " : "") << "\n    {\"x_m\": " << num(xs) << ", \"depth_m\": " << num(depth) << ", \"depth_averaged_u_m_s\": "
-      << num(depth > 0 ? flux / depth : NAN) << ", \"surface_u_m_s\": " << num(surface) << ", \"basal_u_m_s\": " << num(basal)
+    const double strain = nn >= 3 ? (nn * syu - sy * su) / (nn * syy - sy * sy) : NAN;
+    j << (q ? ", " : "") << "\n    {\"x_m\": " << num(xs) << ", \"bed_y_m\": " << num(bed) << ", \"depth_m\": " << num(depth)
+      << ", \"depth_averaged_u_m_s\": " << num(depth > 0 ? flux / depth : NAN) << ", \"surface_u_m_s\": " << num(surface)
+      << ", \"basal_u_m_s\": " << num(basal) << ", \"basal_speed_m_s\": " << num(basal_speed) << ", \"strain_rate_1_s\": " << num(strain)
       << ", \"profile_y_alpha_u\": [" << prof.str() << "]}";
   }
   j << "],\n";
@@ -514,6 +699,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     if (!opt.restart_path.empty()) j << ", \"note\": \"sampled from the restart at t = " << num(restart.state.t) << " s on\"";
     j << "},\n";
   }
+  j << chute.str();
   j << "  \"timings_s\": {\"prepare\": " << num(sum.seconds_prepare) << ", \"run\": " << num(sum.seconds_run)
     << ", \"pressure\": " << num(pressure_s) << ", \"write\": " << num(sum.seconds_write) << ", \"microseconds_per_cell_step\": "
     << num(steps ? 1e6 * sum.seconds_run / steps / m.cells() : NAN) << ", \"microseconds_per_active_cell_step\": "

@@ -89,9 +89,27 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
   if (!(l->x_max() > l->x_min())) bad("lab.x_max", "must exceed lab.x_min");
   if (!(l->y_max() > l->y_min())) bad("lab.y_max", "must exceed lab.y_min");
   if (l->nx() < 2 || l->ny() < 2) bad("lab.nx", "lab.nx and lab.ny must be at least 2");
-  if (double(l->nx()) * l->ny() > 4e6) bad("lab.nx", "more than 4 million cells");
+  if (l->nz() < 0) bad("lab.nz", "must be >= 0 (0: a plane set-up)");
+  if (l->nz() > 0 && !(l->z_max() > l->z_min())) bad("lab.z_max", "must exceed lab.z_min");
+  if (double(l->nx()) * l->ny() * std::max(1, l->nz()) > 4e6) bad("lab.nx", "more than 4 million cells");
+  const bool three_d = l->nz() > 0;
+  for (int k = 0; k < l->obstacles_size(); ++k) {
+    const auto& o = l->obstacles(k);
+    const std::string f = "lab.obstacles[" + std::to_string(k) + "]";
+    if (o.shape() == "polygon") {
+      if (o.polygon_xy_size() < 6 || o.polygon_xy_size() % 2) bad(f + ".polygon_xy", "needs x, y pairs of at least 3 corners");
+    } else if (o.shape() == "cylinder" || o.shape() == "tetrahedron-edge" || o.shape() == "tetrahedron-face") {
+      if (!three_d) bad(f + ".shape", "'" + o.shape() + "' needs a 3D set-up (lab.nz > 0)");
+      if (o.shape() == "cylinder" && !(o.radius() > 0 && o.height() > 0)) bad(f + ".radius", "a cylinder needs radius > 0 and height > 0");
+      if (o.shape() != "cylinder" && !(o.edge() > 0)) bad(f + ".edge", "a tetrahedron needs edge > 0");
+    } else {
+      bad(f + ".shape", "unknown '" + o.shape() + "' (valid: polygon, cylinder, tetrahedron-edge, tetrahedron-face)");
+    }
+  }
   if (!(l->inclination_deg() > -90 && l->inclination_deg() < 90)) bad("lab.inclination_deg", "must lie in (-90, 90)");
-  if (l->fill().empty()) bad("lab.fill", "at least one rectangle of granular material is needed");
+  bool fed = false;
+  for (const auto& b : l->boundaries()) fed |= b.kind() == "inflow";
+  if (l->fill().empty() && !fed) bad("lab.fill", "at least one region of granular material is needed (or an inflow)");
   for (int k = 0; k < l->fill_size(); ++k) {
     const auto& f = l->fill(k);
     if (f.polygon_xy_size() > 0) {
@@ -108,10 +126,12 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
   for (int k = 0; k < l->boundaries_size(); ++k) {
     const auto& b = l->boundaries(k);
     const std::string f = "lab.boundaries[" + std::to_string(k) + "]";
-    if (b.side() != "bottom" && b.side() != "top" && b.side() != "left" && b.side() != "right")
-      bad(f + ".side", "unknown '" + b.side() + "' (valid: bottom, top, left, right)");
-    if (b.kind() != "wall" && b.kind() != "coulomb-slip" && b.kind() != "atmosphere" && b.kind() != "outflow" && b.kind() != "inflow")
-      bad(f + ".kind", "unknown '" + b.kind() + "' (valid: wall, coulomb-slip, atmosphere, outflow, inflow)");
+    if (b.side() != "bottom" && b.side() != "top" && b.side() != "left" && b.side() != "right" && b.side() != "obstacle" &&
+        !(three_d && (b.side() == "back" || b.side() == "front")))
+      bad(f + ".side", "unknown '" + b.side() + "' (valid: bottom, top, left, right, obstacle; 3D also back, front)");
+    if (b.kind() != "wall" && b.kind() != "coulomb-slip" && b.kind() != "atmosphere" && b.kind() != "outflow" && b.kind() != "inflow" &&
+        b.kind() != "symmetry")
+      bad(f + ".kind", "unknown '" + b.kind() + "' (valid: wall, coulomb-slip, atmosphere, outflow, inflow, symmetry)");
     if (b.kind() == "inflow" && !(b.inflow_height() > 0)) bad(f + ".inflow_height", "an inflow needs a fill height > 0 m");
     if (b.kind() == "inflow" && b.side() != "left") bad(f + ".side", "inflow is supported on the left side only");
     if (b.has_from() && b.has_to() && !(b.to() > b.from())) bad(f + ".to", "must exceed from");

@@ -86,7 +86,7 @@ Mesh block_mesh(const BlockSpec& s) {
   for (int j = 0; j < s.ny; ++j)
     for (int i = 0; i < s.nx; ++i) {
       const double cx = 0.5 * (xs[std::size_t(i)] + xs[std::size_t(i) + 1]), cy = 0.5 * (ys[std::size_t(j)] + ys[std::size_t(j) + 1]);
-      if (inside(cx, cy)) continue;
+      if (inside(cx, cy) || (s.blocked_if && s.blocked_if(Vec{cx, cy, 0}))) continue;
       id[std::size_t(j) * std::size_t(s.nx) + std::size_t(i)] = m.cells();
       m.centre.push_back({cx, cy, 0});
       m.volume.push_back((xs[std::size_t(i) + 1] - xs[std::size_t(i)]) * (ys[std::size_t(j) + 1] - ys[std::size_t(j)]) * s.thickness);

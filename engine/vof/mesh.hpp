@@ -58,6 +58,7 @@ struct BlockSpec {
   double thickness = 0.01;
   double y_grading = 1.0;
   std::vector<std::array<double, 2>> blocked;
+  std::function<bool(const Vec&)> blocked_if;  ///< further cells to leave out, by centre
 };
 Mesh block_mesh(const BlockSpec& s);
 
