@@ -31,6 +31,24 @@ static double field(const std::string& json, const std::string& key) {
   return std::atof(json.c_str() + k + key.size() + 4);
 }
 
+// Run a scenario in a temporary directory; its summary and run.json.
+struct Ran {
+  runout::jobs::RunSummary sum;
+  std::string json;
+};
+static Ran run_in_temp(const runout::jobs::ResolvedScenario& r) {
+  const fs::path out = fs::temp_directory_path() / ("runout-bench-vof-" + std::to_string(getpid()));
+  fs::create_directories(out);
+  Ran ran;
+  ran.sum = runout::jobs::run_scenario(r, out.string());
+  std::ifstream in(out / "run.json");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  ran.json = ss.str();
+  fs::remove_all(out);
+  return ran;
+}
+
 // B10 (validation.md): a column L = 5 cm wide, H = a L high, against the left wall, released at t = 0.
 static int b10() {
   std::printf("| a = H/L | cells | (l - L)/L | steps | wall [s] |\n|---:|---:|---:|---:|---:|\n");
@@ -50,10 +68,7 @@ static int b10() {
     lab->set_end_time_s(0.6 + 0.25 * std::sqrt(a));
     lab->set_write_interval_s(0);
     auto r = runout::jobs::resolve_scenario(s, ".");
-    const fs::path out = fs::temp_directory_path() / ("runout-bench-b10-" + std::to_string(getpid()));
-    fs::create_directories(out);
-    const auto sum = runout::jobs::run_scenario(r, out.string());
-    fs::remove_all(out);
+    const auto sum = run_in_temp(r).sum;
     const double rel = (sum.runout_m - L) / L;
     rs.push_back(rel);
     std::printf("| %.1f | %d | %.2f | %ld | %.1f |\n", a, sum.nx * sum.ny, rel, sum.steps, sum.seconds_run);
@@ -90,16 +105,11 @@ static int region() {
       lab->set_nx(int(std::lround(len / 0.005)));
       lab->set_active_layers(mode == 0 ? 0 : -1);
       auto r = runout::jobs::resolve_scenario(sc, ".");
-      const fs::path out = fs::temp_directory_path() / ("runout-bench-region-" + std::to_string(getpid()));
-      fs::create_directories(out);
-      const auto sum = runout::jobs::run_scenario(r, out.string());
-      std::ifstream in(out / "run.json");
-      std::stringstream ss;
-      ss << in.rdbuf();
-      fs::remove_all(out);
+      const auto ran = run_in_temp(r);
+      const auto& sum = ran.sum;
       wall[mode] = sum.seconds_run;
       per_step[mode] = 1e6 * sum.seconds_run / double(sum.steps);
-      if (mode == 0) active = field(ss.str(), "active_cells_mean");
+      if (mode == 0) active = field(ran.json, "active_cells_mean");
       cells = sum.nx * sum.ny;
     }
     std::printf("| %.1f | %d | %.0f | %.2f | %.2f | %.0f | %.0f | %.2f |\n", len, cells, active, wall[0], wall[1], per_step[0], per_step[1],
@@ -121,14 +131,9 @@ static int b7(bool full) {
       lab->set_nz(59);
     }
     lab->set_write_interval_s(0);
-    const fs::path out = fs::temp_directory_path() / ("runout-bench-b7-" + std::to_string(getpid()));
-    fs::create_directories(out);
-    const auto sum = runout::jobs::run_scenario(r, out.string());
-    std::ifstream in(out / "run.json");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    fs::remove_all(out);
-    const std::string j = ss.str();
+    const auto ran = run_in_temp(r);
+    const auto& sum = ran.sum;
+    const std::string& j = ran.json;
     const double cells = field(j, "cells");
     std::printf("| %s | %.0f | %ld | %.0f | %.2f | %.1f | %.1f | %.1f | %.0f |\n", shape, cells, sum.steps, sum.seconds_run,
                 1e6 * sum.seconds_run / sum.steps / cells, 1e3 * field(j, "undisturbed_depth_m"), 1e3 * field(j, "max_depth_m"),
@@ -162,14 +167,9 @@ int main(int argc, char** argv) {
   }
   lab->set_end_time_s(end);
   lab->set_write_interval_s(0);
-  const fs::path out = fs::temp_directory_path() / ("runout-bench-vof-" + std::to_string(getpid()));
-  fs::create_directories(out);
-  const auto sum = runout::jobs::run_scenario(r, out.string());
-  std::ifstream in(out / "run.json");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string j = ss.str();
-  fs::remove_all(out);
+  const auto ran = run_in_temp(r);
+  const auto& sum = ran.sum;
+  const std::string& j = ran.json;
   const double cells = double(sum.nx) * sum.ny, pressure = field(j, "pressure");
   std::printf("| figure | this run | dissertation (interFoam) |\n|---|---:|---:|\n");
   std::printf("| cells | %.0f | 12000 |\n", cells);

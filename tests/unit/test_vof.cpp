@@ -32,6 +32,30 @@ VofConfig box_config() {
   return c;
 }
 
+// Surface angle of a heap against the left wall of a mesh of 5 mm columns: from the column heights
+// between 80 % and 20 % of the height at the wall.
+double surface_angle_deg(const Mesh& m, const VofSolver& s, int columns) {
+  std::vector<double> h(std::size_t(columns), 0.0);
+  for (int k = 0; k < m.cells(); ++k) h[std::size_t(m.centre[std::size_t(k)].x / 0.005)] += s.alpha()[std::size_t(k)] * 0.005;
+  const double hi = 0.8 * h[0], lo = 0.2 * h[0];
+  double xhi = 0, xlo = 0;
+  for (int i = columns - 1; i >= 0; --i) {
+    if (h[std::size_t(i)] < hi) xhi = (i + 0.5) * 0.005;
+    if (h[std::size_t(i)] < lo) xlo = (i + 0.5) * 0.005;
+  }
+  return std::atan((hi - lo) / std::max(1e-9, xlo - xhi)) * 180 / 3.14159265358979;
+}
+
+// Centre of the material along x.
+double centroid_x(const Mesh& m, const VofSolver& s) {
+  double mx = 0, mv = 0;
+  for (int k = 0; k < m.cells(); ++k) {
+    mx += s.alpha()[std::size_t(k)] * m.volume[std::size_t(k)] * m.centre[std::size_t(k)].x;
+    mv += s.alpha()[std::size_t(k)] * m.volume[std::size_t(k)];
+  }
+  return mx / mv;
+}
+
 struct HeapRun {
   double max_speed_end = 0, volume0 = 0, volume1 = 0, alpha_min = 1, alpha_max = 0, divergence = 0, angle_deg = 0;
 };
@@ -54,15 +78,7 @@ HeapRun heap(double top, double slope, double t_end) {
     r.volume1 = st.granular_volume;
     return true;
   });
-  std::vector<double> h(40, 0.0);
-  for (int k = 0; k < m.cells(); ++k) h[std::size_t(m.centre[std::size_t(k)].x / 0.005)] += s.alpha()[std::size_t(k)] * 0.005;
-  const double hi = 0.8 * h[0], lo = 0.2 * h[0];
-  double xhi = 0, xlo = 0;
-  for (int i = 39; i >= 0; --i) {
-    if (h[std::size_t(i)] < hi) xhi = (i + 0.5) * 0.005;
-    if (h[std::size_t(i)] < lo) xlo = (i + 0.5) * 0.005;
-  }
-  r.angle_deg = std::atan((hi - lo) / std::max(1e-9, xlo - xhi)) * 180 / 3.14159265358979;
+  r.angle_deg = surface_angle_deg(m, s, 40);
   return r;
 }
 
@@ -224,22 +240,8 @@ RegionRun failing_heap_in_long_channel(int layers, double air_co = 1.0, double c
     r.volume1 = st.granular_volume;
     return true;
   });
-  double mx = 0, mv = 0;
-  for (int k = 0; k < m.cells(); ++k) {
-    mx += s.alpha()[std::size_t(k)] * m.volume[std::size_t(k)] * m.centre[std::size_t(k)].x;
-    mv += s.alpha()[std::size_t(k)] * m.volume[std::size_t(k)];
-  }
-  r.centroid_x = mx / mv;
-  // Surface angle between 80 % and 20 % of the height at the wall.
-  std::vector<double> h(120, 0.0);
-  for (int k = 0; k < m.cells(); ++k) h[std::size_t(m.centre[std::size_t(k)].x / 0.005)] += s.alpha()[std::size_t(k)] * 0.005;
-  const double hi = 0.8 * h[0], lo = 0.2 * h[0];
-  double xhi = 0, xlo = 0;
-  for (int i = 119; i >= 0; --i) {
-    if (h[std::size_t(i)] < hi) xhi = (i + 0.5) * 0.005;
-    if (h[std::size_t(i)] < lo) xlo = (i + 0.5) * 0.005;
-  }
-  r.angle_deg = std::atan((hi - lo) / std::max(1e-9, xlo - xhi)) * 180 / 3.14159265358979;
+  r.centroid_x = centroid_x(m, s);
+  r.angle_deg = surface_angle_deg(m, s, 120);
   return r;
 }
 }  // namespace
@@ -364,13 +366,8 @@ Heap3 steep_heap(bool three_d, double t_end) {
     r.volume1 = st.granular_volume;
     return true;
   });
-  double mx = 0, mv = 0;
-  for (int k = 0; k < m.cells(); ++k) {
-    mx += s.alpha()[std::size_t(k)] * m.volume[std::size_t(k)] * m.centre[std::size_t(k)].x;
-    mv += s.alpha()[std::size_t(k)] * m.volume[std::size_t(k)];
-    r.max_uz = std::max(r.max_uz, std::abs(s.velocity()[std::size_t(k)].z));
-  }
-  r.centroid_x = mx / mv;
+  for (const auto& u : s.velocity()) r.max_uz = std::max(r.max_uz, std::abs(u.z));
+  r.centroid_x = centroid_x(m, s);
   return r;
 }
 }  // namespace
