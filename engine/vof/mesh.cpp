@@ -54,23 +54,42 @@ void Mesh::finish() {
   }
 }
 
+namespace {
+struct BFace {  // a boundary face while a block is being built
+  int owner;
+  Vec Sf, Cf;
+};
+
+// Append boundary faces as the patch `name` (none: no patch).
+void append_patch(Mesh& m, const std::string& name, const std::vector<BFace>& fs) {
+  if (fs.empty()) return;
+  m.patches.push_back({name, m.faces(), int(fs.size())});
+  for (const auto& f : fs) {
+    m.owner.push_back(f.owner);
+    m.Sf.push_back(f.Sf);
+    m.Cf.push_back(f.Cf);
+  }
+}
+
+// Node coordinates of a graded direction: cell sizes h_k = h0 r^k with r^(n-1) = grading.
+std::vector<double> graded_nodes(double a, double b, int n, double grading) {
+  std::vector<double> v(std::size_t(n) + 1);
+  const double r = n > 1 ? std::pow(grading, 1.0 / (n - 1)) : 1.0;
+  double total = 0, h = 1;
+  for (int k = 0; k < n; ++k, h *= r) total += h;
+  h = (b - a) / total;
+  v[0] = a;
+  double y = a;
+  for (int k = 0; k < n; ++k, h *= r) v[std::size_t(k) + 1] = (y += h);
+  v[std::size_t(n)] = b;
+  return v;
+}
+}  // namespace
+
 Mesh block_mesh(const BlockSpec& s) {
   if (s.nx < 1 || s.ny < 1 || !(s.x1 > s.x0) || !(s.y1 > s.y0) || !(s.thickness > 0) || !(s.y_grading > 0))
     throw std::invalid_argument("block mesh: needs x1 > x0, y1 > y0, nx, ny >= 1, thickness > 0, y_grading > 0");
-  // Node coordinates.
-  std::vector<double> xs(std::size_t(s.nx) + 1), ys(std::size_t(s.ny) + 1);
-  for (int i = 0; i <= s.nx; ++i) xs[std::size_t(i)] = s.x0 + (s.x1 - s.x0) * i / s.nx;
-  {
-    // Geometric cell heights h_k = h0 r^k with r^(ny-1) = grading.
-    const double r = s.ny > 1 ? std::pow(s.y_grading, 1.0 / (s.ny - 1)) : 1.0;
-    double total = 0, h = 1;
-    for (int k = 0; k < s.ny; ++k, h *= r) total += h;
-    double y = s.y0;
-    h = (s.y1 - s.y0) / total;
-    ys[0] = s.y0;
-    for (int k = 0; k < s.ny; ++k, h *= r) ys[std::size_t(k) + 1] = (y += h);
-    ys[std::size_t(s.ny)] = s.y1;
-  }
+  const auto xs = graded_nodes(s.x0, s.x1, s.nx, 1.0), ys = graded_nodes(s.y0, s.y1, s.ny, s.y_grading);
   auto inside = [&](double x, double y) {
     const auto& p = s.blocked;
     if (p.size() < 3) return false;
@@ -94,10 +113,6 @@ Mesh block_mesh(const BlockSpec& s) {
   if (m.cells() == 0) throw std::invalid_argument("block mesh: every cell is blocked");
   auto cell = [&](int i, int j) {
     return (i < 0 || j < 0 || i >= s.nx || j >= s.ny) ? -1 : id[std::size_t(j) * std::size_t(s.nx) + std::size_t(i)];
-  };
-  struct BFace {
-    int owner;
-    Vec Sf, Cf;
   };
   std::vector<BFace> left, right, bottom, top, obstacle;
   // Faces normal to x: between (i-1, j) and (i, j).
@@ -135,39 +150,15 @@ Mesh block_mesh(const BlockSpec& s) {
       }
     }
   m.n_internal = int(m.owner.size());
-  auto add = [&](const std::string& name, const std::vector<BFace>& fs) {
-    if (fs.empty()) return;
-    m.patches.push_back({name, m.faces(), int(fs.size())});
-    for (const auto& f : fs) {
-      m.owner.push_back(f.owner);
-      m.Sf.push_back(f.Sf);
-      m.Cf.push_back(f.Cf);
-    }
-  };
-  add("bottom", bottom);
-  add("right", right);
-  add("top", top);
-  add("left", left);
-  add("obstacle", obstacle);
+  append_patch(m, "bottom", bottom);
+  append_patch(m, "right", right);
+  append_patch(m, "top", top);
+  append_patch(m, "left", left);
+  append_patch(m, "obstacle", obstacle);
   m.finish();
   return m;
 }
 
-namespace {
-// Node coordinates of a graded direction: cell sizes h_k = h0 r^k with r^(n-1) = grading.
-std::vector<double> graded_nodes(double a, double b, int n, double grading) {
-  std::vector<double> v(std::size_t(n) + 1);
-  const double r = n > 1 ? std::pow(grading, 1.0 / (n - 1)) : 1.0;
-  double total = 0, h = 1;
-  for (int k = 0; k < n; ++k, h *= r) total += h;
-  h = (b - a) / total;
-  v[0] = a;
-  double y = a;
-  for (int k = 0; k < n; ++k, h *= r) v[std::size_t(k) + 1] = (y += h);
-  v[std::size_t(n)] = b;
-  return v;
-}
-}  // namespace
 
 Mesh block_mesh_3d(const Block3Spec& s) {
   if (s.nx < 1 || s.ny < 1 || s.nz < 1 || !(s.x1 > s.x0) || !(s.y1 > s.y0) || !(s.z1 > s.z0) || !(s.y_grading > 0))
@@ -192,10 +183,6 @@ Mesh block_mesh_3d(const Block3Spec& s) {
   auto cell = [&](long i, long j, long k) {
     if (i < 0 || j < 0 || k < 0 || i >= s.nx || j >= s.ny || k >= s.nz) return -1;
     return id[at(std::size_t(i), std::size_t(j), std::size_t(k))];
-  };
-  struct BFace {
-    int owner;
-    Vec Sf, Cf;
   };
   std::map<std::string, std::vector<BFace>> bnd;
   // Faces normal to direction d between cell (.., n-1, ..) and (.., n, ..) along d.
@@ -230,16 +217,7 @@ Mesh block_mesh_3d(const Block3Spec& s) {
         }
   }
   m.n_internal = int(m.owner.size());
-  for (const char* name : {"bottom", "right", "top", "left", "back", "front", "obstacle"}) {
-    const auto& fs = bnd[name];
-    if (fs.empty()) continue;
-    m.patches.push_back({name, m.faces(), int(fs.size())});
-    for (const auto& f : fs) {
-      m.owner.push_back(f.owner);
-      m.Sf.push_back(f.Sf);
-      m.Cf.push_back(f.Cf);
-    }
-  }
+  for (const char* name : {"bottom", "right", "top", "left", "back", "front", "obstacle"}) append_patch(m, name, bnd[name]);
   m.finish();
   return m;
 }

@@ -211,7 +211,7 @@ struct RegionRun {
   int cells = 0, active_max = 0, active_end = 0;
 };
 // A 50 deg heap 6 cm wide failing in a 60 cm channel open at the top and the right.
-RegionRun failing_heap_in_long_channel(int layers, double air_co = 1.0, double co = 0.2) {
+RegionRun failing_heap_in_long_channel(int layers) {
   BlockSpec b;
   b.x1 = 0.6;
   b.y1 = 0.1;
@@ -222,8 +222,6 @@ RegionRun failing_heap_in_long_channel(int layers, double air_co = 1.0, double c
   auto c = box_config();
   c.bc["right"].kind = Bc::atmosphere;
   c.active_layers = layers;
-  c.max_air_co = air_co;
-  c.max_co = c.max_alpha_co = co;
   VofSolver s(m, c);
   std::vector<double> a(std::size_t(m.cells()));
   for (int k = 0; k < m.cells(); ++k) {
