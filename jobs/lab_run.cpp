@@ -32,13 +32,6 @@ Material material(const std::string& name) {  // validation.md part B
   return {936.17, 32, 20};
 }
 
-std::string num(double v) {
-  if (!std::isfinite(v)) return "null";
-  std::ostringstream o;
-  o.precision(10);
-  o << v;
-  return o.str();
-}
 
 // The lab block as a grid: nx x ny (x nz in 3D) cells, row-major with j = 0 at the bottom and k = 0
 // at z_min; `cell` maps a grid position to the mesh cell, -1 where an obstacle blocks it.
@@ -381,7 +374,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       throw ScenarioError("checkpoint " + opt.restart_path + " belongs to another scenario (only end_time_s, write_interval_s and "
                           "checkpoint_interval_s may differ)");
     if (!(restart.state.t < L.end_time_s()))
-      throw ScenarioError("checkpoint " + opt.restart_path + " is at t = " + num(restart.state.t) + " s, not before lab.end_time_s");
+      throw ScenarioError("checkpoint " + opt.restart_path + " is at t = " + json_number(restart.state.t) + " s, not before lab.end_time_s");
     try {
       s.restore(restart.state);
     } catch (const vof::VofError& e) {
@@ -601,8 +594,8 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       }
     std::sort(upstream.begin(), upstream.end());
     const double und = upstream.empty() ? NAN : upstream[upstream.size() / 2];
-    chute << "  \"chute\": {\"undisturbed_depth_m\": " << num(und) << ", \"max_depth_m\": " << num(dmax) << ", \"max_depth_x_m\": " << num(xm)
-          << ", \"max_depth_z_m\": " << num(zm) << ", \"max_depth_ratio\": " << num(und > 0 ? dmax / und : NAN) << ", \"obstacles\": [";
+    chute << "  \"chute\": {\"undisturbed_depth_m\": " << json_number(und) << ", \"max_depth_m\": " << json_number(dmax) << ", \"max_depth_x_m\": " << json_number(xm)
+          << ", \"max_depth_z_m\": " << json_number(zm) << ", \"max_depth_ratio\": " << json_number(und > 0 ? dmax / und : NAN) << ", \"obstacles\": [";
     for (int q = 0; q < L.obstacles_size(); ++q) {
       const auto& o = L.obstacles(q);
       const double half = o.shape() == "cylinder" ? o.radius() : o.shape() == "polygon" ? 0.5 * g.width : 0.5 * o.edge();
@@ -614,7 +607,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
               d[std::size_t(k) * g.nx + i] < 1e-3)
             dry += dx * g.dz;
         }
-      chute << (q ? ", " : "") << "{\"shape\": \"" << o.shape() << "\", \"sheltered_dry_area_m2\": " << num(dry) << "}";
+      chute << (q ? ", " : "") << "{\"shape\": \"" << o.shape() << "\", \"sheltered_dry_area_m2\": " << json_number(dry) << "}";
     }
     chute << "]},\n";
   }
@@ -629,16 +622,16 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   j << "{\n  \"software\": {\"name\": \"runout\", \"version\": \"" << RUNOUT_VERSION << "\"},\n";
   j << "  \"engine\": \"vof\",\n  \"scenario\": " << scen << ",\n";
   j << "  \"mesh\": {\"cells\": " << m.cells() << ", \"nx\": " << g.nx << ", \"ny\": " << g.ny << ", \"nz\": " << (g.three_d ? g.nz : 0)
-    << ", \"dx_m\": " << num(dx) << ", \"dy_m\": " << num(dy) << ", \"dz_m\": " << num(g.three_d ? g.dz : NAN) << "},\n";
-  j << "  \"solver\": {\"steps\": " << steps << ", \"simulated_s\": " << num(s.time()) << ", \"pressure_iterations\": " << p_its
-    << ", \"alpha_min\": " << num(alpha_min) << ", \"alpha_max\": " << num(alpha_max) << ", \"max_divergence_1_s\": " << num(div)
-    << ", \"active_cells_mean\": " << num(steps ? active_sum / steps : NAN) << ", \"active_cells_max\": " << active_max
-    << ", \"stop\": \"" << sum.stop << "\", \"continued_from_t_s\": " << num(opt.restart_path.empty() ? NAN : restart.state.t)
+    << ", \"dx_m\": " << json_number(dx) << ", \"dy_m\": " << json_number(dy) << ", \"dz_m\": " << json_number(g.three_d ? g.dz : NAN) << "},\n";
+  j << "  \"solver\": {\"steps\": " << steps << ", \"simulated_s\": " << json_number(s.time()) << ", \"pressure_iterations\": " << p_its
+    << ", \"alpha_min\": " << json_number(alpha_min) << ", \"alpha_max\": " << json_number(alpha_max) << ", \"max_divergence_1_s\": " << json_number(div)
+    << ", \"active_cells_mean\": " << json_number(steps ? active_sum / steps : NAN) << ", \"active_cells_max\": " << active_max
+    << ", \"stop\": \"" << sum.stop << "\", \"continued_from_t_s\": " << json_number(opt.restart_path.empty() ? NAN : restart.state.t)
     << "},\n";
-  j << "  \"results\": {\"peak_speed_m_s\": " << num(peak) << ", \"peak_speed_time_s\": " << num(t_peak)
-    << ", \"rest_time_s\": " << num(t_rest >= 0 ? t_rest : NAN) << ", \"final_speed_m_s\": " << num(last_speed)
-    << ", \"front_x_m\": " << num(front) << ", \"deposit_height_m\": " << num(hmax) << ", \"upper_surface_angle_deg\": " << num(upper) << ", \"mean_surface_angle_deg\": " << num(angle)
-    << ", \"volume_initial_m3\": " << num(v0) << ", \"volume_final_m3\": " << num(v1) << ", \"volume_relative_error\": " << num(sum.volume_error)
+  j << "  \"results\": {\"peak_speed_m_s\": " << json_number(peak) << ", \"peak_speed_time_s\": " << json_number(t_peak)
+    << ", \"rest_time_s\": " << json_number(t_rest >= 0 ? t_rest : NAN) << ", \"final_speed_m_s\": " << json_number(last_speed)
+    << ", \"front_x_m\": " << json_number(front) << ", \"deposit_height_m\": " << json_number(hmax) << ", \"upper_surface_angle_deg\": " << json_number(upper) << ", \"mean_surface_angle_deg\": " << json_number(angle)
+    << ", \"volume_initial_m3\": " << json_number(v0) << ", \"volume_final_m3\": " << json_number(v1) << ", \"volume_relative_error\": " << json_number(sum.volume_error)
     << ", \"frames\": " << frames << "},\n";
   // Stations (centre line in 3D): depth, depth-averaged, surface and basal velocity along x, the
   // basal speed (the slip velocity along the bed, a ramp included), the strain rate du/dy (least
@@ -666,13 +659,13 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
         surface = u;
         sy += y, su += u, syy += y * y, syu += y * u, nn += 1;
       }
-      prof << (first ? "" : ", ") << "[" << num(y) << ", " << num(a) << ", " << num(u) << "]";
+      prof << (first ? "" : ", ") << "[" << json_number(y) << ", " << json_number(a) << ", " << json_number(u) << "]";
       first = false;
     }
     const double strain = nn >= 3 ? (nn * syu - sy * su) / (nn * syy - sy * sy) : NAN;
-    j << (q ? ", " : "") << "\n    {\"x_m\": " << num(xs) << ", \"bed_y_m\": " << num(bed) << ", \"depth_m\": " << num(depth)
-      << ", \"depth_averaged_u_m_s\": " << num(depth > 0 ? flux / depth : NAN) << ", \"surface_u_m_s\": " << num(surface)
-      << ", \"basal_u_m_s\": " << num(basal) << ", \"basal_speed_m_s\": " << num(basal_speed) << ", \"strain_rate_1_s\": " << num(strain)
+    j << (q ? ", " : "") << "\n    {\"x_m\": " << json_number(xs) << ", \"bed_y_m\": " << json_number(bed) << ", \"depth_m\": " << json_number(depth)
+      << ", \"depth_averaged_u_m_s\": " << json_number(depth > 0 ? flux / depth : NAN) << ", \"surface_u_m_s\": " << json_number(surface)
+      << ", \"basal_u_m_s\": " << json_number(basal) << ", \"basal_speed_m_s\": " << json_number(basal_speed) << ", \"strain_rate_1_s\": " << json_number(strain)
       << ", \"profile_y_alpha_u\": [" << prof.str() << "]}";
   }
   j << "],\n";
@@ -687,23 +680,23 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     const double plateau_gate = late_gate.empty() ? NAN : late_gate[late_gate.size() / 2];
     auto series = [&](const std::vector<double>& v) {
       std::ostringstream o;
-      for (std::size_t q = 0; q < v.size(); ++q) o << (q ? ", " : "") << num(v[q]);
+      for (std::size_t q = 0; q < v.size(); ++q) o << (q ? ", " : "") << json_number(v[q]);
       return o.str();
     };
-    j << "  \"monitors\": {\"fluidised_time_s\": " << num(t_fluid >= 0 ? t_fluid : NAN)
-      << ", \"outflow_median_second_half_l_s_10cm\": " << num(plateau) << ", \"gate_flux_median_second_half_l_s_10cm\": "
-      << num(plateau_gate) << ", \"t_s\": [" << series(mon_t)
+    j << "  \"monitors\": {\"fluidised_time_s\": " << json_number(t_fluid >= 0 ? t_fluid : NAN)
+      << ", \"outflow_median_second_half_l_s_10cm\": " << json_number(plateau) << ", \"gate_flux_median_second_half_l_s_10cm\": "
+      << json_number(plateau_gate) << ", \"t_s\": [" << series(mon_t)
       << "], \"outflow_l_s_10cm\": [" << series(mon_q) << "], \"gate_flux_l_s_10cm\": [" << series(mon_gate)
       << "], \"gate_strain_rate_1_s\": [" << series(mon_sr)
       << "], \"moving_share\": [" << series(mon_moving) << "]";
-    if (!opt.restart_path.empty()) j << ", \"note\": \"sampled from the restart at t = " << num(restart.state.t) << " s on\"";
+    if (!opt.restart_path.empty()) j << ", \"note\": \"sampled from the restart at t = " << json_number(restart.state.t) << " s on\"";
     j << "},\n";
   }
   j << chute.str();
-  j << "  \"timings_s\": {\"prepare\": " << num(sum.seconds_prepare) << ", \"run\": " << num(sum.seconds_run)
-    << ", \"pressure\": " << num(pressure_s) << ", \"write\": " << num(sum.seconds_write) << ", \"microseconds_per_cell_step\": "
-    << num(steps ? 1e6 * sum.seconds_run / steps / m.cells() : NAN) << ", \"microseconds_per_active_cell_step\": "
-    << num(active_sum > 0 ? 1e6 * sum.seconds_run / active_sum : NAN) << "}\n}\n";
+  j << "  \"timings_s\": {\"prepare\": " << json_number(sum.seconds_prepare) << ", \"run\": " << json_number(sum.seconds_run)
+    << ", \"pressure\": " << json_number(pressure_s) << ", \"write\": " << json_number(sum.seconds_write) << ", \"microseconds_per_cell_step\": "
+    << json_number(steps ? 1e6 * sum.seconds_run / steps / m.cells() : NAN) << ", \"microseconds_per_active_cell_step\": "
+    << json_number(active_sum > 0 ? 1e6 * sum.seconds_run / active_sum : NAN) << "}\n}\n";
   if (!j) throw std::runtime_error("cannot write run.json");
   return sum;
 }

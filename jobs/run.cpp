@@ -23,6 +23,14 @@
 namespace runout::jobs {
 namespace fs = std::filesystem;
 
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  std::ostringstream o;
+  o.precision(10);
+  o << v;
+  return o.str();
+}
+
 namespace {
 
 double since(std::chrono::steady_clock::time_point t0) {
@@ -50,13 +58,6 @@ std::string jstr(const std::string& s) {
   return o + "\"";
 }
 
-std::string jnum(double v) {
-  if (!std::isfinite(v)) return "null";
-  std::ostringstream o;
-  o.precision(10);
-  o << v;
-  return o.str();
-}
 
 }  // namespace
 
@@ -187,8 +188,8 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
     std::ofstream csv(out("iseesnow_" + opt.iseesnow_id + ".csv"));
     csv << ",testCase,computation duration (CPU) [s],avalanche flow time [s],volume at t0 [m3],"
            "volume at tFinal [m3],spatial resolution x [m],spatial resolution y [m],number of particles\n";
-    csv << index << "," << opt.iseesnow_id.substr(digits) << "," << jnum(sum.cpu_seconds) << "," << jnum(d.t) << ","
-        << jnum(d.volume_initial) << "," << jnum(d.volume_final) << "," << jnum(grid.dx) << "," << jnum(grid.dx) << ",\n";
+    csv << index << "," << opt.iseesnow_id.substr(digits) << "," << json_number(sum.cpu_seconds) << "," << json_number(d.t) << ","
+        << json_number(d.volume_initial) << "," << json_number(d.volume_final) << "," << json_number(grid.dx) << "," << json_number(grid.dx) << ",\n";
     if (!csv) throw std::runtime_error("writing the ISeeSnow CSV failed");
     // The model configuration file the benchmark asks for, named like the peak fields.
     std::ofstream cfg(out(stem + ".txt"));
@@ -197,16 +198,16 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
         << "curvature in the bed friction " << (s.scenario.numerics().curvature_off() ? "off" : "on") << ")\n"
         << "scenario = " << s.scenario.name() << "\n"
         << "rheology = " << (m.rheology().empty() ? "coulomb" : m.rheology()) << "\n";
-    if (m.has_voellmy_mu()) cfg << "mu = " << jnum(m.voellmy_mu()) << "\n";
-    if (m.has_voellmy_xi()) cfg << "xi_m_s2 = " << jnum(m.voellmy_xi()) << "\n";
-    if (m.has_bed_friction_deg()) cfg << "bed_friction_deg = " << jnum(m.bed_friction_deg()) << "\n";
-    if (m.has_internal_friction_deg()) cfg << "internal_friction_deg = " << jnum(m.internal_friction_deg()) << "\n";
+    if (m.has_voellmy_mu()) cfg << "mu = " << json_number(m.voellmy_mu()) << "\n";
+    if (m.has_voellmy_xi()) cfg << "xi_m_s2 = " << json_number(m.voellmy_xi()) << "\n";
+    if (m.has_bed_friction_deg()) cfg << "bed_friction_deg = " << json_number(m.bed_friction_deg()) << "\n";
+    if (m.has_internal_friction_deg()) cfg << "internal_friction_deg = " << json_number(m.internal_friction_deg()) << "\n";
     cfg << "earth_pressure = " << (m.earth_pressure().empty() ? "unity" : m.earth_pressure()) << "\n"
         << "limiter = " << (s.scenario.numerics().limiter().empty() ? "minmod" : s.scenario.numerics().limiter()) << "\n"
-        << "cfl = " << jnum(s.config.time.cfl) << "\n"
-        << "cell_size_m = " << jnum(grid.dx) << "\n"
-        << "release_volume_m3 = " << jnum(d.volume_initial) << "\n"
-        << "stop = " << engine::to_string(d.stop) << " at t = " << jnum(d.t) << " s\n";
+        << "cfl = " << json_number(s.config.time.cfl) << "\n"
+        << "cell_size_m = " << json_number(grid.dx) << "\n"
+        << "release_volume_m3 = " << json_number(d.volume_initial) << "\n"
+        << "stop = " << engine::to_string(d.stop) << " at t = " << json_number(d.t) << " s\n";
     if (!cfg) throw std::runtime_error("writing the ISeeSnow configuration file failed");
     sum.files.push_back(stem + ".txt");
     for (const char* suffix : {"_pft.asc", "_pfv.asc"}) sum.files.push_back(stem + suffix);
@@ -232,32 +233,32 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   for (std::size_t k = 0; k < s.input_files.size(); ++k)
     r << (k ? ", " : "") << "{\"path\": " << jstr(s.input_files[k]) << ", \"sha256\": " << jstr(terrain::sha256_file(s.input_files[k])) << "}";
   r << "],\n";
-  r << "  \"dem\": {\"source_crs\": " << jstr(dem_rep.source_crs) << ", \"source_resolution_m\": " << jnum(dem_rep.source_resolution_m)
-    << ", \"z_min_m\": " << jnum(dem_rep.z_min) << ", \"z_max_m\": " << jnum(dem_rep.z_max)
-    << ", \"slope_mean_deg\": " << jnum(dem_rep.slope_mean_deg) << ", \"slope_p90_deg\": " << jnum(dem_rep.slope_p90_deg)
-    << ", \"slope_max_deg\": " << jnum(dem_rep.slope_max_deg) << ", \"cells_without_data\": " << dem_rep.cells_without_data
+  r << "  \"dem\": {\"source_crs\": " << jstr(dem_rep.source_crs) << ", \"source_resolution_m\": " << json_number(dem_rep.source_resolution_m)
+    << ", \"z_min_m\": " << json_number(dem_rep.z_min) << ", \"z_max_m\": " << json_number(dem_rep.z_max)
+    << ", \"slope_mean_deg\": " << json_number(dem_rep.slope_mean_deg) << ", \"slope_p90_deg\": " << json_number(dem_rep.slope_p90_deg)
+    << ", \"slope_max_deg\": " << json_number(dem_rep.slope_max_deg) << ", \"cells_without_data\": " << dem_rep.cells_without_data
     << ", \"cells_outside_area\": " << dem_rep.cells_outside_area << "},\n";
   r << "  \"grid\": {\"crs\": " << jstr(grid.crs_name) << ", \"nx\": " << grid.nx << ", \"ny\": " << grid.ny
-    << ", \"cell_size_m\": " << jnum(grid.dx) << ", \"x_min\": " << jnum(grid.x_min) << ", \"y_min\": " << jnum(grid.y_min)
-    << ", \"local_origin\": [" << jnum(grid.x_min + 0.5 * grid.nx * grid.dx) << ", " << jnum(grid.y_min + 0.5 * grid.ny * grid.dx)
+    << ", \"cell_size_m\": " << json_number(grid.dx) << ", \"x_min\": " << json_number(grid.x_min) << ", \"y_min\": " << json_number(grid.y_min)
+    << ", \"local_origin\": [" << json_number(grid.x_min + 0.5 * grid.nx * grid.dx) << ", " << json_number(grid.y_min + 0.5 * grid.ny * grid.dx)
     << "]},\n";
   r << "  \"release\": {\"polygons\": " << rel_rep.polygons << ", \"cells\": " << rel_rep.cells << ", \"area_m2\": "
-    << jnum(rel_rep.area_m2) << ", \"volume_m3\": " << jnum(rel_rep.volume_m3) << ", \"notes\": [";
+    << json_number(rel_rep.area_m2) << ", \"volume_m3\": " << json_number(rel_rep.volume_m3) << ", \"notes\": [";
   for (std::size_t k = 0; k < rel_rep.notes.size(); ++k) r << (k ? ", " : "") << jstr(rel_rep.notes[k]);
   r << "]},\n";
-  r << "  \"mass_balance\": {\"volume_initial_m3\": " << jnum(d.volume_initial) << ", \"volume_final_m3\": " << jnum(d.volume_final)
-    << ", \"volume_outflow_m3\": " << jnum(d.volume_outflow) << ", \"relative_error\": " << jnum(d.volume_error()) << "},\n";
-  r << "  \"solver\": {\"steps\": " << d.steps << ", \"simulated_s\": " << jnum(d.t) << ", \"stop\": " << jstr(sum.stop)
-    << ", \"max_speed_m_s\": " << jnum(d.max_speed) << ", \"kinetic_energy_peak\": " << jnum(d.kinetic_energy_peak)
-    << ", \"positivity_limited\": " << d.positivity_limited << ", \"cell_updates\": " << jnum(d.cell_updates)
-    << ", \"mean_active_fraction\": " << jnum(d.mean_active_fraction) << ", \"max_active_fraction\": " << jnum(d.max_active_fraction)
+  r << "  \"mass_balance\": {\"volume_initial_m3\": " << json_number(d.volume_initial) << ", \"volume_final_m3\": " << json_number(d.volume_final)
+    << ", \"volume_outflow_m3\": " << json_number(d.volume_outflow) << ", \"relative_error\": " << json_number(d.volume_error()) << "},\n";
+  r << "  \"solver\": {\"steps\": " << d.steps << ", \"simulated_s\": " << json_number(d.t) << ", \"stop\": " << jstr(sum.stop)
+    << ", \"max_speed_m_s\": " << json_number(d.max_speed) << ", \"kinetic_energy_peak\": " << json_number(d.kinetic_energy_peak)
+    << ", \"positivity_limited\": " << d.positivity_limited << ", \"cell_updates\": " << json_number(d.cell_updates)
+    << ", \"mean_active_fraction\": " << json_number(d.mean_active_fraction) << ", \"max_active_fraction\": " << json_number(d.max_active_fraction)
     << "},\n";
-  r << "  \"results\": {\"affected_area_m2\": " << jnum(sum.affected_area_m2) << ", \"outline_polygons\": " << outline.polygons
-    << ", \"outline_area_m2\": " << jnum(outline.area_m2) << ", \"runout_from_release_centroid_m\": " << jnum(sum.runout_m)
-    << ", \"max_depth_m\": " << jnum(sum.max_depth) << ", \"outline_threshold_m\": " << jnum(s.outline_threshold)
+  r << "  \"results\": {\"affected_area_m2\": " << json_number(sum.affected_area_m2) << ", \"outline_polygons\": " << outline.polygons
+    << ", \"outline_area_m2\": " << json_number(outline.area_m2) << ", \"runout_from_release_centroid_m\": " << json_number(sum.runout_m)
+    << ", \"max_depth_m\": " << json_number(sum.max_depth) << ", \"outline_threshold_m\": " << json_number(s.outline_threshold)
     << ", \"timeseries_frames\": " << frames << "},\n";
-  r << "  \"timings_s\": {\"prepare\": " << jnum(sum.seconds_prepare) << ", \"run\": " << jnum(sum.seconds_run)
-    << ", \"write\": " << jnum(sum.seconds_write) << "},\n";
+  r << "  \"timings_s\": {\"prepare\": " << json_number(sum.seconds_prepare) << ", \"run\": " << json_number(sum.seconds_run)
+    << ", \"write\": " << json_number(sum.seconds_write) << "},\n";
   r << "  \"outputs\": [";
   for (std::size_t k = 0; k < sum.files.size(); ++k) r << (k ? ", " : "") << jstr(sum.files[k]);
   r << ", \"run.json\"]\n}\n";

@@ -10,6 +10,9 @@
 
 namespace runout::jobs {
 
+/// A number for the run records (run.json): 10 significant digits, null when not finite.
+std::string json_number(double v);
+
 struct RunOptions {
   engine::ProgressHook progress;  ///< optional; returning false cancels the run
   long progress_every = 50;

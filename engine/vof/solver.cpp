@@ -12,7 +12,6 @@ namespace runout::engine::vof {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-constexpr double kSmall = 1e-300;
 
 void petsc_check(PetscErrorCode e, const char* what) {
   if (e) throw VofError(std::string("PETSc: ") + what + " failed (error " + std::to_string(int(e)) + ")");
@@ -921,7 +920,6 @@ struct VofSolver::Impl {
         KSPGetIterationNumber(ksp, &k);
         its += k;
         steps_since_pc = 0;
-        ++pc_rebuilds_forced;
       }
       if (reason < 0)
         throw VofError("pressure solver (CG + " + s.cfg_.pressure_pc + ") did not converge at t = " + std::to_string(s.t_) +
@@ -990,7 +988,6 @@ struct VofSolver::Impl {
   std::vector<Vec> U_old;
 
   int steps_since_pc = 0;
-  long pc_rebuilds_forced = 0;  // preconditioners rebuilt because a kept one failed
   std::vector<int> active_index;  // per cell: its row in the pressure system, -1 outside the active region
   std::vector<int> active_cells;  // the active region
   std::vector<int> halo_cells;    // the active region and the cells next to it (alpha may change there)
