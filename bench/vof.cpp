@@ -1,10 +1,12 @@
 // Benchmark of the VOF engine on B2 at 0 deg (validation.md B2) to t = 1 s, the case the
 // dissertation timed: OpenFOAM's interFoam with the Coulomb viscosity took 80 s wall for 1677 steps
 // on 12,000 cells (2.5 mm, about 4 microseconds per cell and step, 53 % in the pressure solve).
-//   runout_bench_vof [--full] [--end T]   (default: 5 mm cells; --full: 2.5 mm, the dissertation's)
+//   runout_bench_vof [--full] [--end T] [--courant C] [--correctors N]   (default: 5 mm cells; --full: 2.5 mm, the dissertation's)
 //   runout_bench_vof --b10                 B10: column collapse for aspect ratios 0.5-6 (5 mm cells),
 //                                          normalised runout and the exponents of its growth
 //   runout_bench_vof [--full] --check      also check the B2 acceptance figures (exit 1 if one fails)
+//   runout_bench_vof --b6 [--full]         B6: the shock at the closed end for the seven set-ups at 1 cm
+//                                          (--full: 5 mm), its position over time and speed upstream
 //   runout_bench_vof --b7 [--full]         B7: the wide chute with each obstacle at 5 mm (--full: 2.5 mm,
 //                                          1.34 million cells), depth figures and cost
 //   runout_bench_vof --region              cost per step against the material region: the same failing
@@ -118,6 +120,54 @@ static int region() {
   return 0;
 }
 
+// A number array from run.json ("key": [a, b, null, ...]; null as NaN).
+static std::vector<double> series(const std::string& json, const std::string& key) {
+  std::vector<double> v;
+  auto k = json.find("\"" + key + "\": [");
+  if (k == std::string::npos) return v;
+  k += key.size() + 5;
+  const auto e = json.find(']', k);
+  while (k < e) {
+    while (k < e && (json[k] == ' ' || json[k] == ',')) ++k;
+    if (k >= e) break;
+    v.push_back(json.compare(k, 4, "null") == 0 ? NAN : std::atof(json.c_str() + k));
+    k = json.find_first_of(",]", k);
+  }
+  return v;
+}
+
+// B6 (validation.md B6): the flow fed at x = -2 m runs into the closed end at x = 0; the shock's
+// position over time and its speed upstream for the seven set-ups.
+static int b6(bool full) {
+  std::printf("| set-up | inflow speed [m/s] | cells | steps | wall [s] | shock formed [s] | shock from the wall at 1.5 / 2.5 / 3.5 s [m] | "
+              "speed upstream [m/s] | deposit at the wall [m] |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  for (const char* name : {"pvc-40deg-5cm", "pvc-40deg-10cm", "pvc-40deg-15cm", "pvc-50deg-5cm", "pvc-50deg-10cm", "pvc-50deg-15cm",
+                           "sand-50deg-10cm"}) {
+    auto r = runout::jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b6-shock-" + name + ".json");
+    auto* lab = r.scenario.mutable_lab();
+    if (!full) {  // 1 cm cells
+      lab->set_nx(200);
+      lab->set_ny(50);
+      lab->mutable_fill(0)->set_x_max(-1.99);
+    }
+    lab->set_write_interval_s(0);
+    const auto ran = run_in_temp(r);
+    const auto& sum = ran.sum;
+    const std::string& j = ran.json;
+    const auto t = series(j, "t_s"), xs = series(j, "shock_x_m");
+    auto at = [&](double when) {
+      for (std::size_t q = 0; q < t.size() && q < xs.size(); ++q)
+        if (t[q] >= when - 1e-9) return -xs[q];  // the end wall is at x = 0
+      return double(NAN);
+    };
+    std::printf("| %s | %.3f | %.0f | %ld | %.0f | %.2f | %.2f / %.2f / %.2f | %.3f | %.3f |\n", name, lab->boundaries(0).inflow_u0(),
+                field(j, "cells"), sum.steps, sum.seconds_run, field(j, "shock_formed_s"), at(1.5), at(2.5), at(3.5),
+                field(j, "shock_speed_upstream_m_s"), field(j, "deposit_height_m"));
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
 // B7 (validation.md B7): the 45 deg wide chute fed 1.5 cm deep at 1 m/s, around each obstacle.
 static int b7(bool full) {
   std::printf("| obstacle | cells | steps to 0.8 s | wall [s] | us per cell-step | undisturbed depth [mm] | max depth [mm] | ratio | "
@@ -145,17 +195,21 @@ static int b7(bool full) {
 
 int main(int argc, char** argv) {
   if (argc > 1 && std::string(argv[1]) == "--b10") return b10();
+  if (argc > 1 && std::string(argv[1]) == "--b6") return b6(argc > 2 && std::string(argv[2]) == "--full");
   if (argc > 1 && std::string(argv[1]) == "--b7") return b7(argc > 2 && std::string(argv[2]) == "--full");
   if (argc > 1 && std::string(argv[1]) == "--region") return region();
   bool full = false, check = false;
-  double end = 1.0;
+  double end = 1.0, courant = 0;
+  int correctors = 0;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     if (a == "--full") full = true;
     else if (a == "--check") check = true;
     else if (a == "--end" && k + 1 < argc) end = std::atof(argv[++k]);
+    else if (a == "--courant" && k + 1 < argc) courant = std::atof(argv[++k]);
+    else if (a == "--correctors" && k + 1 < argc) correctors = std::atoi(argv[++k]);
     else {
-      std::fprintf(stderr, "usage: runout_bench_vof [--full] [--end T] [--check] | --b10 | --b7 [--full] | --region\n");
+      std::fprintf(stderr, "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--check] | --b6 [--full] | --b10 | --b7 [--full] | --region\n");
       return 2;
     }
   }
@@ -167,6 +221,8 @@ int main(int argc, char** argv) {
   }
   lab->set_end_time_s(end);
   lab->set_write_interval_s(0);
+  if (courant > 0) lab->set_max_courant(courant);
+  if (correctors > 0) lab->set_correctors(correctors);
   const auto ran = run_in_temp(r);
   const auto& sum = ran.sum;
   const std::string& j = ran.json;

@@ -344,7 +344,9 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
                                         : vof::Bc::wall;
     if (pb.kind == vof::Bc::inflow) {
       const double u0 = lb.inflow_u0(), dudy = lb.inflow_dudy(), hin = lb.inflow_height(), ybase = L.y_min();
-      pb.inflow_velocity = [=](const vof::Vec& cf) { return vof::Vec{u0 + dudy * std::min(cf.y - ybase, hin), 0, 0}; };
+      // Material below the fill height with the profile; air above enters at rest (appendix A.4:
+      // "else (0, 0)").
+      pb.inflow_velocity = [=](const vof::Vec& cf) { return cf.y - ybase < hin ? vof::Vec{u0 + dudy * (cf.y - ybase), 0, 0} : vof::Vec{}; };
       pb.inflow_alpha = [=](const vof::Vec& cf) { return cf.y - ybase < hin ? 1.0 : 0.0; };
     }
     pb.tan_delta = std::tan(mat.delta_deg * kPi / 180);
@@ -435,8 +437,26 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   for (int f = 0; f < m.n_internal; ++f)
     if (std::abs(m.Cf[std::size_t(f)].x) < 0.25 * dx && std::abs(m.Sf[std::size_t(f)].x) > 0.5 * m.magSf[std::size_t(f)])
       gate_faces.push_back(f);
-  std::vector<double> mon_t, mon_q, mon_gate, mon_sr, mon_moving;
+  std::vector<double> mon_t, mon_q, mon_gate, mon_sr, mon_moving, mon_shock;
   double t_fluid = -1;
+  // The shock at a closed end (validation.md B6: inflow and a wall at the right end): the upstream
+  // edge of the deposit, i.e. of the columns, from the end wall upstream, that hold at least two
+  // cells' depth of material and whose bottom cell rests (below 5 cm/s). (Not the bottom cell's
+  // phase fraction: the impact on the wall traps air in the corner.)
+  bool end_wall = has_inflow;
+  for (const auto& lb : L.boundaries()) end_wall &= lb.side() != "right";
+  auto shock_x = [&] {
+    int i = g.nx - 1;
+    for (; i >= 0; --i) {
+      const int cc = g.id(i, 0, g.kc);
+      if (cc < 0 || vof::norm(s.velocity()[std::size_t(cc)]) >= 0.05) break;
+      double depth = 0;
+      for (int jj = 0; jj < g.ny; ++jj)
+        if (const int c2 = g.id(i, jj, g.kc); c2 >= 0) depth += std::clamp(s.alpha()[std::size_t(c2)], 0.0, 1.0) * dy;
+      if (depth < 2 * dy) break;
+    }
+    return i < g.nx - 1 ? g.x0 + (i + 1) * dx : NAN;
+  };
   auto monitor = [&](double t) {
     double q = 0;
     for (int f : right_faces) q += s.granular_flux()[std::size_t(f)];
@@ -466,6 +486,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
         if (vof::norm(s.velocity()[std::size_t(k)]) > 0.01) moving += 1;
       }
     mon_moving.push_back(mat > 0 ? moving / mat : NAN);
+    if (end_wall) mon_shock.push_back(shock_x());
     if (t_fluid < 0 && mat > 0 && moving >= 0.99 * mat) t_fluid = t;
     mon_t.push_back(t);
   };
@@ -689,6 +710,23 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       << "], \"outflow_l_s_10cm\": [" << series(mon_q) << "], \"gate_flux_l_s_10cm\": [" << series(mon_gate)
       << "], \"gate_strain_rate_1_s\": [" << series(mon_sr)
       << "], \"moving_share\": [" << series(mon_moving) << "]";
+    if (end_wall) {
+      // The shock's speed upstream: least-squares slope of its position over the samples that lie
+      // between 0.1 m from the end wall and 80 % of the channel (clear of the corner and the inflow).
+      double st = 0, sx = 0, stt = 0, stx = 0, n = 0, formed = NAN;
+      const double len = L.x_max() - L.x_min();
+      for (std::size_t q = 0; q < mon_t.size(); ++q) {
+        const double xs = mon_shock[q];
+        if (std::isnan(xs)) continue;
+        if (std::isnan(formed)) formed = mon_t[q];
+        const double d = L.x_max() - xs;
+        if (d < 0.1 || d > 0.8 * len) continue;
+        st += mon_t[q], sx += xs, stt += mon_t[q] * mon_t[q], stx += mon_t[q] * xs, n += 1;
+      }
+      const double speed = n >= 3 ? -(n * stx - st * sx) / (n * stt - st * st) : NAN;
+      j << ", \"shock_formed_s\": " << json_number(formed) << ", \"shock_speed_upstream_m_s\": " << json_number(speed)
+        << ", \"shock_samples_in_fit\": " << n << ", \"shock_x_m\": [" << series(mon_shock) << "]";
+    }
     if (!opt.restart_path.empty()) j << ", \"note\": \"sampled from the restart at t = " << json_number(restart.state.t) << " s on\"";
     j << "},\n";
   }

@@ -375,7 +375,9 @@ TEST(VofSolver, ThreeDimensionalBlockBetweenSymmetryPlanesMatchesThePlaneMesh) {
               1e3 * q.centroid_x, q.max_uz);
   EXPECT_GT(p.centroid_x, 0.032);  // it failed and spread (the initial centroid is at 31 mm)
   EXPECT_NEAR(q.centroid_x, p.centroid_x, 2e-4);
-  EXPECT_LT(q.max_uz, 1e-5);  // against speeds of 0.5 m/s
+  // Against speeds of 0.5 m/s; what is left comes from the correctors before the last, which solve
+  // the pressure to 0.1 only (2.0e-5 m/s; 1.4e-6 m/s when they solved to 1e-2).
+  EXPECT_LT(q.max_uz, 1e-4);
   EXPECT_NEAR(q.volume1, q.volume0, 1e-6 * q.volume0);
   EXPECT_GT(q.alpha_min, -1e-6);
   EXPECT_LT(q.alpha_max, 1 + 1e-6);
