@@ -5,8 +5,10 @@
 //   runout_bench_vof --b10                 B10: column collapse for aspect ratios 0.5-6 (5 mm cells),
 //                                          normalised runout and the exponents of its growth
 //   runout_bench_vof [--full] --check      also check the B2 acceptance figures (exit 1 if one fails)
-//   runout_bench_vof --b6 [--full]         B6: the shock at the closed end for the seven set-ups at 1 cm
-//                                          (--full: 5 mm), its position over time and speed upstream
+//   runout_bench_vof --b6 [--full] [--check]  B6: the shock at the closed end for the seven set-ups at
+//                                          1 cm (--full: 5 mm), its position over time and speed upstream;
+//                                          --check: exit 1 unless each forms a deposit whose edge moves
+//                                          upstream at a constant speed
 //   runout_bench_vof --b7 [--full]         B7: the wide chute with each obstacle at 5 mm (--full: 2.5 mm,
 //                                          1.34 million cells), depth figures and cost
 //   runout_bench_vof --region              cost per step against the material region: the same failing
@@ -138,7 +140,8 @@ static std::vector<double> series(const std::string& json, const std::string& ke
 
 // B6 (validation.md B6): the flow fed at x = -2 m runs into the closed end at x = 0; the shock's
 // position over time and its speed upstream for the seven set-ups.
-static int b6(bool full) {
+static int b6(bool full, bool check) {
+  int failed = 0;
   std::printf("| set-up | inflow speed [m/s] | cells | steps | wall [s] | shock formed [s] | shock from the wall at 1.5 / 2.5 / 3.5 s [m] | "
               "speed upstream [m/s] | deposit at the wall [m] |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const char* name : {"pvc-40deg-5cm", "pvc-40deg-10cm", "pvc-40deg-15cm", "pvc-50deg-5cm", "pvc-50deg-10cm", "pvc-50deg-15cm",
@@ -164,8 +167,19 @@ static int b6(bool full) {
                 field(j, "cells"), sum.steps, sum.seconds_run, field(j, "shock_formed_s"), at(1.5), at(2.5), at(3.5),
                 field(j, "shock_speed_upstream_m_s"), field(j, "deposit_height_m"));
     std::fflush(stdout);
+    if (check) {
+      // validation.md B6's behaviour: a deposit forms at the end wall, deeper than the inflow, and its
+      // upstream edge moves upstream at a constant speed (the speeds over 1.5-2.5 s and 2.5-3.5 s
+      // within 30 % of each other).
+      const double h0 = lab->boundaries(0).inflow_height(), v1 = at(2.5) - at(1.5), v2 = at(3.5) - at(2.5);
+      const bool ok = field(j, "shock_formed_s") > 0 && field(j, "shock_speed_upstream_m_s") > 0 && v1 > 0 && v2 > 0 &&
+                      std::abs(v2 / v1 - 1) <= 0.3 && field(j, "deposit_height_m") > h0;
+      if (!ok) std::printf("NOT MET (%s): a deposit deeper than the inflow whose edge moves upstream at a constant speed\n", name);
+      failed += !ok;
+    }
   }
-  return 0;
+  if (check) std::printf("\n%s\n", failed ? "B6: NOT MET" : "B6: met for every set-up");
+  return failed ? 1 : 0;
 }
 
 // B7 (validation.md B7): the 45 deg wide chute fed 1.5 cm deep at 1 m/s, around each obstacle.
@@ -195,7 +209,11 @@ static int b7(bool full) {
 
 int main(int argc, char** argv) {
   if (argc > 1 && std::string(argv[1]) == "--b10") return b10();
-  if (argc > 1 && std::string(argv[1]) == "--b6") return b6(argc > 2 && std::string(argv[2]) == "--full");
+  if (argc > 1 && std::string(argv[1]) == "--b6") {
+    bool full = false, check = false;
+    for (int k = 2; k < argc; ++k) full |= std::string(argv[k]) == "--full", check |= std::string(argv[k]) == "--check";
+    return b6(full, check);
+  }
   if (argc > 1 && std::string(argv[1]) == "--b7") return b7(argc > 2 && std::string(argv[2]) == "--full");
   if (argc > 1 && std::string(argv[1]) == "--region") return region();
   bool full = false, check = false;
@@ -209,7 +227,7 @@ int main(int argc, char** argv) {
     else if (a == "--courant" && k + 1 < argc) courant = std::atof(argv[++k]);
     else if (a == "--correctors" && k + 1 < argc) correctors = std::atoi(argv[++k]);
     else {
-      std::fprintf(stderr, "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--check] | --b6 [--full] | --b10 | --b7 [--full] | --region\n");
+      std::fprintf(stderr, "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--check] | --b6 [--full] [--check] | --b10 | --b7 [--full] | --region\n");
       return 2;
     }
   }

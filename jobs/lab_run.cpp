@@ -457,7 +457,37 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     }
     return i < g.nx - 1 ? g.x0 + (i + 1) * dx : NAN;
   };
+  // The rotating box (validation.md B1): the free surface's angle to the horizontal (perpendicular
+  // to gravity) in the central region (within 5 cm of the box centre), from the principal axis of
+  // the points where alpha crosses 0.5 between neighbouring cells.
+  const bool rotating = L.rotation_period_s() > 0 && !g.three_d;
+  std::vector<double> mon_surface;
+  const vof::Vec box_centre{0.5 * (L.x_min() + L.x_max()), 0.5 * (L.y_min() + L.y_max()), 0};
+  auto surface_angle = [&](double t) {
+    double n = 0, mx = 0, my = 0, sxx = 0, sxy = 0, syy = 0;
+    for (int f = 0; f < m.n_internal; ++f) {
+      const int o = m.owner[std::size_t(f)], nb = m.neighbour[std::size_t(f)];
+      const double ao = s.alpha()[std::size_t(o)], an = s.alpha()[std::size_t(nb)];
+      if ((ao - 0.5) * (an - 0.5) >= 0) continue;
+      const double w = (0.5 - ao) / (an - ao);
+      const vof::Vec& po = m.centre[std::size_t(o)];
+      const vof::Vec& pn = m.centre[std::size_t(nb)];
+      const double x = po.x + w * (pn.x - po.x), y = po.y + w * (pn.y - po.y);
+      if (std::hypot(x - box_centre.x, y - box_centre.y) > 0.05) continue;
+      n += 1, mx += x, my += y, sxx += x * x, sxy += x * y, syy += y * y;
+    }
+    if (n < 3) return double(NAN);
+    mx /= n, my /= n;
+    const double cxx = sxx / n - mx * mx, cxy = sxy / n - mx * my, cyy = syy / n - my * my;
+    const double dir = 0.5 * std::atan2(2 * cxy, cxx - cyy);  // the principal axis
+    const vof::Vec gv = c.gravity(t);
+    const double horizontal = std::atan2(gv.y, gv.x) + 0.5 * kPi;
+    double d = std::fmod(std::abs(dir - horizontal), kPi);
+    if (d > 0.5 * kPi) d = kPi - d;
+    return d * 180 / kPi;
+  };
   auto monitor = [&](double t) {
+    if (rotating) mon_surface.push_back(surface_angle(t));
     double q = 0;
     for (int f : right_faces) q += s.granular_flux()[std::size_t(f)];
     const double per_width = g.three_d ? 1.0 : 0.1 / g.width;  // plane: as in the 10 cm channel; 3D: the modelled width
@@ -710,6 +740,40 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       << "], \"outflow_l_s_10cm\": [" << series(mon_q) << "], \"gate_flux_l_s_10cm\": [" << series(mon_gate)
       << "], \"gate_strain_rate_1_s\": [" << series(mon_sr)
       << "], \"moving_share\": [" << series(mon_moving) << "]";
+    if (rotating) {
+      // Once the material flows (after the first quarter of the samples that pass 90 % of the peak
+      // angle): the mean and spread of the surface angle, and its mean over each quarter turn
+      // (the box's 90 deg symmetry: a periodic response repeats every quarter turn).
+      double peak_angle = 0;
+      for (double a : mon_surface)
+        if (!std::isnan(a)) peak_angle = std::max(peak_angle, a);
+      double onset = NAN;
+      for (std::size_t q = 0; q < mon_t.size(); ++q)
+        if (!std::isnan(mon_surface[q]) && mon_surface[q] >= 0.9 * peak_angle) {
+          onset = mon_t[q];
+          break;
+        }
+      const double quarter = 0.25 * L.rotation_period_s();
+      double sum_a = 0, sum_aa = 0, cnt = 0;
+      std::vector<double> qsum(64, 0.0), qn(64, 0.0);
+      for (std::size_t q = 0; q < mon_t.size(); ++q) {
+        if (std::isnan(onset) || mon_t[q] < onset + 0.25 * quarter || std::isnan(mon_surface[q])) continue;
+        sum_a += mon_surface[q], sum_aa += mon_surface[q] * mon_surface[q], cnt += 1;
+        const auto k = std::min<std::size_t>(63, std::size_t(mon_t[q] / quarter));
+        qsum[k] += mon_surface[q], qn[k] += 1;
+      }
+      const double mean = cnt > 0 ? sum_a / cnt : NAN;
+      std::ostringstream qm;
+      bool first = true;
+      for (std::size_t k = 0; k < qsum.size(); ++k)
+        if (qn[k] >= 0.5 * quarter / mon_every) {  // quarter turns sampled for at least half their length
+          qm << (first ? "" : ", ") << json_number(qsum[k] / qn[k]);
+          first = false;
+        }
+      j << ", \"surface_angle_onset_s\": " << json_number(onset) << ", \"surface_angle_mean_deg\": " << json_number(mean)
+        << ", \"surface_angle_std_deg\": " << json_number(cnt > 1 ? std::sqrt(std::max(0.0, sum_aa / cnt - mean * mean)) : NAN)
+        << ", \"surface_angle_quarter_turn_means_deg\": [" << qm.str() << "], \"surface_angle_deg\": [" << series(mon_surface) << "]";
+    }
     if (end_wall) {
       // The shock's speed upstream: least-squares slope of its position over the samples that lie
       // between 0.1 m from the end wall and 80 % of the channel (clear of the corner and the inflow).

@@ -904,6 +904,44 @@ TEST(Scenarios, LabB5SandDepositsInFrontOfTheRamp) {
   EXPECT_GT(json_number(j, "depth_averaged_u_m_s", ramp), 0.1);  // material passes over it
 }
 
+// B1 (validation.md B1, coarse: 8 mm cells, 0.8 s): below phi the fine sand turns with the box as a
+// rigid body, so the free surface's angle to the horizontal (run.json's monitor) follows the rotation
+// angle; the closed box keeps its volume.
+TEST(Scenarios, LabB1SurfaceAngleFollowsTheRotationBelowPhi) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b1-rotating-box.json");
+  auto* lab = r.scenario.mutable_lab();
+  lab->set_nx(25);
+  lab->set_ny(25);
+  lab->set_end_time_s(0.8);
+  lab->set_write_interval_s(0);
+  TempDir d;
+  const auto sum = jobs::run_scenario(r, d.p.string());
+  ASSERT_EQ(sum.stop, "end-time");
+  EXPECT_NEAR(sum.volume_final, sum.volume_initial, 1e-6 * sum.volume_initial);
+  const std::string j = read_text(d / "run.json");
+  auto array = [&](const std::string& key) {
+    std::vector<double> v;
+    auto k = j.find("\"" + key + "\": [");
+    if (k == std::string::npos) return v;
+    k += key.size() + 5;
+    const auto e = j.find(']', k);
+    while (k < e) {
+      v.push_back(std::atof(j.c_str() + k));
+      k = j.find_first_of(",]", k) + 1;
+    }
+    return v;
+  };
+  const auto t = array("t_s"), angle = array("surface_angle_deg"), moving = array("moving_share");
+  ASSERT_EQ(angle.size(), t.size());
+  ASSERT_GT(t.size(), 10u);
+  const double omega_deg = 360.0 / lab->rotation_period_s();
+  for (std::size_t q = 0; q < t.size(); q += 5) {
+    EXPECT_NEAR(angle[q], omega_deg * t[q], 2.0) << "t = " << t[q];
+    EXPECT_LT(moving[q], 0.1) << "t = " << t[q];  // at most a few surface cells creep above 1 cm/s
+  }
+  EXPECT_GT(angle.back(), 35.0);  // 0.8 s: 41.6 deg
+}
+
 // B6 (validation.md B6, coarse: the 50 deg PVC set-up fed 10 cm deep, shortened to a 1 m chute with
 // 1 cm cells, 2 s): the flow runs into the closed end, a deposit forms in the corner and its
 // upstream edge (the shock) moves upstream; run.json carries its position over time and its speed.
