@@ -1,4 +1,5 @@
 #include "jobs/lab_run.hpp"
+#include "jobs/lab_figure.hpp"
 
 #include <gdal_priv.h>
 #include <google/protobuf/util/json_util.h>
@@ -800,6 +801,60 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     << json_number(steps ? 1e6 * sum.seconds_run / steps / m.cells() : NAN) << ", \"microseconds_per_active_cell_step\": "
     << json_number(active_sum > 0 ? 1e6 * sum.seconds_run / active_sum : NAN) << "}\n}\n";
   if (!j) throw std::runtime_error("cannot write run.json");
+  if (!g.three_d) {
+    // comparison.png: the section with ours beside the scenario's reference values (lab.reference).
+    SectionFigure fig;
+    fig.title = (r.scenario.name().empty() ? std::string("laboratory run") : r.scenario.name()) + ", t = " + json_number(s.time()) + " s";
+    fig.nx = g.nx, fig.ny = g.ny, fig.x0 = g.x0, fig.y0 = g.y0, fig.dx = dx, fig.dy = dy;
+    fig.alpha.assign(std::size_t(g.nx) * g.ny, NAN);
+    fig.ux.assign(fig.alpha.size(), 0.0);
+    fig.uy.assign(fig.alpha.size(), 0.0);
+    for (int jj = 0; jj < g.ny; ++jj)
+      for (int i = 0; i < g.nx; ++i)
+        if (const int c = g.id(i, jj, 0); c >= 0) {
+          const std::size_t k = std::size_t(i) + std::size_t(g.nx) * std::size_t(jj);
+          fig.alpha[k] = s.alpha()[std::size_t(c)];
+          fig.ux[k] = s.velocity()[std::size_t(c)].x;
+          fig.uy[k] = s.velocity()[std::size_t(c)].y;
+        }
+    double vmax = 0.01;
+    for (int c = 0; c < m.cells(); ++c)
+      if (s.alpha()[std::size_t(c)] > 0.5) vmax = std::max(vmax, vof::norm(s.velocity()[std::size_t(c)]));
+    fig.vmax = vmax;
+    fig.front = front;
+    fig.upper_angle = upper;
+    for (int i = imax; i < g.nx; ++i)
+      if (h[std::size_t(i)] < 0.7 * hmax) {
+        fig.anchor_x = g.x0 + (i + 0.5) * dx;
+        break;
+      }
+    fig.height = hmax;
+    fig.t = mon_t, fig.gate_flux = mon_gate, fig.outflow = mon_q, fig.moving = mon_moving;
+    fig.fluidised = t_fluid >= 0 ? t_fluid : NAN;
+    auto median_between = [&](const std::vector<double>& v, double a, double b) {
+      std::vector<double> w;
+      for (std::size_t q = 0; q < mon_t.size() && q < v.size(); ++q)
+        if (mon_t[q] >= a && mon_t[q] <= b && std::isfinite(v[q])) w.push_back(v[q]);
+      if (w.empty()) return double(NAN);
+      std::nth_element(w.begin(), w.begin() + long(w.size() / 2), w.end());
+      return w[w.size() / 2];
+    };
+    if (!gate_faces.empty()) {
+      fig.gate_flux_early = median_between(mon_gate, 0.12, 0.30);
+      fig.strain_early = median_between(mon_sr, 0.10, 0.20);
+    }
+    if (L.has_reference()) {
+      const auto& ref = L.reference();
+      fig.ref_source = ref.source();
+      if (ref.has_front_x_min()) fig.ref_front_min = ref.front_x_min(), fig.ref_front_max = ref.front_x_max();
+      if (ref.has_surface_angle_deg()) fig.ref_angle = ref.surface_angle_deg();
+      if (ref.has_fluidised_time_s()) fig.ref_fluidised = ref.fluidised_time_s();
+      if (ref.has_outflow_l_s()) fig.ref_outflow = ref.outflow_l_s();
+      if (ref.has_gate_strain_rate_1_s()) fig.ref_strain = ref.gate_strain_rate_1_s();
+    }
+    write_section_figure(out_dir + "/comparison.png", fig);
+    sum.files.push_back("comparison.png");
+  }
   return sum;
 }
 

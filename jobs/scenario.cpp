@@ -147,6 +147,21 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
   if (!(l->max_courant() > 0 && l->max_courant() <= 1)) bad("lab.max_courant", "must lie in (0, 1]");
   if (l->correctors() == 0) l->set_correctors(3);
   if (l->correctors() < 1 || l->correctors() > 50) bad("lab.correctors", "must lie in 1..50");
+  if (l->has_reference()) {
+    const auto& ref = l->reference();
+    auto check = [](bool has, double v, const char* name) {
+      if (has && !(std::isfinite(v) && v >= 0)) bad(std::string("lab.reference.") + name, "must be a number >= 0");
+    };
+    check(ref.has_front_x_min(), std::abs(ref.front_x_min()), "front_x_min");
+    check(ref.has_front_x_max(), std::abs(ref.front_x_max()), "front_x_max");
+    check(ref.has_surface_angle_deg(), ref.surface_angle_deg(), "surface_angle_deg");
+    check(ref.has_fluidised_time_s(), ref.fluidised_time_s(), "fluidised_time_s");
+    check(ref.has_outflow_l_s(), ref.outflow_l_s(), "outflow_l_s");
+    check(ref.has_gate_strain_rate_1_s(), ref.gate_strain_rate_1_s(), "gate_strain_rate_1_s");
+    if (ref.has_front_x_min() != ref.has_front_x_max() || (ref.has_front_x_min() && ref.front_x_max() < ref.front_x_min()))
+      bad("lab.reference.front_x_max", "the front is a range: give front_x_min and front_x_max >= front_x_min");
+    if (ref.has_surface_angle_deg() && ref.surface_angle_deg() >= 90) bad("lab.reference.surface_angle_deg", "must lie below 90 deg");
+  }
   ResolvedScenario r;
   r.vof = true;
   r.scenario = std::move(s);

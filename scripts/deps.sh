@@ -8,6 +8,7 @@ RUNOUT_PACKAGES=(
   petsc-dev libhdf5-openmpi-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libsqlite3-dev libssl-dev openssl
+  libcairo2-dev fonts-dejavu-core
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 

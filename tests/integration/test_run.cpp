@@ -904,6 +904,48 @@ TEST(Scenarios, LabB5SandDepositsInFrontOfTheRamp) {
   EXPECT_GT(json_number(j, "depth_averaged_u_m_s", ramp), 0.1);  // material passes over it
 }
 
+// comparison.png (validation.md part B): a plane run draws its section and monitors, and the
+// reference values of lab.reference in orange; without a reference nothing orange is drawn; a
+// reference front that is no range is refused by name.
+TEST(Scenarios, LabComparisonFigureDrawsTheReference) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json");
+  ASSERT_TRUE(r.scenario.lab().has_reference());
+  auto* lab = r.scenario.mutable_lab();
+  lab->set_nx(50);
+  lab->set_ny(15);
+  lab->set_end_time_s(0.1);
+  lab->set_write_interval_s(0);
+  auto orange_pixels = [](const std::string& png) {
+    GDALDatasetUniquePtr ds(GDALDataset::Open(png.c_str(), GDAL_OF_RASTER));
+    if (!ds || ds->GetRasterCount() < 3) return -1L;
+    const int w = ds->GetRasterXSize(), h = ds->GetRasterYSize();
+    std::vector<unsigned char> band[3];
+    for (int b = 0; b < 3; ++b) {
+      band[b].resize(std::size_t(w) * h);
+      if (ds->GetRasterBand(b + 1)->RasterIO(GF_Read, 0, 0, w, h, band[b].data(), w, h, GDT_Byte, 0, 0) != CE_None) return -1L;
+    }
+    long n = 0;
+    // The reference colour (217, 89, 0); the speed scale never has zero blue with that much green.
+    for (std::size_t k = 0; k < band[0].size(); ++k) n += band[0][k] > 205 && band[0][k] < 230 && band[1][k] > 80 && band[1][k] < 100 && band[2][k] == 0;
+    return n;
+  };
+  TempDir with, without;
+  const auto s1 = jobs::run_scenario(r, with.p.string());
+  EXPECT_NE(std::find(s1.files.begin(), s1.files.end(), "comparison.png"), s1.files.end());
+  EXPECT_GT(orange_pixels(with / "comparison.png"), 50);  // the reference text and the dashed slope
+  lab->clear_reference();
+  jobs::run_scenario(r, without.p.string());
+  EXPECT_EQ(orange_pixels(without / "comparison.png"), 0);
+  auto bad = jobs::parse_scenario_json(R"({"engine": "vof", "lab": {"x_max": 1, "y_max": 1, "nx": 10, "ny": 10,
+      "fill": [{"x_max": 0.5, "y_max": 0.5}], "reference": {"front_x_min": 0.3, "front_x_max": 0.2}}})");
+  try {
+    jobs::resolve_scenario(bad, ".");
+    FAIL();
+  } catch (const jobs::ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("lab.reference.front_x_max"), std::string::npos) << e.what();
+  }
+}
+
 // B1 (validation.md B1, coarse: 8 mm cells, 0.8 s): below phi the fine sand turns with the box as a
 // rigid body, so the free surface's angle to the horizontal (run.json's monitor) follows the rotation
 // angle; the closed box keeps its volume.
