@@ -71,7 +71,17 @@ void write_section_figure(const std::string& path, const SectionFigure& f) {
   cairo_set_source_rgb(cr, 1, 1, 1);
   cairo_paint(cr);
   cairo_select_font_face(cr, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-  text(cr, left, 22, f.title, 13);
+  {
+    // The title, smaller until it fits.
+    double size = 13;
+    cairo_text_extents_t e;
+    for (; size > 7; size -= 0.5) {
+      cairo_set_font_size(cr, size);
+      cairo_text_extents(cr, f.title.c_str(), &e);
+      if (left + e.x_advance < W - 10) break;
+    }
+    text(cr, left, 22, f.title, size);
+  }
 
   // Section: x to the right, y up.
   const double ox = left, oy = top + sec_h;
@@ -190,7 +200,7 @@ void write_section_figure(const std::string& path, const SectionFigure& f) {
     std::string ours = "ours:";
     if (!std::isnan(f.front)) ours += " front " + fmt("%.3f m", f.front) + " (black tick)";
     if (!std::isnan(f.upper_angle)) ours += ", upper surface " + fmt("%.1f deg", f.upper_angle);
-    text(cr, ox, ly, ours, 12);
+    if (ours != "ours:") text(cr, ox, ly, ours, 12);
     std::string ref;
     if (!std::isnan(f.ref_front_min)) ref += " front " + fmt("%.3f", f.ref_front_min) + "-" + fmt("%.3f m", f.ref_front_max) + " (band)";
     if (!std::isnan(f.ref_angle)) ref += std::string(ref.empty() ? "" : ",") + " upper surface " + fmt("%.0f deg", f.ref_angle) + " (dashed, through ours at 70 % height)";
@@ -205,8 +215,9 @@ void write_section_figure(const std::string& path, const SectionFigure& f) {
   // Monitors over time: fluxes [l/s] on the left axis, the moving share [0, 1] on the right.
   const double py = top + sec_h + gap + 40, pw = std::max(sec_w, 500.0), ph = ser_h;
   const double t0 = f.t.front(), t1 = f.t.back();
-  double qmax = 1;
-  for (const auto* v : {&f.gate_flux, &f.outflow})
+  const bool shock = !f.shock.empty();
+  double qmax = shock ? 0.1 : 1;
+  for (const auto* v : shock ? std::vector<const std::vector<double>*>{&f.shock} : std::vector<const std::vector<double>*>{&f.gate_flux, &f.outflow})
     for (double q : *v)
       if (std::isfinite(q)) qmax = std::max(qmax, q);
   if (!std::isnan(f.ref_outflow)) qmax = std::max(qmax, f.ref_outflow);
@@ -237,7 +248,7 @@ void write_section_figure(const std::string& path, const SectionFigure& f) {
     text(cr, ox + pw + 8, SY(sh) + 4, fmt("%.1f", sh), 10);
   }
   text(cr, ox + pw - 25, py + ph + 32, "t [s]", 11);
-  text(cr, 8, py - 8, "flux [l/s, 10 cm channel]", 11);
+  text(cr, 8, py - 8, shock ? "shock from the end wall [m]" : "flux [l/s, 10 cm channel]", 11);
   text(cr, ox + pw - 60, py - 8, "moving share", 11, {0.45, 0.45, 0.45});
   auto line = [&](const std::vector<double>& v, auto yf, const Rgb& c) {
     cairo_set_source_rgb(cr, c.r, c.g, c.b);
@@ -257,8 +268,12 @@ void write_section_figure(const std::string& path, const SectionFigure& f) {
   };
   const Rgb gate_c{0.1, 0.3, 0.9}, out_c{0.1, 0.6, 0.2}, mov_c{0.55, 0.55, 0.55};
   line(f.moving, SY, mov_c);
-  line(f.gate_flux, QY, gate_c);
-  line(f.outflow, QY, out_c);
+  if (shock) {
+    line(f.shock, QY, gate_c);
+  } else {
+    line(f.gate_flux, QY, gate_c);
+    line(f.outflow, QY, out_c);
+  }
   cairo_set_source_rgb(cr, kReference.r, kReference.g, kReference.b);
   cairo_set_line_width(cr, 2);
   dashed(cr, true);
@@ -282,7 +297,10 @@ void write_section_figure(const std::string& path, const SectionFigure& f) {
   }
   cairo_set_line_width(cr, 1);
   double ty = py + ph + 50;
-  text(cr, ox, ty, "gate flux (blue), outflow at the end (green), share of the material moving > 1 cm/s (grey)", 11);
+  text(cr, ox, ty,
+       shock ? "the shock's distance from the end wall (blue), share of the material moving > 1 cm/s (grey)"
+             : "gate flux (blue), outflow at the end (green), share of the material moving > 1 cm/s (grey)",
+       11);
   std::string ours;
   auto add = [](std::string& to, const std::string& s) { to += (to.empty() ? " " : ", ") + s; };
   if (!std::isnan(f.fluidised)) add(ours, "fluidised " + fmt("%.2f s", f.fluidised) + " (black tick)");

@@ -22,6 +22,7 @@ struct SectionFigure {
   double front = NAN, upper_angle = NAN;
   double anchor_x = NAN, height = NAN;  ///< where our surface is at 70 % of the deposit's height [m], and that height
   std::vector<double> t, gate_flux, outflow, moving;  ///< monitors [s], [l/s], [l/s], [-]
+  std::vector<double> shock;  ///< B6: the shock's distance from the end wall [m] (drawn instead of the fluxes)
   double fluidised = NAN, gate_flux_early = NAN, strain_early = NAN;
   // The reference (lab.reference); NaN where not given.
   std::string ref_source;

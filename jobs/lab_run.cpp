@@ -821,8 +821,10 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     for (int c = 0; c < m.cells(); ++c)
       if (s.alpha()[std::size_t(c)] > 0.5) vmax = std::max(vmax, vof::norm(s.velocity()[std::size_t(c)]));
     fig.vmax = vmax;
-    fig.front = front;
-    fig.upper_angle = upper;
+    if (!has_inflow) {  // the deposit figures of a collapse
+      fig.front = front;
+      fig.upper_angle = upper;
+    }
     for (int i = imax; i < g.nx; ++i)
       if (h[std::size_t(i)] < 0.7 * hmax) {
         fig.anchor_x = g.x0 + (i + 0.5) * dx;
@@ -830,7 +832,9 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       }
     fig.height = hmax;
     fig.t = mon_t, fig.gate_flux = mon_gate, fig.outflow = mon_q, fig.moving = mon_moving;
-    fig.fluidised = t_fluid >= 0 ? t_fluid : NAN;
+    fig.fluidised = t_fluid >= 0 && !has_inflow ? t_fluid : NAN;
+    if (end_wall)
+      for (double x : mon_shock) fig.shock.push_back(L.x_max() - x);
     auto median_between = [&](const std::vector<double>& v, double a, double b) {
       std::vector<double> w;
       for (std::size_t q = 0; q < mon_t.size() && q < v.size(); ++q)
