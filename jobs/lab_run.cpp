@@ -721,15 +721,19 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       << ", \"profile_y_alpha_u\": [" << prof.str() << "]}";
   }
   j << "],\n";
+  // The median of a monitor's finite samples between two times.
+  auto median_between = [&](const std::vector<double>& v, double a, double b) {
+    std::vector<double> w;
+    for (std::size_t q = 0; q < mon_t.size() && q < v.size(); ++q)
+      if (mon_t[q] >= a && mon_t[q] <= b && std::isfinite(v[q])) w.push_back(v[q]);
+    if (w.empty()) return double(NAN);
+    std::nth_element(w.begin(), w.begin() + long(w.size() / 2), w.end());
+    return w[w.size() / 2];
+  };
   {
     // The outflow's plateau: the median over the second half of the run.
-    std::vector<double> late, late_gate;
-    for (std::size_t q = 0; q < mon_t.size(); ++q)
-      if (mon_t[q] >= 0.5 * L.end_time_s()) late.push_back(mon_q[q]), late_gate.push_back(mon_gate[q]);
-    std::sort(late.begin(), late.end());
-    const double plateau = late.empty() ? NAN : late[late.size() / 2];
-    std::sort(late_gate.begin(), late_gate.end());
-    const double plateau_gate = late_gate.empty() ? NAN : late_gate[late_gate.size() / 2];
+    const double plateau = median_between(mon_q, 0.5 * L.end_time_s(), 1e300);
+    const double plateau_gate = median_between(mon_gate, 0.5 * L.end_time_s(), 1e300);
     auto series = [&](const std::vector<double>& v) {
       std::ostringstream o;
       for (std::size_t q = 0; q < v.size(); ++q) o << (q ? ", " : "") << json_number(v[q]);
@@ -835,14 +839,6 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     fig.fluidised = t_fluid >= 0 && !has_inflow ? t_fluid : NAN;
     if (end_wall)
       for (double x : mon_shock) fig.shock.push_back(L.x_max() - x);
-    auto median_between = [&](const std::vector<double>& v, double a, double b) {
-      std::vector<double> w;
-      for (std::size_t q = 0; q < mon_t.size() && q < v.size(); ++q)
-        if (mon_t[q] >= a && mon_t[q] <= b && std::isfinite(v[q])) w.push_back(v[q]);
-      if (w.empty()) return double(NAN);
-      std::nth_element(w.begin(), w.begin() + long(w.size() / 2), w.end());
-      return w[w.size() / 2];
-    };
     if (!gate_faces.empty()) {
       fig.gate_flux_early = median_between(mon_gate, 0.12, 0.30);
       fig.strain_early = median_between(mon_sr, 0.10, 0.20);
