@@ -1,7 +1,9 @@
 // Benchmark of the VOF engine on B2 at 0 deg (validation.md B2) to t = 1 s, the case the
 // dissertation timed: OpenFOAM's interFoam with the Coulomb viscosity took 80 s wall for 1677 steps
 // on 12,000 cells (2.5 mm, about 4 microseconds per cell and step, 53 % in the pressure solve).
-//   runout_bench_vof [--full] [--end T] [--courant C] [--correctors N]   (default: 5 mm cells; --full: 2.5 mm, the dissertation's)
+//   runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off]
+//                                          (default: 5 mm cells; --full: 2.5 mm, the dissertation's;
+//                                          --transpose: how the viscous stress's transpose part is taken)
 //   runout_bench_vof --b10                 B10: column collapse for aspect ratios 0.5-6 (5 mm cells),
 //                                          normalised runout and the exponents of its growth
 //   runout_bench_vof [--full] --check      also check the B2 acceptance figures (exit 1 if one fails)
@@ -219,6 +221,7 @@ int main(int argc, char** argv) {
   bool full = false, check = false;
   double end = 1.0, courant = 0;
   int correctors = 0;
+  std::string transpose;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     if (a == "--full") full = true;
@@ -226,8 +229,9 @@ int main(int argc, char** argv) {
     else if (a == "--end" && k + 1 < argc) end = std::atof(argv[++k]);
     else if (a == "--courant" && k + 1 < argc) courant = std::atof(argv[++k]);
     else if (a == "--correctors" && k + 1 < argc) correctors = std::atoi(argv[++k]);
+    else if (a == "--transpose" && k + 1 < argc) transpose = argv[++k];
     else {
-      std::fprintf(stderr, "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--check] | --b6 [--full] [--check] | --b10 | --b7 [--full] | --region\n");
+      std::fprintf(stderr, "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off] [--check] | --b6 [--full] [--check] | --b10 | --b7 [--full] | --region\n");
       return 2;
     }
   }
@@ -241,6 +245,16 @@ int main(int argc, char** argv) {
   lab->set_write_interval_s(0);
   if (courant > 0) lab->set_max_courant(courant);
   if (correctors > 0) lab->set_correctors(correctors);
+  if (!transpose.empty()) {
+    lab->set_viscous_transpose(transpose);
+    try {
+      r = runout::jobs::resolve_scenario(r.scenario, std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab");  // validates the name
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "runout_bench_vof: %s\n", e.what());
+      return 2;
+    }
+    lab = r.scenario.mutable_lab();
+  }
   const auto ran = run_in_temp(r);
   const auto& sum = ran.sum;
   const std::string& j = ran.json;

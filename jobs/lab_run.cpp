@@ -314,6 +314,9 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   c.phi_deg = mat.phi_deg;
   c.max_co = c.max_alpha_co = L.max_courant();
   c.n_correctors = L.correctors();
+  c.viscous_transpose = L.viscous_transpose() == "off"        ? vof::Transpose::off
+                        : L.viscous_transpose() == "harmonic" ? vof::Transpose::harmonic
+                                                              : vof::Transpose::linear;
   c.active_layers = L.active_layers() < 0 ? 0 : L.active_layers();
   const double zeta = L.inclination_deg() * kPi / 180;
   const double omega = L.rotation_period_s() > 0 ? 2 * kPi / L.rotation_period_s() : 0.0;

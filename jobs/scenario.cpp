@@ -147,6 +147,9 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
   if (!(l->max_courant() > 0 && l->max_courant() <= 1)) bad("lab.max_courant", "must lie in (0, 1]");
   if (l->correctors() == 0) l->set_correctors(3);
   if (l->correctors() < 1 || l->correctors() > 50) bad("lab.correctors", "must lie in 1..50");
+  if (l->viscous_transpose().empty()) l->set_viscous_transpose("explicit");
+  if (l->viscous_transpose() != "explicit" && l->viscous_transpose() != "harmonic" && l->viscous_transpose() != "off")
+    bad("lab.viscous_transpose", "unknown '" + l->viscous_transpose() + "' (valid: explicit, harmonic, off)");
   if (l->has_reference()) {
     const auto& ref = l->reference();
     auto check = [](bool has, double v, const char* name) {

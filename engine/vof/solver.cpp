@@ -417,13 +417,15 @@ struct VofSolver::Impl {
     // Transpose part of the viscous stress, explicit and in divergence form as interFoam has it:
     // sum over faces of mu_f (grad U)^T_f . Sf. (The equivalent cell form (grad U) . grad mu, with
     // mu jumping nine orders of magnitude across the interface, moved a heap that should rest.)
-    {
+    if (s.cfg_.viscous_transpose != Transpose::off) {
+      const bool harmonic = s.cfg_.viscous_transpose == Transpose::harmonic;
       for (int f : active_faces) {
         const int o = m.owner[std::size_t(f)];
         const bool in = f < m.n_internal;
         const int nb = in ? m.neighbour[std::size_t(f)] : o;
         const double w = in ? m.weight[std::size_t(f)] : 1.0;
-        const double muf = w * mu[std::size_t(o)] + (1 - w) * mu[std::size_t(nb)];
+        const double mo = mu[std::size_t(o)], mn = mu[std::size_t(nb)];
+        const double muf = harmonic ? mo * mn / (w * mn + (1 - w) * mo) : w * mo + (1 - w) * mn;
         const Vec& S = m.Sf[std::size_t(f)];
         Vec t;
         for (int i = 0; i < 3; ++i) {

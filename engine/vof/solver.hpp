@@ -46,6 +46,9 @@ struct PatchBc {
   std::function<double(const Vec&)> inflow_alpha;  ///< inflow: phase fraction at a face centre
 };
 
+/// How the viscous stress's transpose part is taken (VofConfig::viscous_transpose).
+enum class Transpose { linear, harmonic, off };
+
 struct VofConfig {
   double rho1 = 936.17;        ///< granular bulk density [kg/m3]
   double rho2 = 1.0;           ///< air [kg/m3]
@@ -63,6 +66,12 @@ struct VofConfig {
   double c_alpha = 1.0;        ///< interface compression coefficient
   int n_correctors = 3;        ///< PISO correctors per step
   bool momentum_predictor = false;  ///< solve the momentum matrix before the correctors (see docs/vof.md)
+  /// The viscous stress's transpose part div(mu (grad U)^T), explicit in divergence form:
+  /// linear: mu_f interpolated linearly, as interFoam has it; harmonic: mu_f the harmonic mean of the
+  /// two cells (the stress two layers in series carry); off: left out. Where the Coulomb viscosity
+  /// jumps between its clip (1e2 m2/s) and flowing cells, the linear face value lets this explicit
+  /// term outweigh gravity a hundredfold and drive spurious pressures (docs/vof.md).
+  Transpose viscous_transpose = Transpose::linear;
   int alpha_subcycles = 2;
   std::string pressure_pc = "gamg";  ///< "gamg" or "hypre" (BoomerAMG)
   double pressure_rtol = 1e-8;  ///< relative tolerance of the last corrector's pressure solve

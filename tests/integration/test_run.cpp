@@ -946,6 +946,26 @@ TEST(Scenarios, LabComparisonFigureDrawsTheReference) {
   }
 }
 
+// lab.viscous_transpose: "explicit" by default, "harmonic" and "off" accepted, anything else named
+// in the error.
+TEST(Scenarios, LabViscousTransposeIsValidated) {
+  const std::string head = R"({"engine": "vof", "lab": {"x_max": 1, "y_max": 1, "nx": 10, "ny": 10,
+      "fill": [{"x_max": 0.5, "y_max": 0.5}])";
+  const auto plain = jobs::resolve_scenario(jobs::parse_scenario_json(head + "}}"), ".");
+  EXPECT_EQ(plain.scenario.lab().viscous_transpose(), "explicit");
+  const auto off = jobs::resolve_scenario(jobs::parse_scenario_json(head + R"(, "viscous_transpose": "off"}})"), ".");
+  EXPECT_EQ(off.scenario.lab().viscous_transpose(), "off");
+  jobs::resolve_scenario(jobs::parse_scenario_json(head + R"(, "viscous_transpose": "harmonic"}})"), ".");
+  auto bad = jobs::parse_scenario_json(head + R"(, "viscous_transpose": "implicit"}})");
+  try {
+    jobs::resolve_scenario(bad, ".");
+    FAIL();
+  } catch (const jobs::ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("lab.viscous_transpose"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("implicit"), std::string::npos) << e.what();
+  }
+}
+
 // B1 (validation.md B1, coarse: 8 mm cells, 0.8 s): below phi the fine sand turns with the box as a
 // rigid body, so the free surface's angle to the horizontal (run.json's monitor) follows the rotation
 // angle; the closed box keeps its volume.
