@@ -417,6 +417,8 @@ struct VofSolver::Impl {
     // Transpose part of the viscous stress, explicit and in divergence form as interFoam has it:
     // sum over faces of mu_f (grad U)^T_f . Sf. (The equivalent cell form (grad U) . grad mu, with
     // mu jumping nine orders of magnitude across the interface, moved a heap that should rest.)
+    // The face viscosity is interpolated linearly or taken as the harmonic mean, or the part is left
+    // out (VofConfig::viscous_transpose; validation.md B1 and B2 for what each does).
     if (s.cfg_.viscous_transpose != Transpose::off) {
       const bool harmonic = s.cfg_.viscous_transpose == Transpose::harmonic;
       for (int f : active_faces) {
