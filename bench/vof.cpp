@@ -4,8 +4,11 @@
 //   runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off]
 //                                          (default: 5 mm cells; --full: 2.5 mm, the dissertation's;
 //                                          --transpose: how the viscous stress's transpose part is taken)
-//   runout_bench_vof --b10                 B10: column collapse for aspect ratios 0.5-6 (5 mm cells),
-//                                          normalised runout and the exponents of its growth
+//   runout_bench_vof --b10                 B10: column collapse for aspect ratios 0.5-6 (5 mm cells,
+//                                          scenarios/lab/b10-column-a*.json), normalised runout, rest
+//                                          time and the exponents of its growth
+//   runout_bench_vof --b9 [--full] [--check]  B9: the static and the failing heap (5 mm, --full: 2.5 mm);
+//                                          --check: exit 1 unless both meet the issue's figures
 //   runout_bench_vof [--full] --check      also check the issue's B2 acceptance figures (exit 1 if one fails)
 //   runout_bench_vof --b6 [--full] [--check]  B6: the shock at the closed end for the seven set-ups at
 //                                          1 cm (--full: 5 mm), its position over time and speed upstream;
@@ -55,29 +58,24 @@ static Ran run_in_temp(const runout::jobs::ResolvedScenario& r) {
   return ran;
 }
 
-// B10 (validation.md): a column L = 5 cm wide, H = a L high, against the left wall, released at t = 0.
+// B10 (validation.md): a PVC column L = 5 cm wide and H = a L high against the left wall, released
+// at t = 0, from the scenario files scenarios/lab/b10-column-a*.json (5 mm cells).
 static int b10() {
-  std::printf("| a = H/L | cells | (l - L)/L | steps | wall [s] |\n|---:|---:|---:|---:|---:|\n");
-  std::vector<double> as = {0.5, 1, 2, 4, 6}, rs;
-  for (double a : as) {
-    const double L = 0.05, H = a * L, dx = 0.005;
-    const double xmax = L * (2.5 + 2.0 * std::pow(a, 0.9) + 1.5 * a), ymax = H + 0.02;
-    auto s = runout::jobs::parse_scenario_json(R"({"engine": "vof", "lab": {"boundaries": [{"side": "top", "kind": "atmosphere"}, {"side": "right", "kind": "atmosphere"}]}})");
-    auto* lab = s.mutable_lab();
-    lab->set_x_max(xmax);
-    lab->set_y_max(ymax);
-    lab->set_nx(int(std::ceil(xmax / dx)));
-    lab->set_ny(int(std::ceil(ymax / dx)));
-    auto* f = lab->add_fill();
-    f->set_x_max(L);
-    f->set_y_max(H);
-    lab->set_end_time_s(0.6 + 0.25 * std::sqrt(a));
-    lab->set_write_interval_s(0);
-    auto r = runout::jobs::resolve_scenario(s, ".");
-    const auto sum = run_in_temp(r).sum;
+  std::printf("| a = H/L | cells | (l - L)/L | at rest from [s] | end [s] | steps | wall [s] |\n|---:|---:|---:|---:|---:|---:|---:|\n");
+  const std::vector<std::string> names = {"0.5", "1", "2", "4", "6"};
+  std::vector<double> as, rs;
+  for (const auto& a : names) {
+    auto r = runout::jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b10-column-a" + a + ".json");
+    r.scenario.mutable_lab()->set_write_interval_s(0);
+    const double L = r.scenario.lab().fill(0).x_max() - r.scenario.lab().fill(0).x_min();
+    const auto ran = run_in_temp(r);
+    const auto& sum = ran.sum;
     const double rel = (sum.runout_m - L) / L;
+    as.push_back(std::atof(a.c_str()));
     rs.push_back(rel);
-    std::printf("| %.1f | %d | %.2f | %ld | %.1f |\n", a, sum.nx * sum.ny, rel, sum.steps, sum.seconds_run);
+    std::printf("| %s | %d | %.2f | %.2f | %.2f | %ld | %.1f |\n", a.c_str(), sum.nx * sum.ny, rel, field(ran.json, "rest_time_s"), sum.t,
+                sum.steps, sum.seconds_run);
+    std::fflush(stdout);
   }
   // Exponents: log-log slopes over the small (0.5-2) and large (2-6) aspect ratios.
   auto slope = [&](std::size_t i0, std::size_t i1) {
@@ -91,6 +89,36 @@ static int b10() {
   std::printf("\nexponent of (l - L)/L in a: %.2f for a = 0.5-2 (expected about 1), %.2f for a = 2-6 (expected about 2/3; 0.9 in wide channels)\n",
               slope(0, 2), slope(2, 4));
   return 0;
+}
+
+// B9 (validation.md B9) from scenarios/lab/b9-heap-{static,failing}.json: the heap flatter than phi
+// must stay at rest (below 1 mm/s after 1 s), the steeper one relax to within 3 deg of phi (32 deg);
+// 5 mm cells as the files have them, --full: 2.5 mm.
+static int b9(bool full, bool check) {
+  std::printf("| heap | cells | steps | wall [s] | peak speed [m/s] | speed at the end [m/s] | surface angle (80 %% to 20 %% of the height) "
+              "[deg] | wanted | |\n|---|---:|---:|---:|---:|---:|---:|---|---|\n");
+  int failed = 0;
+  for (const char* name : {"static", "failing"}) {
+    auto r = runout::jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b9-heap-" + name + ".json");
+    auto* lab = r.scenario.mutable_lab();
+    if (full) {
+      lab->set_nx(2 * lab->nx());
+      lab->set_ny(2 * lab->ny());
+    }
+    lab->set_write_interval_s(0);
+    const auto ran = run_in_temp(r);
+    const std::string& j = ran.json;
+    const bool is_static = std::string(name) == "static";
+    const double speed = field(j, "final_speed_m_s"), angle = field(j, "mean_surface_angle_deg");
+    const bool ok = is_static ? speed < 1e-3 : std::abs(angle - 32) <= 3;
+    failed += !ok;
+    std::printf("| %s | %d | %ld | %.1f | %.4f | %.2e | %.1f | %s | %s |\n", name, ran.sum.nx * ran.sum.ny, ran.sum.steps, ran.sum.seconds_run,
+                field(j, "peak_speed_m_s"), speed, angle, is_static ? "below 1 mm/s at 1 s" : "32 +- 3 deg", ok ? "met" : "NOT MET");
+    std::fflush(stdout);
+  }
+  if (!check) return 0;
+  std::printf("\n%s\n", failed ? "B9: NOT MET" : "B9: met");
+  return failed ? 1 : 0;
 }
 
 // The same 50 deg heap (6 cm wide, 7 cm high, PVC) failing at the closed left end of channels of
@@ -211,6 +239,11 @@ static int b7(bool full) {
 
 int main(int argc, char** argv) {
   if (argc > 1 && std::string(argv[1]) == "--b10") return b10();
+  if (argc > 1 && std::string(argv[1]) == "--b9") {
+    bool full = false, check = false;
+    for (int k = 2; k < argc; ++k) full |= std::string(argv[k]) == "--full", check |= std::string(argv[k]) == "--check";
+    return b9(full, check);
+  }
   if (argc > 1 && std::string(argv[1]) == "--b6") {
     bool full = false, check = false;
     for (int k = 2; k < argc; ++k) full |= std::string(argv[k]) == "--full", check |= std::string(argv[k]) == "--check";
@@ -231,7 +264,7 @@ int main(int argc, char** argv) {
     else if (a == "--correctors" && k + 1 < argc) correctors = std::atoi(argv[++k]);
     else if (a == "--transpose" && k + 1 < argc) transpose = argv[++k];
     else {
-      std::fprintf(stderr, "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off] [--check] | --b6 [--full] [--check] | --b10 | --b7 [--full] | --region\n");
+      std::fprintf(stderr, "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off] [--check] | --b6 [--full] [--check] | --b9 [--full] [--check] | --b10 | --b7 [--full] | --region\n");
       return 2;
     }
   }

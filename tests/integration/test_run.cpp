@@ -904,6 +904,61 @@ TEST(Scenarios, LabB5SandDepositsInFrontOfTheRamp) {
   EXPECT_GT(json_number(j, "depth_averaged_u_m_s", ramp), 0.1);  // material passes over it
 }
 
+// B9 (validation.md B9) from its scenario files, 5 mm cells: a heap flatter than phi stays at rest
+// (the issue: below 1 mm/s after 1 s), a heap steeper than phi relaxes to within 3 deg of phi
+// (32 deg for PVC), volume conserved in the box.
+TEST(Scenarios, LabB9StaticHeapStaysAtRest) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b9-heap-static.json");
+  TempDir d;
+  const auto sum = jobs::run_scenario(r, d.p.string());
+  ASSERT_EQ(sum.stop, "end-time");
+  const std::string j = read_text(d / "run.json");
+  std::printf("static heap: speed at %.1f s %.2e m/s\n", sum.t, json_number(j, "final_speed_m_s"));
+  EXPECT_NEAR(sum.t, 1.0, 1e-9);
+  EXPECT_LT(json_number(j, "final_speed_m_s"), 1e-3);
+  EXPECT_LT(json_number(j, "volume_relative_error"), 1e-6);
+}
+
+TEST(Scenarios, LabB9FailingHeapRelaxesToPhi) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b9-heap-failing.json");
+  TempDir d;
+  const auto sum = jobs::run_scenario(r, d.p.string());
+  ASSERT_EQ(sum.stop, "end-time");
+  const std::string j = read_text(d / "run.json");
+  const double angle = json_number(j, "mean_surface_angle_deg");
+  std::printf("failing heap: surface %.1f deg at %.1f s (phi 32 deg), peak %.3f m/s\n", angle, sum.t, json_number(j, "peak_speed_m_s"));
+  EXPECT_GT(json_number(j, "peak_speed_m_s"), 0.1);  // it did fail
+  EXPECT_LT(json_number(j, "final_speed_m_s"), 1e-2);  // and came to rest
+  EXPECT_NEAR(angle, 32.0, 3.0);
+  EXPECT_LT(json_number(j, "volume_relative_error"), 1e-6);
+}
+
+// B10 (validation.md B10): the columns' scenario files run (a = 1 and the tallest, a = 6, at 1 cm
+// cells here; runout_bench_vof --b10 runs all five at 5 mm): the taller column runs out further
+// relative to its width, and both come to rest.
+TEST(Scenarios, LabB10TallerColumnsRunOutFurther) {
+  double rel[2] = {0, 0};
+  int q = 0;
+  for (const char* a : {"1", "6"}) {
+    auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b10-column-a" + a + ".json");
+    auto* lab = r.scenario.mutable_lab();
+    lab->set_nx(lab->nx() / 2);
+    lab->set_ny(lab->ny() / 2);
+    lab->set_write_interval_s(0);
+    TempDir d;
+    const auto sum = jobs::run_scenario(r, d.p.string());
+    ASSERT_EQ(sum.stop, "end-time");
+    const std::string j = read_text(d / "run.json");
+    const double L = lab->fill(0).x_max();
+    rel[q] = (sum.runout_m - L) / L;
+    std::printf("a = %s: (l - L)/L = %.2f, at rest from %.2f s\n", a, rel[q], json_number(j, "rest_time_s"));
+    EXPECT_GT(rel[q], 0);
+    EXPECT_LT(json_number(j, "final_speed_m_s"), 1e-2);
+    ++q;
+  }
+  EXPECT_GT(rel[1], 4 * rel[0]);
+}
+
 // comparison.png (validation.md part B): a plane run draws its section and monitors, and the
 // reference values of lab.reference in orange; without a reference nothing orange is drawn; a
 // reference front that is no range is refused by name.
