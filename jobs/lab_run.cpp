@@ -252,6 +252,40 @@ std::string lab_state_hash(const ResolvedScenario& r) {
   return sha256_hex(json);
 }
 
+// The curved chute of lab.chute (validation.md B8) in channel coordinates (X along the upper chute,
+// Y normal to it): the reference curve C(s) by arc length s, straight to the bend, a circular arc
+// over it (the inclination changes linearly with s), straight after it; the bed lies b(s, z) above
+// it along its normal N(s). point(s, n, z) = C(s) + (b(s, z) + n) N(s) + z e_z.
+class ChuteBed {
+ public:
+  explicit ChuteBed(const v1::Lab& L)
+      : s1_(L.chute().bend_start_m()), s2_(L.chute().bend_end_m()), beta_(L.chute().bend_deg() * kPi / 180),
+        R_(L.chute().channel_radius_m()), k_(beta_ / (s2_ - s1_)) {}
+  vof::Vec point(double s, double n, double z) const {
+    double x, y, b;  // the reference point, its angle to X, the bed's height above it
+    if (s <= s1_) {
+      x = s, y = 0, b = 0;
+    } else if (s <= s2_) {
+      b = k_ * (s - s1_);
+      x = s1_ + std::sin(b) / k_, y = (1 - std::cos(b)) / k_;
+    } else {
+      b = beta_;
+      x = s1_ + std::sin(beta_) / k_ + (s - s2_) * std::cos(beta_), y = (1 - std::cos(beta_)) / k_ + (s - s2_) * std::sin(beta_);
+    }
+    const double a = b;
+    double f = 1;  // the parabola's share: 1 on the chute, smoothly 0 over the bend
+    if (s > s1_) {
+      const double q = std::clamp((s2_ - s) / (s2_ - s1_), 0.0, 1.0);
+      f = q * q * (3 - 2 * q);
+    }
+    const double h = (R_ > 0 ? z * z / (2 * R_) * f : 0) + n;
+    return {x - std::sin(a) * h, y + std::cos(a) * h, z};
+  }
+
+ private:
+  double s1_, s2_, beta_, R_, k_;
+};
+
 }  // namespace
 
 RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt) {
@@ -262,7 +296,9 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   using clk = std::chrono::steady_clock;
   const auto t0 = clk::now();
   const auto& L = r.scenario.lab();
-  const Material mat = material(L.material());
+  Material mat = material(L.material());
+  if (L.has_phi_deg()) mat.phi_deg = L.phi_deg();
+  if (L.has_bed_friction_deg()) mat.delta_deg = L.bed_friction_deg();
   // The block: a plane mesh one cell (dx) thick, or a 3D block with nz cells across the channel.
   LabGrid g;
   g.three_d = L.nz() > 0;
@@ -283,8 +319,22 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     return false;
   };
   vof::Mesh m;
+  // Bed coordinates of each cell's centre (x along the channel, y above its bed, z across): the
+  // mesh's own coordinates for blocks, arc length and height above the bed on a curved chute.
+  std::vector<vof::Vec> local;
   try {
-    if (g.three_d) {
+    if (L.has_chute()) {
+      const ChuteBed bed(L);
+      vof::HexGridSpec h;
+      h.ni = g.nx, h.nj = g.ny, h.nk = g.nz;
+      h.node = [&](int i, int j, int k) { return bed.point(g.x0 + i * g.dx, j * g.dy, g.z0 + k * g.dz); };
+      m = vof::structured_hex_mesh(h);
+      local.resize(std::size_t(m.cells()));
+      for (int k = 0; k < g.nz; ++k)
+        for (int j = 0; j < g.ny; ++j)
+          for (int i = 0; i < g.nx; ++i)
+            local[std::size_t((k * g.ny + j) * g.nx + i)] = {g.x0 + (i + 0.5) * g.dx, (j + 0.5) * g.dy, g.z0 + (k + 0.5) * g.dz};
+    } else if (g.three_d) {
       vof::Block3Spec b3;
       b3.x0 = L.x_min(), b3.x1 = L.x_max(), b3.y0 = L.y_min(), b3.y1 = L.y_max(), b3.z0 = L.z_min(), b3.z1 = L.z_max();
       b3.nx = g.nx, b3.ny = g.ny, b3.nz = g.nz;
@@ -299,11 +349,12 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       m = vof::block_mesh(b);
     }
   } catch (const std::invalid_argument& e) {
-    throw ScenarioError(std::string("lab.obstacles: ") + e.what());
+    throw ScenarioError(std::string(L.has_chute() ? "lab.chute: " : "lab.obstacles: ") + e.what());
   }
+  if (local.empty()) local = m.centre;
   g.cell.assign(std::size_t(g.nx) * g.ny * g.nz, -1);
   for (int c = 0; c < m.cells(); ++c) {
-    const auto& p = m.centre[std::size_t(c)];
+    const auto& p = local[std::size_t(c)];
     const int i = std::clamp(int((p.x - g.x0) / g.dx), 0, g.nx - 1), j = std::clamp(int((p.y - g.y0) / g.dy), 0, g.ny - 1),
               k = g.three_d ? std::clamp(int((p.z - g.z0) / g.dz), 0, g.nz - 1) : 0;
     g.cell[g.at(i, j, k)] = c;
@@ -360,15 +411,19 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     it = m.patch_index(it->first) < 0 ? c.bc.erase(it) : std::next(it);
   vof::VofSolver s(m, c);
   std::vector<double> alpha(std::size_t(m.cells()), 0.0);
-  auto inside = [](const v1::LabRegion& f, double x, double y) {
-    if (f.polygon_xy_size() == 0) return x >= f.x_min() && x <= f.x_max() && y >= f.y_min() && y <= f.y_max();
-    return in_polygon(f.polygon_xy(), x, y);
+  auto inside = [](const v1::LabRegion& f, const vof::Vec& p) {
+    if (f.cap_radius() > 0) {  // a spherical cap on the bed
+      const double r = f.cap_radius(), q = r * r - (p.x - f.cap_x()) * (p.x - f.cap_x()) - (p.z - f.cap_z()) * (p.z - f.cap_z());
+      return q > 0 && p.y < std::sqrt(q) - (r - f.cap_height());
+    }
+    if (f.polygon_xy_size() == 0) return p.x >= f.x_min() && p.x <= f.x_max() && p.y >= f.y_min() && p.y <= f.y_max();
+    return in_polygon(f.polygon_xy(), p.x, p.y);
   };
   bool has_inflow = false;
   for (const auto& lb : L.boundaries()) has_inflow |= lb.kind() == "inflow";
   for (int k = 0; k < m.cells(); ++k)
     for (const auto& f : L.fill())
-      if (inside(f, m.centre[std::size_t(k)].x, m.centre[std::size_t(k)].y)) alpha[std::size_t(k)] = 1;
+      if (inside(f, local[std::size_t(k)])) alpha[std::size_t(k)] = 1;
   double v0 = 0;
   for (int k = 0; k < m.cells(); ++k) v0 += alpha[std::size_t(k)] * m.volume[std::size_t(k)];
   if (v0 <= 0 && !has_inflow) throw ScenarioError("lab.fill: no cell centre lies in the fill regions (and no inflow feeds the channel)");
@@ -665,6 +720,33 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       chute << (q ? ", " : "") << "{\"shape\": \"" << o.shape() << "\", \"sheltered_dry_area_m2\": " << json_number(dry) << "}";
     }
     chute << "]},\n";
+    // The curved chute (validation.md B8): where the deposit lies along the arc length (on the
+    // chute, in the bend, on the run-out), its extent, its half-width on the chute and on the
+    // run-out (z from lab.z_min, the symmetry plane of a half chute), its highest point and centroid.
+    if (L.has_chute()) {
+      const double s1 = L.chute().bend_start_m(), s2 = L.chute().bend_end_m();
+      double vol[3] = {0, 0, 0}, sm = 0, mv = 0, smin = NAN, smax = NAN, w_chute = 0, w_run = 0;
+      for (int c = 0; c < m.cells(); ++c) {
+        const double v = std::clamp(s.alpha()[std::size_t(c)], 0.0, 1.0) * m.volume[std::size_t(c)], x = local[std::size_t(c)].x;
+        vol[x < s1 ? 0 : x <= s2 ? 1 : 2] += v;
+        sm += v * x, mv += v;
+      }
+      for (int k = 0; k < g.nz; ++k)
+        for (int i = 0; i < g.nx; ++i) {
+          if (d[std::size_t(k) * g.nx + i] < 1e-3) continue;
+          const double x = g.x0 + (i + 0.5) * dx, z = std::abs(g.z0 + (k + 1) * g.dz - L.z_min());
+          smin = std::isnan(smin) ? x : std::min(smin, x), smax = std::isnan(smax) ? x : std::max(smax, x);
+          if (x < s1) w_chute = std::max(w_chute, z);
+          if (x > s2) w_run = std::max(w_run, z);
+        }
+      const double tot = std::max(mv, 1e-300);
+      chute << "  \"curved_chute\": {\"share_on_chute\": " << json_number(vol[0] / tot) << ", \"share_in_bend\": " << json_number(vol[1] / tot)
+            << ", \"share_on_runout\": " << json_number(vol[2] / tot) << ", \"deposit_from_m\": " << json_number(smin)
+            << ", \"deposit_to_m\": " << json_number(smax) << ", \"half_width_on_chute_m\": " << json_number(w_chute)
+            << ", \"half_width_on_runout_m\": " << json_number(w_run) << ", \"highest_x_m\": " << json_number(xm)
+            << ", \"highest_z_m\": " << json_number(zm) << ", \"highest_depth_m\": " << json_number(dmax)
+            << ", \"centroid_x_m\": " << json_number(sm / tot) << "},\n";
+    }
   }
   sum.files = {"fields.h5", "fields.xmf", "figure.png", "run.json"};
   sum.seconds_write = std::chrono::duration<double>(clk::now() - t2).count();

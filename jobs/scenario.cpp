@@ -110,9 +110,31 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
   bool fed = false;
   for (const auto& b : l->boundaries()) fed |= b.kind() == "inflow";
   if (l->fill().empty() && !fed) bad("lab.fill", "at least one region of granular material is needed (or an inflow)");
+  if (l->has_chute()) {
+    const auto& c = l->chute();
+    if (!three_d) bad("lab.chute", "a curved chute needs a 3D set-up (lab.nz > 0)");
+    if (l->y_min() != 0) bad("lab.y_min", "must be 0 with a chute (y is the height above its bed)");
+    if (!(c.bend_deg() > 0 && c.bend_deg() < 90)) bad("lab.chute.bend_deg", "must lie in (0, 90) deg");
+    if (!(c.bend_end_m() > c.bend_start_m() && c.bend_start_m() > l->x_min())) bad("lab.chute.bend_end_m", "needs x_min < bend_start_m < bend_end_m");
+    if (!(c.channel_radius_m() >= 0)) bad("lab.chute.channel_radius_m", "must be >= 0 (0: flat across)");
+    // The normals of the bend meet at its centre of curvature: the mesh must stay below it.
+    const double radius = (c.bend_end_m() - c.bend_start_m()) / (c.bend_deg() * 3.14159265358979323846 / 180);
+    const double zmax = std::max(std::abs(l->z_min()), std::abs(l->z_max()));
+    const double bed_max = c.channel_radius_m() > 0 ? zmax * zmax / (2 * c.channel_radius_m()) : 0;
+    if (!(l->y_max() + bed_max < 0.9 * radius))
+      bad("lab.y_max", "the mesh (" + std::to_string(l->y_max() + bed_max) + " m above the reference surface) must stay well below the bend's radius of curvature (" +
+                           std::to_string(radius) + " m)");
+    if (!l->obstacles().empty()) bad("lab.obstacles", "obstacles are not supported on a curved chute");
+  }
+  if (l->has_phi_deg() && !(l->phi_deg() > 0 && l->phi_deg() < 80)) bad("lab.phi_deg", "must lie in (0, 80) deg");
+  if (l->has_bed_friction_deg() && !(l->bed_friction_deg() >= 0 && l->bed_friction_deg() < 80)) bad("lab.bed_friction_deg", "must lie in [0, 80) deg");
   for (int k = 0; k < l->fill_size(); ++k) {
     const auto& f = l->fill(k);
-    if (f.polygon_xy_size() > 0) {
+    if (f.cap_radius() != 0 || f.cap_height() != 0) {
+      if (!three_d) bad("lab.fill[" + std::to_string(k) + "].cap_radius", "a spherical cap needs a 3D set-up (lab.nz > 0)");
+      if (!(f.cap_radius() > 0 && f.cap_height() > 0 && f.cap_height() <= f.cap_radius()))
+        bad("lab.fill[" + std::to_string(k) + "].cap_height", "a cap needs cap_radius > 0 and 0 < cap_height <= cap_radius");
+    } else if (f.polygon_xy_size() > 0) {
       if (f.polygon_xy_size() < 6 || f.polygon_xy_size() % 2)
         bad("lab.fill[" + std::to_string(k) + "].polygon_xy", "needs x, y pairs of at least 3 corners");
     } else if (!(f.x_max() > f.x_min() && f.y_max() > f.y_min())) {
@@ -135,6 +157,8 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
     if (b.kind() == "inflow" && !(b.inflow_height() > 0)) bad(f + ".inflow_height", "an inflow needs a fill height > 0 m");
     if (b.kind() == "inflow" && b.side() != "left") bad(f + ".side", "inflow is supported on the left side only");
     if (b.has_from() && b.has_to() && !(b.to() > b.from())) bad(f + ".to", "must exceed from");
+    if (l->has_chute() && (b.has_from() || b.has_to())) bad(f + ".from", "a curved chute takes whole sides only (no from/to)");
+    if (l->has_chute() && b.kind() == "inflow") bad(f + ".kind", "inflow is not supported on a curved chute");
   }
   if (l->end_time_s() == 0) l->set_end_time_s(1.0);
   if (!(l->end_time_s() > 0)) bad("lab.end_time_s", "must be > 0 s");

@@ -222,4 +222,85 @@ Mesh block_mesh_3d(const Block3Spec& s) {
   return m;
 }
 
+Mesh structured_hex_mesh(const HexGridSpec& s) {
+  if (s.ni < 1 || s.nj < 1 || s.nk < 1 || !s.node) throw std::invalid_argument("hex mesh: needs ni, nj, nk >= 1 and node positions");
+  const std::size_t NI = std::size_t(s.ni), NJ = std::size_t(s.nj), NK = std::size_t(s.nk);
+  std::vector<Vec> X((NI + 1) * (NJ + 1) * (NK + 1));
+  auto nid = [&](std::size_t i, std::size_t j, std::size_t k) { return (k * (NJ + 1) + j) * (NI + 1) + i; };
+  for (std::size_t k = 0; k <= NK; ++k)
+    for (std::size_t j = 0; j <= NJ; ++j)
+      for (std::size_t i = 0; i <= NI; ++i) X[nid(i, j, k)] = s.node(int(i), int(j), int(k));
+  Mesh m;
+  m.thickness = 0;
+  const std::size_t n = NI * NJ * NK;
+  m.centre.resize(n);
+  m.volume.assign(n, 0.0);
+  auto cid = [&](long i, long j, long k) {
+    if (i < 0 || j < 0 || k < 0 || i >= s.ni || j >= s.nj || k >= s.nk) return -1;
+    return int((std::size_t(k) * NJ + std::size_t(j)) * NI + std::size_t(i));
+  };
+  for (std::size_t k = 0; k < NK; ++k)
+    for (std::size_t j = 0; j < NJ; ++j)
+      for (std::size_t i = 0; i < NI; ++i) {
+        Vec c;
+        for (int q = 0; q < 8; ++q) c = c + X[nid(i + (q & 1), j + ((q >> 1) & 1), k + ((q >> 2) & 1))];
+        m.centre[std::size_t(cid(long(i), long(j), long(k)))] = 0.125 * c;
+      }
+  auto cross = [](Vec a, Vec b) { return Vec{a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; };
+  std::map<std::string, std::vector<BFace>> bnd;
+  // Faces normal to grid direction d, between cell (.., n-1, ..) and (.., n, ..) along d.
+  for (int d = 0; d < 3; ++d) {
+    const long ni = s.ni + (d == 0), nj = s.nj + (d == 1), nk = s.nk + (d == 2);
+    const char* lo = d == 0 ? "left" : d == 1 ? "bottom" : "back";
+    const char* hi = d == 0 ? "right" : d == 1 ? "top" : "front";
+    for (long k = 0; k < nk; ++k)
+      for (long j = 0; j < nj; ++j)
+        for (long i = 0; i < ni; ++i) {
+          const int a = cid(i - (d == 0), j - (d == 1), k - (d == 2)), b = cid(i, j, k);
+          if (a < 0 && b < 0) continue;
+          // The face's four nodes: the node (i, j, k) and its neighbours in the two other directions.
+          const int e1 = (d + 1) % 3, e2 = (d + 2) % 3;
+          auto corner = [&](int u, int v) {
+            long I = i, J = j, K = k;
+            (e1 == 0 ? I : e1 == 1 ? J : K) += u;
+            (e2 == 0 ? I : e2 == 1 ? J : K) += v;
+            return X[nid(std::size_t(I), std::size_t(J), std::size_t(K))];
+          };
+          const Vec p00 = corner(0, 0), p10 = corner(1, 0), p11 = corner(1, 1), p01 = corner(0, 1);
+          Vec S = 0.5 * cross(p11 - p00, p01 - p10);
+          const Vec C = 0.25 * (p00 + p10 + p11 + p01);
+          // Orient from a to b (or out of the one cell on the boundary).
+          const Vec along = a >= 0 && b >= 0 ? m.centre[std::size_t(b)] - m.centre[std::size_t(a)]
+                            : a >= 0         ? C - m.centre[std::size_t(a)]
+                                             : m.centre[std::size_t(b)] - C;
+          if (dot(S, along) < 0) S = (-1.0) * S;
+          if (a >= 0 && b >= 0) {
+            m.owner.push_back(a);
+            m.neighbour.push_back(b);
+            m.Sf.push_back(S);
+            m.Cf.push_back(C);
+          } else if (a >= 0) {
+            bnd[hi].push_back({a, S, C});
+          } else {
+            bnd[lo].push_back({b, (-1.0) * S, C});
+          }
+        }
+  }
+  m.n_internal = int(m.owner.size());
+  for (const char* name : {"bottom", "right", "top", "left", "back", "front"}) append_patch(m, name, bnd[name]);
+  // Volumes by the divergence theorem: V = sum over the cell's faces of (Cf - c) . Sf / 3.
+  for (int f = 0; f < m.faces(); ++f) {
+    const int o = m.owner[std::size_t(f)];
+    m.volume[std::size_t(o)] += dot(m.Cf[std::size_t(f)] - m.centre[std::size_t(o)], m.Sf[std::size_t(f)]) / 3;
+    if (f < m.n_internal) {
+      const int nb = m.neighbour[std::size_t(f)];
+      m.volume[std::size_t(nb)] -= dot(m.Cf[std::size_t(f)] - m.centre[std::size_t(nb)], m.Sf[std::size_t(f)]) / 3;
+    }
+  }
+  for (std::size_t c = 0; c < n; ++c)
+    if (!(m.volume[c] > 0)) throw std::invalid_argument("hex mesh: cell " + std::to_string(c) + " is inverted or flat (volume " + std::to_string(m.volume[c]) + ")");
+  m.finish();
+  return m;
+}
+
 }  // namespace runout::engine::vof

@@ -75,6 +75,19 @@ struct Block3Spec {
 };
 Mesh block_mesh_3d(const Block3Spec& s);
 
+/// A structured mesh of hexahedra from its node positions: ni x nj x nk cells, node (i, j, k) at
+/// `node(i, j, k)` for i <= ni, j <= nj, k <= nk (the lab's convention: i along the channel, j away
+/// from its bed, k across it). Cells are numbered as block_mesh_3d numbers them, i fastest then j
+/// then k, so cell (i, j, k) is (k nj + j) ni + i. Faces may be non-planar (area vector from the
+/// diagonals, exact for the quad's outline); volumes by the divergence theorem; cell centre the
+/// mean of its nodes. Patches as block_mesh_3d: "bottom" (j = 0), "top", "left" (i = 0), "right",
+/// "back" (k = 0), "front". For terrain-following meshes (the curved chute of validation.md B8).
+struct HexGridSpec {
+  int ni = 1, nj = 1, nk = 1;
+  std::function<Vec(int i, int j, int k)> node;
+};
+Mesh structured_hex_mesh(const HexGridSpec& s);
+
 /// Rename the part of a patch whose face centres satisfy `pick` into a new patch (e.g. the top
 /// boundary above x > 0 becomes "atmosphere"). Faces are reordered so that patches stay contiguous.
 template <class Pick>
