@@ -2,8 +2,10 @@
 // dissertation timed: OpenFOAM's interFoam with the Coulomb viscosity took 80 s wall for 1677 steps
 // on 12,000 cells (2.5 mm, about 4 microseconds per cell and step, 53 % in the pressure solve).
 //   runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off]
+//                    [--coupling piso|consistent]
 //                                          (default: 5 mm cells; --full: 2.5 mm, the dissertation's;
-//                                          --transpose: how the viscous stress's transpose part is taken)
+//                                          --transpose: how the viscous stress's transpose part is taken;
+//                                          --coupling: the pressure coupling, lab.pressure_coupling)
 //   runout_bench_vof --b10                 B10: column collapse for aspect ratios 0.5-6 (5 mm cells,
 //                                          scenarios/lab/b10-column-a*.json), normalised runout, rest
 //                                          time and the exponents of its growth
@@ -254,7 +256,7 @@ int main(int argc, char** argv) {
   bool full = false, check = false;
   double end = 1.0, courant = 0;
   int correctors = 0;
-  std::string transpose;
+  std::string transpose, coupling;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     if (a == "--full") full = true;
@@ -263,8 +265,9 @@ int main(int argc, char** argv) {
     else if (a == "--courant" && k + 1 < argc) courant = std::atof(argv[++k]);
     else if (a == "--correctors" && k + 1 < argc) correctors = std::atoi(argv[++k]);
     else if (a == "--transpose" && k + 1 < argc) transpose = argv[++k];
+    else if (a == "--coupling" && k + 1 < argc) coupling = argv[++k];
     else {
-      std::fprintf(stderr, "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off] [--check] | --b6 [--full] [--check] | --b9 [--full] [--check] | --b10 | --b7 [--full] | --region\n");
+      std::fprintf(stderr, "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off] [--coupling piso|consistent] [--check] | --b6 [--full] [--check] | --b9 [--full] [--check] | --b10 | --b7 [--full] | --region\n");
       return 2;
     }
   }
@@ -278,8 +281,9 @@ int main(int argc, char** argv) {
   lab->set_write_interval_s(0);
   if (courant > 0) lab->set_max_courant(courant);
   if (correctors > 0) lab->set_correctors(correctors);
-  if (!transpose.empty()) {
-    lab->set_viscous_transpose(transpose);
+  if (!transpose.empty() || !coupling.empty()) {
+    if (!transpose.empty()) lab->set_viscous_transpose(transpose);
+    if (!coupling.empty()) lab->set_pressure_coupling(coupling);
     try {
       r = runout::jobs::resolve_scenario(r.scenario, std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab");  // validates the name
     } catch (const std::exception& e) {

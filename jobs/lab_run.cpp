@@ -369,6 +369,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
                         : L.viscous_transpose() == "harmonic" ? vof::Transpose::harmonic
                                                               : vof::Transpose::linear;
   c.active_layers = L.active_layers() < 0 ? 0 : L.active_layers();
+  c.consistent = c.momentum_predictor = L.pressure_coupling() == "consistent";
   const double zeta = L.inclination_deg() * kPi / 180;
   const double omega = L.rotation_period_s() > 0 ? 2 * kPi / L.rotation_period_s() : 0.0;
   c.gravity = [zeta, omega](double t) {
@@ -394,6 +395,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     pb.kind = lb.kind() == "atmosphere" ? vof::Bc::atmosphere
               : lb.kind() == "outflow"  ? vof::Bc::outflow
               : lb.kind() == "coulomb-slip" ? vof::Bc::coulomb_slip
+              : lb.kind() == "coulomb-friction" ? vof::Bc::coulomb_friction
               : lb.kind() == "inflow"   ? vof::Bc::inflow
               : lb.kind() == "symmetry" ? vof::Bc::symmetry
                                         : vof::Bc::wall;

@@ -151,9 +151,9 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
     if (b.side() != "bottom" && b.side() != "top" && b.side() != "left" && b.side() != "right" && b.side() != "obstacle" &&
         !(three_d && (b.side() == "back" || b.side() == "front")))
       bad(f + ".side", "unknown '" + b.side() + "' (valid: bottom, top, left, right, obstacle; 3D also back, front)");
-    if (b.kind() != "wall" && b.kind() != "coulomb-slip" && b.kind() != "atmosphere" && b.kind() != "outflow" && b.kind() != "inflow" &&
-        b.kind() != "symmetry")
-      bad(f + ".kind", "unknown '" + b.kind() + "' (valid: wall, coulomb-slip, atmosphere, outflow, inflow, symmetry)");
+    if (b.kind() != "wall" && b.kind() != "coulomb-slip" && b.kind() != "coulomb-friction" && b.kind() != "atmosphere" && b.kind() != "outflow" &&
+        b.kind() != "inflow" && b.kind() != "symmetry")
+      bad(f + ".kind", "unknown '" + b.kind() + "' (valid: wall, coulomb-slip, coulomb-friction, atmosphere, outflow, inflow, symmetry)");
     if (b.kind() == "inflow" && !(b.inflow_height() > 0)) bad(f + ".inflow_height", "an inflow needs a fill height > 0 m");
     if (b.kind() == "inflow" && b.side() != "left") bad(f + ".side", "inflow is supported on the left side only");
     if (b.has_from() && b.has_to() && !(b.to() > b.from())) bad(f + ".to", "must exceed from");
@@ -171,6 +171,9 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
   if (!(l->max_courant() > 0 && l->max_courant() <= 1)) bad("lab.max_courant", "must lie in (0, 1]");
   if (l->correctors() == 0) l->set_correctors(3);
   if (l->correctors() < 1 || l->correctors() > 50) bad("lab.correctors", "must lie in 1..50");
+  if (l->pressure_coupling().empty()) l->set_pressure_coupling("piso");
+  if (l->pressure_coupling() != "piso" && l->pressure_coupling() != "consistent")
+    bad("lab.pressure_coupling", "unknown '" + l->pressure_coupling() + "' (valid: piso, consistent)");
   if (l->viscous_transpose().empty()) l->set_viscous_transpose("explicit");
   if (l->viscous_transpose() != "explicit" && l->viscous_transpose() != "harmonic" && l->viscous_transpose() != "off")
     bad("lab.viscous_transpose", "unknown '" + l->viscous_transpose() + "' (valid: explicit, harmonic, off)");

@@ -53,6 +53,7 @@ struct VofSolver::Impl {
   KSP ksp = nullptr;
   // Work arrays.
   std::vector<double> rho, rho_old, mu, A_D, rAU, rAUf, gh, ghf, alpha_phi, rho_phi;
+  std::vector<double> rAtU, rAtUf;  // the consistent coefficients (VofConfig::consistent)
   std::vector<Vec> H, HbyA, bsrc;
   std::vector<double> cO, cN;
   Mat Mu = nullptr;
@@ -146,6 +147,8 @@ struct VofSolver::Impl {
     rAU = rho;
     gh = rho;
     rAUf.assign(std::size_t(nf), 0);
+    rAtU = rAU;
+    rAtUf = rAUf;
     ghf = rAUf;
     alpha_phi = rAUf;
     rho_phi = rAUf;
@@ -163,6 +166,7 @@ struct VofSolver::Impl {
     for (auto* v : {&wc2, &wc3, &wc4, &wc5, &wc6, &wc7}) *v = wc1;
     wv1.assign(std::size_t(nc), Vec{});
     pf_rec = wv1;
+    pf_rec_old = wv1;
     double vsum = 0;
     for (double v : m.volume) vsum += v;
     mean_cell_size = std::cbrt(vsum / nc);
@@ -259,6 +263,8 @@ struct VofSolver::Impl {
       case Bc::inflow: return bc_of(f).inflow_velocity(m.Cf[std::size_t(f)]);
       case Bc::outflow: return Up;
       case Bc::symmetry: return Up - dot(Up, n) * n;
+      case Bc::coulomb_friction:  // material slides (its friction is a force, build_momentum); air sticks
+        return s.alpha_[std::size_t(o)] >= 0.5 ? Up - dot(Up, n) * n : Vec{};
       case Bc::atmosphere: {
         // pressureInletOutletVelocity: zero gradient out, the flux's normal velocity in.
         const double ph = s.phi_[std::size_t(f)];
@@ -457,9 +463,17 @@ struct VofSolver::Impl {
         const Vec Ub = boundary_velocity(f);
         const double D = mu[std::size_t(o)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
         // A symmetry plane carries no shear: no viscous term (its normal velocity is held by the flux).
-        if (k == Bc::wall || k == Bc::coulomb_slip || k == Bc::inflow) {
+        if (k == Bc::wall || k == Bc::coulomb_slip || k == Bc::inflow || (k == Bc::coulomb_friction && s.alpha_[std::size_t(o)] < 0.5)) {
           A_D[std::size_t(o)] += D;
           bsrc[std::size_t(o)] = bsrc[std::size_t(o)] + D * Ub;
+        } else if (k == Bc::coulomb_friction) {
+          // tan(delta) p |Sf| against the sliding velocity, implicit in the velocity: a drag of
+          // tan(delta) p |Sf| / |u_t| (at most the creep speed's), so that the force's magnitude is
+          // the friction while the material slides and material held by less comes to rest.
+          const Vec n = (1.0 / m.magSf[std::size_t(f)]) * m.Sf[std::size_t(f)];
+          const Vec ut = s.U_[std::size_t(o)] - dot(s.U_[std::size_t(o)], n) * n;
+          const PatchBc& pb = bc_of(f);
+          A_D[std::size_t(o)] += pb.tan_delta * std::max(s.p_[std::size_t(o)], 0.0) * m.magSf[std::size_t(f)] / std::max(norm(ut), pb.friction_creep_speed);
         }
         if (F >= 0) {
           A_D[std::size_t(o)] += F;  // leaves with the cell's velocity
@@ -474,6 +488,28 @@ struct VofSolver::Impl {
       rAUf[std::size_t(f)] = f < m.n_internal ? m.weight[std::size_t(f)] * rAU[std::size_t(o)] +
                                                     (1 - m.weight[std::size_t(f)]) * rAU[std::size_t(m.neighbour[std::size_t(f)])]
                                               : rAU[std::size_t(o)];
+    }
+    if (s.cfg_.consistent) {
+      // SIMPLEC: 1 / (A - H1), H1 the sum of the neighbour coefficients; where the viscous coupling
+      // dominates, A - H1 leaves the transient term (and the walls' share). Floored at half the
+      // transient term, where the mass flux leaving a cell exceeds what enters.
+      auto& H1 = wc1;
+      for (int c : halo_cells) H1[std::size_t(c)] = 0;
+      for (int f : active_faces) {
+        if (f >= m.n_internal) break;
+        H1[std::size_t(m.owner[std::size_t(f)])] += cO[std::size_t(f)];
+        H1[std::size_t(m.neighbour[std::size_t(f)])] += cN[std::size_t(f)];
+      }
+      for (int c : halo_cells) {
+        const double V = m.volume[std::size_t(c)];
+        rAtU[std::size_t(c)] = V / std::max(A_D[std::size_t(c)] - H1[std::size_t(c)], 0.5 * rho[std::size_t(c)] * V / dt);
+      }
+      for (int f : active_faces) {
+        const int o = m.owner[std::size_t(f)];
+        rAtUf[std::size_t(f)] = f < m.n_internal ? m.weight[std::size_t(f)] * rAtU[std::size_t(o)] +
+                                                       (1 - m.weight[std::size_t(f)]) * rAtU[std::size_t(m.neighbour[std::size_t(f)])]
+                                                 : rAtU[std::size_t(o)];
+      }
     }
   }
 
@@ -790,6 +826,15 @@ struct VofSolver::Impl {
     // side of the active cell (+1 owner, -1 neighbour) and the pressure outside.
     auto &phiHbyA = pf_phiHbyA, &phig = pf_phig, &coef = pf_coef, &pout = pf_pout;
     auto& open = pf_open;
+    // The consistent coupling (VofConfig::consistent): the pressure equation and the correction take
+    // 1/(A - H1); the part of the last pressure's force that 1/A would have carried, (1/A -
+    // 1/(A - H1)) F_old, stays in the predicted flux and velocity (SIMPLEC).
+    const bool cons = s.cfg_.consistent && !initial;
+    const auto& rA = cons ? rAtU : rAU;
+    const auto& rAf = cons ? rAtUf : rAUf;
+    auto& rec_old = pf_rec_old;
+    if (cons)
+      for (int c : active_cells) rec_old[std::size_t(c)] = Vec{};
     for (int f : active_faces) {
       phiHbyA[std::size_t(f)] = phig[std::size_t(f)] = coef[std::size_t(f)] = pout[std::size_t(f)] = 0;
       open[std::size_t(f)] = 0;
@@ -803,14 +848,27 @@ struct VofSolver::Impl {
           const Vec Hf = w * HbyA[std::size_t(o)] + (1 - w) * HbyA[std::size_t(nb)];
           phiHbyA[std::size_t(f)] = initial ? 0.0 : dot(Hf, m.Sf[std::size_t(f)]);
           phig[std::size_t(f)] = -ghf[std::size_t(f)] * (rho[std::size_t(nb)] - rho[std::size_t(o)]) * m.delta_coeff[std::size_t(f)] *
-                                 m.magSf[std::size_t(f)] * rAUf[std::size_t(f)];
-          coef[std::size_t(f)] = rAUf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+                                 m.magSf[std::size_t(f)] * rAf[std::size_t(f)];
+          coef[std::size_t(f)] = rAf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+          if (cons) {
+            const double dl = m.delta_coeff[std::size_t(f)];
+            const double Fold = -(s.p_rgh_[std::size_t(nb)] - s.p_rgh_[std::size_t(o)]) * dl - ghf[std::size_t(f)] * (rho[std::size_t(nb)] - rho[std::size_t(o)]) * dl;
+            phiHbyA[std::size_t(f)] += (rAUf[std::size_t(f)] - rAtUf[std::size_t(f)]) * Fold * m.magSf[std::size_t(f)];
+            rec_old[std::size_t(o)] = rec_old[std::size_t(o)] + Fold * m.Sf[std::size_t(f)];
+            rec_old[std::size_t(nb)] = rec_old[std::size_t(nb)] + Fold * m.Sf[std::size_t(f)];
+          }
         } else if (ao || an) {
           const int a = ao ? o : nb;
           open[std::size_t(f)] = ao ? 1 : -1;
           phiHbyA[std::size_t(f)] = initial ? 0.0 : dot(HbyA[std::size_t(a)], m.Sf[std::size_t(f)]);
-          coef[std::size_t(f)] = rAU[std::size_t(a)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+          coef[std::size_t(f)] = rA[std::size_t(a)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
           pout[std::size_t(f)] = outside_p_rgh(f, a);
+          if (cons) {
+            const double sg = open[std::size_t(f)];
+            const double Fout = -(pout[std::size_t(f)] - s.p_rgh_[std::size_t(a)]) * m.delta_coeff[std::size_t(f)];  // out of a
+            phiHbyA[std::size_t(f)] += sg * (rAU[std::size_t(a)] - rAtU[std::size_t(a)]) * Fout * m.magSf[std::size_t(f)];
+            rec_old[std::size_t(a)] = rec_old[std::size_t(a)] + (sg * Fout) * m.Sf[std::size_t(f)];
+          }
         }
       } else if (ao) {
         const Bc k = kind_of(f);
@@ -819,8 +877,13 @@ struct VofSolver::Impl {
           phiHbyA[std::size_t(f)] = initial ? 0.0 : dot(HbyA[std::size_t(o)], m.Sf[std::size_t(f)]);
         if (k == Bc::atmosphere) {
           open[std::size_t(f)] = 1;
-          coef[std::size_t(f)] = rAUf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+          coef[std::size_t(f)] = rAf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
           pout[std::size_t(f)] = outside_p_rgh(f, o);
+          if (cons) {
+            const double Fout = -(pout[std::size_t(f)] - s.p_rgh_[std::size_t(o)]) * m.delta_coeff[std::size_t(f)];
+            phiHbyA[std::size_t(f)] += (rAU[std::size_t(o)] - rAtU[std::size_t(o)]) * Fout * m.magSf[std::size_t(f)];
+            rec_old[std::size_t(o)] = rec_old[std::size_t(o)] + Fout * m.Sf[std::size_t(f)];
+          }
         }
       }
       phiHbyA[std::size_t(f)] += phig[std::size_t(f)];
@@ -948,8 +1011,8 @@ struct VofSolver::Impl {
         const double sg = op;
         const double pflux_out = -coef[std::size_t(f)] * (pout[std::size_t(f)] - s.p_rgh_[std::size_t(a)]);
         s.phi_[std::size_t(f)] = phiHbyA[std::size_t(f)] + sg * pflux_out;
-        if (rAU[std::size_t(a)] > 0) {
-          const double q = pflux_out / rAU[std::size_t(a)] / m.magSf[std::size_t(f)];
+        if (rA[std::size_t(a)] > 0) {
+          const double q = pflux_out / rA[std::size_t(a)] / m.magSf[std::size_t(f)];
           rec[std::size_t(a)] = rec[std::size_t(a)] + (q * sg) * m.Sf[std::size_t(f)];
         }
         continue;
@@ -960,8 +1023,8 @@ struct VofSolver::Impl {
         pflux = -coef[std::size_t(f)] * (s.p_rgh_[std::size_t(nb)] - s.p_rgh_[std::size_t(o)]);
       }
       s.phi_[std::size_t(f)] = phiHbyA[std::size_t(f)] + pflux;
-      if (f < m.n_internal && rAUf[std::size_t(f)] > 0) {
-        const double q = (phig[std::size_t(f)] + pflux) / rAUf[std::size_t(f)] / m.magSf[std::size_t(f)];
+      if (f < m.n_internal && rAf[std::size_t(f)] > 0) {
+        const double q = (phig[std::size_t(f)] + pflux) / rAf[std::size_t(f)] / m.magSf[std::size_t(f)];
         rec[std::size_t(o)] = rec[std::size_t(o)] + q * m.Sf[std::size_t(f)];
         rec[std::size_t(m.neighbour[std::size_t(f)])] = rec[std::size_t(m.neighbour[std::size_t(f)])] + q * m.Sf[std::size_t(f)];
       }
@@ -969,7 +1032,8 @@ struct VofSolver::Impl {
     if (!initial)
       for (int c : active_cells) {
         const Vec R = reconstruct(c, rec[std::size_t(c)]);
-        s.U_[std::size_t(c)] = HbyA[std::size_t(c)] + rAU[std::size_t(c)] * R;
+        s.U_[std::size_t(c)] = HbyA[std::size_t(c)] + rA[std::size_t(c)] * R;
+        if (cons) s.U_[std::size_t(c)] = s.U_[std::size_t(c)] + (rAU[std::size_t(c)] - rAtU[std::size_t(c)]) * reconstruct(c, rec_old[std::size_t(c)]);
       }
     for (int c : active_cells) s.p_[std::size_t(c)] = s.p_rgh_[std::size_t(c)] + rho[std::size_t(c)] * gh[std::size_t(c)];
     if (closed) {
@@ -1009,7 +1073,7 @@ struct VofSolver::Impl {
   std::vector<Vec> wv1;
   std::vector<double> pf_phiHbyA, pf_phig, pf_coef, pf_pout;  // pressure_correct's per-face values
   std::vector<signed char> pf_open;
-  std::vector<Vec> pf_rec;
+  std::vector<Vec> pf_rec, pf_rec_old;
   bool system_fresh = true;  // the pressure system was just (re)created
 };
 

@@ -37,11 +37,16 @@ namespace runout::engine::vof {
 /// wall: stick; coulomb_slip: listing B.2; atmosphere: total pressure of air at rest outside, air in
 /// and anything out; inflow: prescribed velocity and phase fraction; outflow: zero gradient;
 /// symmetry: no flow through it and no shear along it (a plane of symmetry, a frictionless wall).
-enum class Bc { wall, coulomb_slip, atmosphere, inflow, outflow, symmetry };
+/// coulomb_friction: the bed's Coulomb friction as a force, tan(delta) p per area against the sliding
+/// velocity (regularised below friction_creep_speed, so that material held by less than it sticks);
+/// unlike coulomb_slip, whose slip fraction divides by the cell's own Coulomb viscosity, it gives the
+/// bed friction delta also where delta < phi (docs/vof.md).
+enum class Bc { wall, coulomb_slip, atmosphere, inflow, outflow, symmetry, coulomb_friction };
 
 struct PatchBc {
   Bc kind = Bc::wall;
-  double tan_delta = 0;  ///< Coulomb slip wall: bed friction
+  double tan_delta = 0;  ///< Coulomb slip wall and Coulomb friction: bed friction
+  double friction_creep_speed = 1e-4;  ///< Coulomb friction: below this sliding speed [m/s] the friction force falls linearly
   std::function<Vec(const Vec&)> inflow_velocity;  ///< inflow: velocity at a face centre
   std::function<double(const Vec&)> inflow_alpha;  ///< inflow: phase fraction at a face centre
 };
@@ -66,6 +71,11 @@ struct VofConfig {
   double c_alpha = 1.0;        ///< interface compression coefficient
   int n_correctors = 3;        ///< PISO correctors per step
   bool momentum_predictor = false;  ///< solve the momentum matrix before the correctors (see docs/vof.md)
+  /// The pressure equation's coefficient: false: 1/A (PISO, interFoam); true: the consistent
+  /// 1/(A - H1) of SIMPLEC (H1 the sum of the neighbour coefficients), so that in cells where the
+  /// viscous coupling dominates A the pressure correction moves the velocity as the transient term
+  /// alone would (a projection), instead of being amplified by the viscosity (docs/vof.md).
+  bool consistent = false;
   /// The viscous stress's transpose part div(mu (grad U)^T), explicit in divergence form:
   /// linear: mu_f interpolated linearly, as interFoam has it; harmonic: mu_f the harmonic mean of the
   /// two cells (the stress two layers in series carry); off: left out. Where the Coulomb viscosity
