@@ -205,6 +205,11 @@ struct VofSolver::Impl {
     const double g = ghf[std::size_t(f)];
     return s.cfg_.rho2 * (g - gh_ref) - rho[std::size_t(a)] * g;
   }
+  // The pressure on a wall face, as OpenFOAM's p.boundaryField() under the buoyantPressure
+  // condition (p_rgh the cell's, the density the cell's, gh the face's): the bed pressure the
+  // Coulomb conditions need (listing B.2), not the cell centre's, which in a flow one or two cells
+  // deep is half of it or less.
+  double wall_pressure(int f, int o) const { return s.p_rgh_[std::size_t(o)] + rho[std::size_t(o)] * ghf[std::size_t(f)]; }
   double gh_ref = 0;
   Vec g_last;
   bool gravity_set = false;
@@ -276,7 +281,7 @@ struct VofSolver::Impl {
         double vf = 1.0;  // stick
         if (s.alpha_[std::size_t(o)] >= 0.5) {
           const double mub = mu[std::size_t(o)];
-          const double pb = s.p_[std::size_t(o)];
+          const double pb = wall_pressure(f, o);
           vf = std::clamp(bc_of(f).tan_delta / m.delta_coeff[std::size_t(f)] * pb / std::max(1e-300, mub * mag), 0.0, 1.0);
         }
         return (1 - vf) * ut;
@@ -473,7 +478,7 @@ struct VofSolver::Impl {
           const Vec n = (1.0 / m.magSf[std::size_t(f)]) * m.Sf[std::size_t(f)];
           const Vec ut = s.U_[std::size_t(o)] - dot(s.U_[std::size_t(o)], n) * n;
           const PatchBc& pb = bc_of(f);
-          A_D[std::size_t(o)] += pb.tan_delta * std::max(s.p_[std::size_t(o)], 0.0) * m.magSf[std::size_t(f)] / std::max(norm(ut), pb.friction_creep_speed);
+          A_D[std::size_t(o)] += pb.tan_delta * std::max(wall_pressure(f, o), 0.0) * m.magSf[std::size_t(f)] / std::max(norm(ut), pb.friction_creep_speed);
         }
         if (F >= 0) {
           A_D[std::size_t(o)] += F;  // leaves with the cell's velocity
@@ -492,7 +497,11 @@ struct VofSolver::Impl {
     if (s.cfg_.consistent) {
       // SIMPLEC: 1 / (A - H1), H1 the sum of the neighbour coefficients; where the viscous coupling
       // dominates, A - H1 leaves the transient term (and the walls' share). Floored at half the
-      // transient term, where the mass flux leaving a cell exceeds what enters.
+      // transient term, where the mass flux leaving a cell exceeds what enters. Only in cells that
+      // are mostly material: in the air next to it, 1 / (A - H1) is the light phase's dt / rho, a
+      // thousand times the material's, and the linear face value between the two made a flat layer
+      // at rest unstable (a round-off disturbance grew to 0.1 m/s in 0.3 s, test
+      // VofSolver.FlatLayerStaysAtRestWithTheConsistentCoupling); the air keeps 1/A.
       auto& H1 = wc1;
       for (int c : halo_cells) H1[std::size_t(c)] = 0;
       for (int f : active_faces) {
@@ -502,7 +511,8 @@ struct VofSolver::Impl {
       }
       for (int c : halo_cells) {
         const double V = m.volume[std::size_t(c)];
-        rAtU[std::size_t(c)] = V / std::max(A_D[std::size_t(c)] - H1[std::size_t(c)], 0.5 * rho[std::size_t(c)] * V / dt);
+        rAtU[std::size_t(c)] = s.alpha_[std::size_t(c)] < 0.5 ? rAU[std::size_t(c)]
+                                                              : V / std::max(A_D[std::size_t(c)] - H1[std::size_t(c)], 0.5 * rho[std::size_t(c)] * V / dt);
       }
       for (int f : active_faces) {
         const int o = m.owner[std::size_t(f)];
@@ -529,32 +539,49 @@ struct VofSolver::Impl {
   // Momentum predictor: solve the momentum matrix with the last pressure and buoyancy forces,
   // so that the viscous coupling (the Coulomb viscosity reaches 1e2 m2/s) is converged every step.
   int predict() {
-    // Force per cell: V reconstruct(-ghf snGrad(rho) - snGrad(p_rgh)) |Sf|.
-    std::vector<Vec> rec(static_cast<std::size_t>(nc));
-    for (int f = 0; f < nf; ++f) {
+    // Force per cell: V reconstruct(-ghf snGrad(rho) - snGrad(p_rgh)) |Sf|, over the active region;
+    // a face to the air at rest outside it is an opening with the outside's pressure, as in the
+    // pressure equation.
+    const auto& ix = active_index;
+    auto& rec = pf_rec;
+    for (int c : active_cells) rec[std::size_t(c)] = Vec{};
+    for (int f : active_faces) {
       const int o = m.owner[std::size_t(f)];
-      double q = 0;  // force per area, normal to the face
+      const bool ao = ix[std::size_t(o)] >= 0;
+      double q = 0;  // force per area, normal to the face (along Sf)
       if (f < m.n_internal) {
         const int nb = m.neighbour[std::size_t(f)];
+        const bool an = ix[std::size_t(nb)] >= 0;
         const double dl = m.delta_coeff[std::size_t(f)];
-        q = -ghf[std::size_t(f)] * (rho[std::size_t(nb)] - rho[std::size_t(o)]) * dl - (s.p_rgh_[std::size_t(nb)] - s.p_rgh_[std::size_t(o)]) * dl;
-      } else if (kind_of(f) == Bc::atmosphere) {
+        if (ao && an) {
+          q = -ghf[std::size_t(f)] * (rho[std::size_t(nb)] - rho[std::size_t(o)]) * dl - (s.p_rgh_[std::size_t(nb)] - s.p_rgh_[std::size_t(o)]) * dl;
+          rec[std::size_t(o)] = rec[std::size_t(o)] + q * m.Sf[std::size_t(f)];
+          rec[std::size_t(nb)] = rec[std::size_t(nb)] + q * m.Sf[std::size_t(f)];
+        } else {
+          const int c = ao ? o : nb;
+          const double sg = ao ? 1 : -1;  // Sf out of c
+          q = -(outside_p_rgh(f, c) - s.p_rgh_[std::size_t(c)]) * dl;  // out of c
+          rec[std::size_t(c)] = rec[std::size_t(c)] + (sg * q) * m.Sf[std::size_t(f)];
+        }
+      } else if (ao && kind_of(f) == Bc::atmosphere) {
         q = -(outside_p_rgh(f, o) - s.p_rgh_[std::size_t(o)]) * m.delta_coeff[std::size_t(f)];
-      } else {
-        continue;  // walls and inflow: the pressure gradient normal to them is balanced (fixed flux)
-      }
-      rec[std::size_t(o)] = rec[std::size_t(o)] + q * m.Sf[std::size_t(f)];
-      if (f < m.n_internal) rec[std::size_t(m.neighbour[std::size_t(f)])] = rec[std::size_t(m.neighbour[std::size_t(f)])] + q * m.Sf[std::size_t(f)];
+        rec[std::size_t(o)] = rec[std::size_t(o)] + q * m.Sf[std::size_t(f)];
+      }  // walls and inflow: the pressure gradient normal to them is balanced (fixed flux)
     }
+    // The matrix over every cell, cells outside the active region as rows of the identity with the
+    // velocity zero (the air at rest there), so that its structure stays that of the whole mesh.
+    // (Every face's entries are set, zero where they are not used, so that the matrix keeps the
+    // whole mesh's nonzero structure from one assembly to the next.)
     petsc_check(MatZeroEntries(Mu), "MatZeroEntries");
     for (int f = 0; f < m.n_internal; ++f) {
       const PetscInt o = m.owner[std::size_t(f)], nb = m.neighbour[std::size_t(f)];
-      const PetscScalar a = -cO[std::size_t(f)], c = -cN[std::size_t(f)];
+      const bool both = ix[std::size_t(o)] >= 0 && ix[std::size_t(nb)] >= 0;
+      const PetscScalar a = both ? -cO[std::size_t(f)] : 0.0, c = both ? -cN[std::size_t(f)] : 0.0;
       petsc_check(MatSetValues(Mu, 1, &o, 1, &nb, &a, INSERT_VALUES), "MatSetValues");
       petsc_check(MatSetValues(Mu, 1, &nb, 1, &o, &c, INSERT_VALUES), "MatSetValues");
     }
     for (PetscInt c = 0; c < nc; ++c) {
-      const PetscScalar d = A_D[std::size_t(c)];
+      const PetscScalar d = ix[std::size_t(c)] >= 0 ? A_D[std::size_t(c)] : 1.0;
       petsc_check(MatSetValues(Mu, 1, &c, 1, &c, &d, INSERT_VALUES), "MatSetValues");
     }
     petsc_check(MatAssemblyBegin(Mu, MAT_FINAL_ASSEMBLY), "MatAssembly");
@@ -563,10 +590,14 @@ struct VofSolver::Impl {
     int its_total = 0;
     for (int comp_i = 0; comp_i < dims; ++comp_i) {
       for (int c = 0; c < nc; ++c) {
-        const Vec F = reconstruct(c, rec[std::size_t(c)]);
-        const double src = comp(bsrc[std::size_t(c)], comp_i) + m.volume[std::size_t(c)] * comp(F, comp_i);
+        double src = 0, x0 = 0;
+        if (ix[std::size_t(c)] >= 0) {
+          const Vec F = reconstruct(c, rec[std::size_t(c)]);
+          src = comp(bsrc[std::size_t(c)], comp_i) + m.volume[std::size_t(c)] * comp(F, comp_i);
+          x0 = comp(s.U_[std::size_t(c)], comp_i);
+        }
         VecSetValue(bu, c, src, INSERT_VALUES);
-        VecSetValue(xu, c, comp(s.U_[std::size_t(c)], comp_i), INSERT_VALUES);
+        VecSetValue(xu, c, x0, INSERT_VALUES);
       }
       VecAssemblyBegin(bu);
       VecAssemblyEnd(bu);
@@ -583,7 +614,7 @@ struct VofSolver::Impl {
                        std::to_string(int(reason)));
       const PetscScalar* xv;
       VecGetArrayRead(xu, &xv);
-      for (int c = 0; c < nc; ++c) (comp_i == 0 ? s.U_[std::size_t(c)].x : comp_i == 1 ? s.U_[std::size_t(c)].y : s.U_[std::size_t(c)].z) = xv[c];
+      for (int c : active_cells) (comp_i == 0 ? s.U_[std::size_t(c)].x : comp_i == 1 ? s.U_[std::size_t(c)].y : s.U_[std::size_t(c)].z) = xv[c];
       VecRestoreArrayRead(xu, &xv);
     }
     return its_total;
@@ -596,7 +627,7 @@ struct VofSolver::Impl {
   // material comes within two layers of its edge, so it keeps its shape (and the pressure
   // preconditioner) for many steps. Returns true when it changed.
   bool update_active(bool force) {
-    const int layers = s.cfg_.momentum_predictor ? 0 : s.cfg_.active_layers;  // the predictor solves every cell
+    const int layers = s.cfg_.active_layers;
     if (layers <= 0) {
       if (n_active == nc && !force) return false;
       std::vector<int> all(std::size_t(nc), 0);
