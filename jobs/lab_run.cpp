@@ -649,7 +649,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   std::vector<double> h(std::size_t(g.nx), 0.0);
   double v1 = 0;
   for (int k = 0; k < m.cells(); ++k) {
-    const auto& p = m.centre[std::size_t(k)];
+    const auto& p = local[std::size_t(k)];  // bed coordinates (on a curved chute: arc length)
     h[std::size_t(std::clamp(int((p.x - g.x0) / dx), 0, g.nx - 1))] += s.alpha()[std::size_t(k)] * dy * g.dz / g.width;
     v1 += s.alpha()[std::size_t(k)] * m.volume[std::size_t(k)];
   }

@@ -478,7 +478,11 @@ struct VofSolver::Impl {
           const Vec n = (1.0 / m.magSf[std::size_t(f)]) * m.Sf[std::size_t(f)];
           const Vec ut = s.U_[std::size_t(o)] - dot(s.U_[std::size_t(o)], n) * n;
           const PatchBc& pb = bc_of(f);
-          A_D[std::size_t(o)] += pb.tan_delta * std::max(wall_pressure(f, o), 0.0) * m.magSf[std::size_t(f)] / std::max(norm(ut), pb.friction_creep_speed);
+          const double drag = pb.tan_delta * std::max(wall_pressure(f, o), 0.0) * m.magSf[std::size_t(f)] / std::max(norm(ut), pb.friction_creep_speed);
+          // The drag sits on the diagonal, which both components share; the part it would put on
+          // the velocity normal to the bed is given back explicitly, so that it acts along the bed.
+          A_D[std::size_t(o)] += drag;
+          bsrc[std::size_t(o)] = bsrc[std::size_t(o)] + (drag * dot(s.U_[std::size_t(o)], n)) * n;
         }
         if (F >= 0) {
           A_D[std::size_t(o)] += F;  // leaves with the cell's velocity
