@@ -81,11 +81,29 @@ bool in_obstacle(const v1::LabObstacle& o, const vof::Vec& c, double y0) {
 // Fields of the lab grid in one HDF5 file, frame by frame (blocked cells NaN).
 class FieldWriter {
  public:
-  explicit FieldWriter(const std::string& dir, const LabGrid& g) : dir_(dir), g_(g) {
+  /// `centres`: for a mesh that is not the lab block's box (a curved chute), the mesh's cell
+  /// centres, written once as /centres so that fields.xmf places the values where they are.
+  FieldWriter(const std::string& dir, const LabGrid& g, const std::vector<vof::Vec>* centres = nullptr) : dir_(dir), g_(g) {
     std::lock_guard lk(hdf5_mutex());
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
     file_ = H5Fcreate((dir + "/fields.h5").c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     if (file_ < 0) throw std::runtime_error("cannot create " + dir + "/fields.h5");
+    if (centres && g.three_d) {
+      std::vector<float> xyz(3 * g.cell.size(), NAN);
+      for (std::size_t q = 0; q < g.cell.size(); ++q)
+        if (const int c = g.cell[q]; c >= 0) {
+          const auto& v = (*centres)[std::size_t(c)];
+          xyz[3 * q] = float(v.x), xyz[3 * q + 1] = float(v.y), xyz[3 * q + 2] = float(v.z);
+        }
+      const hsize_t dims[4] = {hsize_t(g.nz), hsize_t(g.ny), hsize_t(g.nx), 3};
+      hid_t sp = H5Screate_simple(4, dims, nullptr);
+      hid_t ds = H5Dcreate2(file_, "centres", H5T_IEEE_F32LE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+      const herr_t st = H5Dwrite(ds, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, xyz.data());
+      H5Dclose(ds);
+      H5Sclose(sp);
+      if (st < 0) throw std::runtime_error("fields.h5: writing the cell centres failed");
+      curvilinear_ = true;
+    }
   }
   ~FieldWriter() {
     std::lock_guard lk(hdf5_mutex());
@@ -145,7 +163,11 @@ class FieldWriter {
       char grp[32];
       std::snprintf(grp, sizeof grp, "f%05zu", f);
       x << "   <Grid Name=\"" << grp << "\" GridType=\"Uniform\">\n    <Time Value=\"" << times_[f] << "\"/>\n";
-      if (g.three_d) {
+      if (curvilinear_) {  // the values at the cell centres as they lie (a curved chute)
+        x << "    <Topology TopologyType=\"3DSMesh\" Dimensions=\"" << dims.str() << "\"/>\n";
+        x << "    <Geometry GeometryType=\"XYZ\">\n     <DataItem Dimensions=\"" << dims.str()
+          << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">fields.h5:/centres</DataItem>\n    </Geometry>\n";
+      } else if (g.three_d) {
         x << "    <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"" << dims.str() << "\"/>\n";
         x << "    <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n     <DataItem Dimensions=\"3\" Format=\"XML\">" << g.z0 + 0.5 * g.dz << " "
           << g.y0 + 0.5 * g.dy << " " << g.x0 + 0.5 * g.dx << "</DataItem>\n     <DataItem Dimensions=\"3\" Format=\"XML\">" << g.dz << " "
@@ -173,6 +195,7 @@ class FieldWriter {
   const LabGrid& g_;
   hid_t file_ = -1;
   std::vector<double> times_;
+  bool curvilinear_ = false;
 };
 
 // figure.png: material (alpha > 0.5) coloured by speed (blue slow ... red fast), air white.
@@ -455,7 +478,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   sum.release_volume_m3 = v0;
   sum.volume_initial = v0;
   sum.seconds_prepare = std::chrono::duration<double>(clk::now() - t0).count();
-  FieldWriter fields(out_dir, g);
+  FieldWriter fields(out_dir, g, L.has_chute() ? &m.centre : nullptr);
   double next_write = L.write_interval_s() > 0 ? L.write_interval_s() : 1e300;
   double peak = 0, t_peak = 0, t_rest = -1, pressure_s = 0, alpha_min = 1, alpha_max = 0, div = 0, last_speed = 0;
   long steps = 0, p_its = 0;
