@@ -285,17 +285,16 @@ class ChuteBed {
       : s1_(L.chute().bend_start_m()), s2_(L.chute().bend_end_m()), beta_(L.chute().bend_deg() * kPi / 180),
         R_(L.chute().channel_radius_m()), k_(beta_ / (s2_ - s1_)) {}
   vof::Vec point(double s, double n, double z) const {
-    double x, y, b;  // the reference point, its angle to X, the bed's height above it
+    double x, y, a;  // the reference point and its tangent's angle to X
     if (s <= s1_) {
-      x = s, y = 0, b = 0;
+      x = s, y = 0, a = 0;
     } else if (s <= s2_) {
-      b = k_ * (s - s1_);
-      x = s1_ + std::sin(b) / k_, y = (1 - std::cos(b)) / k_;
+      a = k_ * (s - s1_);
+      x = s1_ + std::sin(a) / k_, y = (1 - std::cos(a)) / k_;
     } else {
-      b = beta_;
+      a = beta_;
       x = s1_ + std::sin(beta_) / k_ + (s - s2_) * std::cos(beta_), y = (1 - std::cos(beta_)) / k_ + (s - s2_) * std::sin(beta_);
     }
-    const double a = b;
     double f = 1;  // the parabola's share: 1 on the chute, smoothly 0 over the bend
     if (s > s1_) {
       const double q = std::clamp((s2_ - s) / (s2_ - s1_), 0.0, 1.0);

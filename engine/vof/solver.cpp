@@ -210,6 +210,16 @@ struct VofSolver::Impl {
   // Coulomb conditions need (listing B.2), not the cell centre's, which in a flow one or two cells
   // deep is half of it or less.
   double wall_pressure(int f, int o) const { return s.p_rgh_[std::size_t(o)] + rho[std::size_t(o)] * ghf[std::size_t(f)]; }
+  // The last pressure's and the buoyancy's force per area on an internal face, along Sf:
+  // -ghf snGrad(rho) - snGrad(p_rgh) (the momentum predictor's and the consistent coupling's F_old).
+  double face_force(int f) const {
+    const int o = m.owner[std::size_t(f)], nb = m.neighbour[std::size_t(f)];
+    const double dl = m.delta_coeff[std::size_t(f)];
+    return -ghf[std::size_t(f)] * (rho[std::size_t(nb)] - rho[std::size_t(o)]) * dl - (s.p_rgh_[std::size_t(nb)] - s.p_rgh_[std::size_t(o)]) * dl;
+  }
+  // The same on an opening (atmosphere, edge of the active region), out of the active cell a, with
+  // the outside's p_rgh pout.
+  double opening_force(int f, int a, double pout) const { return -(pout - s.p_rgh_[std::size_t(a)]) * m.delta_coeff[std::size_t(f)]; }
   double gh_ref = 0;
   Vec g_last;
   bool gravity_set = false;
@@ -556,26 +566,24 @@ struct VofSolver::Impl {
       if (f < m.n_internal) {
         const int nb = m.neighbour[std::size_t(f)];
         const bool an = ix[std::size_t(nb)] >= 0;
-        const double dl = m.delta_coeff[std::size_t(f)];
         if (ao && an) {
-          q = -ghf[std::size_t(f)] * (rho[std::size_t(nb)] - rho[std::size_t(o)]) * dl - (s.p_rgh_[std::size_t(nb)] - s.p_rgh_[std::size_t(o)]) * dl;
+          q = face_force(f);
           rec[std::size_t(o)] = rec[std::size_t(o)] + q * m.Sf[std::size_t(f)];
           rec[std::size_t(nb)] = rec[std::size_t(nb)] + q * m.Sf[std::size_t(f)];
         } else {
           const int c = ao ? o : nb;
           const double sg = ao ? 1 : -1;  // Sf out of c
-          q = -(outside_p_rgh(f, c) - s.p_rgh_[std::size_t(c)]) * dl;  // out of c
+          q = opening_force(f, c, outside_p_rgh(f, c));  // out of c
           rec[std::size_t(c)] = rec[std::size_t(c)] + (sg * q) * m.Sf[std::size_t(f)];
         }
       } else if (ao && kind_of(f) == Bc::atmosphere) {
-        q = -(outside_p_rgh(f, o) - s.p_rgh_[std::size_t(o)]) * m.delta_coeff[std::size_t(f)];
+        q = opening_force(f, o, outside_p_rgh(f, o));
         rec[std::size_t(o)] = rec[std::size_t(o)] + q * m.Sf[std::size_t(f)];
       }  // walls and inflow: the pressure gradient normal to them is balanced (fixed flux)
     }
     // The matrix over every cell, cells outside the active region as rows of the identity with the
-    // velocity zero (the air at rest there), so that its structure stays that of the whole mesh.
-    // (Every face's entries are set, zero where they are not used, so that the matrix keeps the
-    // whole mesh's nonzero structure from one assembly to the next.)
+    // velocity zero (the air at rest there). Every face's entries are set, zero where they are not
+    // used, so that the matrix keeps the whole mesh's nonzero structure from one assembly to the next.
     petsc_check(MatZeroEntries(Mu), "MatZeroEntries");
     for (int f = 0; f < m.n_internal; ++f) {
       const PetscInt o = m.owner[std::size_t(f)], nb = m.neighbour[std::size_t(f)];
@@ -886,8 +894,7 @@ struct VofSolver::Impl {
                                  m.magSf[std::size_t(f)] * rAf[std::size_t(f)];
           coef[std::size_t(f)] = rAf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
           if (cons) {
-            const double dl = m.delta_coeff[std::size_t(f)];
-            const double Fold = -(s.p_rgh_[std::size_t(nb)] - s.p_rgh_[std::size_t(o)]) * dl - ghf[std::size_t(f)] * (rho[std::size_t(nb)] - rho[std::size_t(o)]) * dl;
+            const double Fold = face_force(f);
             phiHbyA[std::size_t(f)] += (rAUf[std::size_t(f)] - rAtUf[std::size_t(f)]) * Fold * m.magSf[std::size_t(f)];
             rec_old[std::size_t(o)] = rec_old[std::size_t(o)] + Fold * m.Sf[std::size_t(f)];
             rec_old[std::size_t(nb)] = rec_old[std::size_t(nb)] + Fold * m.Sf[std::size_t(f)];
@@ -900,7 +907,7 @@ struct VofSolver::Impl {
           pout[std::size_t(f)] = outside_p_rgh(f, a);
           if (cons) {
             const double sg = open[std::size_t(f)];
-            const double Fout = -(pout[std::size_t(f)] - s.p_rgh_[std::size_t(a)]) * m.delta_coeff[std::size_t(f)];  // out of a
+            const double Fout = opening_force(f, a, pout[std::size_t(f)]);  // out of a
             phiHbyA[std::size_t(f)] += sg * (rAU[std::size_t(a)] - rAtU[std::size_t(a)]) * Fout * m.magSf[std::size_t(f)];
             rec_old[std::size_t(a)] = rec_old[std::size_t(a)] + (sg * Fout) * m.Sf[std::size_t(f)];
           }
@@ -915,7 +922,7 @@ struct VofSolver::Impl {
           coef[std::size_t(f)] = rAf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
           pout[std::size_t(f)] = outside_p_rgh(f, o);
           if (cons) {
-            const double Fout = -(pout[std::size_t(f)] - s.p_rgh_[std::size_t(o)]) * m.delta_coeff[std::size_t(f)];
+            const double Fout = opening_force(f, o, pout[std::size_t(f)]);
             phiHbyA[std::size_t(f)] += (rAU[std::size_t(o)] - rAtU[std::size_t(o)]) * Fout * m.magSf[std::size_t(f)];
             rec_old[std::size_t(o)] = rec_old[std::size_t(o)] + Fout * m.Sf[std::size_t(f)];
           }
