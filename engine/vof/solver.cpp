@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <mutex>
 
 namespace runout::engine::vof {
@@ -108,6 +110,8 @@ struct VofSolver::Impl {
       if (m.patch_index(name) < 0) throw VofError("boundary conditions: the mesh has no patch '" + name + "'");
     if (s.cfg_.rheology != "coulomb") throw VofError("rheology: unknown '" + s.cfg_.rheology + "' (valid: coulomb)");
     if (!(s.cfg_.phi_deg > 0 && s.cfg_.phi_deg < 90)) throw VofError("phi_deg must lie in (0, 90)");
+    if (!(s.cfg_.momentum_rtol > 0 && s.cfg_.momentum_rtol < 1)) throw VofError("momentum_rtol must lie in (0, 1)");
+    if (!(s.cfg_.consistent_alpha > 0 && s.cfg_.consistent_alpha <= 1)) throw VofError("consistent_alpha must lie in (0, 1]");
     cell_faces.assign(std::size_t(nc), {});
     for (int f = 0; f < nf; ++f) {
       cell_faces[std::size_t(m.owner[std::size_t(f)])].push_back(f);
@@ -178,8 +182,10 @@ struct VofSolver::Impl {
     PC pcu;
     petsc_check(KSPGetPC(kspU, &pcu), "KSPGetPC");
     petsc_check(PCSetType(pcu, PCILU), "PCSetType ilu");
-    petsc_check(KSPSetTolerances(kspU, 1e-10, 1e-300, PETSC_DEFAULT, 2000), "KSPSetTolerances");
+    petsc_check(KSPSetTolerances(kspU, s.cfg_.momentum_rtol, 1e-300, PETSC_DEFAULT, 2000), "KSPSetTolerances");
     petsc_check(KSPSetInitialGuessNonzero(kspU, PETSC_TRUE), "KSPSetInitialGuessNonzero");
+    petsc_check(KSPSetOptionsPrefix(kspU, "runout_u_"), "KSPSetOptionsPrefix");
+    petsc_check(KSPSetFromOptions(kspU), "KSPSetFromOptions");
   }
 
   void update_gravity(double t) {
@@ -426,6 +432,14 @@ struct VofSolver::Impl {
       rho_phi[std::size_t(f)] = alpha_phi[std::size_t(f)] * (s.cfg_.rho1 - s.cfg_.rho2) + s.phi_[std::size_t(f)] * s.cfg_.rho2;
   }
 
+  // Viscosity on an internal face: the cells' mixture viscosities interpolated linearly (interFoam's
+  // twoPhaseMixture::muf(), which weights each phase's interpolated viscosity by the face's phase
+  // fraction, gave the same B2 figures to the third digit under PISO).
+  double face_mu(int f) const {
+    const double w = m.weight[std::size_t(f)];
+    return w * mu[std::size_t(m.owner[std::size_t(f)])] + (1 - w) * mu[std::size_t(m.neighbour[std::size_t(f)])];
+  }
+
   // Momentum matrix (both velocity components share it): diagonal A_D, the neighbour coefficients of
   // each internal face (cO: owner row, cN: neighbour row; A_D U_P - sum c U_nb = bsrc) and the
   // sources. Boundary values and the transpose viscous part are taken from the current velocity.
@@ -448,7 +462,7 @@ struct VofSolver::Impl {
         const int nb = in ? m.neighbour[std::size_t(f)] : o;
         const double w = in ? m.weight[std::size_t(f)] : 1.0;
         const double mo = mu[std::size_t(o)], mn = mu[std::size_t(nb)];
-        const double muf = harmonic ? mo * mn / (w * mn + (1 - w) * mo) : w * mo + (1 - w) * mn;
+        const double muf = harmonic ? mo * mn / (w * mn + (1 - w) * mo) : (in ? face_mu(f) : mo);
         const Vec& S = m.Sf[std::size_t(f)];
         Vec t;
         for (int i = 0; i < 3; ++i) {
@@ -466,7 +480,7 @@ struct VofSolver::Impl {
       if (f < m.n_internal) {
         const int nb = m.neighbour[std::size_t(f)];
         const double w = m.weight[std::size_t(f)];
-        const double muf = w * mu[std::size_t(o)] + (1 - w) * mu[std::size_t(nb)];
+        const double muf = face_mu(f);
         const double D = muf * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
         // Row o: + max(F,0) U_o + min(F,0) U_nb + D (U_o - U_nb); row nb: the flux out of nb is -F.
         A_D[std::size_t(o)] += std::max(F, 0.0) + D;
@@ -525,7 +539,7 @@ struct VofSolver::Impl {
       }
       for (int c : halo_cells) {
         const double V = m.volume[std::size_t(c)];
-        rAtU[std::size_t(c)] = s.alpha_[std::size_t(c)] < 0.5 ? rAU[std::size_t(c)]
+        rAtU[std::size_t(c)] = s.alpha_[std::size_t(c)] < s.cfg_.consistent_alpha ? rAU[std::size_t(c)]
                                                               : V / std::max(A_D[std::size_t(c)] - H1[std::size_t(c)], 0.5 * rho[std::size_t(c)] * V / dt);
       }
       for (int f : active_faces) {
@@ -581,19 +595,33 @@ struct VofSolver::Impl {
         rec[std::size_t(o)] = rec[std::size_t(o)] + q * m.Sf[std::size_t(f)];
       }  // walls and inflow: the pressure gradient normal to them is balanced (fixed flux)
     }
-    // The matrix over every cell, cells outside the active region as rows of the identity with the
-    // velocity zero (the air at rest there). Every face's entries are set, zero where they are not
+    // The matrix over every cell, cells outside the active region (or not predicted) as rows of the
+    // identity with their velocity (zero for the air at rest outside the region). Every face's entries are set, zero where they are not
     // used, so that the matrix keeps the whole mesh's nonzero structure from one assembly to the next.
+    // Under the consistent coupling only the material's cells (alpha >= consistent_alpha) are
+    // predicted; the air around them keeps its velocity (the cells' coefficients to it go to the
+    // right-hand side), as under PISO. Predicting the air too let the cell-reconstructed buoyancy
+    // force drive air currents over a resting heap's stair-stepped surface (0.1 m/s) that dragged
+    // it along at 2 mm/s (docs/vof.md).
+    const bool material_only = s.cfg_.consistent;
+    auto solved = [&](int c) {
+      return ix[std::size_t(c)] >= 0 && (!material_only || s.alpha_[std::size_t(c)] >= s.cfg_.consistent_alpha);
+    };
+    auto& known = pf_known;
+    known.assign(std::size_t(nc), Vec{});
     petsc_check(MatZeroEntries(Mu), "MatZeroEntries");
     for (int f = 0; f < m.n_internal; ++f) {
       const PetscInt o = m.owner[std::size_t(f)], nb = m.neighbour[std::size_t(f)];
-      const bool both = ix[std::size_t(o)] >= 0 && ix[std::size_t(nb)] >= 0;
+      const bool so = solved(int(o)), sn = solved(int(nb));
+      const bool both = so && sn;
       const PetscScalar a = both ? -cO[std::size_t(f)] : 0.0, c = both ? -cN[std::size_t(f)] : 0.0;
       petsc_check(MatSetValues(Mu, 1, &o, 1, &nb, &a, INSERT_VALUES), "MatSetValues");
       petsc_check(MatSetValues(Mu, 1, &nb, 1, &o, &c, INSERT_VALUES), "MatSetValues");
+      if (so && !sn && ix[std::size_t(nb)] >= 0) known[std::size_t(o)] = known[std::size_t(o)] + cO[std::size_t(f)] * s.U_[std::size_t(nb)];
+      if (sn && !so && ix[std::size_t(o)] >= 0) known[std::size_t(nb)] = known[std::size_t(nb)] + cN[std::size_t(f)] * s.U_[std::size_t(o)];
     }
     for (PetscInt c = 0; c < nc; ++c) {
-      const PetscScalar d = ix[std::size_t(c)] >= 0 ? A_D[std::size_t(c)] : 1.0;
+      const PetscScalar d = solved(int(c)) ? A_D[std::size_t(c)] : 1.0;
       petsc_check(MatSetValues(Mu, 1, &c, 1, &c, &d, INSERT_VALUES), "MatSetValues");
     }
     petsc_check(MatAssemblyBegin(Mu, MAT_FINAL_ASSEMBLY), "MatAssembly");
@@ -603,10 +631,12 @@ struct VofSolver::Impl {
     for (int comp_i = 0; comp_i < dims; ++comp_i) {
       for (int c = 0; c < nc; ++c) {
         double src = 0, x0 = 0;
-        if (ix[std::size_t(c)] >= 0) {
+        if (solved(c)) {
           const Vec F = reconstruct(c, rec[std::size_t(c)]);
-          src = comp(bsrc[std::size_t(c)], comp_i) + m.volume[std::size_t(c)] * comp(F, comp_i);
+          src = comp(bsrc[std::size_t(c)], comp_i) + m.volume[std::size_t(c)] * comp(F, comp_i) + comp(known[std::size_t(c)], comp_i);
           x0 = comp(s.U_[std::size_t(c)], comp_i);
+        } else if (ix[std::size_t(c)] >= 0) {
+          src = x0 = comp(s.U_[std::size_t(c)], comp_i);
         }
         VecSetValue(bu, c, src, INSERT_VALUES);
         VecSetValue(xu, c, x0, INSERT_VALUES);
@@ -1115,7 +1145,7 @@ struct VofSolver::Impl {
   std::vector<Vec> wv1;
   std::vector<double> pf_phiHbyA, pf_phig, pf_coef, pf_pout;  // pressure_correct's per-face values
   std::vector<signed char> pf_open;
-  std::vector<Vec> pf_rec, pf_rec_old;
+  std::vector<Vec> pf_rec, pf_rec_old, pf_known;
   bool system_fresh = true;  // the pressure system was just (re)created
 };
 

@@ -76,6 +76,13 @@ struct VofConfig {
   /// viscous coupling dominates A the pressure correction moves the velocity as the transient term
   /// alone would (a projection), instead of being amplified by the viscosity (docs/vof.md).
   bool consistent = false;
+  /// Under the consistent coupling: cells with at least this much material take SIMPLEC's
+  /// coefficient and the momentum predictor; the rest (the air) keep PISO's 1/A and their velocity.
+  double consistent_alpha = 0.5;
+  /// Relative tolerance of the momentum predictor's solve (BiCGStab + ILU; PETSc options with the
+  /// prefix runout_u_ override it). 1e-6 gave B2's figures of 1e-10 to the third digit in a tenth
+  /// of the iterations.
+  double momentum_rtol = 1e-6;
   /// The viscous stress's transpose part div(mu (grad U)^T), explicit in divergence form:
   /// linear: mu_f interpolated linearly, as interFoam has it; harmonic: mu_f the harmonic mean of the
   /// two cells (the stress two layers in series carry); off: left out. Where the Coulomb viscosity
