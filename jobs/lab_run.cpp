@@ -445,9 +445,27 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   };
   bool has_inflow = false;
   for (const auto& lb : L.boundaries()) has_inflow |= lb.kind() == "inflow";
-  for (int k = 0; k < m.cells(); ++k)
-    for (const auto& f : L.fill())
-      if (inside(f, local[std::size_t(k)])) alpha[std::size_t(k)] = 1;
+  // Cells cut by a fill's outline get the share of their cell inside it, sampled on 4 x 4 (x 4 in
+  // 3D) points: a stair-stepped surface is locally steeper than phi at every step, and its corner
+  // cells fail at once (on the static B9 heap at 2.5 mm one reached 0.12 m/s).
+  const int ns = 4;
+  const int nsz = g.three_d ? ns : 1;
+  for (int k = 0; k < m.cells(); ++k) {
+    const vof::Vec& c = local[std::size_t(k)];
+    int in = 0;
+    for (int a = 0; a < ns; ++a)
+      for (int b = 0; b < ns; ++b)
+        for (int e = 0; e < nsz; ++e) {
+          const vof::Vec q{c.x + ((a + 0.5) / ns - 0.5) * g.dx, c.y + ((b + 0.5) / ns - 0.5) * g.dy,
+                           g.three_d ? c.z + ((e + 0.5) / nsz - 0.5) * g.dz : c.z};
+          for (const auto& f : L.fill())
+            if (inside(f, q)) {
+              ++in;
+              break;
+            }
+        }
+    alpha[std::size_t(k)] = double(in) / (ns * ns * nsz);
+  }
   double v0 = 0;
   for (int k = 0; k < m.cells(); ++k) v0 += alpha[std::size_t(k)] * m.volume[std::size_t(k)];
   if (v0 <= 0 && !has_inflow) throw ScenarioError("lab.fill: no cell centre lies in the fill regions (and no inflow feeds the channel)");
