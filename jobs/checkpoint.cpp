@@ -12,7 +12,7 @@ namespace runout::jobs {
 
 namespace {
 
-constexpr const char* kFormat = "runout VOF checkpoint 1";
+constexpr const char* kFormat = "runout VOF checkpoint 2";  // 2: with the run's monitor series
 
 void put_attr_string(hid_t loc, const char* name, const std::string& v) {
   hid_t t = H5Tcopy(H5T_C_S1);
@@ -98,6 +98,15 @@ void write_checkpoint(const std::string& path, const LabCheckpoint& cp) {
       put_doubles(f, "U", U, 3);
       std::vector<double> act(s.active_cells.begin(), s.active_cells.end());
       put_doubles(f, "active_cells", act);
+      hid_t g = H5Gcreate2(f, "series", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+      if (g < 0) throw std::runtime_error("checkpoint: cannot write the series");
+      try {
+        for (const auto& [k, v] : cp.series) put_doubles(g, k.c_str(), v);
+      } catch (...) {
+        H5Gclose(g);
+        throw;
+      }
+      H5Gclose(g);
     } catch (...) {
       H5Fclose(f);
       std::filesystem::remove(tmp);
@@ -119,7 +128,11 @@ LabCheckpoint read_checkpoint(const std::string& path) {
   if (f < 0) throw ScenarioError("checkpoint " + path + ": cannot open it");
   LabCheckpoint cp;
   try {
-    if (get_attr_string(f, "format") != kFormat) throw ScenarioError("checkpoint " + path + ": not a runout VOF checkpoint");
+    const std::string format = get_attr_string(f, "format");
+    if (format.rfind("runout VOF checkpoint ", 0) == 0 && format != kFormat)
+      throw ScenarioError("checkpoint " + path + ": written by another build of runout (" + format + ", this build reads '" + kFormat +
+                          "'); run the scenario again from the start");
+    if (format != kFormat) throw ScenarioError("checkpoint " + path + ": not a runout VOF checkpoint");
     cp.scenario_hash = get_attr_string(f, "scenario_sha256");
     const auto sc = get<double>(f, "time_dt_steps", H5T_NATIVE_DOUBLE, path);
     if (sc.size() != 3) throw ScenarioError("checkpoint " + path + ": damaged (time_dt_steps)");
@@ -146,6 +159,22 @@ LabCheckpoint read_checkpoint(const std::string& path) {
     if (U.size() % 3) throw ScenarioError("checkpoint " + path + ": damaged (U)");
     for (std::size_t i = 0; i + 2 < U.size(); i += 3) s.U.push_back({U[i], U[i + 1], U[i + 2]});
     for (double a : get<double>(f, "active_cells", H5T_NATIVE_DOUBLE, path)) s.active_cells.push_back(int(a));
+    if (H5Lexists(f, "series", H5P_DEFAULT) <= 0) throw ScenarioError("checkpoint " + path + ": damaged (no series)");
+    hid_t g = H5Gopen2(f, "series", H5P_DEFAULT);
+    H5G_info_t info;
+    H5Gget_info(g, &info);
+    try {
+      for (hsize_t q = 0; q < info.nlinks; ++q) {
+        char name[256];
+        if (H5Lget_name_by_idx(g, ".", H5_INDEX_NAME, H5_ITER_INC, q, name, sizeof name, H5P_DEFAULT) < 0)
+          throw ScenarioError("checkpoint " + path + ": damaged (series)");
+        cp.series[name] = get<double>(g, name, H5T_NATIVE_DOUBLE, path);
+      }
+    } catch (...) {
+      H5Gclose(g);
+      throw;
+    }
+    H5Gclose(g);
   } catch (...) {
     H5Fclose(f);
     throw;

@@ -4,6 +4,7 @@
 // where it stopped and a checkpoint cannot be applied to another scenario.
 #include <map>
 #include <string>
+#include <vector>
 
 #include "engine/vof/solver.hpp"
 
@@ -13,6 +14,7 @@ struct LabCheckpoint {
   std::string scenario_hash;
   long steps = 0;
   std::map<std::string, double> figures;  ///< the run's running figures by name (peak speed, ...)
+  std::map<std::string, std::vector<double>> series;  ///< the run's monitor series so far, by name
   engine::vof::VofState state;
 };
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <sstream>
@@ -83,12 +84,49 @@ class FieldWriter {
  public:
   /// `centres`: for a mesh that is not the lab block's box (a curved chute), the mesh's cell
   /// centres, written once as /centres so that fields.xmf places the values where they are.
-  FieldWriter(const std::string& dir, const LabGrid& g, const std::vector<vof::Vec>* centres = nullptr) : dir_(dir), g_(g) {
+  /// `work`: where the frames are written while the run goes on (empty: dir/fields.h5; a run with
+  /// checkpoints keeps them next to its checkpoint, so that a continued run has them); finish()
+  /// moves them to dir/fields.h5. `continue_from`: a frames file of an interrupted run; its frames up
+  /// to `t_restart` are kept and the run's frames follow them.
+  FieldWriter(const std::string& dir, const LabGrid& g, const std::vector<vof::Vec>* centres = nullptr, std::string work = {},
+              const std::string& continue_from = {}, double t_restart = 0)
+      : dir_(dir), work_(work.empty() ? dir + "/fields.h5" : std::move(work)), g_(g) {
     std::lock_guard lk(hdf5_mutex());
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-    file_ = H5Fcreate((dir + "/fields.h5").c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-    if (file_ < 0) throw std::runtime_error("cannot create " + dir + "/fields.h5");
-    if (centres && g.three_d) {
+    curvilinear_ = centres && g.three_d;
+    if (!continue_from.empty() && std::filesystem::is_regular_file(continue_from) && H5Fis_hdf5(continue_from.c_str()) > 0) {
+      std::error_code ec;
+      if (std::filesystem::absolute(continue_from) != std::filesystem::absolute(work_))
+        std::filesystem::copy_file(continue_from, work_, std::filesystem::copy_options::overwrite_existing, ec);
+      if (ec) throw std::runtime_error("cannot copy the frames " + continue_from + " to " + work_ + ": " + ec.message());
+      file_ = H5Fopen(work_.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+      if (file_ < 0) throw ScenarioError("frames " + continue_from + ": cannot open them");
+      // Keep the frames up to the checkpoint's time, in order; drop the later ones.
+      for (std::size_t f = 0;; ++f) {
+        char name[32];
+        std::snprintf(name, sizeof name, "f%05zu", f);
+        if (H5Lexists(file_, name, H5P_DEFAULT) <= 0) break;
+        double t = NAN;
+        hid_t gr = H5Gopen2(file_, name, H5P_DEFAULT);
+        if (gr >= 0 && H5Aexists(gr, "t") > 0) {
+          hid_t a = H5Aopen(gr, "t", H5P_DEFAULT);
+          H5Aread(a, H5T_NATIVE_DOUBLE, &t);
+          H5Aclose(a);
+        }
+        if (gr >= 0) H5Gclose(gr);
+        if (std::isnan(t)) throw ScenarioError("frames " + continue_from + ": frame " + name + " has no time");
+        if (t <= t_restart + 1e-12 && dropped_ == 0) {
+          times_.push_back(t);
+        } else {
+          H5Ldelete(file_, name, H5P_DEFAULT);
+          ++dropped_;
+        }
+      }
+      return;
+    }
+    file_ = H5Fcreate(work_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    if (file_ < 0) throw std::runtime_error("cannot create " + work_);
+    if (curvilinear_) {
       std::vector<float> xyz(3 * g.cell.size(), NAN);
       for (std::size_t q = 0; q < g.cell.size(); ++q)
         if (const int c = g.cell[q]; c >= 0) {
@@ -102,9 +140,10 @@ class FieldWriter {
       H5Dclose(ds);
       H5Sclose(sp);
       if (st < 0) throw std::runtime_error("fields.h5: writing the cell centres failed");
-      curvilinear_ = true;
     }
   }
+  /// Frames kept from the interrupted run.
+  int kept() const { return int(times_.size()); }
   ~FieldWriter() {
     std::lock_guard lk(hdf5_mutex());
     if (file_ >= 0) H5Fclose(file_);
@@ -142,7 +181,19 @@ class FieldWriter {
         throw std::runtime_error("fields.h5: writing failed");
       }
     }
+    {
+      hid_t sp = H5Screate(H5S_SCALAR);
+      hid_t a = H5Acreate2(gr, "t", H5T_IEEE_F64LE, sp, H5P_DEFAULT, H5P_DEFAULT);
+      const herr_t st = H5Awrite(a, H5T_NATIVE_DOUBLE, &t);
+      H5Aclose(a);
+      H5Sclose(sp);
+      if (st < 0) {
+        H5Gclose(gr);
+        throw std::runtime_error("fields.h5: writing a frame's time failed");
+      }
+    }
     H5Gclose(gr);
+    H5Fflush(file_, H5F_SCOPE_LOCAL);  // a checkpoint taken now finds the frame on disk
     times_.push_back(t);
   }
   // fields.xmf: a temporal collection on the cell centres (ORIGIN_DXDY, ORIGIN_DXDYDZ in 3D).
@@ -151,6 +202,16 @@ class FieldWriter {
       std::lock_guard lk(hdf5_mutex());
       if (file_ >= 0) H5Fclose(file_);
       file_ = -1;
+    }
+    if (work_ != dir_ + "/fields.h5") {
+      std::error_code ec;
+      std::filesystem::rename(work_, dir_ + "/fields.h5", ec);
+      if (ec) {  // another file system: copy
+        ec.clear();
+        std::filesystem::copy_file(work_, dir_ + "/fields.h5", std::filesystem::copy_options::overwrite_existing, ec);
+        if (ec) throw std::runtime_error("cannot move the frames " + work_ + " to " + dir_ + "/fields.h5: " + ec.message());
+        std::filesystem::remove(work_, ec);
+      }
     }
     const auto& g = g_;
     std::ostringstream dims;
@@ -191,9 +252,10 @@ class FieldWriter {
   }
 
  private:
-  std::string dir_;
+  std::string dir_, work_;
   const LabGrid& g_;
   hid_t file_ = -1;
+  int dropped_ = 0;
   std::vector<double> times_;
   bool curvilinear_ = false;
 };
@@ -495,7 +557,12 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   sum.release_volume_m3 = v0;
   sum.volume_initial = v0;
   sum.seconds_prepare = std::chrono::duration<double>(clk::now() - t0).count();
-  FieldWriter fields(out_dir, g, L.has_chute() ? &m.centre : nullptr);
+  // With checkpoints the frames are written next to the checkpoint (CHECKPOINT.fields.h5), so that
+  // a continued run carries on with them; a run continued from RESTART takes RESTART.fields.h5's
+  // frames up to its time.
+  FieldWriter fields(out_dir, g, L.has_chute() ? &m.centre : nullptr,
+                     opt.checkpoint_path.empty() ? std::string() : opt.checkpoint_path + ".fields.h5",
+                     opt.restart_path.empty() ? std::string() : opt.restart_path + ".fields.h5", restart.state.t);
   double next_write = L.write_interval_s() > 0 ? L.write_interval_s() : 1e300;
   double peak = 0, t_peak = 0, t_rest = -1, pressure_s = 0, alpha_min = 1, alpha_max = 0, div = 0, last_speed = 0;
   long steps = 0, p_its = 0;
@@ -624,11 +691,34 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   const bool checkpoints = !opt.checkpoint_path.empty();
   const double cp_every = L.checkpoint_interval_s() > 0 ? L.checkpoint_interval_s() : 1e300;
   double next_cp = cp_every < 1e300 ? cp_every * (std::floor(s.time() / cp_every + 1e-9) + 1) : 1e300;
+  // The monitors so far travel with the checkpoint, so that a continued run's run.json is the
+  // uninterrupted run's.
+  auto series_refs = [&] {
+    return std::vector<std::pair<const char*, std::vector<double>*>>{{"t", &mon_t},           {"outflow", &mon_q},
+                                                                     {"gate_flux", &mon_gate}, {"gate_strain_rate", &mon_sr},
+                                                                     {"moving_share", &mon_moving}, {"shock", &mon_shock},
+                                                                     {"surface_angle", &mon_surface}};
+  };
+  if (!opt.restart_path.empty()) {
+    for (auto [name, v] : series_refs()) {
+      const auto it = restart.series.find(name);
+      if (it == restart.series.end()) throw ScenarioError("checkpoint " + opt.restart_path + ": damaged (no series '" + name + "')");
+      *v = it->second;
+    }
+    const auto tf = restart.figures.find("t_fluid"), nm = restart.figures.find("next_mon");
+    if (tf == restart.figures.end() || nm == restart.figures.end())
+      throw ScenarioError("checkpoint " + opt.restart_path + ": damaged (no monitor times)");
+    t_fluid = tf->second;
+    next_mon = nm->second;
+  }
   auto write_cp = [&] {
     LabCheckpoint cp;
     cp.scenario_hash = state_hash;
     cp.steps = steps;
     cp.figures = figures();
+    cp.figures["t_fluid"] = t_fluid;
+    cp.figures["next_mon"] = next_mon;
+    for (auto [name, v] : series_refs()) cp.series[name] = *v;
     cp.state = s.state();
     write_checkpoint(opt.checkpoint_path, cp);
   };
@@ -923,7 +1013,6 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       j << ", \"shock_formed_s\": " << json_number(formed) << ", \"shock_speed_upstream_m_s\": " << json_number(speed)
         << ", \"shock_samples_in_fit\": " << n << ", \"shock_x_m\": [" << series(mon_shock) << "]";
     }
-    if (!opt.restart_path.empty()) j << ", \"note\": \"sampled from the restart at t = " << json_number(restart.state.t) << " s on\"";
     j << "},\n";
   }
   j << chute.str();

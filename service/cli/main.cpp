@@ -22,8 +22,8 @@ commands:
         ISeeSnow benchmark files (peak thickness/velocity ESRI ASCII on the DEM's grid, result CSV).
         VOF runs (engine "vof"): --checkpoint writes the run's state to FILE every
         lab.checkpoint_interval_s and when the run is interrupted (Ctrl-C, SIGTERM); --restart
-        continues from such a file exactly as the run would have gone on (fields.h5 then holds the
-        frames from the restart on).
+        continues from such a file exactly as the run would have gone on (its monitors travel in
+        FILE, its frames so far in FILE.fields.h5, so run.json and fields.h5 are the whole run's).
   verify [CASE...] [--full] [--resolutions R1,R2,...] [--limiter NAME] [--csv] [--threads N]
         Run the verification cases against exact solutions and invariants and print a table
         (or CSV). Cases: A1 A2 A3 A4 A5 A6 A7 STRESS (default: all). --full adds the finest

@@ -771,6 +771,19 @@ TEST(Scenarios, LabInflowFeedsTheChannelAndStationsReport) {
 }
 
 namespace {
+double json_number(const std::string& j, const std::string& key, std::size_t from = 0) {
+  const auto k = j.find("\"" + key + "\": ", from);
+  return k == std::string::npos ? NAN : std::atof(j.c_str() + k + key.size() + 4);
+}
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+}  // namespace
+
+namespace {
 std::string results_block(const std::string& dir) {
   std::ifstream rec(dir + "/run.json");
   std::stringstream ss;
@@ -779,11 +792,26 @@ std::string results_block(const std::string& dir) {
   const auto a = j.find("\"results\"");
   return a == std::string::npos ? std::string() : j.substr(a, j.find('}', a) - a);
 }
+// run.json's "monitors" block, and from it one series (a JSON array's text).
+std::string monitors_block(const std::string& dir) {
+  std::ifstream rec(dir + "/run.json");
+  std::stringstream ss;
+  ss << rec.rdbuf();
+  const std::string j = ss.str();
+  const auto a = j.find("\"monitors\"");
+  return a == std::string::npos ? std::string() : j.substr(a, j.find('}', a) - a);
+}
+std::string series_text(const std::string& block, const std::string& key) {
+  const auto a = block.find("\"" + key + "\": [");
+  return a == std::string::npos ? std::string() : block.substr(a, block.find(']', a) - a);
+}
 }  // namespace
 
 // A VOF run continued from its checkpoint ends exactly as the run that wrote it; a run interrupted
 // (Ctrl-C) leaves a checkpoint from which it ends as the uninterrupted run does, to the solver
-// tolerance (the uninterrupted run kept its pressure preconditioner at that step).
+// tolerance (the uninterrupted run kept its pressure preconditioner at that step). The monitors
+// and the frames continue too: run.json's series and fields.h5's frames are the uninterrupted
+// run's.
 TEST(Scenarios, LabRunContinuesFromItsCheckpoint) {
   auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json");
   auto* lab = r.scenario.mutable_lab();
@@ -807,6 +835,7 @@ TEST(Scenarios, LabRunContinuesFromItsCheckpoint) {
   EXPECT_EQ(s2.steps, s0.steps);
   EXPECT_EQ(s2.volume_final, s0.volume_final);
   EXPECT_EQ(results(second), results(whole));
+  EXPECT_EQ(monitors_block(second.p.string()), monitors_block(whole.p.string()));
   // Interrupted after 150 steps.
   jobs::RunOptions o1;
   o1.checkpoint_path = first / "cp.h5";
@@ -815,6 +844,7 @@ TEST(Scenarios, LabRunContinuesFromItsCheckpoint) {
   const auto s1 = jobs::run_scenario(r, first.p.string(), o1);
   ASSERT_EQ(s1.stop, "cancelled");
   ASSERT_TRUE(fs::exists(first / "cp.h5"));
+  ASSERT_TRUE(fs::exists(first / "cp.h5.fields.h5"));  // the frames so far, beside the checkpoint
   jobs::RunOptions o3;
   o3.restart_path = first / "cp.h5";
   const auto s3 = jobs::run_scenario(r, third.p.string(), o3);
@@ -822,6 +852,25 @@ TEST(Scenarios, LabRunContinuesFromItsCheckpoint) {
   EXPECT_NEAR(s3.volume_final, s0.volume_final, 1e-9 * s0.volume_final);
   EXPECT_NEAR(s3.runout_m, s0.runout_m, 1e-9);
   EXPECT_NEAR(s3.max_speed, s0.max_speed, 1e-6 * s0.max_speed);
+  // Sampled at the same times from the start (to the solver tolerance the two runs differ by), and
+  // the same frames.
+  auto numbers = [](const std::string& text) {
+    std::vector<double> v;
+    for (auto k = text.find('['); k != std::string::npos && k + 1 < text.size(); k = text.find(", ", k + 1))
+      v.push_back(std::atof(text.c_str() + k + (text[k] == '[' ? 1 : 2)));
+    return v;
+  };
+  const auto t0 = numbers(series_text(monitors_block(whole.p.string()), "t_s"));
+  const auto t3 = numbers(series_text(monitors_block(third.p.string()), "t_s"));
+  ASSERT_GT(t0.size(), 10u);
+  ASSERT_EQ(t3.size(), t0.size());
+  for (std::size_t q = 0; q < t0.size(); ++q) EXPECT_NEAR(t3[q], t0[q], 1e-6) << "sample " << q;
+  const auto g0 = numbers(series_text(monitors_block(whole.p.string()), "gate_flux_l_s_10cm"));
+  const auto g3 = numbers(series_text(monitors_block(third.p.string()), "gate_flux_l_s_10cm"));
+  ASSERT_EQ(g3.size(), g0.size());
+  EXPECT_NEAR(g3.front(), g0.front(), 1e-9);  // from before the interruption: carried by the checkpoint
+  EXPECT_EQ(json_number(read_text(third / "run.json"), "frames"), json_number(read_text(whole / "run.json"), "frames"));
+  EXPECT_GT(json_number(read_text(third / "run.json"), "frames"), 3);
   // Another scenario's checkpoint, and a file that is none, are refused by name.
   auto other = r;
   other.scenario.mutable_lab()->set_nx(40);
@@ -871,19 +920,6 @@ TEST(Scenarios, LabB3MonitorsFluidisationGateFluxAndStrainRate) {
   const auto last = j.rfind(", ", e);
   EXPECT_GT(std::atof(j.c_str() + last + 2), 1.0);
 }
-
-namespace {
-double json_number(const std::string& j, const std::string& key, std::size_t from = 0) {
-  const auto k = j.find("\"" + key + "\": ", from);
-  return k == std::string::npos ? NAN : std::atof(j.c_str() + k + key.size() + 4);
-}
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-}  // namespace
 
 // B5 (validation.md B5, coarse: 5 mm cells, 0.5 s): the steady flow of B4 meets the ramp; sand
 // builds a deposit in front of it (slow at the bed), the flow goes on over the ramp; the stations on
