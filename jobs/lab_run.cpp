@@ -689,7 +689,9 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     mon_t.push_back(t);
   };
   const bool checkpoints = !opt.checkpoint_path.empty();
-  const double cp_every = L.checkpoint_interval_s() > 0 ? L.checkpoint_interval_s() : 1e300;
+  const double cp_every = L.checkpoint_interval_s() > 0      ? L.checkpoint_interval_s()
+                          : opt.checkpoint_interval_s > 0 ? opt.checkpoint_interval_s
+                                                          : 1e300;
   double next_cp = cp_every < 1e300 ? cp_every * (std::floor(s.time() / cp_every + 1e-9) + 1) : 1e300;
   // The monitors so far travel with the checkpoint, so that a continued run's run.json is the
   // uninterrupted run's.

@@ -26,6 +26,9 @@ struct RunOptions {
   /// VOF runs: continue from this checkpoint instead of the initial state (same scenario; the end
   /// time and the write and checkpoint intervals may differ).
   std::string restart_path;
+  /// VOF runs with a checkpoint_path whose scenario sets no lab.checkpoint_interval_s: the interval
+  /// of simulated time to use instead (0: checkpoints only when the run is interrupted).
+  double checkpoint_interval_s = 0;
 };
 
 struct RunSummary {

@@ -43,6 +43,18 @@ Scheduler::Scheduler(JobStore& store, SchedulerConfig cfg) : store_(store), cfg_
   if (cfg_.threads_per_run <= 0) cfg_.threads_per_run = std::max(1, omp_get_num_procs() / cfg_.workers);
   fs::create_directories(fs::path(cfg_.state_dir) / "results");
   fs::create_directories(fs::path(cfg_.state_dir) / "logs");
+  fs::create_directories(fs::path(cfg_.state_dir) / "checkpoints");
+}
+
+std::string Scheduler::checkpoint_path(const std::string& id) const {
+  return (fs::path(cfg_.state_dir) / "checkpoints" / (id + ".h5")).string();
+}
+
+void Scheduler::remove_checkpoint(const std::string& id) const {
+  std::error_code ec;
+  fs::remove(checkpoint_path(id), ec);
+  fs::remove(checkpoint_path(id) + ".fields.h5", ec);
+  fs::remove(checkpoint_path(id) + ".part", ec);
 }
 
 Scheduler::~Scheduler() { stop(); }
@@ -60,7 +72,8 @@ std::string Scheduler::log_path(const std::string& id) const {
 }
 
 void Scheduler::start() {
-  const int n = store_.requeue_running("the server stopped during the run; queued to run again from the start");
+  const int n = store_.requeue_running(
+      "the server stopped during the run; queued to run again (a VOF run continues from its last checkpoint)");
   if (n) log("queued again " + std::to_string(n) + " job(s) left running by the previous server process");
   // Work in progress of a dead process is worthless: its jobs run again.
   std::error_code ec;
@@ -212,9 +225,17 @@ void Scheduler::run_job(StoredJob sj) {
 
   const fs::path final_dir = results_dir(hash);
   std::error_code ec;
+  // VOF runs keep a checkpoint (and their frames so far) in checkpoints/ID.h5 while they run, so
+  // that a job interrupted by the server stopping, or by its death, continues from there.
+  const std::string cp = checkpoint_path(id);
+  const bool had_checkpoint = fs::exists(cp, ec);
+  auto finish_and_forget = [&](v1::JobState state, const std::string& reason, const std::string& error, std::int64_t bytes) {
+    remove_checkpoint(id);
+    finish(state, reason, error, bytes);
+  };
   if (fs::exists(final_dir / "run.json", ec)) {
-    finish(v1::SUCCEEDED, "an identical scenario was computed before: its results answer this job", "",
-           folder_bytes(final_dir));
+    finish_and_forget(v1::SUCCEEDED, "an identical scenario was computed before: its results answer this job", "",
+                      folder_bytes(final_dir));
     return;
   }
   const fs::path tmp = fs::path(final_dir.string() + ".tmp-" + id);
@@ -225,7 +246,7 @@ void Scheduler::run_job(StoredJob sj) {
     cancelled_early = cancelled_early || cancel_.count(id) > 0;
   }
   if (cancelled_early) {
-    finish(v1::CANCELLED, "cancelled by the client before the run started", "", 0);
+    finish_and_forget(v1::CANCELLED, "cancelled by the client before the run started", "", 0);
     return;
   }
   try {
@@ -233,6 +254,16 @@ void Scheduler::run_job(StoredJob sj) {
     fs::create_directories(tmp);
     RunOptions opt;
     opt.progress_every = 20;
+    if (r.vof) {
+      opt.checkpoint_path = cp;
+      opt.checkpoint_interval_s = sj.scenario.lab().end_time_s() / 20;
+      if (had_checkpoint) {
+        opt.restart_path = cp;
+        say("continuing from its checkpoint");
+      }
+    } else if (had_checkpoint) {
+      remove_checkpoint(id);
+    }
     const auto wall0 = std::chrono::steady_clock::now();
     auto last_save = wall0;
     const double t_end = r.config.time.t_end;
@@ -280,7 +311,20 @@ void Scheduler::run_job(StoredJob sj) {
       }
       return go;
     };
-    const RunSummary sum = run_scenario(r, tmp.string(), opt);
+    RunSummary sum;
+    try {
+      sum = run_scenario(r, tmp.string(), opt);
+    } catch (const ScenarioError& e) {
+      if (opt.restart_path.empty()) throw;
+      // A checkpoint this build cannot continue (damaged, or from another build): from the start.
+      say(std::string("its checkpoint cannot be continued (") + e.what() + "); running again from the start");
+      log("job " + id + ": checkpoint refused (" + e.what() + "); running from the start");
+      remove_checkpoint(id);
+      fs::remove_all(tmp, ec);
+      fs::create_directories(tmp);
+      opt.restart_path.clear();
+      sum = run_scenario(r, tmp.string(), opt);
+    }
     if (sum.stop == "cancelled") {
       fs::remove_all(tmp, ec);
       bool by_client = false;
@@ -289,7 +333,10 @@ void Scheduler::run_job(StoredJob sj) {
         by_client = cancel_.count(id) > 0;
       }
       if (by_client)
-        finish(v1::CANCELLED, "cancelled by the client at t = " + std::to_string(sum.t) + " s; no results kept", "", 0);
+        finish_and_forget(v1::CANCELLED, "cancelled by the client at t = " + std::to_string(sum.t) + " s; no results kept", "", 0);
+      else if (r.vof)
+        finish(v1::QUEUED, "interrupted by the server stopping at t = " + std::to_string(sum.t) +
+                               " s; queued to continue from its checkpoint", "", 0);
       else
         finish(v1::QUEUED, "interrupted by the server stopping; queued to run again from the start", "", 0);
       return;
@@ -304,10 +351,10 @@ void Scheduler::run_job(StoredJob sj) {
     std::snprintf(b, sizeof b, "finished: %ld steps to t = %.1f s (stop: %s), affected area %.0f m2, runout %.0f m, max speed %.1f m/s",
                   sum.steps, sum.t, sum.stop.c_str(), sum.affected_area_m2, sum.runout_m, sum.max_speed);
     say(b);
-    finish(v1::SUCCEEDED, "completed", "", folder_bytes(final_dir));
+    finish_and_forget(v1::SUCCEEDED, "completed", "", folder_bytes(final_dir));
   } catch (const std::exception& e) {
     fs::remove_all(tmp, ec);
-    finish(v1::FAILED, "the run failed", e.what(), 0);
+    finish_and_forget(v1::FAILED, "the run failed", e.what(), 0);
   }
 }
 

@@ -62,6 +62,9 @@ class Scheduler {
 
   std::string results_dir(const std::string& hash) const;
   std::string log_path(const std::string& id) const;
+  /// A VOF job's checkpoint while it runs (its frames so far beside it, ID.h5.fields.h5).
+  std::string checkpoint_path(const std::string& id) const;
+  void remove_checkpoint(const std::string& id) const;
   /// Delete results per the retention policy now.
   void apply_retention();
 

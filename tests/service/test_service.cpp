@@ -7,7 +7,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -373,6 +375,70 @@ TEST(Service, TerminatedServerRequeuesItsRunningJob) {
   EXPECT_TRUE(interrupted);
   EXPECT_NE(j.state(), v1::FAILED);
   c.cancel(id);
+}
+
+// A VOF job interrupted by the server stopping continues from its checkpoint after the restart,
+// and its results are the uninterrupted run's: the same frames and monitor samples in run.json.
+TEST(Service, StoppedServerContinuesAVofJobFromItsCheckpoint) {
+  auto lab = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json").scenario;
+  lab.mutable_lab()->set_nx(100);
+  lab.mutable_lab()->set_ny(30);
+  lab.mutable_lab()->set_end_time_s(1.0);
+  TempDir d;
+  std::string id;
+  double t_stop = 0;
+  {
+    ServerProcess srv(d.p / "state", {"--data-root", kScenarios});
+    service::Client c(client_options(srv.address(), ""));
+    id = c.submit(lab).id();
+    for (int k = 0; k < 2000; ++k) {
+      const auto g = c.get(id);
+      if (g.state() == v1::RUNNING && g.progress().simulated_s() > 0.3) break;
+      std::this_thread::sleep_for(10ms);
+    }
+    t_stop = c.get(id).progress().simulated_s();
+    ASSERT_GT(t_stop, 0.3);
+    srv.stop(SIGTERM);
+  }
+  EXPECT_TRUE(fs::exists(d.p / "state" / "checkpoints" / (id + ".h5")));
+  EXPECT_TRUE(fs::exists(d.p / "state" / "checkpoints" / (id + ".h5.fields.h5")));
+  ServerProcess srv(d.p / "state", {"--data-root", kScenarios});
+  service::Client c(client_options(srv.address(), ""));
+  const auto fin = c.watch(id);
+  ASSERT_EQ(fin.state(), v1::SUCCEEDED) << fin.error();
+  bool continued = false;
+  for (const auto& t : fin.transitions()) continued |= t.reason().find("queued to continue from its checkpoint") != std::string::npos;
+  EXPECT_TRUE(continued);
+  EXPECT_FALSE(fs::exists(d.p / "state" / "checkpoints" / (id + ".h5")));  // gone with the finished job
+  c.download(id, "run.json", (d.p / "continued.json").string());
+  // The same scenario uninterrupted, on a second server.
+  TempDir ref;
+  ServerProcess other(ref.p / "state", {"--data-root", kScenarios});
+  service::Client c2(client_options(other.address(), ""));
+  const auto whole = c2.watch(c2.submit(lab).id());
+  ASSERT_EQ(whole.state(), v1::SUCCEEDED);
+  c2.download(whole.id(), "run.json", (d.p / "whole.json").string());
+  auto text = [](const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  const std::string a = text(d.p / "continued.json"), b = text(d.p / "whole.json");
+  auto number = [](const std::string& j, const std::string& key) {
+    const auto k = j.find("\"" + key + "\": ");
+    return k == std::string::npos ? NAN : std::atof(j.c_str() + k + key.size() + 4);
+  };
+  auto samples = [](const std::string& j) {
+    const auto k = j.find("\"t_s\": [");
+    return k == std::string::npos ? -1L : long(std::count(j.begin() + long(k), j.begin() + long(j.find(']', k)), ','));
+  };
+  EXPECT_GT(number(a, "continued_from_t_s"), 0.2);
+  EXPECT_EQ(number(a, "frames"), number(b, "frames"));
+  EXPECT_EQ(samples(a), samples(b));
+  EXPECT_GT(samples(b), 40);
+  EXPECT_NEAR(number(a, "front_x_m"), number(b, "front_x_m"), 1e-9);
+  EXPECT_NEAR(number(a, "volume_final_m3"), number(b, "volume_final_m3"), 1e-6 * number(b, "volume_final_m3"));
 }
 
 TEST(Service, TlsWithTheServersCertificate) {
