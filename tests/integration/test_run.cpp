@@ -784,23 +784,15 @@ std::string read_text(const std::string& path) {
 }  // namespace
 
 namespace {
-std::string results_block(const std::string& dir) {
-  std::ifstream rec(dir + "/run.json");
-  std::stringstream ss;
-  ss << rec.rdbuf();
-  const std::string j = ss.str();
-  const auto a = j.find("\"results\"");
+// A block of run.json ("results", "monitors"): its text up to the block's first closing brace.
+std::string run_json_block(const std::string& dir, const std::string& name) {
+  const std::string j = read_text(dir + "/run.json");
+  const auto a = j.find("\"" + name + "\"");
   return a == std::string::npos ? std::string() : j.substr(a, j.find('}', a) - a);
 }
-// run.json's "monitors" block, and from it one series (a JSON array's text).
-std::string monitors_block(const std::string& dir) {
-  std::ifstream rec(dir + "/run.json");
-  std::stringstream ss;
-  ss << rec.rdbuf();
-  const std::string j = ss.str();
-  const auto a = j.find("\"monitors\"");
-  return a == std::string::npos ? std::string() : j.substr(a, j.find('}', a) - a);
-}
+std::string results_block(const std::string& dir) { return run_json_block(dir, "results"); }
+std::string monitors_block(const std::string& dir) { return run_json_block(dir, "monitors"); }
+// One series of a block (a JSON array's text).
 std::string series_text(const std::string& block, const std::string& key) {
   const auto a = block.find("\"" + key + "\": [");
   return a == std::string::npos ? std::string() : block.substr(a, block.find(']', a) - a);
