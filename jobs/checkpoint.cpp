@@ -162,7 +162,10 @@ LabCheckpoint read_checkpoint(const std::string& path) {
     if (H5Lexists(f, "series", H5P_DEFAULT) <= 0) throw ScenarioError("checkpoint " + path + ": damaged (no series)");
     hid_t g = H5Gopen2(f, "series", H5P_DEFAULT);
     H5G_info_t info;
-    H5Gget_info(g, &info);
+    if (g < 0 || H5Gget_info(g, &info) < 0) {
+      if (g >= 0) H5Gclose(g);
+      throw ScenarioError("checkpoint " + path + ": damaged (series)");
+    }
     try {
       for (hsize_t q = 0; q < info.nlinks; ++q) {
         char name[256];

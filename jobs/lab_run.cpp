@@ -94,13 +94,17 @@ class FieldWriter {
     std::lock_guard lk(hdf5_mutex());
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
     curvilinear_ = centres && g.three_d;
-    if (!continue_from.empty() && std::filesystem::is_regular_file(continue_from) && H5Fis_hdf5(continue_from.c_str()) > 0) {
+    if (!continue_from.empty()) {
+      // The frames written before the checkpoint: without them the results would lack the run's
+      // start, so a missing or unreadable file is an error, not a fresh file.
+      if (!std::filesystem::is_regular_file(continue_from) || H5Fis_hdf5(continue_from.c_str()) <= 0)
+        throw ScenarioError("the checkpoint's frames " + continue_from + " are missing or not HDF5 (they are written beside the checkpoint)");
       std::error_code ec;
-      if (std::filesystem::absolute(continue_from) != std::filesystem::absolute(work_))
+      if (std::filesystem::weakly_canonical(continue_from, ec) != std::filesystem::weakly_canonical(work_, ec))
         std::filesystem::copy_file(continue_from, work_, std::filesystem::copy_options::overwrite_existing, ec);
       if (ec) throw std::runtime_error("cannot copy the frames " + continue_from + " to " + work_ + ": " + ec.message());
       file_ = H5Fopen(work_.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-      if (file_ < 0) throw ScenarioError("frames " + continue_from + ": cannot open them");
+      if (file_ < 0) throw ScenarioError("the checkpoint's frames " + continue_from + ": cannot open them");
       // Keep the frames up to the checkpoint's time, in order; drop the later ones.
       for (std::size_t f = 0;; ++f) {
         char name[32];
@@ -114,7 +118,11 @@ class FieldWriter {
           H5Aclose(a);
         }
         if (gr >= 0) H5Gclose(gr);
-        if (std::isnan(t)) throw ScenarioError("frames " + continue_from + ": frame " + name + " has no time");
+        if (std::isnan(t)) {
+          H5Fclose(file_);
+          file_ = -1;
+          throw ScenarioError("the checkpoint's frames " + continue_from + ": frame " + name + " has no time");
+        }
         if (t <= t_restart + 1e-12 && dropped_ == 0) {
           times_.push_back(t);
         } else {
@@ -139,11 +147,13 @@ class FieldWriter {
       const herr_t st = H5Dwrite(ds, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, xyz.data());
       H5Dclose(ds);
       H5Sclose(sp);
-      if (st < 0) throw std::runtime_error("fields.h5: writing the cell centres failed");
+      if (st < 0) {
+        H5Fclose(file_);
+        file_ = -1;
+        throw std::runtime_error("fields.h5: writing the cell centres failed");
+      }
     }
   }
-  /// Frames kept from the interrupted run.
-  int kept() const { return int(times_.size()); }
   ~FieldWriter() {
     std::lock_guard lk(hdf5_mutex());
     if (file_ >= 0) H5Fclose(file_);
@@ -204,14 +214,11 @@ class FieldWriter {
       file_ = -1;
     }
     if (work_ != dir_ + "/fields.h5") {
+      // Copied, not moved: the frames stay beside the checkpoint, which may continue the run later
+      // (to a later end time).
       std::error_code ec;
-      std::filesystem::rename(work_, dir_ + "/fields.h5", ec);
-      if (ec) {  // another file system: copy
-        ec.clear();
-        std::filesystem::copy_file(work_, dir_ + "/fields.h5", std::filesystem::copy_options::overwrite_existing, ec);
-        if (ec) throw std::runtime_error("cannot move the frames " + work_ + " to " + dir_ + "/fields.h5: " + ec.message());
-        std::filesystem::remove(work_, ec);
-      }
+      std::filesystem::copy_file(work_, dir_ + "/fields.h5", std::filesystem::copy_options::overwrite_existing, ec);
+      if (ec) throw std::runtime_error("cannot copy the frames " + work_ + " to " + dir_ + "/fields.h5: " + ec.message());
     }
     const auto& g = g_;
     std::ostringstream dims;
@@ -530,7 +537,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   }
   double v0 = 0;
   for (int k = 0; k < m.cells(); ++k) v0 += alpha[std::size_t(k)] * m.volume[std::size_t(k)];
-  if (v0 <= 0 && !has_inflow) throw ScenarioError("lab.fill: no cell centre lies in the fill regions (and no inflow feeds the channel)");
+  if (v0 <= 0 && !has_inflow) throw ScenarioError("lab.fill: no cell has material from the fill regions (and no inflow feeds the channel)");
   const std::string state_hash = lab_state_hash(r);
   LabCheckpoint restart;
   if (!opt.restart_path.empty()) {
@@ -762,7 +769,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       p.max_speed = st.max_speed;
       p.active_fraction = double(st.active_cells) / m.cells();
       p.step = steps;
-      if (!opt.progress(p)) {
+      if (!opt.progress(p) && st.t < L.end_time_s() - 1e-12) {  // on the last step the run is done anyway
         cancelled = true;
         if (checkpoints) write_cp();  // the run can continue from here
         return false;

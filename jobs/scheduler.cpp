@@ -135,12 +135,34 @@ void Scheduler::touch(const std::string& id) {
   change_cv_.notify_all();
 }
 
+void Scheduler::remove_orphan_checkpoints() {
+  // A checkpoint is kept only for a job that will run again: one cancelled while it waited in the
+  // queue, or ended by the store at a restart (cancel flag, too many attempts), leaves its own.
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(fs::path(cfg_.state_dir) / "checkpoints", ec)) {
+    std::string id = e.path().filename().string();
+    id = id.substr(0, id.find('.'));
+    std::optional<StoredJob> job;
+    try {
+      job = store_.get(id);
+    } catch (...) {
+      continue;
+    }
+    const bool live = job && (job->job.state() == v1::QUEUED || job->job.state() == v1::RUNNING);
+    if (!live) {
+      fs::remove(e.path(), ec);
+      log("removed the checkpoint file " + e.path().filename().string() + " of a job that will not run again");
+    }
+  }
+}
+
 void Scheduler::apply_retention() {
   std::lock_guard once(retention_mu_);  // one pass at a time
   {
     std::lock_guard lk(mu_);
     last_retention_ = std::chrono::steady_clock::now();
   }
+  remove_orphan_checkpoints();
   if (cfg_.retention_days <= 0 && cfg_.retention_max_bytes <= 0) return;
   auto finished = store_.finished_results();  // oldest first
   const double now = double(std::time(nullptr));

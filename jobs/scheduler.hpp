@@ -65,6 +65,7 @@ class Scheduler {
   /// A VOF job's checkpoint while it runs (its frames so far beside it, ID.h5.fields.h5).
   std::string checkpoint_path(const std::string& id) const;
   void remove_checkpoint(const std::string& id) const;
+  void remove_orphan_checkpoints();
   /// Delete results per the retention policy now.
   void apply_retention();
 

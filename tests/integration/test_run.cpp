@@ -828,6 +828,9 @@ TEST(Scenarios, LabRunContinuesFromItsCheckpoint) {
   EXPECT_EQ(s2.volume_final, s0.volume_final);
   EXPECT_EQ(results(second), results(whole));
   EXPECT_EQ(monitors_block(second.p.string()), monitors_block(whole.p.string()));
+  // The frames stay beside the finished run's checkpoint, so the continued run has them all.
+  EXPECT_EQ(json_number(read_text(second / "run.json"), "frames"), json_number(read_text(whole / "run.json"), "frames"));
+  EXPECT_EQ(read_text(second / "fields.xmf"), read_text(whole / "fields.xmf"));
   // Interrupted after 150 steps.
   jobs::RunOptions o1;
   o1.checkpoint_path = first / "cp.h5";
@@ -875,6 +878,15 @@ TEST(Scenarios, LabRunContinuesFromItsCheckpoint) {
   std::ofstream(first / "junk.h5") << "not a checkpoint";
   o2.restart_path = first / "junk.h5";
   EXPECT_THROW(jobs::run_scenario(r, second.p.string(), o2), jobs::ScenarioError);
+  // Without the frames beside it a checkpoint cannot give the whole run's results: refused by name.
+  fs::remove(first / "cp.h5.fields.h5");
+  o2.restart_path = first / "cp.h5";
+  try {
+    jobs::run_scenario(r, second.p.string(), o2);
+    FAIL() << "a checkpoint without its frames was accepted";
+  } catch (const jobs::ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("cp.h5.fields.h5"), std::string::npos) << e.what();
+  }
 }
 
 // B3 monitors (validation.md B3, coarse): the triangle fluidises, drains through the gate at x = 0
@@ -969,7 +981,6 @@ TEST(Scenarios, LabB9FailingHeapRelaxesToPhi) {
   const double angle = json_number(j, "mean_surface_angle_deg");
   std::printf("failing heap: surface %.1f deg at %.1f s (phi 32 deg), peak %.3f m/s\n", angle, sum.t, json_number(j, "peak_speed_m_s"));
   EXPECT_GT(json_number(j, "peak_speed_m_s"), 0.05);  // it did fail (from 40 deg)
-  EXPECT_LT(angle, 37.0);
   EXPECT_LT(json_number(j, "final_speed_m_s"), 1e-2);  // and came to rest
   EXPECT_NEAR(angle, 32.0, 3.0);
   EXPECT_LT(json_number(j, "volume_relative_error"), 1e-6);

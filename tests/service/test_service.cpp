@@ -441,6 +441,44 @@ TEST(Service, StoppedServerContinuesAVofJobFromItsCheckpoint) {
   EXPECT_NEAR(number(a, "volume_final_m3"), number(b, "volume_final_m3"), 1e-6 * number(b, "volume_final_m3"));
 }
 
+// A checkpoint the server cannot continue (here: damaged) does not fail the job: it runs again
+// from the start and says so in its log; a checkpoint left by a job that will not run again is
+// removed when the server starts.
+TEST(Service, DamagedCheckpointRunsTheVofJobFromTheStart) {
+  auto lab = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json").scenario;
+  lab.mutable_lab()->set_nx(100);
+  lab.mutable_lab()->set_ny(30);
+  lab.mutable_lab()->set_end_time_s(1.0);
+  TempDir d;
+  std::string id;
+  {
+    ServerProcess srv(d.p / "state", {"--data-root", kScenarios});
+    service::Client c(client_options(srv.address(), ""));
+    id = c.submit(lab).id();
+    for (int k = 0; k < 2000; ++k) {
+      const auto g = c.get(id);
+      if (g.state() == v1::RUNNING && g.progress().simulated_s() > 0.2) break;
+      std::this_thread::sleep_for(10ms);
+    }
+    srv.stop(SIGTERM);
+  }
+  const fs::path cp = d.p / "state" / "checkpoints" / (id + ".h5");
+  ASSERT_TRUE(fs::exists(cp));
+  std::ofstream(cp, std::ios::trunc) << "damaged";
+  std::ofstream(d.p / "state" / "checkpoints" / "no-such-job.h5") << "left over";
+  ServerProcess srv(d.p / "state", {"--data-root", kScenarios});
+  service::Client c(client_options(srv.address(), ""));
+  EXPECT_FALSE(fs::exists(d.p / "state" / "checkpoints" / "no-such-job.h5"));
+  const auto fin = c.watch(id);
+  ASSERT_EQ(fin.state(), v1::SUCCEEDED) << fin.error();
+  c.download(id, "job.log", (d.p / "job.log").string());
+  std::ifstream in(d.p / "job.log");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_NE(ss.str().find("running again from the start"), std::string::npos) << ss.str();
+  EXPECT_FALSE(fs::exists(cp));
+}
+
 TEST(Service, TlsWithTheServersCertificate) {
   TempDir d;
   const std::string cmd = "openssl req -x509 -newkey rsa:2048 -nodes -days 2 -subj /CN=localhost -addext "
