@@ -86,7 +86,7 @@ class FieldWriter {
   /// centres, written once as /centres so that fields.xmf places the values where they are.
   /// `work`: where the frames are written while the run goes on (empty: dir/fields.h5; a run with
   /// checkpoints keeps them next to its checkpoint, so that a continued run has them); finish()
-  /// moves them to dir/fields.h5. `continue_from`: a frames file of an interrupted run; its frames up
+  /// copies them to dir/fields.h5. `continue_from`: a frames file of an interrupted run; its frames up
   /// to `t_restart` are kept and the run's frames follow them.
   FieldWriter(const std::string& dir, const LabGrid& g, const std::vector<vof::Vec>* centres = nullptr, std::string work = {},
               const std::string& continue_from = {}, double t_restart = 0)
@@ -106,6 +106,7 @@ class FieldWriter {
       file_ = H5Fopen(work_.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
       if (file_ < 0) throw ScenarioError("the checkpoint's frames " + continue_from + ": cannot open them");
       // Keep the frames up to the checkpoint's time, in order; drop the later ones.
+      bool dropping = false;
       for (std::size_t f = 0;; ++f) {
         char name[32];
         std::snprintf(name, sizeof name, "f%05zu", f);
@@ -123,12 +124,9 @@ class FieldWriter {
           file_ = -1;
           throw ScenarioError("the checkpoint's frames " + continue_from + ": frame " + name + " has no time");
         }
-        if (t <= t_restart + 1e-12 && dropped_ == 0) {
-          times_.push_back(t);
-        } else {
-          H5Ldelete(file_, name, H5P_DEFAULT);
-          ++dropped_;
-        }
+        dropping = dropping || t > t_restart + 1e-12;
+        if (dropping) H5Ldelete(file_, name, H5P_DEFAULT);
+        else times_.push_back(t);
       }
       return;
     }
@@ -262,7 +260,6 @@ class FieldWriter {
   std::string dir_, work_;
   const LabGrid& g_;
   hid_t file_ = -1;
-  int dropped_ = 0;
   std::vector<double> times_;
   bool curvilinear_ = false;
 };

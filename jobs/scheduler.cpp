@@ -283,8 +283,6 @@ void Scheduler::run_job(StoredJob sj) {
         opt.restart_path = cp;
         say("continuing from its checkpoint");
       }
-    } else if (had_checkpoint) {
-      remove_checkpoint(id);
     }
     const auto wall0 = std::chrono::steady_clock::now();
     auto last_save = wall0;

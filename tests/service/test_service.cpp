@@ -26,6 +26,13 @@ using namespace std::chrono_literals;
 
 namespace {
 
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
 struct TempDir {
   fs::path p;
   TempDir() {
@@ -60,10 +67,7 @@ class ServerProcess {
     }
     // The server writes server.json (atomically) once it listens.
     for (int k = 0; k < 300 && !fs::exists(state_ / "server.json"); ++k) std::this_thread::sleep_for(50ms);
-    std::ifstream in(state_ / "server.json");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    const std::string s = ss.str();
+    const std::string s = read_text(state_ / "server.json");
     const auto a = s.find("\"listen\": \"") + 11;
     address_ = s.substr(a, s.find('"', a) - a);
   }
@@ -93,10 +97,7 @@ service::ClientOptions client_options(const std::string& address, const std::str
 
 // The In den Arelen test scenario (30 m) with its inputs named relative to the scenarios folder.
 v1::Scenario arelen(double end_time = 600, double stop_fraction = 0.01) {
-  std::ifstream in(std::string(RUNOUT_SOURCE_DIR) + "/tests/data/arelen-30m.json");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  auto s = jobs::parse_scenario_json(ss.str());
+  auto s = jobs::parse_scenario_json(read_text(std::string(RUNOUT_SOURCE_DIR) + "/tests/data/arelen-30m.json"));
   s.mutable_dem()->set_path("data/arelen/davos_srtm3.tif");
   s.mutable_area_of_interest()->set_path("data/arelen/aoi.geojson");
   s.mutable_releases(0)->set_path("data/arelen/release.geojson");
@@ -377,29 +378,40 @@ TEST(Service, TerminatedServerRequeuesItsRunningJob) {
   c.cancel(id);
 }
 
-// A VOF job interrupted by the server stopping continues from its checkpoint after the restart,
-// and its results are the uninterrupted run's: the same frames and monitor samples in run.json.
-TEST(Service, StoppedServerContinuesAVofJobFromItsCheckpoint) {
+namespace {
+// B2's collapse at 5 mm to 1 s: a VOF job of a few seconds.
+v1::Scenario coarse_collapse() {
   auto lab = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json").scenario;
   lab.mutable_lab()->set_nx(100);
   lab.mutable_lab()->set_ny(30);
   lab.mutable_lab()->set_end_time_s(1.0);
-  TempDir d;
-  std::string id;
-  double t_stop = 0;
-  {
-    ServerProcess srv(d.p / "state", {"--data-root", kScenarios});
-    service::Client c(client_options(srv.address(), ""));
-    id = c.submit(lab).id();
-    for (int k = 0; k < 2000; ++k) {
-      const auto g = c.get(id);
-      if (g.state() == v1::RUNNING && g.progress().simulated_s() > 0.3) break;
-      std::this_thread::sleep_for(10ms);
-    }
-    t_stop = c.get(id).progress().simulated_s();
-    ASSERT_GT(t_stop, 0.3);
-    srv.stop(SIGTERM);
+  return lab;
+}
+
+// Submits `s` to a server on `state`, stops that server (SIGTERM) once the job has simulated more
+// than `t_min` seconds; returns the job's id and the simulated time last reported.
+std::pair<std::string, double> submit_and_stop_after(const fs::path& state, const v1::Scenario& s, double t_min) {
+  ServerProcess srv(state, {"--data-root", kScenarios});
+  service::Client c(client_options(srv.address(), ""));
+  const std::string id = c.submit(s).id();
+  for (int k = 0; k < 2000; ++k) {
+    const auto g = c.get(id);
+    if (g.state() == v1::RUNNING && g.progress().simulated_s() > t_min) break;
+    std::this_thread::sleep_for(10ms);
   }
+  const double t = c.get(id).progress().simulated_s();
+  srv.stop(SIGTERM);
+  return {id, t};
+}
+}  // namespace
+
+// A VOF job interrupted by the server stopping continues from its checkpoint after the restart,
+// and its results are the uninterrupted run's: the same frames and monitor samples in run.json.
+TEST(Service, StoppedServerContinuesAVofJobFromItsCheckpoint) {
+  const auto lab = coarse_collapse();
+  TempDir d;
+  const auto [id, t_stop] = submit_and_stop_after(d.p / "state", lab, 0.3);
+  ASSERT_GT(t_stop, 0.3);
   EXPECT_TRUE(fs::exists(d.p / "state" / "checkpoints" / (id + ".h5")));
   EXPECT_TRUE(fs::exists(d.p / "state" / "checkpoints" / (id + ".h5.fields.h5")));
   ServerProcess srv(d.p / "state", {"--data-root", kScenarios});
@@ -418,13 +430,7 @@ TEST(Service, StoppedServerContinuesAVofJobFromItsCheckpoint) {
   const auto whole = c2.watch(c2.submit(lab).id());
   ASSERT_EQ(whole.state(), v1::SUCCEEDED);
   c2.download(whole.id(), "run.json", (d.p / "whole.json").string());
-  auto text = [](const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  };
-  const std::string a = text(d.p / "continued.json"), b = text(d.p / "whole.json");
+  const std::string a = read_text(d.p / "continued.json"), b = read_text(d.p / "whole.json");
   auto number = [](const std::string& j, const std::string& key) {
     const auto k = j.find("\"" + key + "\": ");
     return k == std::string::npos ? NAN : std::atof(j.c_str() + k + key.size() + 4);
@@ -445,23 +451,8 @@ TEST(Service, StoppedServerContinuesAVofJobFromItsCheckpoint) {
 // from the start and says so in its log; a checkpoint left by a job that will not run again is
 // removed when the server starts.
 TEST(Service, DamagedCheckpointRunsTheVofJobFromTheStart) {
-  auto lab = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json").scenario;
-  lab.mutable_lab()->set_nx(100);
-  lab.mutable_lab()->set_ny(30);
-  lab.mutable_lab()->set_end_time_s(1.0);
   TempDir d;
-  std::string id;
-  {
-    ServerProcess srv(d.p / "state", {"--data-root", kScenarios});
-    service::Client c(client_options(srv.address(), ""));
-    id = c.submit(lab).id();
-    for (int k = 0; k < 2000; ++k) {
-      const auto g = c.get(id);
-      if (g.state() == v1::RUNNING && g.progress().simulated_s() > 0.2) break;
-      std::this_thread::sleep_for(10ms);
-    }
-    srv.stop(SIGTERM);
-  }
+  const std::string id = submit_and_stop_after(d.p / "state", coarse_collapse(), 0.2).first;
   const fs::path cp = d.p / "state" / "checkpoints" / (id + ".h5");
   ASSERT_TRUE(fs::exists(cp));
   std::ofstream(cp, std::ios::trunc) << "damaged";
@@ -472,10 +463,8 @@ TEST(Service, DamagedCheckpointRunsTheVofJobFromTheStart) {
   const auto fin = c.watch(id);
   ASSERT_EQ(fin.state(), v1::SUCCEEDED) << fin.error();
   c.download(id, "job.log", (d.p / "job.log").string());
-  std::ifstream in(d.p / "job.log");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  EXPECT_NE(ss.str().find("running again from the start"), std::string::npos) << ss.str();
+  const std::string log = read_text(d.p / "job.log");
+  EXPECT_NE(log.find("running again from the start"), std::string::npos) << log;
   EXPECT_FALSE(fs::exists(cp));
 }
 
