@@ -2,10 +2,11 @@
 // dissertation timed: OpenFOAM's interFoam with the Coulomb viscosity took 80 s wall for 1677 steps
 // on 12,000 cells (2.5 mm, about 4 microseconds per cell and step, 53 % in the pressure solve).
 //   runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off]
-//                    [--coupling piso|consistent]
+//                    [--coupling piso|consistent] [--convection upwind|limited_linear]
 //                                          (default: 5 mm cells; --full: 2.5 mm, the dissertation's;
 //                                          --transpose: how the viscous stress's transpose part is taken;
-//                                          --coupling: the pressure coupling, lab.pressure_coupling)
+//                                          --coupling: the pressure coupling, lab.pressure_coupling;
+//                                          --convection: the momentum's convection, lab.momentum_convection)
 //   runout_bench_vof --b10                 B10: column collapse for aspect ratios 0.5-6 (5 mm cells,
 //                                          scenarios/lab/b10-column-a*.json), normalised runout, rest
 //                                          time and the exponents of its growth
@@ -256,7 +257,7 @@ int main(int argc, char** argv) {
   bool full = false, check = false;
   double end = 1.0, courant = 0;
   int correctors = 0;
-  std::string transpose, coupling;
+  std::string transpose, coupling, convection;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     if (a == "--full") full = true;
@@ -266,8 +267,9 @@ int main(int argc, char** argv) {
     else if (a == "--correctors" && k + 1 < argc) correctors = std::atoi(argv[++k]);
     else if (a == "--transpose" && k + 1 < argc) transpose = argv[++k];
     else if (a == "--coupling" && k + 1 < argc) coupling = argv[++k];
+    else if (a == "--convection" && k + 1 < argc) convection = argv[++k];
     else {
-      std::fprintf(stderr, "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off] [--coupling piso|consistent] [--check] | --b6 [--full] [--check] | --b9 [--full] [--check] | --b10 | --b7 [--full] | --region\n");
+      std::fprintf(stderr, "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off] [--coupling piso|consistent] [--convection upwind|limited_linear] [--check] | --b6 [--full] [--check] | --b9 [--full] [--check] | --b10 | --b7 [--full] | --region\n");
       return 2;
     }
   }
@@ -281,8 +283,9 @@ int main(int argc, char** argv) {
   lab->set_write_interval_s(0);
   if (courant > 0) lab->set_max_courant(courant);
   if (correctors > 0) lab->set_correctors(correctors);
-  if (!transpose.empty() || !coupling.empty()) {
+  if (!transpose.empty() || !coupling.empty() || !convection.empty()) {
     if (!transpose.empty()) lab->set_viscous_transpose(transpose);
+    if (!convection.empty()) lab->set_momentum_convection(convection);
     if (!coupling.empty()) lab->set_pressure_coupling(coupling);
     try {
       r = runout::jobs::resolve_scenario(r.scenario, std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab");  // validates the name

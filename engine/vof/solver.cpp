@@ -474,6 +474,7 @@ struct VofSolver::Impl {
         if (in) bsrc[std::size_t(nb)] = bsrc[std::size_t(nb)] - t;
       }
     }
+    const bool limited = s.cfg_.momentum_convection == Convection::limited_linear;
     for (int f : active_faces) {
       const int o = m.owner[std::size_t(f)];
       const double F = rho_phi[std::size_t(f)];
@@ -487,6 +488,31 @@ struct VofSolver::Impl {
         cO[std::size_t(f)] = D - std::min(F, 0.0);
         A_D[std::size_t(nb)] += std::max(-F, 0.0) + D;
         cN[std::size_t(f)] = D - std::min(-F, 0.0);
+        // limitedLinearV 1 (interFoam's damBreak): the face value moves from upwind towards the
+        // linear one by a TVD limiter of one ratio per face (the vector's own direction), as a
+        // deferred correction on the right-hand side, so the matrix stays upwind.
+        if (limited && F != 0) {
+          const Vec Uo = s.U_[std::size_t(o)], Un = s.U_[std::size_t(nb)];
+          const Vec dU = Un - Uo;
+          const double gf = dot(dU, dU);
+          if (gf > 0) {
+            const Vec d = m.centre[std::size_t(nb)] - m.centre[std::size_t(o)];
+            const auto& g = G[std::size_t(F > 0 ? o : nb)].g;
+            Vec dg;
+            for (int j = 0; j < 3; ++j) {
+              double v = 0;
+              for (int i = 0; i < 3; ++i) v += comp(d, i) * g[i][j];
+              add_comp(dg, j, v);
+            }
+            const double gc = dot(dU, dg);
+            const double r = std::abs(gc) >= 1000 * gf ? 2 * 1000 * (gc > 0 ? 1 : -1) - 1 : 2 * gc / gf - 1;
+            const double lim = std::clamp(2 * r, 0.0, 1.0);
+            const Vec Ulin = w * Uo + (1 - w) * Un;
+            const Vec corr = (F * lim) * (Ulin - (F > 0 ? Uo : Un));
+            bsrc[std::size_t(o)] = bsrc[std::size_t(o)] - corr;
+            bsrc[std::size_t(nb)] = bsrc[std::size_t(nb)] + corr;
+          }
+        }
       } else {
         const Bc k = kind_of(f);
         const Vec Ub = boundary_velocity(f);

@@ -53,6 +53,8 @@ struct PatchBc {
 
 /// How the viscous stress's transpose part is taken (VofConfig::viscous_transpose).
 enum class Transpose { linear, harmonic, off };
+/// How the momentum's convection term takes its face values (VofConfig::momentum_convection).
+enum class Convection { upwind, limited_linear };
 
 struct VofConfig {
   double rho1 = 936.17;        ///< granular bulk density [kg/m3]
@@ -89,6 +91,11 @@ struct VofConfig {
   /// jumps between its clip (1e2 m2/s) and flowing cells, the linear face value lets this explicit
   /// term outweigh gravity a hundredfold and drive spurious pressures (docs/vof.md).
   Transpose viscous_transpose = Transpose::linear;
+  /// Face values of the momentum's convection term: upwind (first order), or limited_linear:
+  /// interFoam's limitedLinearV 1, upwind blended towards linear by a TVD limiter, applied as a
+  /// deferred correction (validation.md B2: upwind's numerical viscosity, about u dx / 2, is as
+  /// large as the Coulomb viscosity in the thin flowing layers near the surface and the front).
+  Convection momentum_convection = Convection::upwind;
   int alpha_subcycles = 2;
   std::string pressure_pc = "gamg";  ///< "gamg" or "hypre" (BoomerAMG)
   double pressure_rtol = 1e-8;  ///< relative tolerance of the last corrector's pressure solve
