@@ -201,13 +201,13 @@ static int b6(bool full, bool check) {
                 field(j, "shock_speed_upstream_m_s"), field(j, "deposit_height_m"));
     std::fflush(stdout);
     if (check) {
-      // validation.md B6's behaviour: a deposit forms at the end wall, deeper than the inflow, and its
-      // upstream edge moves upstream at a constant speed (the speeds over 1.5-2.5 s and 2.5-3.5 s
-      // within 30 % of each other).
+      // validation.md B6's behaviour: a deposit forms at the end wall, deeper than the inflow, and the
+      // bore at its upstream edge moves upstream at a constant speed (the speeds over 1.5-2.5 s and
+      // 2.5-3.5 s within 30 % of each other).
       const double h0 = lab->boundaries(0).inflow_height(), v1 = at(2.5) - at(1.5), v2 = at(3.5) - at(2.5);
       const bool ok = field(j, "shock_formed_s") > 0 && field(j, "shock_speed_upstream_m_s") > 0 && v1 > 0 && v2 > 0 &&
                       std::abs(v2 / v1 - 1) <= 0.3 && field(j, "deposit_height_m") > h0;
-      if (!ok) std::printf("NOT MET (%s): a deposit deeper than the inflow whose edge moves upstream at a constant speed\n", name);
+      if (!ok) std::printf("NOT MET (%s): a deposit deeper than the inflow whose bore moves upstream at a constant speed\n", name);
       failed += !ok;
     }
   }

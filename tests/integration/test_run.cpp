@@ -1198,8 +1198,8 @@ TEST(Scenarios, LabB1SurfaceAngleFollowsTheRotationBelowPhi) {
 }
 
 // B6 (validation.md B6, coarse: the 50 deg PVC set-up fed 10 cm deep, shortened to a 1 m chute with
-// 1 cm cells, 2 s): the flow runs into the closed end, a deposit forms in the corner and its
-// upstream edge (the shock) moves upstream; run.json carries its position over time and its speed.
+// 1 cm cells, 2 s): the flow runs into the closed end, a deposit forms in the corner and the bore
+// at its upstream edge (the shock) moves upstream; run.json carries its position over time and its speed.
 TEST(Scenarios, LabB6ShockMovesUpstreamFromTheClosedEnd) {
   auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b6-shock-pvc-50deg-10cm.json");
   auto* lab = r.scenario.mutable_lab();
