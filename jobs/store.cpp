@@ -156,7 +156,8 @@ JobStore::JobStore(const std::string& path) {
            progress BLOB,
            result_bytes INTEGER NOT NULL DEFAULT 0,
            results_removed INTEGER NOT NULL DEFAULT 0,
-           cancel_requested INTEGER NOT NULL DEFAULT 0);
+           cancel_requested INTEGER NOT NULL DEFAULT 0,
+           interrupted INTEGER NOT NULL DEFAULT 0);
          CREATE UNIQUE INDEX IF NOT EXISTS jobs_request ON jobs(owner, request_id) WHERE request_id IS NOT NULL;
          CREATE INDEX IF NOT EXISTS jobs_owner_hash ON jobs(owner, hash);
          CREATE INDEX IF NOT EXISTS jobs_state ON jobs(state, seq);
@@ -170,6 +171,11 @@ JobStore::JobStore(const std::string& path) {
   sqlite3_stmt* probe = nullptr;
   if (sqlite3_prepare_v2(db_, "SELECT cancel_requested FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
     exec("ALTER TABLE jobs ADD COLUMN cancel_requested INTEGER NOT NULL DEFAULT 0");
+  sqlite3_finalize(probe);
+  // ... and the count of attempts the server ended cleanly (interrupted by a stop, queued again).
+  probe = nullptr;
+  if (sqlite3_prepare_v2(db_, "SELECT interrupted FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
+    exec("ALTER TABLE jobs ADD COLUMN interrupted INTEGER NOT NULL DEFAULT 0");
   sqlite3_finalize(probe);
 }
 
@@ -359,10 +365,13 @@ void JobStore::transition(const std::string& id, v1::JobState state, const std::
   std::lock_guard lk(mu_);
   Transaction tx(db_);
   const std::string now = utc_now();
+  // Back to the queue from a run: the server ended that attempt cleanly (a stop), so it does not
+  // count towards the attempts a crashing job is allowed (requeue_running).
   Stmt up(db_,
-          "UPDATE jobs SET state = ?, updated = ?, error = ?, result_bytes = CASE WHEN ? >= 0 THEN ? ELSE result_bytes END "
-          "WHERE id = ?");
-  up.bind(1, std::int64_t(state)).bind(2, now).bind(3, error).bind(4, result_bytes).bind(5, result_bytes).bind(6, id).step();
+          "UPDATE jobs SET state = ?, updated = ?, error = ?, result_bytes = CASE WHEN ? >= 0 THEN ? ELSE result_bytes END, "
+          "interrupted = interrupted + CASE WHEN ? = 1 AND state = 2 THEN 1 ELSE 0 END WHERE id = ?");
+  up.bind(1, std::int64_t(state)).bind(2, now).bind(3, error).bind(4, result_bytes).bind(5, result_bytes)
+      .bind(6, std::int64_t(state)).bind(7, id).step();
   add_transition(db_, id, state, now, reason);
   tx.commit();
 }
@@ -398,7 +407,8 @@ int JobStore::requeue_running(const std::string& reason, int max_attempts) {
   };
   std::vector<Row> rows;
   {
-    Stmt st(db_, "SELECT id, attempts, cancel_requested FROM jobs WHERE state = 2");
+    // Attempts that ended with the server going down (not those it interrupted cleanly).
+    Stmt st(db_, "SELECT id, attempts - interrupted, cancel_requested FROM jobs WHERE state = 2");
     while (st.step()) rows.push_back({st.text(0), st.i64(1), st.i64(2)});
   }
   const std::string now = utc_now();
@@ -409,7 +419,7 @@ int JobStore::requeue_running(const std::string& reason, int max_attempts) {
       add_transition(db_, r.id, v1::CANCELLED, now, "cancelled by the client; the server stopped before the run did");
     } else if (r.attempts >= max_attempts) {
       // A job that takes the server down with it must not do so for ever.
-      const std::string e = "the server stopped during each of " + std::to_string(r.attempts) + " attempts of this job";
+      const std::string e = "the server went down during " + std::to_string(r.attempts) + " attempts of this job";
       Stmt(db_, "UPDATE jobs SET state = 4, updated = ?, error = ? WHERE id = ?").bind(1, now).bind(2, e).bind(3, r.id).step();
       add_transition(db_, r.id, v1::FAILED, now, e);
     } else {

@@ -64,7 +64,8 @@ class JobStore {
   /// Queued jobs become cancelled here; running ones are left for the worker (returns their state).
   std::optional<StoredJob> cancel(const std::string& id, const std::string& owner);
   /// Jobs left running by a server that died: queued again (cancelled when the client had asked;
-  /// failed after `max_attempts` runs, so that a job that kills the server cannot do so for ever).
+  /// failed after `max_attempts` runs that ended with the server down, so that a job that kills
+  /// the server cannot do so for ever; runs the server interrupted cleanly do not count).
   /// Returns how many were queued again.
   int requeue_running(const std::string& reason, int max_attempts = 3);
   /// Whether the client asked to cancel this (running) job.

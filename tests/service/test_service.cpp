@@ -18,6 +18,7 @@
 
 #include "jobs/scenario.hpp"
 #include "jobs/sha256.hpp"
+#include "jobs/store.hpp"
 #include "service/client/client.hpp"
 
 namespace fs = std::filesystem;
@@ -466,6 +467,28 @@ TEST(Service, DamagedCheckpointRunsTheVofJobFromTheStart) {
   const std::string log = read_text(d.p / "job.log");
   EXPECT_NE(log.find("running again from the start"), std::string::npos) << log;
   EXPECT_FALSE(fs::exists(cp));
+}
+
+// The attempt limit counts only runs that ended with the server down: a job that the server
+// interrupted cleanly (a stop; a VOF job then continues from its checkpoint) three times and that
+// crashed once is queued again, and one that crashed three times fails and says why.
+TEST(Store, CleanInterruptionsDoNotCountTowardsTheAttemptLimit) {
+  TempDir d;
+  jobs::JobStore store((d.p / "jobs.db").string());
+  const auto id = store.submit("client", "hash", "", v1::Scenario(), 10).job.job.id();
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_TRUE(store.claim_next());
+    store.transition(id, v1::QUEUED, "interrupted by the server stopping");
+  }
+  for (int crash = 1; crash <= 3; ++crash) {
+    ASSERT_TRUE(store.claim_next());
+    EXPECT_EQ(store.requeue_running("the server stopped during the run", 3), crash < 3 ? 1 : 0) << "crash " << crash;
+  }
+  const auto j = store.get(id);
+  ASSERT_TRUE(j);
+  EXPECT_EQ(j->job.attempts(), 6);
+  EXPECT_EQ(j->job.state(), v1::FAILED);
+  EXPECT_NE(j->job.error().find("went down during 3 attempts"), std::string::npos) << j->job.error();
 }
 
 TEST(Service, TlsWithTheServersCertificate) {
