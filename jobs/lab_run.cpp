@@ -614,7 +614,8 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   double t_fluid = -1;
   // The shock at a closed end (validation.md B6: inflow and a wall at the right end): the bore,
   // i.e. the upstream edge of the columns, from the end wall upstream, that hold at least two cells'
-  // depth of material and whose depth-averaged speed is below half the inflow's mean speed. (Not the
+  // depth of material and whose depth-averaged speed is below half the inflow's mean speed (at least
+  // 5 cm/s). (Not the
   // edge of the resting deposit: under sand's bore the deposit keeps creeping for a while, and that
   // edge stalls and jumps while the bore runs at a constant speed; validation.md B6.)
   bool end_wall = has_inflow;
@@ -632,7 +633,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
           depth += a;
           flux += a * vof::norm(s.velocity()[std::size_t(c2)]);
         }
-      if (depth < 2 * dy || flux >= 0.5 * inflow_speed * depth) break;
+      if (depth < 2 * dy || flux >= std::max(0.5 * inflow_speed, 0.05) * depth) break;  // at least 5 cm/s
     }
     return i < g.nx - 1 ? g.x0 + (i + 1) * dx : NAN;
   };

@@ -174,9 +174,11 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
   if (l->pressure_coupling().empty()) l->set_pressure_coupling("piso");
   if (l->pressure_coupling() != "piso" && l->pressure_coupling() != "consistent")
     bad("lab.pressure_coupling", "unknown '" + l->pressure_coupling() + "' (valid: piso, consistent)");
-  if (l->momentum_convection().empty()) l->set_momentum_convection("upwind");
-  if (l->momentum_convection() != "upwind" && l->momentum_convection() != "limited_linear")
+  // Upwind, the default, stays unset, so that scenarios (and their hashes, checkpoints and cached
+  // results) from before the option existed are the same scenarios.
+  if (l->momentum_convection() != "" && l->momentum_convection() != "upwind" && l->momentum_convection() != "limited_linear")
     bad("lab.momentum_convection", "unknown '" + l->momentum_convection() + "' (valid: upwind, limited_linear)");
+  if (l->momentum_convection() == "upwind") l->clear_momentum_convection();
   if (l->viscous_transpose().empty()) l->set_viscous_transpose("explicit");
   if (l->viscous_transpose() != "explicit" && l->viscous_transpose() != "harmonic" && l->viscous_transpose() != "off")
     bad("lab.viscous_transpose", "unknown '" + l->viscous_transpose() + "' (valid: explicit, harmonic, off)");

@@ -174,8 +174,12 @@ JobStore::JobStore(const std::string& path) {
   sqlite3_finalize(probe);
   // ... and the count of attempts the server ended cleanly (interrupted by a stop, queued again).
   probe = nullptr;
-  if (sqlite3_prepare_v2(db_, "SELECT interrupted FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
-    exec("ALTER TABLE jobs ADD COLUMN interrupted INTEGER NOT NULL DEFAULT 0");
+  if (sqlite3_prepare_v2(db_, "SELECT interrupted FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK) {
+    // The clean interruptions so far, from the transitions they left.
+    exec("ALTER TABLE jobs ADD COLUMN interrupted INTEGER NOT NULL DEFAULT 0;"
+         "UPDATE jobs SET interrupted = (SELECT COUNT(*) FROM transitions t WHERE t.job = jobs.id AND t.state = 1 "
+         "AND t.reason LIKE 'interrupted by the server stopping%')");
+  }
   sqlite3_finalize(probe);
 }
 

@@ -1120,7 +1120,9 @@ TEST(Scenarios, LabMomentumConvectionIsValidatedAndChangesTheRun) {
       "fill": [{"x_min": -0.1, "x_max": 0, "y_max": 0.05}], "boundaries": [{"side": "top", "kind": "atmosphere"},
       {"side": "right", "kind": "atmosphere"}], "end_time_s": 0.15, "write_interval_s": 0)";
   const auto plain = jobs::resolve_scenario(jobs::parse_scenario_json(head + "}}"), ".");
-  EXPECT_EQ(plain.scenario.lab().momentum_convection(), "upwind");
+  EXPECT_EQ(plain.scenario.lab().momentum_convection(), "");  // upwind, unset: the scenario's hash is unchanged
+  const auto up = jobs::resolve_scenario(jobs::parse_scenario_json(head + R"(, "momentum_convection": "upwind"}})"), ".");
+  EXPECT_EQ(up.scenario.SerializeAsString(), plain.scenario.SerializeAsString());
   const auto ll = jobs::resolve_scenario(jobs::parse_scenario_json(head + R"(, "momentum_convection": "limited_linear"}})"), ".");
   EXPECT_EQ(ll.scenario.lab().momentum_convection(), "limited_linear");
   const TempDir d1, d2;
@@ -1129,6 +1131,8 @@ TEST(Scenarios, LabMomentumConvectionIsValidatedAndChangesTheRun) {
                fb = json_number(read_text((d2.p / "run.json").string()), "front_x_m");
   std::printf("collapse to 0.15 s on 1 cm cells: front %.3f m (upwind), %.3f m (limited linear); %ld and %ld steps\n", fa, fb, a.steps, b.steps);
   EXPECT_GE(fb, fa);  // less numerical viscosity: the front runs at least as far
+  EXPECT_NE(a.steps, b.steps);  // the option reaches the engine
+  EXPECT_NE(a.max_speed, b.max_speed);
   auto bad = jobs::parse_scenario_json(head + R"(, "momentum_convection": "central"}})");
   try {
     jobs::resolve_scenario(bad, ".");

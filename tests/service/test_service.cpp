@@ -19,6 +19,7 @@
 #include "jobs/scenario.hpp"
 #include "jobs/sha256.hpp"
 #include "jobs/store.hpp"
+#include <sqlite3.h>
 #include "service/client/client.hpp"
 
 namespace fs = std::filesystem;
@@ -489,6 +490,30 @@ TEST(Store, CleanInterruptionsDoNotCountTowardsTheAttemptLimit) {
   EXPECT_EQ(j->job.attempts(), 6);
   EXPECT_EQ(j->job.state(), v1::FAILED);
   EXPECT_NE(j->job.error().find("went down during 3 attempts"), std::string::npos) << j->job.error();
+}
+
+// A store written before the count of clean interruptions existed gets it from the transitions
+// its jobs left: two clean stops and then a crash do not make the job fail at the limit of three.
+TEST(Store, OldStoreLearnsItsCleanInterruptions) {
+  TempDir d;
+  const std::string path = (d.p / "jobs.db").string();
+  std::string id;
+  {
+    jobs::JobStore store(path);
+    id = store.submit("client", "hash", "", v1::Scenario(), 10).job.job.id();
+    for (int k = 0; k < 2; ++k) {
+      ASSERT_TRUE(store.claim_next());
+      store.transition(id, v1::QUEUED, "interrupted by the server stopping at t = 0.5 s; queued to continue from its checkpoint");
+    }
+  }
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(path.c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "ALTER TABLE jobs DROP COLUMN interrupted", nullptr, nullptr, nullptr), SQLITE_OK);  // the old schema
+  sqlite3_close(db);
+  jobs::JobStore store(path);
+  ASSERT_TRUE(store.claim_next());
+  EXPECT_EQ(store.requeue_running("the server stopped during the run", 3), 1);
+  EXPECT_EQ(store.get(id)->job.state(), v1::QUEUED);
 }
 
 TEST(Service, TlsWithTheServersCertificate) {
