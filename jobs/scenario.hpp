@@ -30,7 +30,8 @@ struct ResolvedScenario {
 };
 
 /// SHA-256 of a resolved scenario: its message with the input paths left out, and the content of
-/// every input file. Two scenarios with the same hash compute the same result.
+/// every input file; for VOF scenarios also the version of what their results contain. Two
+/// scenarios with the same hash compute the same result.
 std::string scenario_hash(const ResolvedScenario& r);
 
 /// The raster names an output list may hold.

@@ -1143,6 +1143,17 @@ TEST(Scenarios, LabMomentumConvectionIsValidatedAndChangesTheRun) {
   }
 }
 
+// A VOF scenario's hash carries the version of what its results contain, so that results of an
+// older kind (e.g. B6's shock as the resting deposit's edge) are not answered for it.
+TEST(Scenarios, VofHashCarriesTheResultsVersion) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b6-shock-sand-50deg-10cm.json");
+  ASSERT_TRUE(r.vof);
+  auto plain = r;
+  plain.vof = false;
+  EXPECT_NE(jobs::scenario_hash(r), jobs::scenario_hash(plain));
+  EXPECT_EQ(jobs::scenario_hash(r), jobs::scenario_hash(jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b6-shock-sand-50deg-10cm.json")));
+}
+
 // lab.viscous_transpose: "explicit" by default, "harmonic" and "off" accepted, anything else named
 // in the error.
 TEST(Scenarios, LabViscousTransposeIsValidated) {
