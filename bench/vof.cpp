@@ -7,9 +7,15 @@
 //                                          --transpose: how the viscous stress's transpose part is taken;
 //                                          --coupling: the pressure coupling, lab.pressure_coupling;
 //                                          --convection: the momentum's convection, lab.momentum_convection)
-//   runout_bench_vof --b10                 B10: column collapse for aspect ratios 0.5-6 (5 mm cells,
+//   runout_bench_vof --b10 [--check]       B10: column collapse for aspect ratios 0.5-6 (5 mm cells,
 //                                          scenarios/lab/b10-column-a*.json), normalised runout, rest
 //                                          time and the exponents of its growth
+//   runout_bench_vof --b1|--b2-inclined|--b3|--b4|--b5|--b8 [--check]
+//                                          B1, B2 at 10/20/30 deg, B3, B4, B5, B8 from their scenario files at the files'
+//                                          resolution (the full variants): the figures validation.md
+//                                          names, beside the measured ones where it gives them;
+//                                          --check: exit 1 unless the described behaviour holds
+//                                          (bench/vof_cases.cpp)
 //   runout_bench_vof --b9 [--full] [--check]  B9: the static and the failing heap (5 mm, --full: 2.5 mm);
 //                                          --check: exit 1 unless both meet the figures
 //   runout_bench_vof [--full] --check      also check the B2 acceptance figures (exit 1 if one fails)
@@ -17,82 +23,24 @@
 //                                          1 cm (--full: 5 mm), its position over time and speed upstream;
 //                                          --check: exit 1 unless each forms a deposit whose edge moves
 //                                          upstream at a constant speed
-//   runout_bench_vof --b7 [--full]         B7: the wide chute with each obstacle at 5 mm (--full: 2.5 mm,
-//                                          1.34 million cells), depth figures and cost
+//   runout_bench_vof --b7 [--full] [--check]  B7: the wide chute with each obstacle at 5 mm (--full:
+//                                          2.5 mm, 1.34 million cells), depth figures and cost;
+//                                          --check: exit 1 unless the described behaviour holds
 //   runout_bench_vof --region              cost per step against the material region: the same failing
 //                                          heap in channels 0.3-2.4 m long, with the active region and
 //                                          with every cell computed
 #include <cmath>
 #include <cstdio>
-#include <vector>
 #include <cstdlib>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
-#include <unistd.h>
+#include <vector>
 
-#include "jobs/run.hpp"
-#include "jobs/scenario.hpp"
+#include "bench/vof_cases.hpp"
+#include "bench/vof_common.hpp"
 
-namespace fs = std::filesystem;
-
-static double field(const std::string& json, const std::string& key) {
-  const auto k = json.find("\"" + key + "\": ");
-  if (k == std::string::npos || json.compare(k + key.size() + 4, 4, "null") == 0) return NAN;
-  return std::atof(json.c_str() + k + key.size() + 4);
-}
-
-// Run a scenario in a temporary directory; its summary and run.json.
-struct Ran {
-  runout::jobs::RunSummary sum;
-  std::string json;
-};
-static Ran run_in_temp(const runout::jobs::ResolvedScenario& r) {
-  const fs::path out = fs::temp_directory_path() / ("runout-bench-vof-" + std::to_string(getpid()));
-  fs::create_directories(out);
-  Ran ran;
-  ran.sum = runout::jobs::run_scenario(r, out.string());
-  std::ifstream in(out / "run.json");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  ran.json = ss.str();
-  fs::remove_all(out);
-  return ran;
-}
-
-// B10 (validation.md): a PVC column L = 5 cm wide and H = a L high against the left wall, released
-// at t = 0, from the scenario files scenarios/lab/b10-column-a*.json (5 mm cells).
-static int b10() {
-  std::printf("| a = H/L | cells | (l - L)/L | at rest from [s] | end [s] | steps | wall [s] |\n|---:|---:|---:|---:|---:|---:|---:|\n");
-  const std::vector<std::string> names = {"0.5", "1", "2", "4", "6"};
-  std::vector<double> as, rs;
-  for (const auto& a : names) {
-    auto r = runout::jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b10-column-a" + a + ".json");
-    r.scenario.mutable_lab()->set_write_interval_s(0);
-    const double L = r.scenario.lab().fill(0).x_max() - r.scenario.lab().fill(0).x_min();
-    const auto ran = run_in_temp(r);
-    const auto& sum = ran.sum;
-    const double rel = (sum.runout_m - L) / L;
-    as.push_back(std::atof(a.c_str()));
-    rs.push_back(rel);
-    std::printf("| %s | %d | %.2f | %.2f | %.2f | %ld | %.1f |\n", a.c_str(), sum.nx * sum.ny, rel, field(ran.json, "rest_time_s"), sum.t,
-                sum.steps, sum.seconds_run);
-    std::fflush(stdout);
-  }
-  // Exponents: log-log slopes over the small (0.5-2) and large (2-6) aspect ratios.
-  auto slope = [&](std::size_t i0, std::size_t i1) {
-    double sx = 0, sy = 0, sxx = 0, sxy = 0, n = 0;
-    for (std::size_t k = i0; k <= i1; ++k) {
-      const double x = std::log(as[k]), y = std::log(std::max(rs[k], 1e-9));
-      sx += x, sy += y, sxx += x * x, sxy += x * y, n += 1;
-    }
-    return (n * sxy - sx * sy) / (n * sxx - sx * sx);
-  };
-  std::printf("\nexponent of (l - L)/L in a: %.2f for a = 0.5-2 (expected about 1), %.2f for a = 2-6 (expected about 2/3; 0.9 in wide channels)\n",
-              slope(0, 2), slope(2, 4));
-  return 0;
-}
+using runout::bench::field;
+using runout::bench::run_in_temp;
+using runout::bench::series;
 
 // B9 (validation.md B9) from scenarios/lab/b9-heap-{static,failing}.json: the heap flatter than phi
 // must stay at rest (below 1 mm/s after 1 s), the steeper one relax to within 3 deg of phi (32 deg);
@@ -102,7 +50,7 @@ static int b9(bool full, bool check) {
               "[deg] | wanted | |\n|---|---:|---:|---:|---:|---:|---:|---|---|\n");
   int failed = 0;
   for (const char* name : {"static", "failing"}) {
-    auto r = runout::jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b9-heap-" + name + ".json");
+    auto r = runout::bench::lab_scenario(std::string("b9-heap-") + name);
     auto* lab = r.scenario.mutable_lab();
     if (full) {
       lab->set_nx(2 * lab->nx());
@@ -155,22 +103,6 @@ static int region() {
   return 0;
 }
 
-// A number array from run.json ("key": [a, b, null, ...]; null as NaN).
-static std::vector<double> series(const std::string& json, const std::string& key) {
-  std::vector<double> v;
-  auto k = json.find("\"" + key + "\": [");
-  if (k == std::string::npos) return v;
-  k += key.size() + 5;
-  const auto e = json.find(']', k);
-  while (k < e) {
-    while (k < e && (json[k] == ' ' || json[k] == ',')) ++k;
-    if (k >= e) break;
-    v.push_back(json.compare(k, 4, "null") == 0 ? NAN : std::atof(json.c_str() + k));
-    k = json.find_first_of(",]", k);
-  }
-  return v;
-}
-
 // B6 (validation.md B6): the flow fed at x = -2 m runs into the closed end at x = 0; the shock's
 // position over time and its speed upstream for the seven set-ups.
 static int b6(bool full, bool check) {
@@ -179,7 +111,7 @@ static int b6(bool full, bool check) {
               "speed upstream [m/s] | deposit at the wall [m] |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const char* name : {"pvc-40deg-5cm", "pvc-40deg-10cm", "pvc-40deg-15cm", "pvc-50deg-5cm", "pvc-50deg-10cm", "pvc-50deg-15cm",
                            "sand-50deg-10cm"}) {
-    auto r = runout::jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b6-shock-" + name + ".json");
+    auto r = runout::bench::lab_scenario(std::string("b6-shock-") + name);
     auto* lab = r.scenario.mutable_lab();
     if (!full) {  // 1 cm cells
       lab->set_nx(200);
@@ -215,33 +147,21 @@ static int b6(bool full, bool check) {
   return failed ? 1 : 0;
 }
 
-// B7 (validation.md B7): the 45 deg wide chute fed 1.5 cm deep at 1 m/s, around each obstacle.
-static int b7(bool full) {
-  std::printf("| obstacle | cells | steps to 0.8 s | wall [s] | us per cell-step | undisturbed depth [mm] | max depth [mm] | ratio | "
-              "dry shadow [cm2] |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-  for (const char* shape : {"tetrahedron-edge", "tetrahedron-face", "cylinder"}) {
-    auto r = runout::jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b7-wide-chute-" + shape + ".json");
-    auto* lab = r.scenario.mutable_lab();
-    if (!full) {
-      lab->set_nx(118);
-      lab->set_ny(24);
-      lab->set_nz(59);
-    }
-    lab->set_write_interval_s(0);
-    const auto ran = run_in_temp(r);
-    const auto& sum = ran.sum;
-    const std::string& j = ran.json;
-    const double cells = field(j, "cells");
-    std::printf("| %s | %.0f | %ld | %.0f | %.2f | %.1f | %.1f | %.1f | %.0f |\n", shape, cells, sum.steps, sum.seconds_run,
-                1e6 * sum.seconds_run / sum.steps / cells, 1e3 * field(j, "undisturbed_depth_m"), 1e3 * field(j, "max_depth_m"),
-                field(j, "max_depth_ratio"), 1e4 * field(j, "sheltered_dry_area_m2"));
-    std::fflush(stdout);
-  }
-  return 0;
-}
-
 int main(int argc, char** argv) {
-  if (argc > 1 && std::string(argv[1]) == "--b10") return b10();
+  {
+    // The cases of bench/vof_cases.cpp: --bN [--full] [--check].
+    bool full = false, check = false;
+    for (int k = 2; k < argc; ++k) full |= std::string(argv[k]) == "--full", check |= std::string(argv[k]) == "--check";
+    const std::string mode = argc > 1 ? argv[1] : "";
+    if (mode == "--b1") return runout::bench::lab_b1(check);
+    if (mode == "--b2-inclined") return runout::bench::lab_b2_inclined(check);
+    if (mode == "--b3") return runout::bench::lab_b3(check);
+    if (mode == "--b4") return runout::bench::lab_b4(check);
+    if (mode == "--b5") return runout::bench::lab_b5(check);
+    if (mode == "--b7") return runout::bench::lab_b7(full, check);
+    if (mode == "--b8") return runout::bench::lab_b8(check);
+    if (mode == "--b10") return runout::bench::lab_b10(check);
+  }
   if (argc > 1 && std::string(argv[1]) == "--b9") {
     bool full = false, check = false;
     for (int k = 2; k < argc; ++k) full |= std::string(argv[k]) == "--full", check |= std::string(argv[k]) == "--check";
@@ -252,7 +172,6 @@ int main(int argc, char** argv) {
     for (int k = 2; k < argc; ++k) full |= std::string(argv[k]) == "--full", check |= std::string(argv[k]) == "--check";
     return b6(full, check);
   }
-  if (argc > 1 && std::string(argv[1]) == "--b7") return b7(argc > 2 && std::string(argv[2]) == "--full");
   if (argc > 1 && std::string(argv[1]) == "--region") return region();
   bool full = false, check = false;
   double end = 1.0, courant = 0;
@@ -269,11 +188,11 @@ int main(int argc, char** argv) {
     else if (a == "--coupling" && k + 1 < argc) coupling = argv[++k];
     else if (a == "--convection" && k + 1 < argc) convection = argv[++k];
     else {
-      std::fprintf(stderr, "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off] [--coupling piso|consistent] [--convection upwind|limited_linear] [--check] | --b6 [--full] [--check] | --b9 [--full] [--check] | --b10 | --b7 [--full] | --region\n");
+      std::fprintf(stderr, "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off] [--coupling piso|consistent] [--convection upwind|limited_linear] [--check] | --b6 [--full] [--check] | --b9 [--full] [--check] | --b1|--b2-inclined|--b3|--b4|--b5|--b8|--b10 [--check] | --b7 [--full] [--check] | --region\n");
       return 2;
     }
   }
-  auto r = runout::jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json");
+  auto r = runout::bench::lab_scenario("b2-collapse-0deg");
   auto* lab = r.scenario.mutable_lab();
   if (!full) {
     lab->set_nx(100);

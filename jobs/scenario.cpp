@@ -359,10 +359,8 @@ std::string scenario_hash(const ResolvedScenario& r) {
   Sha256 h;
   h.update("runout.v1.Scenario\n");
   h.update(bytes);
-  // What a VOF run's results contain, by version: bump it when run.json or the fields change meaning
-  // for an unchanged scenario, so that a service does not answer from results of the older kind
-  // (2: B6's shock is the bore, no longer the resting deposit's edge).
-  if (r.vof) h.update("\nvof results 2");
+  // What a VOF run's results contain, by version (kVofResultsVersion).
+  if (r.vof) h.update("\nvof results " + std::to_string(kVofResultsVersion));
   for (const auto& f : r.input_files) {
     h.update("\n");
     h.update(fs::path(f).extension().string());

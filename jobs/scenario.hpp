@@ -29,6 +29,13 @@ struct ResolvedScenario {
   bool vof = false;  ///< engine "vof": the `lab` block holds the set-up; DEM and releases unused
 };
 
+/// The version of what a VOF run's results contain (run.json, the fields) for an unchanged scenario.
+/// Bump it when they change meaning or value, so that a service does not answer from results of the
+/// older kind (2: B6's shock is the bore, no longer the resting deposit's edge). The test
+/// Scenarios.VofResultsMatchTheFingerprintOfTheirVersion holds the figures of this version and fails
+/// when the numerics change them.
+inline constexpr int kVofResultsVersion = 2;
+
 /// SHA-256 of a resolved scenario: its message with the input paths left out, and the content of
 /// every input file; for VOF scenarios also the version of what their results contain. Two
 /// scenarios with the same hash compute the same result.

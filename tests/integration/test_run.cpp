@@ -23,6 +23,18 @@ using namespace runout;
 
 namespace {
 
+// A number of run.json ("key": value, searched from `from` on; NaN if missing) and a file's text.
+double json_number(const std::string& j, const std::string& key, std::size_t from = 0) {
+  const auto k = j.find("\"" + key + "\": ", from);
+  return k == std::string::npos ? NAN : std::atof(j.c_str() + k + key.size() + 4);
+}
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
 struct TempDir {
   fs::path p;
   TempDir() {
@@ -711,6 +723,35 @@ TEST(Scenarios, LabCollapseRunsThroughTheRunDriver) {
   EXPECT_EQ(fr->GetRasterXSize(), 50);
 }
 
+// B2 at 10, 20 and 30 deg from their scenario files (validation.md B2, coarse: a quarter of the
+// files' cells each way, about 1.1 cm, to 0.4 s): the steeper the channel, the faster the collapse
+// and the further its front; the material stays within [0, 1] and leaves only through the open end.
+// (runout_bench_vof --b2-inclined --check runs the files as they are, label full.)
+TEST(Scenarios, LabB2InclinedCollapsesRunFasterOnSteeperChannels) {
+  double peak_before = 0, front_before = -1;
+  for (const char* zeta : {"10", "20", "30"}) {
+    auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-" + zeta + "deg.json");
+    auto* lab = r.scenario.mutable_lab();
+    EXPECT_NEAR(lab->inclination_deg(), std::atof(zeta), 1e-12);
+    lab->set_nx(lab->nx() / 4);
+    lab->set_ny(lab->ny() / 4);
+    lab->set_end_time_s(0.4);
+    lab->set_write_interval_s(0);
+    TempDir d;
+    const auto sum = jobs::run_scenario(r, d.p.string());
+    ASSERT_EQ(sum.stop, "end-time");
+    const std::string j = read_text(d / "run.json");
+    std::printf("B2 at %s deg, coarse: peak %.2f m/s, front %.3f m at 0.4 s\n", zeta, sum.max_speed, sum.runout_m);
+    EXPECT_GT(sum.max_speed, peak_before) << zeta;
+    EXPECT_GT(sum.runout_m, front_before) << zeta;
+    peak_before = sum.max_speed, front_before = sum.runout_m;
+    EXPECT_LE(sum.volume_final, sum.volume_initial * (1 + 1e-9));
+    EXPECT_GT(json_number(j, "alpha_min"), -1e-6);
+    EXPECT_LT(json_number(j, "alpha_max"), 1 + 1e-6);
+    EXPECT_LT(json_number(j, "max_divergence_1_s"), 1e-6);
+  }
+}
+
 TEST(Scenarios, LabScenarioErrorsNameTheField) {
   auto s = jobs::parse_scenario_json(R"({"engine": "vof"})");
   try {
@@ -774,19 +815,6 @@ TEST(Scenarios, LabInflowFeedsTheChannelAndStationsReport) {
   EXPECT_LT(std::atof(j.c_str() + j.find("\"alpha_max\": ") + 13), 1 + 1e-6);
   EXPECT_GT(std::atof(j.c_str() + j.find("\"alpha_min\": ") + 13), -1e-6);
 }
-
-namespace {
-double json_number(const std::string& j, const std::string& key, std::size_t from = 0) {
-  const auto k = j.find("\"" + key + "\": ", from);
-  return k == std::string::npos ? NAN : std::atof(j.c_str() + k + key.size() + 4);
-}
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-}  // namespace
 
 namespace {
 // A block of run.json ("results", "monitors"): its text up to the block's first closing brace.
@@ -1146,6 +1174,47 @@ TEST(Scenarios, VofHashCarriesTheResultsVersion) {
   plain.vof = false;
   EXPECT_NE(jobs::scenario_hash(r), jobs::scenario_hash(plain));
   EXPECT_EQ(jobs::scenario_hash(r), jobs::scenario_hash(jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b6-shock-sand-50deg-10cm.json")));
+}
+
+// The figures that VOF results version kVofResultsVersion gives for two short coarse runs (B2 under
+// PISO, B3 under the consistent coupling). A change to the numerics that alters them for an
+// unchanged scenario fails here: then bump kVofResultsVersion (jobs/scenario.hpp), so that services
+// compute such scenarios anew instead of answering from results of the older kind, and record the
+// new figures below. (An edit of the two scenario files moves them too; that changes the scenarios'
+// hashes already, so record the new figures without a bump. Compared to 1e-6 relative: run.json carries ten digits, and rounding in the
+// last bits on another machine stays far below that over a few hundred steps.)
+TEST(Scenarios, VofResultsMatchTheFingerprintOfTheirVersion) {
+  constexpr int version = 2;
+  struct Case {
+    const char* file;
+    int nx, ny;
+    double end;
+    double want[5];  // peak speed, its time, final speed, mean surface angle, final volume
+  };
+  const Case cases[] = {
+      {"b2-collapse-0deg", 50, 15, 0.3, {0.8955085827, 0.2040603931, 0.603601247, 27.69799729, 0.0004199460235}},
+      {"b3-triangle-pvc", 100, 24, 0.1, {0.9911803737, 0.1, 0.9911803737, 75.39672198, 0.000207955}},
+  };
+  EXPECT_EQ(jobs::kVofResultsVersion, version) << "record this version's figures below";
+  for (const auto& c : cases) {
+    auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/" + c.file + ".json");
+    auto* lab = r.scenario.mutable_lab();
+    lab->set_nx(c.nx);
+    lab->set_ny(c.ny);
+    lab->set_end_time_s(c.end);
+    lab->set_write_interval_s(0);
+    TempDir d;
+    ASSERT_EQ(jobs::run_scenario(r, d.p.string()).stop, "end-time");
+    const std::string j = read_text(d / "run.json");
+    const char* keys[] = {"peak_speed_m_s", "peak_speed_time_s", "final_speed_m_s", "mean_surface_angle_deg", "volume_final_m3"};
+    std::printf("%s:", c.file);
+    for (int k = 0; k < 5; ++k) std::printf(" %.10g", json_number(j, keys[k]));
+    std::printf("\n");
+    for (int k = 0; k < 5; ++k)
+      EXPECT_NEAR(json_number(j, keys[k]), c.want[k], 1e-6 * std::abs(c.want[k]))
+          << c.file << ": " << keys[k] << " differs from results version " << version
+          << "'s. If the change is meant, bump kVofResultsVersion and record the new figures here.";
+  }
 }
 
 // lab.viscous_transpose: "explicit" by default, "harmonic" and "off" accepted, anything else named
