@@ -49,6 +49,7 @@ static int b9(bool full, bool check) {
   std::printf("| heap | cells | steps | wall [s] | peak speed [m/s] | speed at the end [m/s] | surface angle (80 %% to 20 %% of the height) "
               "[deg] | wanted | |\n|---|---:|---:|---:|---:|---:|---:|---|---|\n");
   int failed = 0;
+  runout::bench::Checks inv("B9, the invariants");
   for (const char* name : {"static", "failing"}) {
     auto r = runout::bench::lab_scenario(std::string("b9-heap-") + name);
     auto* lab = r.scenario.mutable_lab();
@@ -63,11 +64,14 @@ static int b9(bool full, bool check) {
     const double speed = field(j, "final_speed_m_s"), angle = field(j, "mean_surface_angle_deg");
     const bool ok = is_static ? speed < 1e-3 : std::abs(angle - 32) <= 3;
     failed += !ok;
+    runout::bench::invariants(inv, std::string("B9 ") + name, ran);
+    inv(std::abs(field(j, "volume_relative_error")) <= 1e-6, std::string("B9 ") + name + ": volume conserved to 1e-6");
     std::printf("| %s | %d | %ld | %.1f | %.4f | %.2e | %.1f | %s | %s |\n", name, ran.sum.nx * ran.sum.ny, ran.sum.steps, ran.sum.seconds_run,
                 field(j, "peak_speed_m_s"), speed, angle, is_static ? "below 1 mm/s at 1 s" : "32 +- 3 deg", ok ? "met" : "NOT MET");
     std::fflush(stdout);
   }
   if (!check) return 0;
+  failed += inv.report();
   std::printf("\n%s\n", failed ? "B9: NOT MET" : "B9: met");
   return failed ? 1 : 0;
 }
@@ -107,6 +111,7 @@ static int region() {
 // position over time and its speed upstream for the seven set-ups.
 static int b6(bool full, bool check) {
   int failed = 0;
+  runout::bench::Checks inv("B6, the invariants");
   std::printf("| set-up | inflow speed [m/s] | cells | steps | wall [s] | shock formed [s] | shock from the wall at 1.5 / 2.5 / 3.5 s [m] | "
               "speed upstream [m/s] | deposit at the wall [m] |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const char* name : {"pvc-40deg-5cm", "pvc-40deg-10cm", "pvc-40deg-15cm", "pvc-50deg-5cm", "pvc-50deg-10cm", "pvc-50deg-15cm",
@@ -141,38 +146,47 @@ static int b6(bool full, bool check) {
                       std::abs(v2 / v1 - 1) <= 0.3 && field(j, "deposit_height_m") > h0;
       if (!ok) std::printf("NOT MET (%s): a deposit deeper than the inflow whose bore moves upstream at a constant speed\n", name);
       failed += !ok;
+      runout::bench::invariants(inv, std::string("B6 ") + name, ran);
     }
   }
+  if (check) failed += inv.report();
   if (check) std::printf("\n%s\n", failed ? "B6: NOT MET" : "B6: met for every set-up");
   return failed ? 1 : 0;
 }
 
+static int usage() {
+  std::fprintf(stderr,
+               "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off] "
+               "[--coupling piso|consistent] [--convection upwind|limited_linear] [--check] | --b1|--b2-inclined|--b3|--b4|--b5|--b8|--b10 "
+               "[--check] | --b6|--b7|--b9 [--full] [--check] | --region\n");
+  return 2;
+}
+
 int main(int argc, char** argv) {
-  {
-    // The cases of bench/vof_cases.cpp: --bN [--full] [--check].
+  const std::string mode = argc > 1 ? argv[1] : "";
+  if (mode.size() > 2 && mode.compare(0, 3, "--b") == 0) {
+    // One case: --bN [--full] [--check]; --full only where the case has a coarser default.
+    const bool takes_full = mode == "--b6" || mode == "--b7" || mode == "--b9";
     bool full = false, check = false;
-    for (int k = 2; k < argc; ++k) full |= std::string(argv[k]) == "--full", check |= std::string(argv[k]) == "--check";
-    const std::string mode = argc > 1 ? argv[1] : "";
+    for (int k = 2; k < argc; ++k) {
+      const std::string a = argv[k];
+      if (a == "--check") check = true;
+      else if (a == "--full" && takes_full) full = true;
+      else return usage();
+    }
     if (mode == "--b1") return runout::bench::lab_b1(check);
     if (mode == "--b2-inclined") return runout::bench::lab_b2_inclined(check);
     if (mode == "--b3") return runout::bench::lab_b3(check);
     if (mode == "--b4") return runout::bench::lab_b4(check);
     if (mode == "--b5") return runout::bench::lab_b5(check);
+    if (mode == "--b6") return b6(full, check);
     if (mode == "--b7") return runout::bench::lab_b7(full, check);
     if (mode == "--b8") return runout::bench::lab_b8(check);
+    if (mode == "--b9") return b9(full, check);
     if (mode == "--b10") return runout::bench::lab_b10(check);
+    return usage();
   }
-  if (argc > 1 && std::string(argv[1]) == "--b9") {
-    bool full = false, check = false;
-    for (int k = 2; k < argc; ++k) full |= std::string(argv[k]) == "--full", check |= std::string(argv[k]) == "--check";
-    return b9(full, check);
-  }
-  if (argc > 1 && std::string(argv[1]) == "--b6") {
-    bool full = false, check = false;
-    for (int k = 2; k < argc; ++k) full |= std::string(argv[k]) == "--full", check |= std::string(argv[k]) == "--check";
-    return b6(full, check);
-  }
-  if (argc > 1 && std::string(argv[1]) == "--region") return region();
+  if (mode == "--region") return argc == 2 ? region() : usage();
   bool full = false, check = false;
   double end = 1.0, courant = 0;
   int correctors = 0;
@@ -187,10 +201,7 @@ int main(int argc, char** argv) {
     else if (a == "--transpose" && k + 1 < argc) transpose = argv[++k];
     else if (a == "--coupling" && k + 1 < argc) coupling = argv[++k];
     else if (a == "--convection" && k + 1 < argc) convection = argv[++k];
-    else {
-      std::fprintf(stderr, "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off] [--coupling piso|consistent] [--convection upwind|limited_linear] [--check] | --b6 [--full] [--check] | --b9 [--full] [--check] | --b1|--b2-inclined|--b3|--b4|--b5|--b8|--b10 [--check] | --b7 [--full] [--check] | --region\n");
-      return 2;
-    }
+    else return usage();
   }
   auto r = runout::bench::lab_scenario("b2-collapse-0deg");
   auto* lab = r.scenario.mutable_lab();
@@ -237,22 +248,14 @@ int main(int argc, char** argv) {
   // The acceptance figures for B2 at 0 deg: within 10 % of the dissertation's method, the
   // front within 2 cells of 0.19-0.20 m.
   const double dx = 0.5 / lab->nx();
-  struct Check {
-    const char* what;
-    bool ok;
-  };
   const double pk = field(j, "peak_speed_m_s"), tp = field(j, "peak_speed_time_s"), rest = field(j, "rest_time_s"),
                up = field(j, "upper_surface_angle_deg"), fr = field(j, "front_x_m");
-  const Check checks[] = {{"peak speed within 10 % of 1.1 m/s", std::abs(pk - 1.1) <= 0.11},
-                          {"its time within 10 % of 0.15 s", std::abs(tp - 0.15) <= 0.015},
-                          {"at rest within 10 % of 0.6 s", std::abs(rest - 0.6) <= 0.06},
-                          {"upper surface within 10 % of 33 deg", std::abs(up - 33) <= 3.3},
-                          {"front within 2 cells of 0.19-0.20 m", fr >= 0.19 - 2 * dx && fr <= 0.20 + 2 * dx}};
-  int failed = 0;
-  std::printf("\n");
-  for (const auto& c : checks) {
-    std::printf("%s: %s\n", c.ok ? "met" : "NOT MET", c.what);
-    failed += !c.ok;
-  }
-  return failed ? 1 : 0;
+  runout::bench::Checks c("B2 at 0 deg");
+  runout::bench::invariants(c, "B2", ran);
+  c(std::abs(pk - 1.1) <= 0.11, "peak speed within 10 % of 1.1 m/s");
+  c(std::abs(tp - 0.15) <= 0.015, "its time within 10 % of 0.15 s");
+  c(std::abs(rest - 0.6) <= 0.06, "at rest within 10 % of 0.6 s");
+  c(std::abs(up - 33) <= 3.3, "upper surface within 10 % of 33 deg");
+  c(fr >= 0.19 - 2 * dx && fr <= 0.20 + 2 * dx, "front within 2 cells of 0.19-0.20 m");
+  return c.report();
 }

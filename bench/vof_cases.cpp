@@ -32,22 +32,6 @@ std::size_t station(const std::string& j, double x) {
   return std::string::npos;
 }
 
-// The invariants every case keeps (the issue: alpha within [0, 1] up to 1e-6, no NaN, face fluxes
-// divergence-free to the solver tolerance).
-void invariants(Checks& c, const std::string& what, const Ran& ran) {
-  const std::string& j = ran.json;
-  c(field(j, "alpha_min") > -1e-6 && field(j, "alpha_max") < 1 + 1e-6, what + ": alpha within [0, 1] up to 1e-6");
-  // Divergence-free to the solver tolerance: the largest cell's flux imbalance against the flow's own
-  // velocity-gradient scale (peak speed / cell size), within 100 times the last pressure solve's
-  // relative tolerance (1e-8). An absolute bound in 1/s would tighten with every refinement.
-  const double div = field(j, "max_divergence_1_s"), scale = std::max(field(j, "peak_speed_m_s"), 1e-3) / field(j, "dx_m");
-  char b[160];
-  std::snprintf(b, sizeof b, ": face fluxes divergence-free to the solver tolerance (largest %.1e 1/s, %.1e of peak speed / cell size; at most 1e-6)",
-                div, div / scale);
-  c(div / scale <= 1e-6, what + b);
-  c(std::isfinite(field(j, "peak_speed_m_s")) && std::isfinite(field(j, "final_speed_m_s")), what + ": no NaN in the speeds");
-}
-
 }  // namespace
 
 // B1 (validation.md B1): the rotating box of fine sand, one full turn. Described: a thin flowing
@@ -64,10 +48,10 @@ int lab_b1(bool check) {
   const double omega = 360.0 / lab->rotation_period_s(), phi = 54.5;
   std::printf("B1, %d x %d cells, one turn (%.2f s): %ld steps, %.0f s\n\n| t [s] | rotation [deg] | surface angle [deg] |\n|---:|---:|---:|\n",
               ran.sum.nx, ran.sum.ny, ran.sum.t, ran.sum.steps, ran.sum.seconds_run);
-  double next = 0.4, at30 = NAN, peak = 0;
+  double next = 0.4, at30 = NAN, peak = NAN;  // NaN until a sample is finite: the checks then fail
   for (std::size_t q = 0; q < t.size() && q < angle.size(); ++q) {
     if (std::isnan(at30) && omega * t[q] >= 30) at30 = angle[q];
-    if (std::isfinite(angle[q])) peak = std::max(peak, angle[q]);
+    if (std::isfinite(angle[q])) peak = std::isnan(peak) ? angle[q] : std::max(peak, angle[q]);
     if (t[q] >= next - 1e-9) {
       std::printf("| %.1f | %.0f | %.1f |\n", t[q], omega * t[q], angle[q]);
       next += 0.4;
@@ -96,7 +80,7 @@ int lab_b2_inclined(bool check) {
               "horizontal [deg] | moving share at the end | out of the open end | fastest cell at the end [m/s] |\n"
               "|---:|---:|---:|---:|---|---:|---|---:|---:|---:|\n");
   Checks c("B2 inclined");
-  double peak_before = 0;
+  double peak_before = NAN;
   for (int zeta : {10, 20, 30}) {
     auto r = lab_scenario("b2-collapse-" + std::to_string(zeta) + "deg");
     r.scenario.mutable_lab()->set_write_interval_s(0);
@@ -110,9 +94,11 @@ int lab_b2_inclined(bool check) {
     std::fflush(stdout);
     const std::string w = "B2 " + std::to_string(zeta) + " deg";
     invariants(c, w, ran);
-    c(peak > peak_before, w + ": faster than the flatter set-up");
+    if (!std::isnan(peak_before)) c(peak > peak_before, w + ": a higher peak speed than on the flatter channel");
     peak_before = peak;
-    c(share < 0.9, w + ": a static core remains (less than 90 % of the material moving at the end; the model's stick bed)");
+    // validation.md: the experiment fluidises all material at 30 deg; the model's stick bed keeps a
+    // static core. A tenth of the material at rest at the end (moving share below 0.9) counts as one.
+    c(share < 0.9, w + ": a static core remains (at least 10 % of the material at rest at the end; the model's stick bed)");
     if (zeta == 10) c(std::abs(up + zeta - 32) <= 5, w + ": the deposit's upper surface within 5 deg of phi (32 deg) against the horizontal");
   }
   return check ? c.report() : 0;
@@ -181,9 +167,11 @@ int lab_b4(bool check) {
                    ub = field(j, "basal_u_m_s", k), sr = field(j, "strain_rate_1_s", k);
       // The profile's points in the material (alpha above 0.5): [y, alpha, u] triples.
       long points = 0;
-      if (k != std::string::npos) {
-        const auto pk = j.find("\"profile_y_alpha_u\": [", k) + 22, pe = j.find("]]", pk);
-        for (auto b = j.find('[', pk); b != std::string::npos && b < pe; b = j.find('[', b + 1))
+      const auto pk = k == std::string::npos ? k : j.find("\"profile_y_alpha_u\": [", k);
+      if (pk != std::string::npos) {
+        const auto p0 = pk + 22;                                       // after the array's '['
+        const auto pe = j[p0] == ']' ? p0 : j.find("]]", p0);           // empty, or its last triple's end
+        for (auto b = j.find('[', p0); b != std::string::npos && b < pe; b = j.find('[', b + 1))
           points += std::atof(j.c_str() + j.find(", ", b) + 2) > 0.5;
       }
       std::printf("| %s | x = %.1f m | %.2f | %.2f | %.2f | %.2f | %.0f | %ld |\n", mat, x, 100 * d, um, us, ub, sr, points);

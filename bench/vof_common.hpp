@@ -2,6 +2,7 @@
 // in a temporary directory.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -10,6 +11,7 @@
 #include <sstream>
 #include <string>
 #include <unistd.h>
+#include <utility>
 #include <vector>
 
 #include "jobs/run.hpp"
@@ -17,8 +19,14 @@
 
 namespace runout::bench {
 
-// A number from run.json ("key": value; null or missing as NaN), searched from `from` on.
-inline double field(const std::string& json, const std::string& key, std::size_t from = 0) {
+// A number from run.json ("key": value; null or missing as NaN), searched from `from` on; by
+// default from the run's own blocks on (after the echoed scenario, whose compact JSON has no
+// "key": with a space, but a later change of its format must not make a key match there).
+inline double field(const std::string& json, const std::string& key, std::size_t from = std::string::npos) {
+  if (from == std::string::npos) {
+    from = json.find("\n  \"mesh\": ");
+    if (from == std::string::npos) from = 0;
+  }
   const auto k = json.find("\"" + key + "\": ", from);
   if (k == std::string::npos || json.compare(k + key.size() + 4, 4, "null") == 0) return NAN;
   return std::atof(json.c_str() + k + key.size() + 4);
@@ -45,22 +53,36 @@ inline runout::jobs::ResolvedScenario lab_scenario(const std::string& name) {
   return runout::jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/" + name + ".json");
 }
 
-// Run a scenario in a temporary directory; its summary and run.json.
+// Run a scenario in a temporary directory; its summary and run.json, or the error that ended it
+// (then json is empty and every figure reads as NaN).
 struct Ran {
   runout::jobs::RunSummary sum;
   std::string json;
+  std::string error;
 };
 inline Ran run_in_temp(const runout::jobs::ResolvedScenario& r) {
   namespace fs = std::filesystem;
   const fs::path out = fs::temp_directory_path() / ("runout-bench-vof-" + std::to_string(getpid()));
+  struct Remove {
+    fs::path p;
+    ~Remove() {
+      std::error_code ec;
+      fs::remove_all(p, ec);
+    }
+  } remove{out};
   fs::create_directories(out);
   Ran ran;
-  ran.sum = runout::jobs::run_scenario(r, out.string());
+  try {
+    ran.sum = runout::jobs::run_scenario(r, out.string());
+  } catch (const std::exception& e) {
+    ran.error = e.what();
+    std::fprintf(stderr, "runout_bench_vof: the run failed: %s\n", e.what());
+    return ran;
+  }
   std::ifstream in(out / "run.json");
   std::stringstream ss;
   ss << in.rdbuf();
   ran.json = ss.str();
-  fs::remove_all(out);
   return ran;
 }
 
@@ -86,5 +108,28 @@ class Checks {
   std::vector<std::string> lines_;
   int failed_ = 0;
 };
+
+
+// The invariants for a run (alpha within [0, 1] up to 1e-6, face fluxes divergence-free to
+// the solver tolerance), and that it finished.
+inline void invariants(Checks& c, const std::string& what, const Ran& ran) {
+  const std::string& j = ran.json;
+  c(ran.error.empty() && ran.sum.stop == "end-time",
+    what + ": the run finished" + (ran.error.empty() ? std::string() : " (it failed: " + ran.error + ")"));
+  c(field(j, "alpha_min") > -1e-6 && field(j, "alpha_max") < 1 + 1e-6, what + ": alpha within [0, 1] up to 1e-6");
+  // Divergence-free to the solver tolerance: the largest cell's flux imbalance over the run against
+  // the flow's velocity-gradient scale (peak speed over the smallest cell size), at most 1e-6: a
+  // hundred times the last pressure solve's relative tolerance (1e-8), a bound of our choosing.
+  // An absolute bound in 1/s would tighten with every refinement.
+  double h = field(j, "dx_m");
+  for (const char* k : {"dy_m", "dz_m"})
+    if (std::isfinite(field(j, k))) h = std::min(h, field(j, k));
+  const double div = field(j, "max_divergence_1_s"), scale = std::max(field(j, "peak_speed_m_s"), 1e-3) / h;
+  char b[200];
+  std::snprintf(b, sizeof b,
+                ": face fluxes divergence-free to the solver tolerance (largest %.1e 1/s, %.1e of peak speed / cell size; at most 1e-6)", div,
+                div / scale);
+  c(div / scale <= 1e-6, what + b);
+}
 
 }  // namespace runout::bench

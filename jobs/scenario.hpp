@@ -32,8 +32,9 @@ struct ResolvedScenario {
 /// The version of what a VOF run's results contain (run.json, the fields) for an unchanged scenario.
 /// Bump it when they change meaning or value, so that a service does not answer from results of the
 /// older kind (2: B6's shock is the bore, no longer the resting deposit's edge). The test
-/// Scenarios.VofResultsMatchTheFingerprintOfTheirVersion holds the figures of this version and fails
-/// when the numerics change them.
+/// Scenarios.VofResultsMatchTheFingerprintOfTheirVersion holds this version's figures for four
+/// short runs and fails when a change to the numerics moves them (options those runs do not take
+/// are not covered).
 inline constexpr int kVofResultsVersion = 2;
 
 /// SHA-256 of a resolved scenario: its message with the input paths left out, and the content of

@@ -725,7 +725,8 @@ TEST(Scenarios, LabCollapseRunsThroughTheRunDriver) {
 
 // B2 at 10, 20 and 30 deg from their scenario files (validation.md B2, coarse: a quarter of the
 // files' cells each way, about 1.1 cm, to 0.4 s): the steeper the channel, the faster the collapse
-// and the further its front; the material stays within [0, 1] and leaves only through the open end.
+// and its front no shorter (at 30 deg it reaches the open end); alpha stays within [0, 1], no
+// material is gained and the fluxes stay divergence-free.
 // (runout_bench_vof --b2-inclined --check runs the files as they are, label full.)
 TEST(Scenarios, LabB2InclinedCollapsesRunFasterOnSteeperChannels) {
   double peak_before = 0, front_before = -1;
@@ -743,7 +744,7 @@ TEST(Scenarios, LabB2InclinedCollapsesRunFasterOnSteeperChannels) {
     const std::string j = read_text(d / "run.json");
     std::printf("B2 at %s deg, coarse: peak %.2f m/s, front %.3f m at 0.4 s\n", zeta, sum.max_speed, sum.runout_m);
     EXPECT_GT(sum.max_speed, peak_before) << zeta;
-    EXPECT_GT(sum.runout_m, front_before) << zeta;
+    EXPECT_GE(sum.runout_m, front_before) << zeta;
     peak_before = sum.max_speed, front_before = sum.runout_m;
     EXPECT_LE(sum.volume_final, sum.volume_initial * (1 + 1e-9));
     EXPECT_GT(json_number(j, "alpha_min"), -1e-6);
@@ -1176,24 +1177,39 @@ TEST(Scenarios, VofHashCarriesTheResultsVersion) {
   EXPECT_EQ(jobs::scenario_hash(r), jobs::scenario_hash(jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b6-shock-sand-50deg-10cm.json")));
 }
 
-// The figures that VOF results version kVofResultsVersion gives for two short coarse runs (B2 under
-// PISO, B3 under the consistent coupling). A change to the numerics that alters them for an
-// unchanged scenario fails here: then bump kVofResultsVersion (jobs/scenario.hpp), so that services
-// compute such scenarios anew instead of answering from results of the older kind, and record the
-// new figures below. (An edit of the two scenario files moves them too; that changes the scenarios'
-// hashes already, so record the new figures without a bump. Compared to 1e-6 relative: run.json carries ten digits, and rounding in the
-// last bits on another machine stays far below that over a few hundred steps.)
+// The figures that VOF results version kVofResultsVersion gives for four short coarse runs: B2
+// (PISO), B3 (the consistent coupling, the gate monitor), B4 (an inflow, a station) and B7 (3D, an
+// obstacle). A change to the numerics that moves them for an unchanged scenario fails here: then
+// bump kVofResultsVersion (jobs/scenario.hpp), so that services compute such scenarios anew instead
+// of answering from results of the older kind, and record the new figures below. (An edit of these
+// scenario files moves them too; that changes the scenarios' hashes already, so record the new
+// figures without a bump.) Compared to 1e-4 relative: a build with -march=native (fused
+// multiply-adds) moved B2's peak speed by 2e-6, while a Courant number lower by 0.1 % moves it by
+// 2e-3. Options these runs do not take (limited-linear convection, the Coulomb conditions, the
+// rotating box, the curved chute) are not covered.
 TEST(Scenarios, VofResultsMatchTheFingerprintOfTheirVersion) {
   constexpr int version = 2;
+  struct Figure {
+    const char* key;
+    double want;
+  };
   struct Case {
     const char* file;
-    int nx, ny;
+    int nx, ny, nz;
     double end;
-    double want[5];  // peak speed, its time, final speed, mean surface angle, final volume
+    const char* station;  // run.json text after which the figures are read ("" for the whole file)
+    std::vector<Figure> figures;
   };
-  const Case cases[] = {
-      {"b2-collapse-0deg", 50, 15, 0.3, {0.8955085827, 0.2040603931, 0.603601247, 27.69799729, 0.0004199460235}},
-      {"b3-triangle-pvc", 100, 24, 0.1, {0.9911803737, 0.1, 0.9911803737, 75.39672198, 0.000207955}},
+  const std::vector<Case> cases = {
+      {"b2-collapse-0deg", 50, 15, 0, 0.3, "",
+       {{"peak_speed_m_s", 0.8955085827}, {"final_speed_m_s", 0.603601247}, {"mean_surface_angle_deg", 27.69799729},
+        {"upper_surface_angle_deg", 29.08302421}}},
+      {"b3-triangle-pvc", 100, 24, 0, 0.2, "",
+       {{"peak_speed_m_s", 1.733811608}, {"mean_surface_angle_deg", 23.67623436}, {"gate_flux_median_second_half_l_s_10cm", 5.456605626}}},
+      {"b4-steady-pvc", 175, 10, 0, 0.4, "{\"x_m\": 1,",
+       {{"depth_m", 0.02061925789}, {"depth_averaged_u_m_s", 2.467148928}, {"surface_u_m_s", 2.941161624}}},
+      {"b7-wide-chute-tetrahedron-edge", 47, 10, 24, 0.3, "",
+       {{"peak_speed_m_s", 2.158455698}, {"volume_final_m3", 0.001061999925}, {"max_depth_m", 0.02688599366}}},
   };
   EXPECT_EQ(jobs::kVofResultsVersion, version) << "record this version's figures below";
   for (const auto& c : cases) {
@@ -1201,18 +1217,20 @@ TEST(Scenarios, VofResultsMatchTheFingerprintOfTheirVersion) {
     auto* lab = r.scenario.mutable_lab();
     lab->set_nx(c.nx);
     lab->set_ny(c.ny);
+    if (c.nz) lab->set_nz(c.nz);
     lab->set_end_time_s(c.end);
     lab->set_write_interval_s(0);
     TempDir d;
     ASSERT_EQ(jobs::run_scenario(r, d.p.string()).stop, "end-time");
     const std::string j = read_text(d / "run.json");
-    const char* keys[] = {"peak_speed_m_s", "peak_speed_time_s", "final_speed_m_s", "mean_surface_angle_deg", "volume_final_m3"};
+    const auto from = *c.station ? j.find(c.station) : 0;
+    ASSERT_NE(from, std::string::npos) << c.file << ": " << c.station;
     std::printf("%s:", c.file);
-    for (int k = 0; k < 5; ++k) std::printf(" %.10g", json_number(j, keys[k]));
+    for (const auto& f : c.figures) std::printf(" %.10g", json_number(j, f.key, from));
     std::printf("\n");
-    for (int k = 0; k < 5; ++k)
-      EXPECT_NEAR(json_number(j, keys[k]), c.want[k], 1e-6 * std::abs(c.want[k]))
-          << c.file << ": " << keys[k] << " differs from results version " << version
+    for (const auto& f : c.figures)
+      EXPECT_NEAR(json_number(j, f.key, from), f.want, 1e-4 * std::abs(f.want))
+          << c.file << ": " << f.key << " differs from results version " << version
           << "'s. If the change is meant, bump kVofResultsVersion and record the new figures here.";
   }
 }
