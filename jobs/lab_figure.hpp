@@ -3,7 +3,7 @@
 // the material coloured by speed, velocity arrows and the free surface, our front and surface angle
 // beside the reference values of the scenario's lab.reference block; below it the monitors over time
 // (granular flux through the gate and out of the open end, the moving share) with the reference
-// outflow and fluidisation time. Drawn with cairo.
+// outflow and fluidisation time. Drawn with cairo. 3D runs get a plan view instead (PlanFigure).
 #include <cmath>
 #include <string>
 #include <vector>
@@ -31,5 +31,32 @@ struct SectionFigure {
 
 /// Writes the figure as PNG; throws std::runtime_error if it cannot.
 void write_section_figure(const std::string& path, const SectionFigure& f);
+
+/// comparison.png of a 3D laboratory run (validation.md B7, B8): the plan view at the end (x along
+/// the chute, or the arc length on a curved one; z across), the flow depth coloured from 0 to the
+/// deepest column, depth-averaged velocity arrows, obstacles grey, dry ground white; our undisturbed
+/// depth, the deepest column (a cross) and their ratio, each obstacle's shadow window (dashed) with
+/// its dry area, beside the reference's depth ratio (an orange mark on the colour bar).
+struct PlanFigure {
+  std::string title;
+  int nx = 0, nz = 0;
+  double x0 = 0, z0 = 0, dx = 0, dz = 0;
+  /// Per column (i + nx * k, k = 0 at z0): flow depth [m] (NaN: an obstacle not covered by flow)
+  /// and the depth-averaged velocity along x and z [m/s].
+  std::vector<double> depth, ux, uz;
+  std::string xlabel = "x [m]";
+  double undisturbed = NAN, deepest = NAN, deepest_x = NAN, deepest_z = NAN;
+  struct Shadow {
+    std::string shape;
+    double x0, x1, z0, z1;  ///< the window [m]
+    double dry_m2;          ///< its dry area (depth below 1 mm)
+  };
+  std::vector<Shadow> shadows;
+  std::string ref_source;
+  double ref_depth_ratio = NAN;  ///< deepest column over the undisturbed depth, at most (described)
+};
+
+/// Writes the plan view as PNG; throws std::runtime_error if it cannot.
+void write_plan_figure(const std::string& path, const PlanFigure& f);
 
 }  // namespace runout::jobs

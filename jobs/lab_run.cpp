@@ -831,16 +831,33 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   // per obstacle the dry area (depth below 1 mm) in its shadow: up to 15 cm downstream of its
   // centre, as wide as the obstacle.
   std::ostringstream chute;
+  PlanFigure plan;  // comparison.png of a 3D run
   if (g.three_d) {
     std::vector<double> d(std::size_t(g.nx) * g.nz, 0.0), upstream;
     std::vector<char> blocked_col(d.size(), 0);
+    plan.ux.assign(d.size(), 0.0);
+    plan.uz.assign(d.size(), 0.0);
     for (int k = 0; k < g.nz; ++k)
       for (int i = 0; i < g.nx; ++i)
         for (int j = 0; j < g.ny; ++j) {
           const int c = g.id(i, j, k);
-          if (c < 0) blocked_col[std::size_t(k) * g.nx + i] = 1;
-          else d[std::size_t(k) * g.nx + i] += std::clamp(s.alpha()[std::size_t(c)], 0.0, 1.0) * dy;
+          const std::size_t col = std::size_t(k) * g.nx + i;
+          if (c < 0) {
+            blocked_col[col] = 1;
+            continue;
+          }
+          const double a = std::clamp(s.alpha()[std::size_t(c)], 0.0, 1.0) * dy;
+          const auto& u = s.velocity()[std::size_t(c)];
+          d[col] += a;
+          // Along the bed: on a curved chute the speed in the x-y plane (the flow follows the bed).
+          plan.ux[col] += a * (L.has_chute() ? std::copysign(std::hypot(u.x, u.y), u.x) : u.x);
+          plan.uz[col] += a * u.z;
         }
+    plan.depth.resize(d.size());
+    for (std::size_t col = 0; col < d.size(); ++col) {
+      if (d[col] > 0) plan.ux[col] /= d[col], plan.uz[col] /= d[col];
+      plan.depth[col] = blocked_col[col] && d[col] < 1e-3 ? NAN : d[col];  // grey: an obstacle not covered by flow
+    }
     double dmax = 0, xm = NAN, zm = NAN;
     for (int k = 0; k < g.nz; ++k)
       for (int i = 0; i < g.nx; ++i) {
@@ -850,6 +867,14 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       }
     std::sort(upstream.begin(), upstream.end());
     const double und = upstream.empty() ? NAN : upstream[upstream.size() / 2];
+    plan.title = (r.scenario.name().empty() ? std::string("laboratory run") : r.scenario.name()) + ", t = " + json_number(s.time()) + " s";
+    plan.nx = g.nx, plan.nz = g.nz, plan.x0 = g.x0, plan.z0 = g.z0, plan.dx = dx, plan.dz = g.dz;
+    if (L.has_chute()) plan.xlabel = "arc length [m]";
+    plan.undisturbed = und, plan.deepest = dmax, plan.deepest_x = xm, plan.deepest_z = zm;
+    if (L.has_reference()) {
+      plan.ref_source = L.reference().source();
+      if (L.reference().has_depth_ratio_max()) plan.ref_depth_ratio = L.reference().depth_ratio_max();
+    }
     chute << "  \"chute\": {\"undisturbed_depth_m\": " << json_number(und) << ", \"max_depth_m\": " << json_number(dmax) << ", \"max_depth_x_m\": " << json_number(xm)
           << ", \"max_depth_z_m\": " << json_number(zm) << ", \"max_depth_ratio\": " << json_number(und > 0 ? dmax / und : NAN) << ", \"obstacles\": [";
     for (int q = 0; q < L.obstacles_size(); ++q) {
@@ -864,6 +889,9 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
             dry += dx * g.dz;
         }
       chute << (q ? ", " : "") << "{\"shape\": \"" << o.shape() << "\", \"sheltered_dry_area_m2\": " << json_number(dry) << "}";
+      plan.shadows.push_back({o.shape() == "cylinder" ? "cylinder" : o.shape() == "tetrahedron-edge" ? "tetrahedron (edge upstream)"
+                              : o.shape() == "tetrahedron-face" ? "tetrahedron (face upstream)" : o.shape(),
+                              o.x(), o.x() + 0.15, o.z() - half, o.z() + half, dry});
     }
     chute << "]},\n";
     // The curved chute (validation.md B8): where the deposit lies along the arc length (on the
@@ -1035,7 +1063,10 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     << json_number(steps ? 1e6 * sum.seconds_run / steps / m.cells() : NAN) << ", \"microseconds_per_active_cell_step\": "
     << json_number(active_sum > 0 ? 1e6 * sum.seconds_run / active_sum : NAN) << "}\n}\n";
   if (!j) throw std::runtime_error("cannot write run.json");
-  if (!g.three_d) {
+  if (g.three_d) {
+    write_plan_figure(out_dir + "/comparison.png", plan);
+    sum.files.push_back("comparison.png");
+  } else {
     // comparison.png: the section with ours beside the scenario's reference values (lab.reference).
     SectionFigure fig;
     fig.title = (r.scenario.name().empty() ? std::string("laboratory run") : r.scenario.name()) + ", t = " + json_number(s.time()) + " s";

@@ -193,6 +193,7 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
     check(ref.has_fluidised_time_s(), ref.fluidised_time_s(), "fluidised_time_s");
     check(ref.has_outflow_l_s(), ref.outflow_l_s(), "outflow_l_s");
     check(ref.has_gate_strain_rate_1_s(), ref.gate_strain_rate_1_s(), "gate_strain_rate_1_s");
+    check(ref.has_depth_ratio_max(), ref.depth_ratio_max(), "depth_ratio_max");
     if (ref.has_front_x_min() != ref.has_front_x_max() || (ref.has_front_x_min() && ref.front_x_max() < ref.front_x_min()))
       bad("lab.reference.front_x_max", "the front is a range: give front_x_min and front_x_max >= front_x_min");
     if (ref.has_surface_angle_deg() && ref.surface_angle_deg() >= 90) bad("lab.reference.surface_angle_deg", "must lie below 90 deg");

@@ -1105,9 +1105,10 @@ TEST(Scenarios, LabChuteErrorsNameTheField) {
   expect([](runout::v1::Lab* l) { l->set_phi_deg(85); }, "lab.phi_deg");
 }
 
-// comparison.png (validation.md part B): a plane run draws its section and monitors, and the
-// reference values of lab.reference in orange; without a reference nothing orange is drawn; a
-// reference front that is no range is refused by name.
+// comparison.png (validation.md part B): a plane run draws its section and monitors, a 3D run its
+// plan view, and the reference values of lab.reference in orange; without a reference nothing
+// orange is drawn; a reference front that is no range and a negative depth ratio are refused by
+// name.
 TEST(Scenarios, LabComparisonFigureDrawsTheReference) {
   auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json");
   ASSERT_TRUE(r.scenario.lab().has_reference());
@@ -1140,6 +1141,26 @@ TEST(Scenarios, LabComparisonFigureDrawsTheReference) {
   auto bad = jobs::parse_scenario_json(R"({"engine": "vof", "lab": {"x_max": 1, "y_max": 1, "nx": 10, "ny": 10,
       "fill": [{"x_max": 0.5, "y_max": 0.5}], "reference": {"front_x_min": 0.3, "front_x_max": 0.2}}})");
   expect_resolve_error(bad, {"lab.reference.front_x_max"});
+  // A 3D run draws its plan view (flow depth, arrows, the deepest column, the obstacle's shadow)
+  // with the reference depth ratio in orange (B7's files: "up to four times", described).
+  auto r3 = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b7-wide-chute-cylinder.json");
+  ASSERT_TRUE(r3.scenario.lab().reference().has_depth_ratio_max());
+  auto* l3 = r3.scenario.mutable_lab();
+  l3->set_nx(47);
+  l3->set_ny(10);
+  l3->set_nz(24);
+  l3->set_end_time_s(0.1);
+  l3->set_write_interval_s(0);
+  TempDir with3, without3;
+  const auto s3 = jobs::run_scenario(r3, with3.p.string());
+  EXPECT_NE(std::find(s3.files.begin(), s3.files.end(), "comparison.png"), s3.files.end());
+  EXPECT_GT(orange_pixels(with3 / "comparison.png"), 50);
+  l3->clear_reference();
+  jobs::run_scenario(r3, without3.p.string());
+  EXPECT_EQ(orange_pixels(without3 / "comparison.png"), 0);
+  auto bad3 = jobs::parse_scenario_json(R"({"engine": "vof", "lab": {"x_max": 1, "y_max": 1, "nx": 10, "ny": 10,
+      "fill": [{"x_max": 0.5, "y_max": 0.5}], "reference": {"depth_ratio_max": -4}}})");
+  expect_resolve_error(bad3, {"lab.reference.depth_ratio_max"});
 }
 
 // lab.momentum_convection: "upwind" by default, "limited_linear" accepted and passed to the
