@@ -112,13 +112,13 @@ void draw_field(cairo_t* cr, const Field& f, double ox, double top, double scale
     cairo_move_to(cr, X(x), oy);
     cairo_line_to(cr, X(x), oy + 5);
     cairo_stroke(cr);
-    text(cr, X(x) - 12, oy + 18, fmt("%.2f", x), 10);
+    text(cr, X(x) - 12, oy + 18, fmt("%.2f", x + 0.0), 10);  // + 0.0: no "-0.00"
   }
   for (double y = std::ceil(f.y0 / sy - 1e-9) * sy; y <= f.y0 + Ly + 1e-9; y += sy) {
     cairo_move_to(cr, ox - 5, Y(y));
     cairo_line_to(cr, ox, Y(y));
     cairo_stroke(cr);
-    text(cr, ox - 8, Y(y) + 4, fmt("%.2f", y), 10, kOurs, true);
+    text(cr, ox - 8, Y(y) + 4, fmt("%.2f", y + 0.0), 10, kOurs, true);
   }
   text(cr, ox + sec_w - 30, oy + 32, f.xlabel, 11);
   text(cr, 8, top + 12, f.ylabel, 11);
@@ -364,7 +364,7 @@ void write_plan_figure(const std::string& path, const PlanFigure& f) {
     throw std::runtime_error("comparison figure: the plan view does not match its grid");
   const double Lx = f.nx * f.dx, Lz = f.nz * f.dz, left = 70, right = 30, top = 40;
   const double scale = std::min(900 / Lx, 420 / Lz), map_w = Lx * scale, map_h = Lz * scale;
-  const int W = int(left + std::max(map_w, 500.0) + right + 90), H = int(top + map_h + 120);
+  const int W = int(left + std::max(map_w, 500.0) + right + 90), H = int(top + map_h + 120 + 17 * f.shadows.size());
   auto [surf, ctx] = canvas(W, H, f.title, left);
   cairo_t* cr = ctx.get();
   // The colour scale runs to the deepest column, or to the reference's depth if that is deeper.
@@ -378,7 +378,7 @@ void write_plan_figure(const std::string& path, const PlanFigure& f) {
   for (std::size_t k = 0; k < n; ++k) {
     const double d = f.depth[k];
     fl.value[k] = std::isnan(d) ? NAN : d / dmax;
-    fl.opacity[k] = std::isnan(d) ? 0 : std::min(1.0, d / 1e-3);  // white: dry (below 1 mm), faint below
+    fl.opacity[k] = d >= 1e-3 ? 1 : 0;  // white: dry, depth below 1 mm as in the shadows' dry area (arrows only where wet)
     if (d >= 1e-3) umax = std::max(umax, std::hypot(f.ux[k], f.uz[k]));
   }
   fl.ux = f.ux, fl.uy = f.uz, fl.arrow_max = umax;
@@ -390,10 +390,14 @@ void write_plan_figure(const std::string& path, const PlanFigure& f) {
   cairo_set_source_rgb(cr, 0, 0, 0);
   cairo_set_line_width(cr, 1.5);
   dashed(cr, true);
+  cairo_save(cr);
+  cairo_rectangle(cr, left, top, map_w, map_h);  // the windows clipped to the map
+  cairo_clip(cr);
   for (const auto& w : f.shadows) {
     cairo_rectangle(cr, X(w.x0), Z(w.z1), (w.x1 - w.x0) * scale, (w.z1 - w.z0) * scale);
     cairo_stroke(cr);
   }
+  cairo_restore(cr);
   dashed(cr, false);
   if (std::isfinite(f.deepest_x) && std::isfinite(f.deepest_z)) {  // the deepest column: a cross
     const double x = X(f.deepest_x), z = Z(f.deepest_z);
@@ -406,10 +410,13 @@ void write_plan_figure(const std::string& path, const PlanFigure& f) {
   }
   cairo_set_line_width(cr, 1);
   double ly = top + map_h + 50;
-  std::string ours = "ours: deepest column " + fmt("%.1f mm", 1e3 * f.deepest) + " at x = " + fmt("%.3f", f.deepest_x) + ", z = " +
-                     fmt("%.3f m", f.deepest_z) + " (cross)";
-  if (!f.shadows.empty() && f.undisturbed > 0)
-    ours += ", " + fmt("%.2f", f.deepest / f.undisturbed) + " times the undisturbed " + fmt("%.1f mm", 1e3 * f.undisturbed);
+  std::string ours = "ours: no material";
+  if (f.deepest > 0) {
+    ours = "ours: deepest column " + fmt("%.1f mm", 1e3 * f.deepest) + " at x = " + fmt("%.3f", f.deepest_x) + ", z = " +
+           fmt("%.3f m", f.deepest_z) + " (cross)";
+    if (f.undisturbed > 0)
+      ours += ", " + fmt("%.2f", f.deepest / f.undisturbed) + " times the undisturbed " + fmt("%.1f mm", 1e3 * f.undisturbed);
+  }
   text(cr, left, ly, ours, 12);
   for (const auto& w : f.shadows) {
     ly += 17;
@@ -418,7 +425,7 @@ void write_plan_figure(const std::string& path, const PlanFigure& f) {
   if (std::isfinite(f.ref_depth_ratio))
     text(cr, left, ly + 17,
          (f.ref_source.empty() ? std::string("reference") : f.ref_source) + ": deepest column up to " + fmt("%g", f.ref_depth_ratio) +
-             " times the undisturbed depth (orange mark on the colour bar)",
+             " times the undisturbed depth" + (std::isfinite(ref_depth) ? " (orange mark on the colour bar)" : ""),
          12, kReference);
   write_png(surf.get(), path);
 }

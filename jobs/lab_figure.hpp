@@ -34,7 +34,8 @@ void write_section_figure(const std::string& path, const SectionFigure& f);
 
 /// comparison.png of a 3D laboratory run (validation.md B7, B8): the plan view at the end (x along
 /// the chute, or the arc length on a curved one; z across), the flow depth coloured from 0 to the
-/// deepest column, depth-averaged velocity arrows, obstacles grey, dry ground white; our undisturbed
+/// deepest column (or to the reference depth ratio times the undisturbed depth, if that is deeper),
+/// depth-averaged velocity arrows, obstacles grey, dry ground (below 1 mm) white; our undisturbed
 /// depth, the deepest column (a cross) and their ratio, each obstacle's shadow window (dashed) with
 /// its dry area, beside the reference's depth ratio (an orange mark on the colour bar).
 struct PlanFigure {

@@ -369,6 +369,8 @@ class ChuteBed {
     const double h = (R_ > 0 ? z * z / (2 * R_) * f : 0) + n;
     return {x - std::sin(a) * h, y + std::cos(a) * h, z};
   }
+  // The reference curve's tangent at s: its angle to X (the tangent is (cos, sin) in X-Y).
+  double angle(double s) const { return s <= s1_ ? 0.0 : s <= s2_ ? k_ * (s - s1_) : beta_; }
 
  private:
   double s1_, s2_, beta_, R_, k_;
@@ -832,6 +834,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   // centre, as wide as the obstacle.
   std::ostringstream chute;
   PlanFigure plan;  // comparison.png of a 3D run
+  const ChuteBed chute_bed(L);  // used on a curved chute only
   if (g.three_d) {
     std::vector<double> d(std::size_t(g.nx) * g.nz, 0.0), upstream;
     std::vector<char> blocked_col(d.size(), 0);
@@ -849,8 +852,9 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
           const double a = std::clamp(s.alpha()[std::size_t(c)], 0.0, 1.0) * dy;
           const auto& u = s.velocity()[std::size_t(c)];
           d[col] += a;
-          // Along the bed: on a curved chute the speed in the x-y plane (the flow follows the bed).
-          plan.ux[col] += a * (L.has_chute() ? std::copysign(std::hypot(u.x, u.y), u.x) : u.x);
+          // Along the bed: on a curved chute along the reference curve's tangent at the cell.
+          const double ta = L.has_chute() ? chute_bed.angle(local[std::size_t(c)].x) : 0.0;
+          plan.ux[col] += a * (u.x * std::cos(ta) + u.y * std::sin(ta));
           plan.uz[col] += a * u.z;
         }
     plan.depth.resize(d.size());
@@ -879,19 +883,27 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
           << ", \"max_depth_z_m\": " << json_number(zm) << ", \"max_depth_ratio\": " << json_number(und > 0 ? dmax / und : NAN) << ", \"obstacles\": [";
     for (int q = 0; q < L.obstacles_size(); ++q) {
       const auto& o = L.obstacles(q);
-      const double half = o.shape() == "cylinder" ? o.radius() : o.shape() == "polygon" ? 0.5 * g.width : 0.5 * o.edge();
+      // The window: from the centre (a polygon across the width: from its downstream end) 15 cm
+      // downstream, as wide as the obstacle (a polygon: the whole width).
+      const bool poly = o.shape() == "polygon";
+      double wx0 = o.x(), wz0 = o.z() - 0.5 * o.edge(), wz1 = o.z() + 0.5 * o.edge();
+      if (o.shape() == "cylinder") wz0 = o.z() - o.radius(), wz1 = o.z() + o.radius();
+      if (poly) {
+        wx0 = -1e300, wz0 = g.z0, wz1 = g.z0 + g.width;
+        for (int q2 = 0; q2 + 1 < o.polygon_xy_size(); q2 += 2) wx0 = std::max(wx0, o.polygon_xy(q2));
+      }
+      const double wx1 = wx0 + 0.15;
       double dry = 0;
       for (int k = 0; k < g.nz; ++k)
         for (int i = 0; i < g.nx; ++i) {
           const double x = g.x0 + (i + 0.5) * dx, z = g.z0 + (k + 0.5) * g.dz;
-          if (x > o.x() && x < o.x() + 0.15 && std::abs(z - o.z()) < half && !blocked_col[std::size_t(k) * g.nx + i] &&
-              d[std::size_t(k) * g.nx + i] < 1e-3)
+          if (x > wx0 && x < wx1 && z > wz0 && z < wz1 && !blocked_col[std::size_t(k) * g.nx + i] && d[std::size_t(k) * g.nx + i] < 1e-3)
             dry += dx * g.dz;
         }
       chute << (q ? ", " : "") << "{\"shape\": \"" << o.shape() << "\", \"sheltered_dry_area_m2\": " << json_number(dry) << "}";
       plan.shadows.push_back({o.shape() == "cylinder" ? "cylinder" : o.shape() == "tetrahedron-edge" ? "tetrahedron (edge upstream)"
                               : o.shape() == "tetrahedron-face" ? "tetrahedron (face upstream)" : o.shape(),
-                              o.x(), o.x() + 0.15, o.z() - half, o.z() + half, dry});
+                              wx0, wx1, wz0, wz1, dry});
     }
     chute << "]},\n";
     // The curved chute (validation.md B8): where the deposit lies along the arc length (on the
