@@ -47,6 +47,9 @@ double tick_step(double range, int target) {
   return 10 * p;
 }
 
+// How the reference's values are introduced in the figure text.
+std::string source_name(const std::string& source) { return source.empty() ? "reference" : source; }
+
 void dashed(cairo_t* cr, bool on) {
   const double d[] = {6, 4};
   cairo_set_dash(cr, on ? d : nullptr, on ? 2 : 0, 0);
@@ -248,7 +251,7 @@ void write_section_figure(const std::string& path, const SectionFigure& f) {
     std::string ref;
     if (!std::isnan(f.ref_front_min)) ref += " front " + fmt("%.3f", f.ref_front_min) + "-" + fmt("%.3f m", f.ref_front_max) + " (band)";
     if (!std::isnan(f.ref_angle)) ref += std::string(ref.empty() ? "" : ",") + " upper surface " + fmt("%.0f deg", f.ref_angle) + " (dashed, through ours at 70 % height)";
-    if (!ref.empty()) text(cr, ox, ly + 17, (f.ref_source.empty() ? std::string("reference") : f.ref_source) + ":" + ref, 12, kReference);
+    if (!ref.empty()) text(cr, ox, ly + 17, source_name(f.ref_source) + ":" + ref, 12, kReference);
   }
 
   if (!series) {
@@ -354,7 +357,7 @@ void write_section_figure(const std::string& path, const SectionFigure& f) {
   if (!std::isnan(f.ref_fluidised)) add(ref, "fluidised " + fmt("%.2f s", f.ref_fluidised) + " (dashed)");
   if (!std::isnan(f.ref_outflow)) add(ref, "outflow " + fmt("%.2f l/s", f.ref_outflow) + " (dashed)");
   if (!std::isnan(f.ref_strain)) add(ref, "gate strain rate " + fmt("%.0f 1/s", f.ref_strain));
-  if (!ref.empty()) text(cr, ox, ty + 34, (f.ref_source.empty() ? std::string("reference") : f.ref_source) + ":" + ref, 11, kReference);
+  if (!ref.empty()) text(cr, ox, ty + 34, source_name(f.ref_source) + ":" + ref, 11, kReference);
   write_png(surf.get(), path);
 }
 
@@ -424,7 +427,7 @@ void write_plan_figure(const std::string& path, const PlanFigure& f) {
   }
   if (std::isfinite(f.ref_depth_ratio))
     text(cr, left, ly + 17,
-         (f.ref_source.empty() ? std::string("reference") : f.ref_source) + ": deepest column up to " + fmt("%g", f.ref_depth_ratio) +
+         source_name(f.ref_source) + ": deepest column up to " + fmt("%g", f.ref_depth_ratio) +
              " times the undisturbed depth" + (std::isfinite(ref_depth) ? " (orange mark on the colour bar)" : ""),
          12, kReference);
   write_png(surf.get(), path);

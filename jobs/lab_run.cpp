@@ -833,6 +833,8 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   // per obstacle the dry area (depth below 1 mm) in its shadow: up to 15 cm downstream of its
   // centre, as wide as the obstacle.
   std::ostringstream chute;
+  // comparison.png's title (the section of a plane run, the plan view of a 3D one).
+  const std::string figure_title = (r.scenario.name().empty() ? std::string("laboratory run") : r.scenario.name()) + ", t = " + json_number(s.time()) + " s";
   PlanFigure plan;  // comparison.png of a 3D run
   const ChuteBed chute_bed(L);  // used on a curved chute only
   if (g.three_d) {
@@ -871,7 +873,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
       }
     std::sort(upstream.begin(), upstream.end());
     const double und = upstream.empty() ? NAN : upstream[upstream.size() / 2];
-    plan.title = (r.scenario.name().empty() ? std::string("laboratory run") : r.scenario.name()) + ", t = " + json_number(s.time()) + " s";
+    plan.title = figure_title;
     plan.nx = g.nx, plan.nz = g.nz, plan.x0 = g.x0, plan.z0 = g.z0, plan.dx = dx, plan.dz = g.dz;
     if (L.has_chute()) plan.xlabel = "arc length [m]";
     plan.undisturbed = und, plan.deepest = dmax, plan.deepest_x = xm, plan.deepest_z = zm;
@@ -1081,7 +1083,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   } else {
     // comparison.png: the section with ours beside the scenario's reference values (lab.reference).
     SectionFigure fig;
-    fig.title = (r.scenario.name().empty() ? std::string("laboratory run") : r.scenario.name()) + ", t = " + json_number(s.time()) + " s";
+    fig.title = figure_title;
     fig.nx = g.nx, fig.ny = g.ny, fig.x0 = g.x0, fig.y0 = g.y0, fig.dx = dx, fig.dy = dy;
     fig.alpha.assign(std::size_t(g.nx) * g.ny, NAN);
     fig.ux.assign(fig.alpha.size(), 0.0);
