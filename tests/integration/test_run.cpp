@@ -1210,17 +1210,19 @@ TEST(Scenarios, VofHashCarriesTheResultsVersion) {
   EXPECT_EQ(jobs::scenario_hash(b2), "63090c37139a4b0bf672b639be550ad107a78c8b2f1209d576ca3779fa918d60");
 }
 
-// The figures that VOF results version kVofResultsVersion gives for five short coarse runs: B2
+// The figures that VOF results version kVofResultsVersion gives for eight short coarse runs: B2
 // (PISO), B3 (the consistent coupling, the gate monitor; once more with limited-linear convection
-// and the Coulomb friction bed), B4 (an inflow, a station) and B7 (3D, an obstacle). A change to the numerics that moves them for an unchanged scenario fails here: then
-// bump kVofResultsVersion (jobs/scenario.hpp), so that services compute such scenarios anew instead
-// of answering from results of the older kind, record the new figures below and the new pinned
-// hash in VofHashCarriesTheResultsVersion. (An edit of these
-// scenario files moves them too; that changes the scenarios' hashes already, so record the new
-// figures without a bump.) Compared to 1e-4 relative: a build with -march=native (fused
-// multiply-adds) moved B2's peak speed by 2e-6, while a Courant number lower by 0.1 % moves it by
-// 2e-3. What these runs do not take (appendix B.2's Coulomb slip wall, the rotating box, the
-// curved chute) is not covered.
+// and the Coulomb friction bed, once with appendix B.2's Coulomb slip wall), B4 (an inflow, a
+// station), B7 (3D, an obstacle), B1 (gravity turning with time) and B8 (the curved chute's
+// terrain-following mesh). A change to the numerics that moves them for an unchanged scenario
+// fails here: then bump kVofResultsVersion (jobs/scenario.hpp), so that services compute such
+// scenarios anew instead of answering from results of the older kind, record the new figures below
+// and the new pinned hash in VofHashCarriesTheResultsVersion. (An edit of these scenario files
+// moves them too; that changes the scenarios' hashes already, so record the new figures without a
+// bump.) Compared to 1e-4 relative: a build with -march=native (fused multiply-adds) moved B2's
+// peak speed by 2e-6, while a Courant number lower by 0.1 % moves it by 2e-3. The last three runs were
+// chosen so that a Courant number changed by 1e-6 moves none of their figures by more than 3e-7
+// (B4 with the slip wall was not: its station lies at the front, and moved by 1e-3).
 TEST(Scenarios, VofResultsMatchTheFingerprintOfTheirVersion) {
   constexpr int version = 3;
   struct Figure {
@@ -1253,6 +1255,21 @@ TEST(Scenarios, VofResultsMatchTheFingerprintOfTheirVersion) {
          auto* b = l->add_boundaries();
          b->set_side("bottom");
          b->set_kind("coulomb-friction");
+       }},
+      // The rotating box (gravity turning with time), while the sand still turns with it.
+      {"b1-rotating-box", 25, 25, 0, 0.75, "",
+       {{"peak_speed_m_s", 1.181971899e-4}, {"final_speed_m_s", 1.104870702e-4}, {"deposit_height_m", 0.1100145836}}},
+      // The curved chute's terrain-following mesh with its Coulomb friction bed.
+      {"b8-curved-chute", 40, 6, 13, 0.6, "",
+       {{"peak_speed_m_s", 2.450299961}, {"max_depth_m", 0.09135757333}, {"centroid_x_m", 0.910506112}}},
+      // Appendix B.2's Coulomb slip wall as the bed. (On B4 the station at x = 1 m lies at the front
+      // by 0.2-0.4 s, where a change of the Courant number by 1e-6 moves its figures by 1e-3.)
+      {"b3-triangle-pvc", 100, 24, 0, 0.1, "",
+       {{"peak_speed_m_s", 0.9870810771}, {"mean_surface_angle_deg", 75.49162232}, {"gate_flux_median_second_half_l_s_10cm", 6.179466926}},
+       [](runout::v1::Lab* l) {
+         auto* b = l->add_boundaries();
+         b->set_side("bottom");
+         b->set_kind("coulomb-slip");
        }},
   };
   EXPECT_EQ(jobs::kVofResultsVersion, version) << "record this version's figures below";
