@@ -3,10 +3,12 @@
 // on 12,000 cells (2.5 mm, about 4 microseconds per cell and step, 53 % in the pressure solve).
 //   runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off]
 //                    [--coupling piso|consistent] [--convection upwind|limited_linear]
+//                    [--coulomb-pressure total|excess]
 //                                          (default: 5 mm cells; --full: 2.5 mm, the dissertation's;
 //                                          --transpose: how the viscous stress's transpose part is taken;
 //                                          --coupling: the pressure coupling, lab.pressure_coupling;
-//                                          --convection: the momentum's convection, lab.momentum_convection)
+//                                          --convection: the momentum's convection, lab.momentum_convection;
+//                                          --coulomb-pressure: the Coulomb viscosity's pressure, lab.coulomb_pressure)
 //   runout_bench_vof --b10 [--check]       B10: column collapse for aspect ratios 0.5-6 (5 mm cells,
 //                                          scenarios/lab/b10-column-a*.json), normalised runout, rest
 //                                          time and the exponents of its growth
@@ -157,7 +159,7 @@ static int b6(bool full, bool check) {
 static int usage() {
   std::fprintf(stderr,
                "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off] "
-               "[--coupling piso|consistent] [--convection upwind|limited_linear] [--check] | --b1|--b2-inclined|--b3|--b4|--b5|--b8|--b10 "
+               "[--coupling piso|consistent] [--convection upwind|limited_linear] [--coulomb-pressure total|excess] [--check] | --b1|--b2-inclined|--b3|--b4|--b5|--b8|--b10 "
                "[--check] | --b6|--b7|--b9 [--full] [--check] | --region\n");
   return 2;
 }
@@ -190,7 +192,7 @@ int main(int argc, char** argv) {
   bool full = false, check = false;
   double end = 1.0, courant = 0;
   int correctors = 0;
-  std::string transpose, coupling, convection;
+  std::string transpose, coupling, convection, coulomb_pressure;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     if (a == "--full") full = true;
@@ -201,6 +203,7 @@ int main(int argc, char** argv) {
     else if (a == "--transpose" && k + 1 < argc) transpose = argv[++k];
     else if (a == "--coupling" && k + 1 < argc) coupling = argv[++k];
     else if (a == "--convection" && k + 1 < argc) convection = argv[++k];
+    else if (a == "--coulomb-pressure" && k + 1 < argc) coulomb_pressure = argv[++k];
     else return usage();
   }
   auto r = runout::bench::lab_scenario("b2-collapse-0deg");
@@ -213,8 +216,9 @@ int main(int argc, char** argv) {
   lab->set_write_interval_s(0);
   if (courant > 0) lab->set_max_courant(courant);
   if (correctors > 0) lab->set_correctors(correctors);
-  if (!transpose.empty() || !coupling.empty() || !convection.empty()) {
+  if (!transpose.empty() || !coupling.empty() || !convection.empty() || !coulomb_pressure.empty()) {
     if (!transpose.empty()) lab->set_viscous_transpose(transpose);
+    if (!coulomb_pressure.empty()) lab->set_coulomb_pressure(coulomb_pressure);
     if (!convection.empty()) lab->set_momentum_convection(convection);
     if (!coupling.empty()) lab->set_pressure_coupling(coupling);
     try {

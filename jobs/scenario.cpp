@@ -179,6 +179,10 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
   if (l->momentum_convection() != "" && l->momentum_convection() != "upwind" && l->momentum_convection() != "limited_linear")
     bad("lab.momentum_convection", "unknown '" + l->momentum_convection() + "' (valid: upwind, limited_linear)");
   if (l->momentum_convection() == "upwind") l->clear_momentum_convection();
+  // The same for the Coulomb viscosity's pressure: "total", the default, stays unset.
+  if (l->coulomb_pressure() != "" && l->coulomb_pressure() != "total" && l->coulomb_pressure() != "excess")
+    bad("lab.coulomb_pressure", "unknown '" + l->coulomb_pressure() + "' (valid: total, excess)");
+  if (l->coulomb_pressure() == "total") l->clear_coulomb_pressure();
   if (l->viscous_transpose().empty()) l->set_viscous_transpose("explicit");
   if (l->viscous_transpose() != "explicit" && l->viscous_transpose() != "harmonic" && l->viscous_transpose() != "off")
     bad("lab.viscous_transpose", "unknown '" + l->viscous_transpose() + "' (valid: explicit, harmonic, off)");

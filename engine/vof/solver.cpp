@@ -215,7 +215,17 @@ struct VofSolver::Impl {
   // condition (p_rgh the cell's, the density the cell's, gh the face's): the bed pressure the
   // Coulomb conditions need (listing B.2), not the cell centre's, which in a flow one or two cells
   // deep is half of it or less.
-  double wall_pressure(int f, int o) const { return s.p_rgh_[std::size_t(o)] + rho[std::size_t(o)] * ghf[std::size_t(f)]; }
+  double wall_pressure(int f, int o) const {
+    const double p = s.p_rgh_[std::size_t(o)] + rho[std::size_t(o)] * ghf[std::size_t(f)];
+    return s.cfg_.coulomb_pressure == CoulombPressure::excess ? p - s.cfg_.rho2 * (ghf[std::size_t(f)] - gh_ref) : p;
+  }
+  // The confining pressure of the Coulomb viscosity in cell c (VofConfig::coulomb_pressure): p, or
+  // p less the still air's hydrostatic pressure at the cell centre, rho_air g.(x - x_ref), the
+  // pressure outside_p_rgh() gives the air at rest.
+  double confining_pressure(int c) const {
+    const double p = s.p_[std::size_t(c)];
+    return s.cfg_.coulomb_pressure == CoulombPressure::excess ? p - s.cfg_.rho2 * (gh[std::size_t(c)] - gh_ref) : p;
+  }
   // The last pressure's and the buoyancy's force per area on an internal face, along Sf:
   // -ghf snGrad(rho) - snGrad(p_rgh) (the momentum predictor's and the consistent coupling's F_old).
   double face_force(int f) const {
@@ -318,7 +328,7 @@ struct VofSolver::Impl {
           dd += d * d;
         }
       const double sr = std::sqrt(2 * dd);
-      const double nu = tanphi * s.p_[std::size_t(c)] / (s.cfg_.rho1 * std::max(sr, 1e-300));
+      const double nu = tanphi * confining_pressure(c) / (s.cfg_.rho1 * std::max(sr, 1e-300));
       s.nu1_[std::size_t(c)] = std::clamp(std::isfinite(nu) ? nu : s.cfg_.nu_max, s.cfg_.nu_min, s.cfg_.nu_max);
       const double al = std::clamp(s.alpha_[std::size_t(c)], 0.0, 1.0);
       mu[std::size_t(c)] = al * s.cfg_.rho1 * s.nu1_[std::size_t(c)] + (1 - al) * s.cfg_.rho2 * s.cfg_.nu2;

@@ -53,6 +53,10 @@ struct PatchBc {
 
 /// How the viscous stress's transpose part is taken (VofConfig::viscous_transpose).
 enum class Transpose { linear, harmonic, off };
+/// The pressure the Coulomb viscosity (and the Coulomb bed conditions) take as the confining
+/// stress: the full pressure p, or its excess over the still air's hydrostatic pressure at the same
+/// height (what the grains carry beyond the ambient air; docs/vof.md).
+enum class CoulombPressure { total, excess };
 /// How the momentum's convection term takes its face values (VofConfig::momentum_convection).
 enum class Convection { upwind, limited_linear };
 
@@ -96,6 +100,11 @@ struct VofConfig {
   /// deferred correction (validation.md B2: upwind's numerical viscosity, about u dx / 2, is as
   /// large as the Coulomb viscosity in the thin flowing layers near the surface and the front).
   Convection momentum_convection = Convection::upwind;
+  /// total: p, as the dissertation (its level is zero at the highest point open to the atmosphere,
+  /// so the air above the material adds rho_air g per metre of air the domain holds above it);
+  /// excess: p less rho_air g.(x - x_ref), the air at rest's pressure at the same point, which does
+  /// not depend on how much air lies above the material (docs/vof.md).
+  CoulombPressure coulomb_pressure = CoulombPressure::total;
   int alpha_subcycles = 2;
   std::string pressure_pc = "gamg";  ///< "gamg" or "hypre" (BoomerAMG)
   double pressure_rtol = 1e-8;  ///< relative tolerance of the last corrector's pressure solve
