@@ -21,13 +21,16 @@
 //   runout_bench_vof --b9 [--full] [--check]  B9: the static and the failing heap (5 mm, --full: 2.5 mm);
 //                                          --check: exit 1 unless both meet the figures
 //   runout_bench_vof [--full] --check      also check the B2 acceptance figures (exit 1 if one fails)
-//   runout_bench_vof --b6 [--full] [--check]  B6: the shock at the closed end for the seven set-ups at
-//                                          1 cm (--full: 5 mm), its position over time and speed upstream;
-//                                          --check: exit 1 unless each forms a deposit whose edge moves
-//                                          upstream at a constant speed
-//   runout_bench_vof --b7 [--full] [--check]  B7: the wide chute with each obstacle at 5 mm (--full:
-//                                          2.5 mm, 1.34 million cells), depth figures and cost;
+//   runout_bench_vof --b6 [--full] [--check] [--jobs N]  B6: the shock at the closed end for the seven
+//                                          set-ups at 1 cm (--full: 5 mm), its position over time and speed
+//                                          upstream; --check: exit 1 unless each forms a deposit whose edge
+//                                          moves upstream at a constant speed
+//   runout_bench_vof --b7 [--full] [--check] [--jobs N]  B7: the wide chute with each obstacle at 5 mm
+//                                          (--full: 2.5 mm, 1.34 million cells), depth figures and cost;
 //                                          --check: exit 1 unless the described behaviour holds
+//                                          --jobs N (B6, B7): N set-ups at a time, each in a process of its
+//                                          own (0: as many as cores; default 1, so that the wall times are
+//                                          each run's alone)
 //   runout_bench_vof --region              cost per step against the material region: the same failing
 //                                          heap in channels 0.3-2.4 m long, with the active region and
 //                                          with every cell computed
@@ -111,14 +114,16 @@ static int region() {
 
 // B6 (validation.md B6): the flow fed at x = -2 m runs into the closed end at x = 0; the shock's
 // position over time and its speed upstream for the seven set-ups.
-static int b6(bool full, bool check) {
+static int b6(bool full, bool check, int jobs) {
   int failed = 0;
   runout::bench::Checks inv("B6, the invariants");
   std::printf("| set-up | inflow speed [m/s] | cells | steps | wall [s] | shock formed [s] | shock from the wall at 1.5 / 2.5 / 3.5 s [m] | "
               "speed upstream [m/s] | deposit at the wall [m] |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-  for (const char* name : {"pvc-40deg-5cm", "pvc-40deg-10cm", "pvc-40deg-15cm", "pvc-50deg-5cm", "pvc-50deg-10cm", "pvc-50deg-15cm",
-                           "sand-50deg-10cm"}) {
-    auto r = runout::bench::lab_scenario(std::string("b6-shock-") + name);
+  const std::vector<std::string> names = {"pvc-40deg-5cm", "pvc-40deg-10cm", "pvc-40deg-15cm", "pvc-50deg-5cm",
+                                          "pvc-50deg-10cm", "pvc-50deg-15cm", "sand-50deg-10cm"};
+  std::vector<runout::jobs::ResolvedScenario> rs;
+  for (const auto& name : names) {
+    auto r = runout::bench::lab_scenario("b6-shock-" + name);
     auto* lab = r.scenario.mutable_lab();
     if (!full) {  // 1 cm cells
       lab->set_nx(200);
@@ -126,7 +131,13 @@ static int b6(bool full, bool check) {
       lab->mutable_fill(0)->set_x_max(-1.99);
     }
     lab->set_write_interval_s(0);
-    const auto ran = run_in_temp(r);
+    rs.push_back(std::move(r));
+  }
+  const auto rans = runout::bench::run_all(rs, jobs);
+  for (std::size_t k = 0; k < rs.size(); ++k) {
+    const char* name = names[k].c_str();
+    const auto* lab = &rs[k].scenario.lab();
+    const auto& ran = rans[k];
     const auto& sum = ran.sum;
     const std::string& j = ran.json;
     const auto t = series(j, "t_s"), xs = series(j, "shock_x_m");
@@ -160,7 +171,7 @@ static int usage() {
   std::fprintf(stderr,
                "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off] "
                "[--coupling piso|consistent] [--convection upwind|limited_linear] [--coulomb-pressure total|excess] [--check] | --b1|--b2-inclined|--b3|--b4|--b5|--b8|--b10 "
-               "[--check] | --b6|--b7|--b9 [--full] [--check] | --region\n");
+               "[--check] | --b6|--b7 [--full] [--check] [--jobs N] | --b9 [--full] [--check] | --region\n");
   return 2;
 }
 
@@ -169,20 +180,26 @@ int main(int argc, char** argv) {
   if (mode.size() > 2 && mode.compare(0, 3, "--b") == 0) {
     // One case: --bN [--full] [--check]; --full only where the case has a coarser default.
     const bool takes_full = mode == "--b6" || mode == "--b7" || mode == "--b9";
+    const bool takes_jobs = mode == "--b6" || mode == "--b7";
     bool full = false, check = false;
+    int jobs = 1;
     for (int k = 2; k < argc; ++k) {
       const std::string a = argv[k];
       if (a == "--check") check = true;
       else if (a == "--full" && takes_full) full = true;
-      else return usage();
+      else if (a == "--jobs" && takes_jobs && k + 1 < argc) {
+        char* end = nullptr;
+        jobs = int(std::strtol(argv[++k], &end, 10));
+        if (*end || jobs < 0) return usage();
+      } else return usage();
     }
     if (mode == "--b1") return runout::bench::lab_b1(check);
     if (mode == "--b2-inclined") return runout::bench::lab_b2_inclined(check);
     if (mode == "--b3") return runout::bench::lab_b3(check);
     if (mode == "--b4") return runout::bench::lab_b4(check);
     if (mode == "--b5") return runout::bench::lab_b5(check);
-    if (mode == "--b6") return b6(full, check);
-    if (mode == "--b7") return runout::bench::lab_b7(full, check);
+    if (mode == "--b6") return b6(full, check, jobs);
+    if (mode == "--b7") return runout::bench::lab_b7(full, check, jobs);
     if (mode == "--b8") return runout::bench::lab_b8(check);
     if (mode == "--b9") return b9(full, check);
     if (mode == "--b10") return runout::bench::lab_b10(check);

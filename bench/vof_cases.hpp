@@ -9,7 +9,7 @@ int lab_b2_inclined(bool check);  // 10, 20 and 30 deg
 int lab_b3(bool check);
 int lab_b4(bool check);
 int lab_b5(bool check);
-int lab_b7(bool full, bool check);  // full: the scenario files' 2.5 mm; otherwise 5 mm
+int lab_b7(bool full, bool check, int jobs);  // full: the scenario files' 2.5 mm; otherwise 5 mm; jobs: run_all's
 int lab_b8(bool check);
 int lab_b10(bool check);
 

@@ -10,6 +10,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <sys/wait.h>
+#include <thread>
 #include <unistd.h>
 #include <utility>
 #include <vector>
@@ -84,6 +86,83 @@ inline Ran run_in_temp(const runout::jobs::ResolvedScenario& r) {
   ss << in.rdbuf();
   ran.json = ss.str();
   return ran;
+}
+
+// Run scenarios as run_in_temp does, at most `jobs` at a time, each in a child process of its own
+// (PETSc, with it MPI, and HDF5 are started in the children only), and return the results in the
+// given order. jobs 0: as many as the machine has cores; 1: one after the other in this process.
+// A child that dies (a signal, memory) gives a result with the error set.
+inline std::vector<Ran> run_all(const std::vector<runout::jobs::ResolvedScenario>& rs, int jobs) {
+  namespace fs = std::filesystem;
+  std::vector<Ran> out(rs.size());
+  if (jobs == 0) jobs = int(std::max(1u, std::thread::hardware_concurrency()));
+  if (jobs <= 1 || rs.size() <= 1) {
+    for (std::size_t k = 0; k < rs.size(); ++k) out[k] = run_in_temp(rs[k]);
+    return out;
+  }
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const fs::path dir = fs::temp_directory_path() / ("runout-bench-vof-all-" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  auto file = [&](std::size_t k, const char* ext) { return dir / (std::to_string(k) + ext); };
+  std::vector<std::pair<pid_t, std::size_t>> running;
+  auto collect = [&](pid_t pid, int status) {
+    for (std::size_t q = 0; q < running.size(); ++q) {
+      if (running[q].first != pid) continue;
+      const std::size_t k = running[q].second;
+      running.erase(running.begin() + long(q));
+      Ran& ran = out[k];
+      std::ifstream meta(file(k, ".meta"));
+      std::string line;
+      if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && std::getline(meta, ran.sum.stop)) {
+        meta >> ran.sum.steps >> ran.sum.seconds_run >> ran.sum.t >> ran.sum.nx >> ran.sum.ny;
+        std::getline(meta, line);
+        std::getline(meta, ran.error);
+        std::ifstream in(file(k, ".json"));
+        std::stringstream ss;
+        ss << in.rdbuf();
+        ran.json = ss.str();
+      } else {
+        ran.error = WIFSIGNALED(status) ? "the run's process ended with signal " + std::to_string(WTERMSIG(status))
+                                        : "the run's process ended with status " + std::to_string(WEXITSTATUS(status));
+        std::fprintf(stderr, "runout_bench_vof: %s\n", ran.error.c_str());
+      }
+      return;
+    }
+  };
+  for (std::size_t k = 0; k < rs.size(); ++k) {
+    while (int(running.size()) >= jobs) {
+      int status = 0;
+      const pid_t pid = wait(&status);
+      if (pid > 0) collect(pid, status);
+    }
+    const pid_t pid = fork();
+    if (pid == 0) {
+      const Ran ran = run_in_temp(rs[k]);
+      {
+        std::ofstream(file(k, ".json")) << ran.json;
+        std::ofstream meta(file(k, ".meta"));
+        meta << ran.sum.stop << "\n" << ran.sum.steps << " " << ran.sum.seconds_run << " " << ran.sum.t << " " << ran.sum.nx << " "
+             << ran.sum.ny << "\n" << ran.error << "\n";
+      }
+      std::fflush(stdout);
+      _exit(0);
+    }
+    if (pid < 0) {
+      out[k].error = "could not start a process for the run";
+      continue;
+    }
+    running.emplace_back(pid, k);
+  }
+  while (!running.empty()) {
+    int status = 0;
+    const pid_t pid = wait(&status);
+    if (pid <= 0) break;
+    collect(pid, status);
+  }
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+  return out;
 }
 
 // A list of named checks, printed as "met" / "NOT MET" lines; failed() counts the misses.

@@ -100,8 +100,9 @@ struct VofConfig {
   /// deferred correction (validation.md B2: upwind's numerical viscosity, about u dx / 2, is as
   /// large as the Coulomb viscosity in the thin flowing layers near the surface and the front).
   Convection momentum_convection = Convection::upwind;
-  /// total: p, as the dissertation (its level is zero at the highest point open to the atmosphere,
-  /// so the air above the material adds rho_air g per metre of air the domain holds above it);
+  /// total: p, the dissertation's formula (our level is zero at the highest point open to the
+  /// atmosphere, so the air above the material adds rho_air g per metre of air the domain holds
+  /// above it);
   /// excess: p less rho_air g.(x - x_ref), the air at rest's pressure at the same point, which does
   /// not depend on how much air lies above the material (docs/vof.md).
   CoulombPressure coulomb_pressure = CoulombPressure::total;

@@ -756,8 +756,10 @@ TEST(Scenarios, LabB2InclinedCollapsesRunFasterOnSteeperChannels) {
 // lab.coulomb_pressure: "excess" takes the Coulomb viscosity's pressure less the still air's
 // hydrostatic pressure, so that the air a domain holds above the material adds no strength. B2 at
 // 5 mm with the whole top open, once 15 cm and once 30 cm high: with "excess" the collapse is the
-// same; with the full pressure (the default) the taller domain's extra 1.5 Pa of air change it
-// (printed: the rest time moves from 0.88 to 0.52 s and the front by four cells).
+// same (within half a cell, 2 % of the rest time, 0.05 deg). With the full pressure (the default)
+// the taller domain's extra 1.5 Pa of air change it: run to 1 s, the rest time moves from 0.88 to
+// 0.52 s and the front by four cells (docs/vof.md), which the checks below would catch. (The peak
+// speed, in the thin surface layer, differs by less than 1 % either way.)
 TEST(Scenarios, LabCoulombExcessPressureDoesNotDependOnTheAirAbove) {
   struct Fig {
     double peak, rest, angle, front;
@@ -788,7 +790,7 @@ TEST(Scenarios, LabCoulombExcessPressureDoesNotDependOnTheAirAbove) {
   EXPECT_NEAR(high.peak, low.peak, 0.02 * low.peak);
   EXPECT_NEAR(high.rest, low.rest, 0.02 * low.rest);
   EXPECT_NEAR(high.angle, low.angle, 0.05);
-  EXPECT_NEAR(high.front, low.front, 1e-9);
+  EXPECT_NEAR(high.front, low.front, 0.5 * 0.005);
   EXPECT_GT(low.rest, 0);  // came to rest
 }
 
@@ -1277,7 +1279,9 @@ TEST(Scenarios, VofHashCarriesTheResultsVersion) {
 // bump.) Compared to 1e-4 relative: a build with -march=native (fused multiply-adds) moved B2's
 // peak speed by 2e-6, while a Courant number lower by 0.1 % moves it by 2e-3. The last four runs were
 // chosen so that a Courant number changed by 1e-6 moves none of their figures by more than 2e-6
-// (B4 with the slip wall was not: its station lies at the front, and moved by 1e-3).
+// (B4 with the slip wall was not: its station lies at the front, and moved by 1e-3). B1's steps
+// are limited by the largest step, not the Courant number; a rotation period changed by 1e-9
+// moves its figures by at most 2e-5.
 TEST(Scenarios, VofResultsMatchTheFingerprintOfTheirVersion) {
   constexpr int version = 3;
   struct Figure {
