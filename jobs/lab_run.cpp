@@ -460,6 +460,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
                                                               : vof::Transpose::linear;
   c.momentum_convection = L.momentum_convection() == "limited_linear" ? vof::Convection::limited_linear : vof::Convection::upwind;
   c.coulomb_pressure = L.coulomb_pressure() == "excess" ? vof::CoulombPressure::excess : vof::CoulombPressure::total;
+  if (!L.pressure_preconditioner().empty()) c.pressure_pc = L.pressure_preconditioner();
   c.active_layers = L.active_layers() < 0 ? 0 : L.active_layers();
   c.consistent = c.momentum_predictor = L.pressure_coupling() == "consistent";
   const double zeta = L.inclination_deg() * kPi / 180;

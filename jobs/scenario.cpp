@@ -183,6 +183,9 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
   if (l->coulomb_pressure() != "" && l->coulomb_pressure() != "total" && l->coulomb_pressure() != "excess")
     bad("lab.coulomb_pressure", "unknown '" + l->coulomb_pressure() + "' (valid: total, excess)");
   if (l->coulomb_pressure() == "total") l->clear_coulomb_pressure();
+  if (l->pressure_preconditioner() != "" && l->pressure_preconditioner() != "gamg" && l->pressure_preconditioner() != "hypre")
+    bad("lab.pressure_preconditioner", "unknown '" + l->pressure_preconditioner() + "' (valid: gamg, hypre)");
+  if (l->pressure_preconditioner() == "gamg") l->clear_pressure_preconditioner();
   if (l->viscous_transpose().empty()) l->set_viscous_transpose("explicit");
   if (l->viscous_transpose() != "explicit" && l->viscous_transpose() != "harmonic" && l->viscous_transpose() != "off")
     bad("lab.viscous_transpose", "unknown '" + l->viscous_transpose() + "' (valid: explicit, harmonic, off)");

@@ -892,6 +892,8 @@ struct VofSolver::Impl {
     } else if (s.cfg_.pressure_pc == "hypre") {
       if (PCSetType(pc, PCHYPRE)) throw VofError("pressure_pc: this PETSc has no hypre (valid here: gamg)");
       petsc_check(PCHYPRESetType(pc, "boomeramg"), "PCHYPRESetType");
+      petsc_check(KSPSetOptionsPrefix(ksp, "runout_p_"), "KSPSetOptionsPrefix");
+      petsc_check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
     } else {
       throw VofError("pressure_pc: unknown '" + s.cfg_.pressure_pc + "' (valid: gamg, hypre)");
     }
