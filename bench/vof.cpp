@@ -133,11 +133,9 @@ static int b6(bool full, bool check, int jobs) {
     lab->set_write_interval_s(0);
     rs.push_back(std::move(r));
   }
-  const auto rans = runout::bench::run_all(rs, jobs);
-  for (std::size_t k = 0; k < rs.size(); ++k) {
+  runout::bench::run_all(rs, jobs, [&](std::size_t k, const runout::bench::Ran& ran) {
     const char* name = names[k].c_str();
     const auto* lab = &rs[k].scenario.lab();
-    const auto& ran = rans[k];
     const auto& sum = ran.sum;
     const std::string& j = ran.json;
     const auto t = series(j, "t_s"), xs = series(j, "shock_x_m");
@@ -161,7 +159,7 @@ static int b6(bool full, bool check, int jobs) {
       failed += !ok;
       runout::bench::invariants(inv, std::string("B6 ") + name, ran);
     }
-  }
+  });
   if (check) failed += inv.report();
   if (check) std::printf("\n%s\n", failed ? "B6: NOT MET" : "B6: met for every set-up");
   return failed ? 1 : 0;

@@ -236,11 +236,10 @@ int lab_b7(bool full, bool check, int jobs) {
     lab->set_write_interval_s(0);
     rs.push_back(std::move(r));
   }
-  const auto rans = run_all(rs, jobs);
-  for (int q = 0; q < 3; ++q) {
+  run_all(rs, jobs, [&](std::size_t k, const Ran& ran) {
+    const int q = int(k);
     const char* shape = shapes[q];
-    const auto* lab = &rs[std::size_t(q)].scenario.lab();
-    const auto& ran = rans[std::size_t(q)];
+    const auto* lab = &rs[k].scenario.lab();
     const auto& sum = ran.sum;
     const std::string& j = ran.json;
     const double cells = field(j, "cells"), ratio = field(j, "max_depth_ratio"), xd = field(j, "max_depth_x_m"), zd = field(j, "max_depth_z_m");
@@ -256,7 +255,7 @@ int lab_b7(bool full, bool check, int jobs) {
     if (q == 1)
       c(xd < lab->obstacles(0).x() && std::abs(zd - lab->obstacles(0).z()) < 0.02,
         w + ": the deepest column in front of it, within 2 cm of the centre line (the deposit in front)");
-  }
+  });
   c(shadow[0] > shadow[1] && shadow[0] > shadow[2], "B7: the dry shadow behind the edge-first tetrahedron the largest of the three");
   return check ? c.report() : 0;
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -88,81 +89,115 @@ inline Ran run_in_temp(const runout::jobs::ResolvedScenario& r) {
   return ran;
 }
 
-// Run scenarios as run_in_temp does, at most `jobs` at a time, each in a child process of its own
-// (PETSc, with it MPI, and HDF5 are started in the children only), and return the results in the
-// given order. jobs 0: as many as the machine has cores; 1: one after the other in this process.
-// A child that dies (a signal, memory) gives a result with the error set.
-inline std::vector<Ran> run_all(const std::vector<runout::jobs::ResolvedScenario>& rs, int jobs) {
+// Run scenarios as run_in_temp does, at most `jobs` at a time, each in a child process of its own,
+// and hand each result to `done(k, ran)` in the given order as soon as it and all before it have
+// finished (so tables fill in as the runs end). jobs 0: as many as the machine has cores; 1: one
+// after the other in this process. The callers fork before anything starts PETSc, MPI or HDF5 in
+// this process (they only load scenarios first). A child that dies (a signal, memory) gives a
+// result with the error set.
+template <class Done>
+void run_all(const std::vector<runout::jobs::ResolvedScenario>& rs, int jobs, Done done) {
   namespace fs = std::filesystem;
-  std::vector<Ran> out(rs.size());
   if (jobs == 0) jobs = int(std::max(1u, std::thread::hardware_concurrency()));
   if (jobs <= 1 || rs.size() <= 1) {
-    for (std::size_t k = 0; k < rs.size(); ++k) out[k] = run_in_temp(rs[k]);
-    return out;
+    for (std::size_t k = 0; k < rs.size(); ++k) done(k, run_in_temp(rs[k]));
+    return;
   }
   std::fflush(stdout);
   std::fflush(stderr);
   const fs::path dir = fs::temp_directory_path() / ("runout-bench-vof-all-" + std::to_string(getpid()));
   fs::create_directories(dir);
   auto file = [&](std::size_t k, const char* ext) { return dir / (std::to_string(k) + ext); };
+  std::vector<Ran> out(rs.size());
+  std::vector<bool> ready(rs.size(), false);
+  std::size_t next = 0;  // the next result to hand on
+  auto deliver = [&] {
+    while (next < rs.size() && ready[next]) {
+      done(next, out[next]);
+      ++next;
+    }
+  };
   std::vector<std::pair<pid_t, std::size_t>> running;
-  auto collect = [&](pid_t pid, int status) {
-    for (std::size_t q = 0; q < running.size(); ++q) {
-      if (running[q].first != pid) continue;
-      const std::size_t k = running[q].second;
-      running.erase(running.begin() + long(q));
-      Ran& ran = out[k];
-      std::ifstream meta(file(k, ".meta"));
-      std::string line;
-      if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && std::getline(meta, ran.sum.stop)) {
-        meta >> ran.sum.steps >> ran.sum.seconds_run >> ran.sum.t >> ran.sum.nx >> ran.sum.ny;
-        std::getline(meta, line);
-        std::getline(meta, ran.error);
-        std::ifstream in(file(k, ".json"));
-        std::stringstream ss;
-        ss << in.rdbuf();
-        ran.json = ss.str();
-      } else {
-        ran.error = WIFSIGNALED(status) ? "the run's process ended with signal " + std::to_string(WTERMSIG(status))
-                                        : "the run's process ended with status " + std::to_string(WEXITSTATUS(status));
-        std::fprintf(stderr, "runout_bench_vof: %s\n", ran.error.c_str());
+  auto collect = [&](std::size_t q, int status) {
+    const std::size_t k = running[q].second;
+    running.erase(running.begin() + long(q));
+    Ran& ran = out[k];
+    std::ifstream meta(file(k, ".meta"));
+    std::string stop, steps, seconds, t, nx, ny;
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && std::getline(meta, stop) && std::getline(meta, steps) &&
+        std::getline(meta, seconds) && std::getline(meta, t) && std::getline(meta, nx) && std::getline(meta, ny)) {
+      ran.sum.stop = stop;
+      ran.sum.steps = std::strtol(steps.c_str(), nullptr, 10);
+      ran.sum.seconds_run = std::strtod(seconds.c_str(), nullptr);
+      ran.sum.t = std::strtod(t.c_str(), nullptr);
+      ran.sum.nx = int(std::strtol(nx.c_str(), nullptr, 10));
+      ran.sum.ny = int(std::strtol(ny.c_str(), nullptr, 10));
+      std::getline(meta, ran.error);
+      std::ifstream in(file(k, ".json"));
+      std::stringstream ss;
+      ss << in.rdbuf();
+      ran.json = ss.str();
+    } else {
+      ran.error = WIFSIGNALED(status) ? "the run's process ended with signal " + std::to_string(WTERMSIG(status))
+                                      : "the run's process ended with status " + std::to_string(WEXITSTATUS(status));
+      std::fprintf(stderr, "runout_bench_vof: %s\n", ran.error.c_str());
+    }
+    ready[k] = true;
+  };
+  // Wait for one of the running children; false when none can be waited for.
+  auto wait_one = [&] {
+    for (;;) {
+      int status = 0;
+      const pid_t pid = waitpid(-1, &status, 0);
+      if (pid < 0) {
+        if (errno == EINTR) continue;
+        for (const auto& [p, k] : running) {  // lost (e.g. reaped elsewhere): no result
+          out[k].error = "the run's process could not be waited for";
+          ready[k] = true;
+        }
+        running.clear();
+        return false;
       }
-      return;
+      for (std::size_t q = 0; q < running.size(); ++q)
+        if (running[q].first == pid) {
+          collect(q, status);
+          return true;
+        }
     }
   };
   for (std::size_t k = 0; k < rs.size(); ++k) {
-    while (int(running.size()) >= jobs) {
-      int status = 0;
-      const pid_t pid = wait(&status);
-      if (pid > 0) collect(pid, status);
-    }
+    while (int(running.size()) >= jobs && wait_one()) deliver();
     const pid_t pid = fork();
     if (pid == 0) {
-      const Ran ran = run_in_temp(rs[k]);
-      {
+      int rc = 0;
+      try {
+        const Ran ran = run_in_temp(rs[k]);
+        std::string error = ran.error;
+        std::replace(error.begin(), error.end(), '\n', ' ');
         std::ofstream(file(k, ".json")) << ran.json;
         std::ofstream meta(file(k, ".meta"));
-        meta << ran.sum.stop << "\n" << ran.sum.steps << " " << ran.sum.seconds_run << " " << ran.sum.t << " " << ran.sum.nx << " "
-             << ran.sum.ny << "\n" << ran.error << "\n";
+        meta.precision(17);
+        meta << ran.sum.stop << "\n" << ran.sum.steps << "\n" << ran.sum.seconds_run << "\n" << ran.sum.t << "\n" << ran.sum.nx << "\n"
+             << ran.sum.ny << "\n" << error << "\n";
+      } catch (...) {
+        rc = 1;
       }
       std::fflush(stdout);
-      _exit(0);
+      std::fflush(stderr);
+      _exit(rc);
     }
     if (pid < 0) {
       out[k].error = "could not start a process for the run";
-      continue;
+      ready[k] = true;
+    } else {
+      running.emplace_back(pid, k);
     }
-    running.emplace_back(pid, k);
+    deliver();
   }
-  while (!running.empty()) {
-    int status = 0;
-    const pid_t pid = wait(&status);
-    if (pid <= 0) break;
-    collect(pid, status);
-  }
+  while (!running.empty() && wait_one()) deliver();
+  deliver();
   std::error_code ec;
   fs::remove_all(dir, ec);
-  return out;
 }
 
 // A list of named checks, printed as "met" / "NOT MET" lines; failed() counts the misses.

@@ -883,22 +883,27 @@ struct VofSolver::Impl {
       // The 1/A of the two phases differ a thousandfold: GAMG's default Chebyshev smoothers, with their
       // estimated eigenvalue bounds, then made the preconditioner indefinite for CG now and then.
       // Damped Jacobi smoothing (Richardson, scale 0.6) is symmetric and stays positive definite.
-      petsc_check(KSPSetOptionsPrefix(ksp, "runout_p_"), "KSPSetOptionsPrefix");
-      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_ksp_type", "richardson");
-      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_pc_type", "jacobi");
-      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_ksp_richardson_scale", "0.6");
-      PetscOptionsSetValue(nullptr, "-runout_p_mg_levels_ksp_max_it", "2");
-      petsc_check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
+      // (Defaults only: a user's PETSc options with the same names are kept.)
+      for (const auto& [name, value] : {std::pair<const char*, const char*>{"-runout_p_mg_levels_ksp_type", "richardson"},
+                                        {"-runout_p_mg_levels_pc_type", "jacobi"},
+                                        {"-runout_p_mg_levels_ksp_richardson_scale", "0.6"},
+                                        {"-runout_p_mg_levels_ksp_max_it", "2"}}) {
+        PetscBool set = PETSC_FALSE;
+        PetscOptionsHasName(nullptr, nullptr, name, &set);
+        if (!set) PetscOptionsSetValue(nullptr, name, value);
+      }
     } else if (s.cfg_.pressure_pc == "hypre") {
       if (PCSetType(pc, PCHYPRE)) throw VofError("pressure_pc: this PETSc has no hypre (valid here: gamg)");
       petsc_check(PCHYPRESetType(pc, "boomeramg"), "PCHYPRESetType");
-      petsc_check(KSPSetOptionsPrefix(ksp, "runout_p_"), "KSPSetOptionsPrefix");
-      petsc_check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
     } else {
       throw VofError("pressure_pc: unknown '" + s.cfg_.pressure_pc + "' (valid: gamg, hypre)");
     }
     petsc_check(KSPSetTolerances(ksp, s.cfg_.pressure_rtol, 1e-300, PETSC_DEFAULT, 2000), "KSPSetTolerances");
     petsc_check(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
+    // PETSc options with the prefix runout_p_ (PETSC_OPTIONS) set the preconditioner's details; the
+    // relative tolerances are set again for each solve (VofConfig::pressure_rtol*).
+    petsc_check(KSPSetOptionsPrefix(ksp, "runout_p_"), "KSPSetOptionsPrefix");
+    petsc_check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
   }
 
   // (Re)create the pressure system for the current active region.

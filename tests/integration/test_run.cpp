@@ -831,7 +831,12 @@ TEST(Scenarios, LabPressurePreconditionerIsChosenByName) {
     if (k == 1) lab->set_pressure_preconditioner("hypre");
     r = jobs::resolve_scenario(r.scenario, std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab");
     TempDir d;
-    ASSERT_EQ(jobs::run_scenario(r, d.p.string()).stop, "end-time");
+    try {
+      ASSERT_EQ(jobs::run_scenario(r, d.p.string()).stop, "end-time");
+    } catch (const std::exception& e) {
+      if (k == 1 && std::string(e.what()).find("no hypre") != std::string::npos) GTEST_SKIP() << e.what();
+      throw;
+    }
     const std::string j = read_text(d / "run.json");
     peak[k] = json_number(j, "peak_speed_m_s");
     angle[k] = json_number(j, "mean_surface_angle_deg");
