@@ -9,7 +9,7 @@
 //                                          --coupling: the pressure coupling, lab.pressure_coupling;
 //                                          --convection: the momentum's convection, lab.momentum_convection;
 //                                          --coulomb-pressure: the Coulomb viscosity's pressure, lab.coulomb_pressure)
-//   runout_bench_vof --b10 [--check]       B10: column collapse for aspect ratios 0.5-6 (5 mm cells,
+//   runout_bench_vof --b10 [--check] [--jobs N]  B10: column collapse for aspect ratios 0.5-6 (5 mm cells,
 //                                          scenarios/lab/b10-column-a*.json), normalised runout, rest
 //                                          time and the exponents of its growth
 //   runout_bench_vof --b1|--b2-inclined|--b3|--b4|--b5|--b8 [--check]
@@ -28,7 +28,7 @@
 //   runout_bench_vof --b7 [--full] [--check] [--jobs N]  B7: the wide chute with each obstacle at 5 mm
 //                                          (--full: 2.5 mm, 1.34 million cells), depth figures and cost;
 //                                          --check: exit 1 unless the described behaviour holds
-//                                          --jobs N (B6, B7): N set-ups at a time, each in a process of its
+//                                          --jobs N (B6, B7, B10): N set-ups at a time, each in a process of its
 //                                          own (0: as many as cores; default 1, so that the wall times are
 //                                          each run's alone)
 //   runout_bench_vof --region              cost per step against the material region: the same failing
@@ -168,8 +168,8 @@ static int b6(bool full, bool check, int jobs) {
 static int usage() {
   std::fprintf(stderr,
                "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off] "
-               "[--coupling piso|consistent] [--convection upwind|limited_linear] [--coulomb-pressure total|excess] [--check] | --b1|--b2-inclined|--b3|--b4|--b5|--b8|--b10 "
-               "[--check] | --b6|--b7 [--full] [--check] [--jobs N] | --b9 [--full] [--check] | --region\n");
+               "[--coupling piso|consistent] [--convection upwind|limited_linear] [--coulomb-pressure total|excess] [--check] | --b1|--b2-inclined|--b3|--b4|--b5|--b8 "
+               "[--check] | --b6|--b7 [--full] [--check] [--jobs N] | --b10 [--check] [--jobs N] | --b9 [--full] [--check] | --region\n");
   return 2;
 }
 
@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
   if (mode.size() > 2 && mode.compare(0, 3, "--b") == 0) {
     // One case: --bN [--full] [--check]; --full only where the case has a coarser default.
     const bool takes_full = mode == "--b6" || mode == "--b7" || mode == "--b9";
-    const bool takes_jobs = mode == "--b6" || mode == "--b7";
+    const bool takes_jobs = mode == "--b6" || mode == "--b7" || mode == "--b10";
     bool full = false, check = false;
     int jobs = 1;
     for (int k = 2; k < argc; ++k) {
@@ -200,7 +200,7 @@ int main(int argc, char** argv) {
     if (mode == "--b7") return runout::bench::lab_b7(full, check, jobs);
     if (mode == "--b8") return runout::bench::lab_b8(check);
     if (mode == "--b9") return b9(full, check);
-    if (mode == "--b10") return runout::bench::lab_b10(check);
+    if (mode == "--b10") return runout::bench::lab_b10(check, jobs);
     return usage();
   }
   if (mode == "--region") return argc == 2 ? region() : usage();

@@ -297,16 +297,21 @@ int lab_b8(bool check) {
 // released at t = 0, from scenarios/lab/b10-column-a*.json (5 mm cells). Described (Lube et al.,
 // Lajeunesse et al., Balmforth & Kerswell): (l - L)/L grows about as a for small a and more slowly
 // (about a^(2/3) in narrow channels, a^0.9 in wide ones) for tall columns.
-int lab_b10(bool check) {
+int lab_b10(bool check, int jobs) {
   std::printf("| a = H/L | cells | (l - L)/L | at rest from [s] | end [s] | steps | wall [s] |\n|---:|---:|---:|---:|---:|---:|---:|\n");
   const std::vector<std::string> names = {"0.5", "1", "2", "4", "6"};
   std::vector<double> as, rs;
   Checks c("B10");
+  std::vector<runout::jobs::ResolvedScenario> scenarios;
   for (const auto& a : names) {
     auto r = lab_scenario("b10-column-a" + a);
     r.scenario.mutable_lab()->set_write_interval_s(0);
-    const double L = r.scenario.lab().fill(0).x_max() - r.scenario.lab().fill(0).x_min();
-    const auto ran = run_in_temp(r);
+    scenarios.push_back(std::move(r));
+  }
+  run_all(scenarios, jobs, [&](std::size_t k, const Ran& ran) {
+    const std::string& a = names[k];
+    const auto& lab = scenarios[k].scenario.lab();
+    const double L = lab.fill(0).x_max() - lab.fill(0).x_min();
     const auto& sum = ran.sum;
     const double rel = (sum.runout_m - L) / L;
     as.push_back(std::atof(a.c_str()));
@@ -316,7 +321,7 @@ int lab_b10(bool check) {
     std::fflush(stdout);
     invariants(c, "B10 a = " + a, ran);
     c(field(ran.json, "final_speed_m_s") < 1e-2, "B10 a = " + a + ": at rest by the end (below 1 cm/s)");
-  }
+  });
   // Exponents: log-log slopes over the small (0.5-2) and large (2-6) aspect ratios.
   auto slope = [&](std::size_t i0, std::size_t i1) {
     double sx = 0, sy = 0, sxx = 0, sxy = 0, n = 0;

@@ -94,7 +94,8 @@ inline Ran run_in_temp(const runout::jobs::ResolvedScenario& r) {
 // finished (so tables fill in as the runs end). jobs 0: as many as the machine has cores; 1: one
 // after the other in this process. The callers fork before anything starts PETSc, MPI or HDF5 in
 // this process (they only load scenarios first). A child that dies (a signal, memory) gives a
-// result with the error set.
+// result with the error set. Of the summary, the children hand back the stop, steps, wall time,
+// simulated time, cells, runout, peak speed and depth and the volumes; the rest is in run.json.
 template <class Done>
 void run_all(const std::vector<runout::jobs::ResolvedScenario>& rs, int jobs, Done done) {
   namespace fs = std::filesystem;
@@ -123,15 +124,17 @@ void run_all(const std::vector<runout::jobs::ResolvedScenario>& rs, int jobs, Do
     running.erase(running.begin() + long(q));
     Ran& ran = out[k];
     std::ifstream meta(file(k, ".meta"));
-    std::string stop, steps, seconds, t, nx, ny;
-    if (WIFEXITED(status) && WEXITSTATUS(status) == 0 && std::getline(meta, stop) && std::getline(meta, steps) &&
-        std::getline(meta, seconds) && std::getline(meta, t) && std::getline(meta, nx) && std::getline(meta, ny)) {
-      ran.sum.stop = stop;
-      ran.sum.steps = std::strtol(steps.c_str(), nullptr, 10);
-      ran.sum.seconds_run = std::strtod(seconds.c_str(), nullptr);
-      ran.sum.t = std::strtod(t.c_str(), nullptr);
-      ran.sum.nx = int(std::strtol(nx.c_str(), nullptr, 10));
-      ran.sum.ny = int(std::strtol(ny.c_str(), nullptr, 10));
+    std::string stop;
+    std::vector<std::string> v(11);
+    bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 && std::getline(meta, stop);
+    for (auto& x : v) ok = ok && std::getline(meta, x);
+    if (ok) {
+      auto num = [&](int q) { return std::strtod(v[std::size_t(q)].c_str(), nullptr); };
+      auto& u = ran.sum;
+      u.stop = stop;
+      u.steps = long(num(0)), u.seconds_run = num(1), u.t = num(2), u.nx = int(num(3)), u.ny = int(num(4));
+      u.runout_m = num(5), u.max_speed = num(6), u.max_depth = num(7), u.volume_initial = num(8), u.volume_final = num(9),
+      u.volume_error = num(10);
       std::getline(meta, ran.error);
       std::ifstream in(file(k, ".json"));
       std::stringstream ss;
@@ -177,8 +180,12 @@ void run_all(const std::vector<runout::jobs::ResolvedScenario>& rs, int jobs, Do
         std::ofstream(file(k, ".json")) << ran.json;
         std::ofstream meta(file(k, ".meta"));
         meta.precision(17);
-        meta << ran.sum.stop << "\n" << ran.sum.steps << "\n" << ran.sum.seconds_run << "\n" << ran.sum.t << "\n" << ran.sum.nx << "\n"
-             << ran.sum.ny << "\n" << error << "\n";
+        const auto& u = ran.sum;
+        meta << u.stop << "\n";
+        for (double x : {double(u.steps), u.seconds_run, u.t, double(u.nx), double(u.ny), u.runout_m, u.max_speed, u.max_depth,
+                         u.volume_initial, u.volume_final, u.volume_error})
+          meta << x << "\n";
+        meta << error << "\n";
       } catch (...) {
         rc = 1;
       }
