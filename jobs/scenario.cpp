@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
 
 #include "engine/names.hpp"
@@ -21,6 +22,21 @@ namespace fs = std::filesystem;
 namespace {
 
 [[noreturn]] void bad(const std::string& field, const std::string& problem) { throw ScenarioError(field + ": " + problem); }
+
+// A named option whose default stays unset, so that scenarios from before the option existed keep
+// their hash: empty or one of `valid` (the first is the default). True when it names the default,
+// which the caller then clears.
+bool unset_default(const std::string& value, const std::string& field, std::initializer_list<const char*> valid) {
+  if (value.empty()) return false;
+  std::string list;
+  bool first = true;
+  for (const char* v : valid) {
+    if (value == v) return first;
+    list += (first ? "" : ", ") + std::string(v);
+    first = false;
+  }
+  bad(field, "unknown '" + value + "' (valid: " + list + ")");
+}
 
 std::string num(double v) {
   std::ostringstream o;
@@ -176,16 +192,11 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
     bad("lab.pressure_coupling", "unknown '" + l->pressure_coupling() + "' (valid: piso, consistent)");
   // Upwind, the default, stays unset, so that scenarios (and their hashes, checkpoints and cached
   // results) from before the option existed are the same scenarios.
-  if (l->momentum_convection() != "" && l->momentum_convection() != "upwind" && l->momentum_convection() != "limited_linear")
-    bad("lab.momentum_convection", "unknown '" + l->momentum_convection() + "' (valid: upwind, limited_linear)");
-  if (l->momentum_convection() == "upwind") l->clear_momentum_convection();
-  // The same for the Coulomb viscosity's pressure: "total", the default, stays unset.
-  if (l->coulomb_pressure() != "" && l->coulomb_pressure() != "total" && l->coulomb_pressure() != "excess")
-    bad("lab.coulomb_pressure", "unknown '" + l->coulomb_pressure() + "' (valid: total, excess)");
-  if (l->coulomb_pressure() == "total") l->clear_coulomb_pressure();
-  if (l->pressure_preconditioner() != "" && l->pressure_preconditioner() != "gamg" && l->pressure_preconditioner() != "hypre")
-    bad("lab.pressure_preconditioner", "unknown '" + l->pressure_preconditioner() + "' (valid: gamg, hypre)");
-  if (l->pressure_preconditioner() == "gamg") l->clear_pressure_preconditioner();
+  // The same for the Coulomb viscosity's pressure ("total") and the pressure preconditioner ("gamg").
+  if (unset_default(l->momentum_convection(), "lab.momentum_convection", {"upwind", "limited_linear"})) l->clear_momentum_convection();
+  if (unset_default(l->coulomb_pressure(), "lab.coulomb_pressure", {"total", "excess"})) l->clear_coulomb_pressure();
+  if (unset_default(l->pressure_preconditioner(), "lab.pressure_preconditioner", {"gamg", "hypre"}))
+    l->clear_pressure_preconditioner();
   if (l->viscous_transpose().empty()) l->set_viscous_transpose("explicit");
   if (l->viscous_transpose() != "explicit" && l->viscous_transpose() != "harmonic" && l->viscous_transpose() != "off")
     bad("lab.viscous_transpose", "unknown '" + l->viscous_transpose() + "' (valid: explicit, harmonic, off)");

@@ -34,7 +34,7 @@ struct ResolvedScenario {
 /// older kind (2: B6's shock is the bore, no longer the resting deposit's edge; 3: 3D runs add
 /// comparison.png, and a polygon obstacle's shadow window starts behind the polygon). Adding a
 /// file or a figure counts too: a cached result lacks it. The test
-/// Scenarios.VofResultsMatchTheFingerprintOfTheirVersion holds this version's figures for five
+/// Scenarios.VofResultsMatchTheFingerprintOfTheirVersion holds this version's figures for ten
 /// short runs and fails when a change to the numerics moves them (options those runs do not take
 /// are not covered); Scenarios.VofHashCarriesTheResultsVersion pins a hash that a bump changes.
 inline constexpr int kVofResultsVersion = 3;

@@ -207,25 +207,23 @@ struct VofSolver::Impl {
   // opening next to active cell a, p_rgh_b = p_b - rho_a g.x_b. (Taking p = 0 all along a vertical
   // opening instead drives air through it: the air inside is hydrostatic, and the 1.5 Pa across a
   // 15 cm opening set up a circulation that grew to 5 m/s while the material rested.)
+  double still_air_p(double g_dot_x) const { return s.cfg_.rho2 * (g_dot_x - gh_ref); }
   double outside_p_rgh(int f, int a) const {
     const double g = ghf[std::size_t(f)];
-    return s.cfg_.rho2 * (g - gh_ref) - rho[std::size_t(a)] * g;
+    return still_air_p(g) - rho[std::size_t(a)] * g;
   }
+  // What the Coulomb viscosity and the Coulomb bed conditions subtract from p at a point with
+  // g.x = g_dot_x (VofConfig::coulomb_pressure): nothing, or the still air's pressure there.
+  double coulomb_level(double g_dot_x) const { return s.cfg_.coulomb_pressure == CoulombPressure::excess ? still_air_p(g_dot_x) : 0.0; }
   // The pressure on a wall face, as OpenFOAM's p.boundaryField() under the buoyantPressure
   // condition (p_rgh the cell's, the density the cell's, gh the face's): the bed pressure the
   // Coulomb conditions need (listing B.2), not the cell centre's, which in a flow one or two cells
-  // deep is half of it or less.
+  // deep is half of it or less; less coulomb_level().
   double wall_pressure(int f, int o) const {
-    const double p = s.p_rgh_[std::size_t(o)] + rho[std::size_t(o)] * ghf[std::size_t(f)];
-    return s.cfg_.coulomb_pressure == CoulombPressure::excess ? p - s.cfg_.rho2 * (ghf[std::size_t(f)] - gh_ref) : p;
+    return s.p_rgh_[std::size_t(o)] + rho[std::size_t(o)] * ghf[std::size_t(f)] - coulomb_level(ghf[std::size_t(f)]);
   }
-  // The confining pressure of the Coulomb viscosity in cell c (VofConfig::coulomb_pressure): p, or
-  // p less the still air's hydrostatic pressure at the cell centre, rho_air g.(x - x_ref), the
-  // pressure outside_p_rgh() gives the air at rest.
-  double confining_pressure(int c) const {
-    const double p = s.p_[std::size_t(c)];
-    return s.cfg_.coulomb_pressure == CoulombPressure::excess ? p - s.cfg_.rho2 * (gh[std::size_t(c)] - gh_ref) : p;
-  }
+  // The confining pressure of the Coulomb viscosity in cell c: p less coulomb_level().
+  double confining_pressure(int c) const { return s.p_[std::size_t(c)] - coulomb_level(gh[std::size_t(c)]); }
   // The last pressure's and the buoyancy's force per area on an internal face, along Sf:
   // -ghf snGrad(rho) - snGrad(p_rgh) (the momentum predictor's and the consistent coupling's F_old).
   double face_force(int f) const {
@@ -863,7 +861,7 @@ struct VofSolver::Impl {
       }
       if (active_index[std::size_t(c)] < 0) {  // air at rest outside the region
         s.U_[std::size_t(c)] = Vec{};
-        s.p_[std::size_t(c)] = s.cfg_.rho2 * (gh[std::size_t(c)] - gh_ref);
+        s.p_[std::size_t(c)] = still_air_p(gh[std::size_t(c)]);
         s.p_rgh_[std::size_t(c)] = s.p_[std::size_t(c)] - rho[std::size_t(c)] * gh[std::size_t(c)];
       }
     }
