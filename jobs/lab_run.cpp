@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <mutex>
 #include <sstream>
 
@@ -836,7 +837,13 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   // centre, as wide as the obstacle.
   std::ostringstream chute;
   // comparison.png's title (the section of a plane run, the plan view of a 3D one).
-  const std::string figure_title = (r.scenario.name().empty() ? std::string("laboratory run") : r.scenario.name()) + ", t = " + json_number(s.time()) + " s";
+  // The cell size is stated because a scenario's name may describe its file's resolution while the
+  // run took another (the benchmarks' full variants).
+  std::ostringstream cells_mm;
+  cells_mm << std::setprecision(3) << dx * 1e3 << " x " << dy * 1e3;
+  if (g.three_d) cells_mm << " x " << g.dz * 1e3;
+  const std::string figure_title = (r.scenario.name().empty() ? std::string("laboratory run") : r.scenario.name()) + ", t = " + json_number(s.time()) +
+                                   " s, cells " + cells_mm.str() + " mm";
   PlanFigure plan;  // comparison.png of a 3D run
   const ChuteBed chute_bed(L);  // used on a curved chute only
   if (g.three_d) {
