@@ -197,7 +197,7 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
   if (unset_default(l->coulomb_pressure(), "lab.coulomb_pressure", {"total", "excess"})) l->clear_coulomb_pressure();
   if (unset_default(l->pressure_preconditioner(), "lab.pressure_preconditioner", {"gamg", "hypre"}))
     l->clear_pressure_preconditioner();
-  if (l->viscous_transpose().empty()) l->set_viscous_transpose("explicit");
+  if (l->viscous_transpose().empty()) l->set_viscous_transpose("harmonic");
   if (l->viscous_transpose() != "explicit" && l->viscous_transpose() != "harmonic" && l->viscous_transpose() != "off")
     bad("lab.viscous_transpose", "unknown '" + l->viscous_transpose() + "' (valid: explicit, harmonic, off)");
   if (l->has_reference()) {

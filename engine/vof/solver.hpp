@@ -8,7 +8,8 @@
 //     c_alpha) and a flux-corrected-transport limiter (Zalesak) that keeps alpha within the local
 //     bounds and [0, 1], with sub-cycles;
 //   * Euler implicit time derivative; the momentum matrix (upwind convection of the mass flux,
-//     implicit viscous term, explicit transpose part in divergence form) is built once per step and
+//     implicit viscous term, explicit transpose part in divergence form, by default with the
+//     harmonic face viscosity) is built once per step and
 //     each PISO corrector rebuilds H/A from the latest velocity and solves the pressure equation, as
 //     the dissertation ran it (no momentum predictor, 9 correctors). Each corrector is one
 //     Jacobi-like sweep of the viscous coupling, so the number of correctors and the step size set
@@ -90,11 +91,13 @@ struct VofConfig {
   /// of the iterations.
   double momentum_rtol = 1e-6;
   /// The viscous stress's transpose part div(mu (grad U)^T), explicit in divergence form:
-  /// linear: mu_f interpolated linearly, as interFoam has it; harmonic: mu_f the harmonic mean of the
-  /// two cells (the stress two layers in series carry); off: left out. Where the Coulomb viscosity
-  /// jumps between its clip (1e2 m2/s) and flowing cells, the linear face value lets this explicit
-  /// term outweigh gravity a hundredfold and drive spurious pressures (docs/vof.md).
-  Transpose viscous_transpose = Transpose::linear;
+  /// harmonic (default): mu_f the harmonic mean of the two cells (the stress two layers in series
+  /// carry); linear: mu_f interpolated linearly, as interFoam has it; off: left out. Where the
+  /// Coulomb viscosity jumps between its clip (1e2 m2/s) and flowing cells, the linear face value
+  /// lets this explicit term outweigh gravity a hundredfold and drive spurious pressures, and the
+  /// deposits it converges to lie about 3 deg below phi (B2, B9); the harmonic one's lie at phi
+  /// (validation.md B2, B9; docs/vof.md).
+  Transpose viscous_transpose = Transpose::harmonic;
   /// Face values of the momentum's convection term: upwind (first order), or limited_linear:
   /// interFoam's limitedLinearV 1, upwind blended towards linear by a TVD limiter, applied as a
   /// deferred correction (validation.md B2: upwind's numerical viscosity, about u dx / 2, is as
