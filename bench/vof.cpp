@@ -1,11 +1,12 @@
 // Benchmark of the VOF engine on B2 at 0 deg (validation.md B2) to t = 1 s, the case the
 // dissertation timed: OpenFOAM's interFoam with the Coulomb viscosity took 80 s wall for 1677 steps
 // on 12,000 cells (2.5 mm, about 4 microseconds per cell and step, 53 % in the pressure solve).
-//   runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off]
+//   runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose harmonic|explicit|off]
 //                    [--coupling piso|consistent] [--convection upwind|limited_linear]
 //                    [--coulomb-pressure total|excess]
 //                                          (default: 5 mm cells; --full: 2.5 mm, the dissertation's;
-//                                          --transpose: how the viscous stress's transpose part is taken;
+//                                          --transpose: how the viscous stress's transpose part is taken
+//                                          (default: the scenario's, harmonic);
 //                                          --coupling: the pressure coupling, lab.pressure_coupling;
 //                                          --convection: the momentum's convection, lab.momentum_convection;
 //                                          --coulomb-pressure: the Coulomb viscosity's pressure, lab.coulomb_pressure)
@@ -18,7 +19,7 @@
 //                                          names, beside the measured ones where it gives them;
 //                                          --check: exit 1 unless the described behaviour holds
 //                                          (bench/vof_cases.cpp)
-//   runout_bench_vof --b9 [--full] [--check]  B9: the static and the failing heap (5 mm, --full: 2.5 mm);
+//   runout_bench_vof --b9 [--full] [--check]  B9: the static and the failing heap (2.5 mm, --full: 1.25 mm);
 //                                          --check: exit 1 unless both meet the figures
 //   runout_bench_vof [--full] --check      also check the B2 acceptance figures (exit 1 if one fails)
 //   runout_bench_vof --b6 [--full] [--check] [--jobs N]  B6: the shock at the closed end for the seven
@@ -49,7 +50,7 @@ using runout::bench::series;
 
 // B9 (validation.md B9) from scenarios/lab/b9-heap-{static,failing}.json: the heap flatter than phi
 // must stay at rest (below 1 mm/s after 1 s), the steeper one relax to within 3 deg of phi (32 deg);
-// 5 mm cells as the files have them, --full: 2.5 mm.
+// 2.5 mm cells as the files have them, --full: 1.25 mm.
 static int b9(bool full, bool check) {
   std::printf("| heap | cells | steps | wall [s] | peak speed [m/s] | speed at the end [m/s] | surface angle (80 %% to 20 %% of the height) "
               "[deg] | wanted | |\n|---|---:|---:|---:|---:|---:|---:|---|---|\n");
@@ -167,7 +168,7 @@ static int b6(bool full, bool check, int jobs) {
 
 static int usage() {
   std::fprintf(stderr,
-               "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose explicit|harmonic|off] "
+               "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose harmonic|explicit|off] "
                "[--coupling piso|consistent] [--convection upwind|limited_linear] [--coulomb-pressure total|excess] [--check] | --b1|--b2-inclined|--b3|--b4|--b5|--b8 "
                "[--check] | --b6|--b7 [--full] [--check] [--jobs N] | --b10 [--check] [--jobs N] | --b9 [--full] [--check] | --region\n");
   return 2;

@@ -457,8 +457,8 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   c.max_co = c.max_alpha_co = L.max_courant();
   c.n_correctors = L.correctors();
   c.viscous_transpose = L.viscous_transpose() == "off"        ? vof::Transpose::off
-                        : L.viscous_transpose() == "harmonic" ? vof::Transpose::harmonic
-                                                              : vof::Transpose::linear;
+                        : L.viscous_transpose() == "explicit" ? vof::Transpose::linear
+                                                              : vof::Transpose::harmonic;  // the default
   c.momentum_convection = L.momentum_convection() == "limited_linear" ? vof::Convection::limited_linear : vof::Convection::upwind;
   c.coulomb_pressure = L.coulomb_pressure() == "excess" ? vof::CoulombPressure::excess : vof::CoulombPressure::total;
   if (!L.pressure_preconditioner().empty()) c.pressure_pc = L.pressure_preconditioner();

@@ -95,7 +95,7 @@ struct VofConfig {
   /// carry); linear: mu_f interpolated linearly, as interFoam has it; off: left out. Where the
   /// Coulomb viscosity jumps between its clip (1e2 m2/s) and flowing cells, the linear face value
   /// lets this explicit term outweigh gravity a hundredfold and drive spurious pressures, and the
-  /// deposits it converges to lie about 3 deg below phi (B2, B9); the harmonic one's lie at phi
+  /// deposits it converges to lie 2-3 deg below phi (B2, B9); the harmonic one's lie at phi
   /// (validation.md B2, B9; docs/vof.md).
   Transpose viscous_transpose = Transpose::harmonic;
   /// Face values of the momentum's convection term: upwind (first order), or limited_linear:
