@@ -57,22 +57,36 @@ inline runout::jobs::ResolvedScenario lab_scenario(const std::string& name) {
 }
 
 // Run a scenario in a temporary directory; its summary and run.json, or the error that ended it
-// (then json is empty and every figure reads as NaN).
+// (then json is empty and every figure reads as NaN). With the environment variable
+// RUNOUT_BENCH_KEEP=DIR the run directory is kept instead, as DIR/NAME (NAME the scenario file's
+// stem, then NAME-2, NAME-3, ... for later runs of the same file), with its figures and fields.
 struct Ran {
   runout::jobs::RunSummary sum;
   std::string json;
   std::string error;
 };
+inline std::filesystem::path kept_run_dir(const std::string& keep, const runout::jobs::ResolvedScenario& r) {
+  namespace fs = std::filesystem;
+  fs::create_directories(keep);
+  const std::string stem = r.source.empty() ? std::string("run") : fs::path(r.source).stem().string();
+  for (int k = 1;; ++k) {
+    const fs::path p = fs::path(keep) / (k == 1 ? stem : stem + "-" + std::to_string(k));
+    if (fs::create_directory(p)) return p;  // false when it exists: the next name (parallel runs too)
+  }
+}
 inline Ran run_in_temp(const runout::jobs::ResolvedScenario& r) {
   namespace fs = std::filesystem;
-  const fs::path out = fs::temp_directory_path() / ("runout-bench-vof-" + std::to_string(getpid()));
+  const char* keep = std::getenv("RUNOUT_BENCH_KEEP");
+  const bool kept = keep != nullptr && *keep != 0;
+  const fs::path out =
+      kept ? kept_run_dir(keep, r) : fs::temp_directory_path() / ("runout-bench-vof-" + std::to_string(getpid()));
   struct Remove {
     fs::path p;
     ~Remove() {
       std::error_code ec;
-      fs::remove_all(p, ec);
+      if (!p.empty()) fs::remove_all(p, ec);
     }
-  } remove{out};
+  } remove{kept ? fs::path() : out};
   fs::create_directories(out);
   Ran ran;
   try {
