@@ -229,6 +229,17 @@ void check_iseesnow(const TempDir& d, const std::string& release, const std::str
   EXPECT_NEAR(std::stod(cells[5]), volume, 1e-6 * volume);  // closed: nothing left the grid
 }
 
+// B2 at 0 deg (scenarios/lab/b2-collapse-0deg.json) on 1 cm cells (50 x 15 instead of the file's
+// 2.5 mm) to end_time: the coarse VOF run that several tests start from.
+jobs::ResolvedScenario coarse_b2(double end_time) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json");
+  auto* lab = r.scenario.mutable_lab();
+  lab->set_nx(50);
+  lab->set_ny(15);
+  lab->set_end_time_s(end_time);
+  return r;
+}
+
 }  // namespace
 
 TEST(Terrain, SyntheticSlopeRunsAndWritesEveryOutput) {
@@ -696,12 +707,8 @@ TEST(Scenarios, IseesnowRealTopo) {
 
 // The VOF engine through the same run driver: B2 (validation.md) on a coarse mesh.
 TEST(Scenarios, LabCollapseRunsThroughTheRunDriver) {
-  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json");
+  auto r = coarse_b2(0.4);
   ASSERT_TRUE(r.vof);
-  auto* lab = r.scenario.mutable_lab();
-  lab->set_nx(50);  // 1 cm cells instead of 2.5 mm
-  lab->set_ny(15);
-  lab->set_end_time_s(0.4);
   TempDir d;
   const auto sum = jobs::run_scenario(r, d.p.string());
   EXPECT_EQ(sum.stop, "end-time");
@@ -822,11 +829,8 @@ TEST(Scenarios, LabPressurePreconditionerIsChosenByName) {
   expect_resolve_error(bad, {"lab.pressure_preconditioner", "ilu"});
   double peak[2] = {0, 0}, angle[2] = {0, 0}, iterations[2] = {0, 0};
   for (int k = 0; k < 2; ++k) {
-    auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json");
+    auto r = coarse_b2(0.3);
     auto* lab = r.scenario.mutable_lab();
-    lab->set_nx(50);
-    lab->set_ny(15);
-    lab->set_end_time_s(0.3);
     lab->set_write_interval_s(0);
     if (k == 1) lab->set_pressure_preconditioner("hypre");
     r = jobs::resolve_scenario(r.scenario, std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab");
@@ -937,11 +941,8 @@ std::string series_text(const std::string& block, const std::string& key) {
 // and the frames continue too: run.json's series and fields.h5's frames are the uninterrupted
 // run's.
 TEST(Scenarios, LabRunContinuesFromItsCheckpoint) {
-  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json");
+  auto r = coarse_b2(0.3);
   auto* lab = r.scenario.mutable_lab();
-  lab->set_nx(50);
-  lab->set_ny(15);
-  lab->set_end_time_s(0.3);
   lab->set_checkpoint_interval_s(0.1);
   TempDir whole, first, second, third;
   jobs::RunOptions o;
@@ -1208,12 +1209,9 @@ TEST(Scenarios, LabChuteErrorsNameTheField) {
 // orange is drawn; a reference front that is no range and a negative depth ratio are refused by
 // name.
 TEST(Scenarios, LabComparisonFigureDrawsTheReference) {
-  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json");
+  auto r = coarse_b2(0.1);
   ASSERT_TRUE(r.scenario.lab().has_reference());
   auto* lab = r.scenario.mutable_lab();
-  lab->set_nx(50);
-  lab->set_ny(15);
-  lab->set_end_time_s(0.1);
   lab->set_write_interval_s(0);
   auto orange_pixels = [](const std::string& png, int x_from = 0) {
     GDALDatasetUniquePtr ds(GDALDataset::Open(png.c_str(), GDAL_OF_RASTER));
