@@ -574,14 +574,15 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
                      opt.checkpoint_path.empty() ? std::string() : opt.checkpoint_path + ".fields.h5",
                      opt.restart_path.empty() ? std::string() : opt.restart_path + ".fields.h5", restart.state.t);
   double next_write = L.write_interval_s() > 0 ? L.write_interval_s() : 1e300;
-  double peak = 0, t_peak = 0, t_rest = -1, pressure_s = 0, alpha_min = 1, alpha_max = 0, div = 0, last_speed = 0;
+  double peak = 0, t_peak = 0, t_rest = -1, pressure_s = 0, pressure_solve_s = 0, alpha_min = 1, alpha_max = 0, div = 0, last_speed = 0;
   long steps = 0, p_its = 0;
   double active_sum = 0;
   int active_max = 0;
   // The running figures a checkpoint carries.
   auto figures = [&] {
     return std::map<std::string, double>{{"peak", peak},       {"t_peak", t_peak},         {"t_rest", t_rest},
-                                         {"pressure_s", pressure_s}, {"alpha_min", alpha_min}, {"alpha_max", alpha_max},
+                                         {"pressure_s", pressure_s}, {"pressure_solve_s", pressure_solve_s},
+                                         {"alpha_min", alpha_min}, {"alpha_max", alpha_max},
                                          {"div", div},         {"last_speed", last_speed}, {"p_its", double(p_its)},
                                          {"active_sum", active_sum}, {"active_max", double(active_max)}};
   };
@@ -594,6 +595,9 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     peak = f("peak"), t_peak = f("t_peak"), t_rest = f("t_rest"), pressure_s = f("pressure_s"), alpha_min = f("alpha_min");
     alpha_max = f("alpha_max"), div = f("div"), last_speed = f("last_speed"), p_its = long(f("p_its")), active_sum = f("active_sum");
     active_max = int(f("active_max"));
+    // A timing only, and absent from checkpoints written before it was carried.
+    const auto ps = restart.figures.find("pressure_solve_s");
+    pressure_solve_s = ps == restart.figures.end() ? 0.0 : ps->second;
     steps = restart.steps;
     if (L.write_interval_s() > 0)  // the next regular frame after the checkpoint
       next_write = L.write_interval_s() * (std::floor(restart.state.t / L.write_interval_s() + 1e-9) + 1);
@@ -749,6 +753,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     active_sum += st.active_cells;
     active_max = std::max(active_max, st.active_cells);
     pressure_s += st.seconds_pressure;
+    pressure_solve_s += st.seconds_pressure_solve;
     alpha_min = std::min(alpha_min, st.alpha_min);
     alpha_max = std::max(alpha_max, st.alpha_max);
     div = std::max(div, st.divergence);
@@ -1082,7 +1087,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   }
   j << chute.str();
   j << "  \"timings_s\": {\"prepare\": " << json_number(sum.seconds_prepare) << ", \"run\": " << json_number(sum.seconds_run)
-    << ", \"pressure\": " << json_number(pressure_s) << ", \"write\": " << json_number(sum.seconds_write) << ", \"microseconds_per_cell_step\": "
+    << ", \"pressure\": " << json_number(pressure_s) << ", \"pressure_solve\": " << json_number(pressure_solve_s) << ", \"write\": " << json_number(sum.seconds_write) << ", \"microseconds_per_cell_step\": "
     << json_number(steps ? 1e6 * sum.seconds_run / steps / m.cells() : NAN) << ", \"microseconds_per_active_cell_step\": "
     << json_number(active_sum > 0 ? 1e6 * sum.seconds_run / active_sum : NAN) << "}\n}\n";
   if (!j) throw std::runtime_error("cannot write run.json");

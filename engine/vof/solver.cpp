@@ -1083,7 +1083,9 @@ struct VofSolver::Impl {
       system_fresh = false;
       petsc_check(KSPSetReusePreconditioner(ksp, keep_pc ? PETSC_TRUE : PETSC_FALSE), "KSPSetReusePreconditioner");
       petsc_check(KSPSetOperators(ksp, Ap, Ap), "KSPSetOperators");
+      auto t_ksp = std::chrono::steady_clock::now();
       petsc_check(KSPSolve(ksp, r, dx), "KSPSolve");
+      ksp_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_ksp).count();
       KSPConvergedReason reason;
       KSPGetConvergedReason(ksp, &reason);
       PetscInt k = 0;
@@ -1095,7 +1097,9 @@ struct VofSolver::Impl {
         petsc_check(VecSet(dx, 0.0), "VecSet");
         petsc_check(KSPSetReusePreconditioner(ksp, PETSC_FALSE), "KSPSetReusePreconditioner");
         petsc_check(KSPSetOperators(ksp, Ap, Ap), "KSPSetOperators");
+        t_ksp = std::chrono::steady_clock::now();
         petsc_check(KSPSolve(ksp, r, dx), "KSPSolve");
+        ksp_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_ksp).count();
         KSPGetConvergedReason(ksp, &reason);
         KSPGetIterationNumber(ksp, &k);
         its += k;
@@ -1169,6 +1173,7 @@ struct VofSolver::Impl {
   std::vector<Vec> U_old;
 
   int steps_since_pc = 0;
+  double ksp_seconds = 0;  // time in KSPSolve since step() last took it
   std::vector<int> active_index;  // per cell: its row in the pressure system, -1 outside the active region
   std::vector<int> active_cells;  // the active region
   std::vector<int> halo_cells;    // the active region and the cells next to it (alpha may change there)
@@ -1350,6 +1355,7 @@ StepStats VofSolver::step() {
   // 5-6. Momentum matrix and PISO correctors.
   I.velocity_gradient();
   double t_p = 0;
+  I.ksp_seconds = 0;
   I.build_momentum(dt_);
   if (cfg_.momentum_predictor) st.momentum_iterations = I.predict();
   for (int k = 0; k < std::max(1, cfg_.n_correctors); ++k) {
@@ -1389,6 +1395,7 @@ StepStats VofSolver::step() {
   st.alpha_co = aco;
   st.air_co = air_co;
   st.seconds_pressure = t_p;
+  st.seconds_pressure_solve = I.ksp_seconds;
   st.seconds_total = std::chrono::duration<double>(clk::now() - t0).count();
   return st;
 }

@@ -725,6 +725,14 @@ TEST(Scenarios, LabCollapseRunsThroughTheRunDriver) {
   std::stringstream ss;
   ss << rec.rdbuf();
   EXPECT_NE(ss.str().find("\"upper_surface_angle_deg\""), std::string::npos);
+  // The timings split the pressure correctors' time and, within it, the linear solves'.
+  const auto tk = ss.str().find("\"timings_s\"");
+  ASSERT_NE(tk, std::string::npos);
+  const double t_run = json_number(ss.str(), "run", tk), t_p = json_number(ss.str(), "pressure", tk),
+               t_solve = json_number(ss.str(), "pressure_solve", tk);
+  EXPECT_GT(t_solve, 0);
+  EXPECT_LE(t_solve, t_p);
+  EXPECT_LE(t_p, t_run);
   GDALDatasetUniquePtr fr(GDALDataset::Open(("HDF5:\"" + d / "fields.h5" + "\"://f00000/alpha").c_str(), GDAL_OF_RASTER));
   ASSERT_TRUE(fr);
   EXPECT_EQ(fr->GetRasterXSize(), 50);
