@@ -949,62 +949,83 @@ struct VofSolver::Impl {
     auto& rec_old = pf_rec_old;
     if (cons)
       for (int c : active_cells) rec_old[std::size_t(c)] = Vec{};
-    for (int f : active_faces) {
-      phiHbyA[std::size_t(f)] = phig[std::size_t(f)] = coef[std::size_t(f)] = pout[std::size_t(f)] = 0;
-      open[std::size_t(f)] = 0;
-      const int o = m.owner[std::size_t(f)];
-      const bool ao = ix[std::size_t(o)] >= 0;
-      if (f < m.n_internal) {
-        const int nb = m.neighbour[std::size_t(f)];
-        const bool an = ix[std::size_t(nb)] >= 0;
-        if (ao && an) {
-          const double w = m.weight[std::size_t(f)];
-          const Vec Hf = w * HbyA[std::size_t(o)] + (1 - w) * HbyA[std::size_t(nb)];
-          phiHbyA[std::size_t(f)] = initial ? 0.0 : dot(Hf, m.Sf[std::size_t(f)]);
-          phig[std::size_t(f)] = -ghf[std::size_t(f)] * (rho[std::size_t(nb)] - rho[std::size_t(o)]) * m.delta_coeff[std::size_t(f)] *
-                                 m.magSf[std::size_t(f)] * rAf[std::size_t(f)];
-          coef[std::size_t(f)] = rAf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
-          if (cons) {
-            const double Fold = face_force(f);
-            phiHbyA[std::size_t(f)] += (rAUf[std::size_t(f)] - rAtUf[std::size_t(f)]) * Fold * m.magSf[std::size_t(f)];
-            rec_old[std::size_t(o)] = rec_old[std::size_t(o)] + Fold * m.Sf[std::size_t(f)];
-            rec_old[std::size_t(nb)] = rec_old[std::size_t(nb)] + Fold * m.Sf[std::size_t(f)];
+    // Within a step 1/A, the density and the active region do not change (reuse: a later
+    // corrector of the step), and with them neither which faces are openings, the Laplacian
+    // coefficients, the buoyancy fluxes nor the outside pressures: those are set by the step's
+    // first call. Every call forms the predicted flux from the correctors' H/A.
+    if (!reuse)
+      for (int f : active_faces) {
+        phig[std::size_t(f)] = coef[std::size_t(f)] = pout[std::size_t(f)] = 0;
+        open[std::size_t(f)] = 0;
+        const int o = m.owner[std::size_t(f)];
+        const bool ao = ix[std::size_t(o)] >= 0;
+        if (f < m.n_internal) {
+          const int nb = m.neighbour[std::size_t(f)];
+          const bool an = ix[std::size_t(nb)] >= 0;
+          if (ao && an) {
+            phig[std::size_t(f)] = -ghf[std::size_t(f)] * (rho[std::size_t(nb)] - rho[std::size_t(o)]) * m.delta_coeff[std::size_t(f)] *
+                                   m.magSf[std::size_t(f)] * rAf[std::size_t(f)];
+            coef[std::size_t(f)] = rAf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+          } else if (ao || an) {
+            const int a = ao ? o : nb;
+            open[std::size_t(f)] = ao ? 1 : -1;
+            coef[std::size_t(f)] = rA[std::size_t(a)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+            pout[std::size_t(f)] = outside_p_rgh(f, a);
           }
-        } else if (ao || an) {
-          const int a = ao ? o : nb;
-          open[std::size_t(f)] = ao ? 1 : -1;
-          phiHbyA[std::size_t(f)] = initial ? 0.0 : dot(HbyA[std::size_t(a)], m.Sf[std::size_t(f)]);
-          coef[std::size_t(f)] = rA[std::size_t(a)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
-          pout[std::size_t(f)] = outside_p_rgh(f, a);
-          if (cons) {
-            const double sg = open[std::size_t(f)];
-            const double Fout = opening_force(f, a, pout[std::size_t(f)]);  // out of a
-            phiHbyA[std::size_t(f)] += sg * (rAU[std::size_t(a)] - rAtU[std::size_t(a)]) * Fout * m.magSf[std::size_t(f)];
-            rec_old[std::size_t(a)] = rec_old[std::size_t(a)] + (sg * Fout) * m.Sf[std::size_t(f)];
-          }
-        }
-      } else if (ao) {
-        const Bc k = kind_of(f);
-        if (k == Bc::inflow) phiHbyA[std::size_t(f)] = dot(bc_of(f).inflow_velocity(m.Cf[std::size_t(f)]), m.Sf[std::size_t(f)]);
-        else if (k == Bc::outflow || k == Bc::atmosphere)
-          phiHbyA[std::size_t(f)] = initial ? 0.0 : dot(HbyA[std::size_t(o)], m.Sf[std::size_t(f)]);
-        if (k == Bc::atmosphere) {
+        } else if (ao && kind_of(f) == Bc::atmosphere) {
           open[std::size_t(f)] = 1;
           coef[std::size_t(f)] = rAf[std::size_t(f)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
           pout[std::size_t(f)] = outside_p_rgh(f, o);
-          if (cons) {
-            const double Fout = opening_force(f, o, pout[std::size_t(f)]);
-            phiHbyA[std::size_t(f)] += (rAU[std::size_t(o)] - rAtU[std::size_t(o)]) * Fout * m.magSf[std::size_t(f)];
-            rec_old[std::size_t(o)] = rec_old[std::size_t(o)] + Fout * m.Sf[std::size_t(f)];
-          }
         }
       }
-      phiHbyA[std::size_t(f)] += phig[std::size_t(f)];
+    for (int f : active_faces) {
+      const int o = m.owner[std::size_t(f)];
+      const signed char op = open[std::size_t(f)];
+      double ph = 0;
+      if (f < m.n_internal) {
+        const int nb = m.neighbour[std::size_t(f)];
+        if (op == 0) {
+          if (ix[std::size_t(o)] >= 0) {  // both cells active (an internal face of the region that is no opening)
+            const double w = m.weight[std::size_t(f)];
+            const Vec Hf = w * HbyA[std::size_t(o)] + (1 - w) * HbyA[std::size_t(nb)];
+            ph = initial ? 0.0 : dot(Hf, m.Sf[std::size_t(f)]);
+            if (cons) {
+              const double Fold = face_force(f);
+              ph += (rAUf[std::size_t(f)] - rAtUf[std::size_t(f)]) * Fold * m.magSf[std::size_t(f)];
+              rec_old[std::size_t(o)] = rec_old[std::size_t(o)] + Fold * m.Sf[std::size_t(f)];
+              rec_old[std::size_t(nb)] = rec_old[std::size_t(nb)] + Fold * m.Sf[std::size_t(f)];
+            }
+          }
+        } else {
+          const int a = op > 0 ? o : nb;
+          ph = initial ? 0.0 : dot(HbyA[std::size_t(a)], m.Sf[std::size_t(f)]);
+          if (cons) {
+            const double sg = op;
+            const double Fout = opening_force(f, a, pout[std::size_t(f)]);  // out of a
+            ph += sg * (rAU[std::size_t(a)] - rAtU[std::size_t(a)]) * Fout * m.magSf[std::size_t(f)];
+            rec_old[std::size_t(a)] = rec_old[std::size_t(a)] + (sg * Fout) * m.Sf[std::size_t(f)];
+          }
+        }
+      } else if (ix[std::size_t(o)] >= 0) {
+        const Bc k = kind_of(f);
+        if (k == Bc::inflow) ph = dot(bc_of(f).inflow_velocity(m.Cf[std::size_t(f)]), m.Sf[std::size_t(f)]);
+        else if (k == Bc::outflow || k == Bc::atmosphere)
+          ph = initial ? 0.0 : dot(HbyA[std::size_t(o)], m.Sf[std::size_t(f)]);
+        if (k == Bc::atmosphere && cons) {
+          const double Fout = opening_force(f, o, pout[std::size_t(f)]);
+          ph += (rAU[std::size_t(o)] - rAtU[std::size_t(o)]) * Fout * m.magSf[std::size_t(f)];
+          rec_old[std::size_t(o)] = rec_old[std::size_t(o)] + Fout * m.Sf[std::size_t(f)];
+        }
+      }
+      phiHbyA[std::size_t(f)] = ph + phig[std::size_t(f)];
     }
     // Assemble M p = rhs. Within a step the matrix does not change (1/A is built once per step):
     // later correctors keep it and its preconditioner and assemble only the right-hand side.
     if (!reuse) petsc_check(MatZeroEntries(A), "MatZeroEntries");
-    std::vector<double> diag(std::size_t(n_active), 0.0), rhs(std::size_t(n_active), 0.0);
+    // The diagonal is kept from the step's first call (the closed domain's pinning needs it then too).
+    auto &diag = pf_diag, &rhs = pf_rhs;
+    if (!reuse) diag.assign(std::size_t(n_active), 0.0);
+    rhs.assign(std::size_t(n_active), 0.0);
     for (int f : active_faces) {
       const double c = coef[std::size_t(f)];
       const int io = ix[std::size_t(m.owner[std::size_t(f)])];
@@ -1012,7 +1033,7 @@ struct VofSolver::Impl {
         const int ia = open[std::size_t(f)] > 0 ? io : ix[std::size_t(m.neighbour[std::size_t(f)])];
         const double sg = open[std::size_t(f)];
         rhs[std::size_t(ia)] -= sg * phiHbyA[std::size_t(f)];
-        diag[std::size_t(ia)] += c;
+        if (!reuse) diag[std::size_t(ia)] += c;
         rhs[std::size_t(ia)] += c * pout[std::size_t(f)];
         continue;
       }
@@ -1021,9 +1042,9 @@ struct VofSolver::Impl {
       if (f < m.n_internal) {
         const int in = ix[std::size_t(m.neighbour[std::size_t(f)])];
         rhs[std::size_t(in)] += phiHbyA[std::size_t(f)];
-        diag[std::size_t(io)] += c;
-        diag[std::size_t(in)] += c;
         if (!reuse) {
+          diag[std::size_t(io)] += c;
+          diag[std::size_t(in)] += c;
           const PetscInt r0 = io, c0 = in;
           const PetscScalar v = -c;
           petsc_check(MatSetValues(A, 1, &r0, 1, &c0, &v, INSERT_VALUES), "MatSetValues");
@@ -1191,6 +1212,7 @@ struct VofSolver::Impl {
   std::vector<Vec> wv1;
   std::vector<double> pf_phiHbyA, pf_phig, pf_coef, pf_pout;  // pressure_correct's per-face values
   std::vector<signed char> pf_open;
+  std::vector<double> pf_diag, pf_rhs;  // pressure_correct's per-row values
   std::vector<Vec> pf_rec, pf_rec_old, pf_known;
   bool system_fresh = true;  // the pressure system was just (re)created
 };
