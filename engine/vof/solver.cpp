@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <mutex>
+#include <span>
 
 namespace runout::engine::vof {
 
@@ -47,7 +48,13 @@ struct VofSolver::Impl {
   int nc = 0, nf = 0, dims = 2;
   std::vector<Bc> face_bc;             // per boundary face (index f - n_internal)
   std::vector<const PatchBc*> face_pbc;
-  std::vector<std::vector<int>> cell_faces;  // faces of each cell
+  // Faces of each cell in ascending order, stored flat (cell_faces[c] is a span of face_list).
+  struct CellFaces {
+    std::vector<int> start, face_list;
+    std::span<const int> operator[](std::size_t c) const {
+      return {face_list.data() + start[c], std::size_t(start[c + 1] - start[c])};
+    }
+  } cell_faces;
   bool has_dirichlet = false;
   // Pressure system.
   Mat A = nullptr;
@@ -112,10 +119,20 @@ struct VofSolver::Impl {
     if (!(s.cfg_.phi_deg > 0 && s.cfg_.phi_deg < 90)) throw VofError("phi_deg must lie in (0, 90)");
     if (!(s.cfg_.momentum_rtol > 0 && s.cfg_.momentum_rtol < 1)) throw VofError("momentum_rtol must lie in (0, 1)");
     if (!(s.cfg_.consistent_alpha > 0 && s.cfg_.consistent_alpha <= 1)) throw VofError("consistent_alpha must lie in (0, 1]");
-    cell_faces.assign(std::size_t(nc), {});
-    for (int f = 0; f < nf; ++f) {
-      cell_faces[std::size_t(m.owner[std::size_t(f)])].push_back(f);
-      if (f < m.n_internal) cell_faces[std::size_t(m.neighbour[std::size_t(f)])].push_back(f);
+    {
+      auto& cf = cell_faces;
+      cf.start.assign(std::size_t(nc) + 1, 0);
+      for (int f = 0; f < nf; ++f) {
+        ++cf.start[std::size_t(m.owner[std::size_t(f)]) + 1];
+        if (f < m.n_internal) ++cf.start[std::size_t(m.neighbour[std::size_t(f)]) + 1];
+      }
+      for (int c = 0; c < nc; ++c) cf.start[std::size_t(c) + 1] += cf.start[std::size_t(c)];
+      cf.face_list.assign(std::size_t(cf.start[std::size_t(nc)]), 0);
+      std::vector<int> next(cf.start.begin(), cf.start.end() - 1);
+      for (int f = 0; f < nf; ++f) {
+        cf.face_list[std::size_t(next[std::size_t(m.owner[std::size_t(f)])]++)] = f;
+        if (f < m.n_internal) cf.face_list[std::size_t(next[std::size_t(m.neighbour[std::size_t(f)])]++)] = f;
+      }
     }
     // Reconstruction tensors.
     recon_inv.resize(static_cast<std::size_t>(nc));
