@@ -1001,17 +1001,15 @@ struct VofSolver::Impl {
       double ph = 0;
       if (f < m.n_internal) {
         const int nb = m.neighbour[std::size_t(f)];
-        if (op == 0) {
-          if (ix[std::size_t(o)] >= 0) {  // both cells active (an internal face of the region that is no opening)
-            const double w = m.weight[std::size_t(f)];
-            const Vec Hf = w * HbyA[std::size_t(o)] + (1 - w) * HbyA[std::size_t(nb)];
-            ph = initial ? 0.0 : dot(Hf, m.Sf[std::size_t(f)]);
-            if (cons) {
-              const double Fold = face_force(f);
-              ph += (rAUf[std::size_t(f)] - rAtUf[std::size_t(f)]) * Fold * m.magSf[std::size_t(f)];
-              rec_old[std::size_t(o)] = rec_old[std::size_t(o)] + Fold * m.Sf[std::size_t(f)];
-              rec_old[std::size_t(nb)] = rec_old[std::size_t(nb)] + Fold * m.Sf[std::size_t(f)];
-            }
+        if (op == 0) {  // both cells active (an active face that is no opening)
+          const double w = m.weight[std::size_t(f)];
+          const Vec Hf = w * HbyA[std::size_t(o)] + (1 - w) * HbyA[std::size_t(nb)];
+          ph = initial ? 0.0 : dot(Hf, m.Sf[std::size_t(f)]);
+          if (cons) {
+            const double Fold = face_force(f);
+            ph += (rAUf[std::size_t(f)] - rAtUf[std::size_t(f)]) * Fold * m.magSf[std::size_t(f)];
+            rec_old[std::size_t(o)] = rec_old[std::size_t(o)] + Fold * m.Sf[std::size_t(f)];
+            rec_old[std::size_t(nb)] = rec_old[std::size_t(nb)] + Fold * m.Sf[std::size_t(f)];
           }
         } else {
           const int a = op > 0 ? o : nb;
@@ -1090,6 +1088,12 @@ struct VofSolver::Impl {
       petsc_check(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY), "MatAssembly");
     }
     PetscInt its = 0;
+    auto timed_solve = [&](Mat Ap) {
+      petsc_check(KSPSetOperators(ksp, Ap, Ap), "KSPSetOperators");
+      const auto t_ksp = std::chrono::steady_clock::now();
+      petsc_check(KSPSolve(ksp, r, dx), "KSPSolve");
+      ksp_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_ksp).count();
+    };
     for (int pass = 0; pass < (initial ? 3 : 1); ++pass) {
       petsc_check(MatMult(A, x, r), "MatMult");
       petsc_check(VecAYPX(r, -1.0, b), "VecAYPX");  // r = b - A x
@@ -1120,10 +1124,7 @@ struct VofSolver::Impl {
       }
       system_fresh = false;
       petsc_check(KSPSetReusePreconditioner(ksp, keep_pc ? PETSC_TRUE : PETSC_FALSE), "KSPSetReusePreconditioner");
-      petsc_check(KSPSetOperators(ksp, Ap, Ap), "KSPSetOperators");
-      auto t_ksp = std::chrono::steady_clock::now();
-      petsc_check(KSPSolve(ksp, r, dx), "KSPSolve");
-      ksp_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_ksp).count();
+      timed_solve(Ap);
       KSPConvergedReason reason;
       KSPGetConvergedReason(ksp, &reason);
       PetscInt k = 0;
@@ -1134,10 +1135,7 @@ struct VofSolver::Impl {
         // magnitude somewhere): build it anew and solve again.
         petsc_check(VecSet(dx, 0.0), "VecSet");
         petsc_check(KSPSetReusePreconditioner(ksp, PETSC_FALSE), "KSPSetReusePreconditioner");
-        petsc_check(KSPSetOperators(ksp, Ap, Ap), "KSPSetOperators");
-        t_ksp = std::chrono::steady_clock::now();
-        petsc_check(KSPSolve(ksp, r, dx), "KSPSolve");
-        ksp_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_ksp).count();
+        timed_solve(Ap);
         KSPGetConvergedReason(ksp, &reason);
         KSPGetIterationNumber(ksp, &k);
         its += k;
