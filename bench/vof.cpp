@@ -3,13 +3,14 @@
 // on 12,000 cells (2.5 mm, about 4 microseconds per cell and step, 53 % in the pressure solve).
 //   runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose harmonic|explicit|off]
 //                    [--coupling piso|consistent] [--convection upwind|limited_linear]
-//                    [--coulomb-pressure total|excess]
+//                    [--coulomb-pressure total|excess] [--wall-viscosity face|cell]
 //                                          (default: 5 mm cells; --full: 2.5 mm, the dissertation's;
 //                                          --transpose: how the viscous stress's transpose part is taken
 //                                          (default: the scenario's, harmonic);
 //                                          --coupling: the pressure coupling, lab.pressure_coupling;
 //                                          --convection: the momentum's convection, lab.momentum_convection;
-//                                          --coulomb-pressure: the Coulomb viscosity's pressure, lab.coulomb_pressure)
+//                                          --coulomb-pressure: the Coulomb viscosity's pressure, lab.coulomb_pressure;
+//                                          --wall-viscosity: the walls' viscosity, lab.wall_viscosity)
 //   runout_bench_vof --b10 [--check] [--jobs N]  B10: column collapse for aspect ratios 0.5-6 (5 mm cells,
 //                                          scenarios/lab/b10-column-a*.json), normalised runout, rest
 //                                          time and the exponents of its growth
@@ -169,7 +170,7 @@ static int b6(bool full, bool check, int jobs) {
 static int usage() {
   std::fprintf(stderr,
                "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose harmonic|explicit|off] "
-               "[--coupling piso|consistent] [--convection upwind|limited_linear] [--coulomb-pressure total|excess] [--check] | --b1|--b2-inclined|--b3|--b4|--b5|--b8 "
+               "[--coupling piso|consistent] [--convection upwind|limited_linear] [--coulomb-pressure total|excess] [--wall-viscosity face|cell] [--check] | --b1|--b2-inclined|--b3|--b4|--b5|--b8 "
                "[--check] | --b6|--b7 [--full] [--check] [--jobs N] | --b10 [--check] [--jobs N] | --b9 [--full] [--check] | --region\n");
   return 2;
 }
@@ -208,7 +209,7 @@ int main(int argc, char** argv) {
   bool full = false, check = false;
   double end = 1.0, courant = 0;
   int correctors = 0;
-  std::string transpose, coupling, convection, coulomb_pressure;
+  std::string transpose, coupling, convection, coulomb_pressure, wall_viscosity;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     if (a == "--full") full = true;
@@ -220,6 +221,7 @@ int main(int argc, char** argv) {
     else if (a == "--coupling" && k + 1 < argc) coupling = argv[++k];
     else if (a == "--convection" && k + 1 < argc) convection = argv[++k];
     else if (a == "--coulomb-pressure" && k + 1 < argc) coulomb_pressure = argv[++k];
+    else if (a == "--wall-viscosity" && k + 1 < argc) wall_viscosity = argv[++k];
     else return usage();
   }
   auto r = runout::bench::lab_scenario("b2-collapse-0deg");
@@ -232,8 +234,9 @@ int main(int argc, char** argv) {
   lab->set_write_interval_s(0);
   if (courant > 0) lab->set_max_courant(courant);
   if (correctors > 0) lab->set_correctors(correctors);
-  if (!transpose.empty() || !coupling.empty() || !convection.empty() || !coulomb_pressure.empty()) {
+  if (!transpose.empty() || !coupling.empty() || !convection.empty() || !coulomb_pressure.empty() || !wall_viscosity.empty()) {
     if (!transpose.empty()) lab->set_viscous_transpose(transpose);
+    if (!wall_viscosity.empty()) lab->set_wall_viscosity(wall_viscosity);
     if (!coulomb_pressure.empty()) lab->set_coulomb_pressure(coulomb_pressure);
     if (!convection.empty()) lab->set_momentum_convection(convection);
     if (!coupling.empty()) lab->set_pressure_coupling(coupling);

@@ -461,6 +461,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
                                                               : vof::Transpose::harmonic;  // the default
   c.momentum_convection = L.momentum_convection() == "limited_linear" ? vof::Convection::limited_linear : vof::Convection::upwind;
   c.coulomb_pressure = L.coulomb_pressure() == "excess" ? vof::CoulombPressure::excess : vof::CoulombPressure::total;
+  c.wall_viscosity = L.wall_viscosity() == "cell" ? vof::WallViscosity::cell : vof::WallViscosity::face;
   if (!L.pressure_preconditioner().empty()) c.pressure_pc = L.pressure_preconditioner();
   c.active_layers = L.active_layers() < 0 ? 0 : L.active_layers();
   c.consistent = c.momentum_predictor = L.pressure_coupling() == "consistent";

@@ -192,11 +192,13 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
     bad("lab.pressure_coupling", "unknown '" + l->pressure_coupling() + "' (valid: piso, consistent)");
   // Upwind, the default, stays unset, so that scenarios (and their hashes, checkpoints and cached
   // results) from before the option existed are the same scenarios.
-  // The same for the Coulomb viscosity's pressure ("total") and the pressure preconditioner ("gamg").
+  // The same for the Coulomb viscosity's pressure ("total"), the pressure preconditioner ("gamg")
+  // and the walls' viscosity ("face"; results version 5 tells its results from the cell's).
   if (unset_default(l->momentum_convection(), "lab.momentum_convection", {"upwind", "limited_linear"})) l->clear_momentum_convection();
   if (unset_default(l->coulomb_pressure(), "lab.coulomb_pressure", {"total", "excess"})) l->clear_coulomb_pressure();
   if (unset_default(l->pressure_preconditioner(), "lab.pressure_preconditioner", {"gamg", "hypre"}))
     l->clear_pressure_preconditioner();
+  if (unset_default(l->wall_viscosity(), "lab.wall_viscosity", {"face", "cell"})) l->clear_wall_viscosity();
   if (l->viscous_transpose().empty()) l->set_viscous_transpose("harmonic");
   if (l->viscous_transpose() != "explicit" && l->viscous_transpose() != "harmonic" && l->viscous_transpose() != "off")
     bad("lab.viscous_transpose", "unknown '" + l->viscous_transpose() + "' (valid: explicit, harmonic, off)");

@@ -33,12 +33,13 @@ struct ResolvedScenario {
 /// Bump it when they change meaning or value, so that a service does not answer from results of the
 /// older kind (2: B6's shock is the bore, no longer the resting deposit's edge; 3: 3D runs add
 /// comparison.png, and a polygon obstacle's shadow window starts behind the polygon; 4: the viscous
-/// stress's transpose part takes the harmonic face viscosity by default). Adding a
+/// stress's transpose part takes the harmonic face viscosity by default; 5: walls and inflows take the
+/// granular viscosity evaluated on the face, lab.wall_viscosity "face"). Adding a
 /// file or a figure counts too: a cached result lacks it. The test
-/// Scenarios.VofResultsMatchTheFingerprintOfTheirVersion holds this version's figures for eleven
+/// Scenarios.VofResultsMatchTheFingerprintOfTheirVersion holds this version's figures for twelve
 /// short runs and fails when a change to the numerics moves them (options those runs do not take
 /// are not covered); Scenarios.VofHashCarriesTheResultsVersion pins a hash that a bump changes.
-inline constexpr int kVofResultsVersion = 4;
+inline constexpr int kVofResultsVersion = 5;
 
 /// SHA-256 of a resolved scenario: its message with the input paths left out, and the content of
 /// every input file; for VOF scenarios also the version of what their results contain. Two

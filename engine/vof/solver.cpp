@@ -331,6 +331,34 @@ struct VofSolver::Impl {
     return {};
   }
 
+  // The mixture viscosity on boundary face f of cell o with the boundary velocity Ub, as OpenFOAM
+  // evaluates a strain-rate-dependent viscosity on a patch: the strain rate from the cell's gradient
+  // with its normal part replaced by the face's (Ub - U_o) / d (gaussGrad's boundary correction),
+  // the pressure the face's (wall_pressure), the phase fraction the cell's (zero gradient).
+  double boundary_mu(int f, int o, const Vec& Ub) const {
+    const Vec n = (1.0 / m.magSf[std::size_t(f)]) * m.Sf[std::size_t(f)];
+    const Vec sn = m.delta_coeff[std::size_t(f)] * (Ub - s.U_[std::size_t(o)]);
+    Grad gb = G[std::size_t(o)];
+    auto& g = gb.g;
+    for (int j = 0; j < 3; ++j) {
+      double nG = 0;
+      for (int i = 0; i < 3; ++i) nG += comp(n, i) * g[i][j];
+      for (int i = 0; i < 3; ++i) g[i][j] += comp(n, i) * (comp(sn, j) - nG);
+    }
+    double dd = 0;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        const double d = 0.5 * (g[i][j] + g[j][i]);
+        dd += d * d;
+      }
+    const double sr = std::sqrt(2 * dd);
+    const double tanphi = std::tan(s.cfg_.phi_deg * kPi / 180);
+    const double nu = tanphi * wall_pressure(f, o) / (s.cfg_.rho1 * std::max(sr, 1e-300));
+    const double nu1 = std::clamp(std::isfinite(nu) ? nu : s.cfg_.nu_max, s.cfg_.nu_min, s.cfg_.nu_max);
+    const double al = std::clamp(s.alpha_[std::size_t(o)], 0.0, 1.0);
+    return al * s.cfg_.rho1 * nu1 + (1 - al) * s.cfg_.rho2 * s.cfg_.nu2;
+  }
+
   void update_viscosity() {
     velocity_gradient();
     const double tanphi = std::tan(s.cfg_.phi_deg * kPi / 180);
@@ -541,7 +569,10 @@ struct VofSolver::Impl {
       } else {
         const Bc k = kind_of(f);
         const Vec Ub = boundary_velocity(f);
-        const double D = mu[std::size_t(o)] * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
+        // Walls and inflows take the viscosity evaluated on the face (VofConfig::wall_viscosity); the
+        // Coulomb slip wall keeps the cell's, from which its slip fraction is computed.
+        const bool face_mu_here = s.cfg_.wall_viscosity == WallViscosity::face && k != Bc::coulomb_slip;
+        const double D = (face_mu_here ? boundary_mu(f, o, Ub) : mu[std::size_t(o)]) * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
         // A symmetry plane carries no shear: no viscous term (its normal velocity is held by the flux).
         if (k == Bc::wall || k == Bc::coulomb_slip || k == Bc::inflow || (k == Bc::coulomb_friction && s.alpha_[std::size_t(o)] < 0.5)) {
           A_D[std::size_t(o)] += D;

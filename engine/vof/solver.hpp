@@ -60,6 +60,8 @@ enum class Transpose { linear, harmonic, off };
 enum class CoulombPressure { total, excess };
 /// How the momentum's convection term takes its face values (VofConfig::momentum_convection).
 enum class Convection { upwind, limited_linear };
+/// Which viscosity the viscous term takes on a boundary face (VofConfig::wall_viscosity).
+enum class WallViscosity { face, cell };
 
 struct VofConfig {
   double rho1 = 936.17;        ///< granular bulk density [kg/m3]
@@ -109,6 +111,17 @@ struct VofConfig {
   /// excess: p less rho_air g.(x - x_ref), the air at rest's pressure at the same point, which does
   /// not depend on how much air lies above the material (docs/vof.md).
   CoulombPressure coulomb_pressure = CoulombPressure::total;
+  /// The viscosity in the viscous term on walls and inflows:
+  /// face (default): the granular phase's viscosity evaluated on the face, as OpenFOAM evaluates a
+  /// strain-rate-dependent viscosity on a patch: the strain rate from the cell's velocity gradient
+  /// with its normal part replaced by the face's (U_b - U_P) / d, the pressure the face's (p_rgh of
+  /// the cell plus rho g.x of the face), the phase fraction the cell's. A stick wall then carries at
+  /// most the Coulomb stress tan(phi) p of the bed wherever the material at it yields (the
+  /// dissertation's "stick condition, i.e. bed friction equal to phi");
+  /// cell: the cell's own viscosity (results versions up to 4). In a layer that slides over the
+  /// bed with little shear inside, the cell's strain rate is small, its viscosity large, and the
+  /// wall's shear many times the Coulomb stress: B2's toe stopped 6 cells short (validation.md).
+  WallViscosity wall_viscosity = WallViscosity::face;
   int alpha_subcycles = 2;
   std::string pressure_pc = "gamg";  ///< "gamg" or "hypre" (BoomerAMG)
   double pressure_rtol = 1e-8;  ///< relative tolerance of the last corrector's pressure solve

@@ -265,6 +265,62 @@ TEST(VofSolver, CoulombFrictionBedLetsTheLayerSlideAtDelta) {
   EXPECT_LT(slip, 0.6);  // B.2's degeneracy, kept visible
 }
 
+// A layer 2 cm deep moving at 0.5 m/s over a horizontal stick bed, phi 33 deg. With the viscosity
+// evaluated on the wall face (the default, as OpenFOAM evaluates it on a patch) the bed's shear
+// stress is the Coulomb stress tan(phi) p of the bed wherever the layer slides (checked face by face
+// while writing this test: the two agree to 0.1 %); with the cell's own viscosity (results versions
+// up to 4) it is larger: in a sliding plug the wall cell's strain rate, from the Gauss gradient
+// through its upper face, is about half the wall's, its viscosity twice the face's, and the stress
+// about 1.75 times the Coulomb stress here (estimated: twice, times the cell centre's 7/8 of the
+// bed pressure). So the layer keeps more of its speed with the face viscosity. Neither loses momentum at the rate its bed stress alone implies (a block under
+// Coulomb friction at phi: 0.5 - g tan(phi) 0.04 s = 0.245 m/s; the face viscosity's layer
+// keeps 0.35 m/s under PISO, 0.29 m/s with the consistent coupling): in the first 2.5 ms it loses a
+// twentieth of what its bed stress takes, as the viscous coupling at the clip (1e2 m2/s), not
+// converged by PISO's sweeps nor exactly by the predictor's relative 1e-6, does not conserve
+// momentum to that degree (docs/vof.md).
+double sliding_layer_speed(WallViscosity wall, bool consistent) {
+  BlockSpec b;
+  b.x1 = 1.0, b.y1 = 0.04, b.nx = 200, b.ny = 8, b.thickness = 0.005;
+  Mesh m = block_mesh(b);
+  VofConfig c;
+  c.rho1 = 1626.67;
+  c.phi_deg = 33;
+  c.wall_viscosity = wall;
+  c.consistent = c.momentum_predictor = consistent;
+  c.bc["bottom"].kind = Bc::wall;
+  c.bc["left"].kind = Bc::wall;
+  c.bc["right"].kind = Bc::wall;
+  c.bc["top"].kind = Bc::atmosphere;
+  VofSolver s(m, c);
+  std::vector<double> a(std::size_t(m.cells()));
+  std::vector<Vec> u(std::size_t(m.cells()));
+  for (int k = 0; k < m.cells(); ++k) {
+    const Vec x = m.centre[std::size_t(k)];
+    a[std::size_t(k)] = x.x > 0.2 && x.x < 0.8 && x.y < 0.02;
+    if (a[std::size_t(k)] > 0) u[std::size_t(k)] = Vec{0.5, 0, 0};
+  }
+  s.initialise(a, u);
+  s.run(0.04);
+  double q = 0, v = 0;  // the material's mean speed (its momentum over its mass)
+  for (int k = 0; k < m.cells(); ++k) {
+    q += s.alpha()[std::size_t(k)] * m.volume[std::size_t(k)] * s.velocity()[std::size_t(k)].x;
+    v += s.alpha()[std::size_t(k)] * m.volume[std::size_t(k)];
+  }
+  return q / v;
+}
+
+TEST(VofSolver, StickWallCarriesTheCoulombStressWithTheFaceViscosity) {
+  for (bool consistent : {false, true}) {
+    const double face = sliding_layer_speed(WallViscosity::face, consistent), cell = sliding_layer_speed(WallViscosity::cell, consistent);
+    std::printf("layer sliding at 0.5 m/s over a stick bed (phi 33 deg), speed at 0.04 s (%s): %.3f m/s (face viscosity), %.3f m/s "
+                "(cell viscosity); a block under Coulomb friction at phi: 0.245 m/s\n",
+                consistent ? "consistent" : "PISO", face, cell);
+    EXPECT_GT(face, cell + 0.05);   // the face viscosity's bed holds the layer less
+    EXPECT_GT(face, 0.245 - 0.02);  // never more than Coulomb friction at phi
+    EXPECT_LT(face, 0.45);          // but it does hold it
+  }
+}
+
 // The B9 figures (below 1 mm/s after 1 s; within 3 deg of phi after failing) are checked on
 // the scenario files scenarios/lab/b9-heap-*.json, which hold these heaps (integration tests
 // Scenarios.LabB9*; runout_bench_vof --b9 [--full]).
@@ -541,7 +597,8 @@ TEST(VofSolver, ThreeDimensionalBlockBetweenSymmetryPlanesMatchesThePlaneMesh) {
   const auto p = steep_heap(false, 0.4), q = steep_heap(true, 0.4);
   std::printf("steep heap at 0.4 s: centroid %.3f mm (plane) vs %.3f mm (3D, 2 cells deep), |u_z| <= %.1e m/s\n", 1e3 * p.centroid_x,
               1e3 * q.centroid_x, q.max_uz);
-  EXPECT_GT(p.centroid_x, 0.032);  // it failed and spread (the initial centroid is at 31 mm)
+  EXPECT_GT(p.centroid_x, 0.025);  // it failed and spread (the initial centroid is at 20.8 mm; at rest by
+                                   // 0.5 s near 31.6 mm, 33.2 mm with the walls' viscosity the cell's)
   EXPECT_NEAR(q.centroid_x, p.centroid_x, 2e-4);
   // Against speeds of 0.5 m/s; what is left comes from the correctors before the last, which solve
   // the pressure to 0.1 only (2.0e-5 m/s; 1.4e-6 m/s when they solved to 1e-2).
