@@ -11,7 +11,7 @@
 //                                          --convection: the momentum's convection, lab.momentum_convection;
 //                                          --coulomb-pressure: the Coulomb viscosity's pressure, lab.coulomb_pressure;
 //                                          --wall-viscosity: the walls' viscosity, lab.wall_viscosity)
-//   runout_bench_vof --b10 [--check] [--jobs N]  B10: column collapse for aspect ratios 0.5-6 (5 mm cells,
+//   runout_bench_vof --b10 [--check] [--jobs N]  B10: column collapse for aspect ratios 0.5-6 (2.5 mm cells,
 //                                          scenarios/lab/b10-column-a*.json), normalised runout, rest
 //                                          time and the exponents of its growth
 //   runout_bench_vof --b1|--b2-inclined|--b3|--b4|--b5|--b8 [--check]

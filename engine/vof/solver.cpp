@@ -78,7 +78,8 @@ struct VofSolver::Impl {
     return {T[0] * r.x + T[1] * r.y + T[2] * r.z, T[1] * r.x + T[3] * r.y + T[4] * r.z, T[2] * r.x + T[4] * r.y + T[5] * r.z};
   }
 
-  explicit Impl(VofSolver& solver) : s(solver), m(solver.mesh_) {}
+  explicit Impl(VofSolver& solver) : s(solver), m(solver.mesh_), tan_phi(std::tan(solver.cfg_.phi_deg * kPi / 180)) {}
+  const double tan_phi;  // the granular phase's tan(phi)
   ~Impl() {
     if (ksp) KSPDestroy(&ksp);
     if (kspU) KSPDestroy(&kspU);
@@ -235,9 +236,14 @@ struct VofSolver::Impl {
   // The pressure on a wall face, as OpenFOAM's p.boundaryField() under the buoyantPressure
   // condition (p_rgh the cell's, the density the cell's, gh the face's): the bed pressure the
   // Coulomb conditions need (listing B.2), not the cell centre's, which in a flow one or two cells
-  // deep is half of it or less; less coulomb_level().
+  // deep is half of it or less; less coulomb_level(). Written as the cell's pressure p (from the
+  // last pressure solve) carried hydrostatically to the face, p_P + rho_P (gh_f - gh_P): the same
+  // as p_rgh_P + rho_P gh_f while the density is the one p was formed with, and independent of the
+  // mesh's origin when it is not (at the start of a step the density is already the new one; the
+  // form p_rgh_P + rho_P gh_f then added (rho_new - rho_old) g.x_f, hundreds of Pa at a moving
+  // front on a chute 2 m from the origin, where the bed pressure is about 100 Pa).
   double wall_pressure(int f, int o) const {
-    return s.p_rgh_[std::size_t(o)] + rho[std::size_t(o)] * ghf[std::size_t(f)] - coulomb_level(ghf[std::size_t(f)]);
+    return s.p_[std::size_t(o)] + rho[std::size_t(o)] * (ghf[std::size_t(f)] - gh[std::size_t(o)]) - coulomb_level(ghf[std::size_t(f)]);
   }
   // The confining pressure of the Coulomb viscosity in cell c: p less coulomb_level().
   double confining_pressure(int c) const { return s.p_[std::size_t(c)] - coulomb_level(gh[std::size_t(c)]); }
@@ -334,7 +340,8 @@ struct VofSolver::Impl {
   // The mixture viscosity on boundary face f of cell o with the boundary velocity Ub, as OpenFOAM
   // evaluates a strain-rate-dependent viscosity on a patch: the strain rate from the cell's gradient
   // with its normal part replaced by the face's (Ub - U_o) / d (gaussGrad's boundary correction),
-  // the pressure the face's (wall_pressure), the phase fraction the cell's (zero gradient).
+  // the pressure the face's (wall_pressure), the phase fraction the face's (alpha_b: the cell's on
+  // walls, zero gradient; the inflow's on an inflow).
   double boundary_mu(int f, int o, const Vec& Ub) const {
     const Vec n = (1.0 / m.magSf[std::size_t(f)]) * m.Sf[std::size_t(f)];
     const Vec sn = m.delta_coeff[std::size_t(f)] * (Ub - s.U_[std::size_t(o)]);
@@ -352,10 +359,9 @@ struct VofSolver::Impl {
         dd += d * d;
       }
     const double sr = std::sqrt(2 * dd);
-    const double tanphi = std::tan(s.cfg_.phi_deg * kPi / 180);
-    const double nu = tanphi * wall_pressure(f, o) / (s.cfg_.rho1 * std::max(sr, 1e-300));
+    const double nu = tan_phi * wall_pressure(f, o) / (s.cfg_.rho1 * std::max(sr, 1e-300));
     const double nu1 = std::clamp(std::isfinite(nu) ? nu : s.cfg_.nu_max, s.cfg_.nu_min, s.cfg_.nu_max);
-    const double al = std::clamp(s.alpha_[std::size_t(o)], 0.0, 1.0);
+    const double al = std::clamp(alpha_b(f), 0.0, 1.0);
     return al * s.cfg_.rho1 * nu1 + (1 - al) * s.cfg_.rho2 * s.cfg_.nu2;
   }
 
@@ -569,12 +575,12 @@ struct VofSolver::Impl {
       } else {
         const Bc k = kind_of(f);
         const Vec Ub = boundary_velocity(f);
-        // Walls and inflows take the viscosity evaluated on the face (VofConfig::wall_viscosity); the
-        // Coulomb slip wall keeps the cell's, from which its slip fraction is computed.
-        const bool face_mu_here = s.cfg_.wall_viscosity == WallViscosity::face && k != Bc::coulomb_slip;
-        const double D = (face_mu_here ? boundary_mu(f, o, Ub) : mu[std::size_t(o)]) * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
         // A symmetry plane carries no shear: no viscous term (its normal velocity is held by the flux).
         if (k == Bc::wall || k == Bc::coulomb_slip || k == Bc::inflow || (k == Bc::coulomb_friction && s.alpha_[std::size_t(o)] < 0.5)) {
+          // Walls and inflows take the viscosity evaluated on the face (VofConfig::wall_viscosity);
+          // the Coulomb slip wall keeps the cell's, from which its slip fraction is computed.
+          const bool face_mu_here = s.cfg_.wall_viscosity == WallViscosity::face && k != Bc::coulomb_slip;
+          const double D = (face_mu_here ? boundary_mu(f, o, Ub) : mu[std::size_t(o)]) * m.magSf[std::size_t(f)] * m.delta_coeff[std::size_t(f)];
           A_D[std::size_t(o)] += D;
           bsrc[std::size_t(o)] = bsrc[std::size_t(o)] + D * Ub;
         } else if (k == Bc::coulomb_friction) {
