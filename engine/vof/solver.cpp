@@ -352,33 +352,34 @@ struct VofSolver::Impl {
       for (int i = 0; i < 3; ++i) nG += comp(n, i) * g[i][j];
       for (int i = 0; i < 3; ++i) g[i][j] += comp(n, i) * (comp(sn, j) - nG);
     }
+    const double nu1 = coulomb_nu(wall_pressure(f, o), strain_rate(gb));
+    const double al = std::clamp(alpha_b(f), 0.0, 1.0);
+    return al * s.cfg_.rho1 * nu1 + (1 - al) * s.cfg_.rho2 * s.cfg_.nu2;
+  }
+
+  // |strain rate| = sqrt(2 D:D), D the symmetric part of the velocity gradient (OpenFOAM's
+  // strainRate(), sqrt(2) |symm(grad U)|).
+  static double strain_rate(const Grad& gr) {
+    const auto& g = gr.g;
     double dd = 0;
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {
         const double d = 0.5 * (g[i][j] + g[j][i]);
         dd += d * d;
       }
-    const double sr = std::sqrt(2 * dd);
-    const double nu = tan_phi * wall_pressure(f, o) / (s.cfg_.rho1 * std::max(sr, 1e-300));
-    const double nu1 = std::clamp(std::isfinite(nu) ? nu : s.cfg_.nu_max, s.cfg_.nu_min, s.cfg_.nu_max);
-    const double al = std::clamp(alpha_b(f), 0.0, 1.0);
-    return al * s.cfg_.rho1 * nu1 + (1 - al) * s.cfg_.rho2 * s.cfg_.nu2;
+    return std::sqrt(2 * dd);
+  }
+  // The granular phase's Coulomb viscosity tan(phi) p / (rho |strain rate|) for the confining
+  // pressure p, clipped to [nu_min, nu_max] (listing B.1).
+  double coulomb_nu(double p, double sr) const {
+    const double nu = tan_phi * p / (s.cfg_.rho1 * std::max(sr, 1e-300));
+    return std::clamp(std::isfinite(nu) ? nu : s.cfg_.nu_max, s.cfg_.nu_min, s.cfg_.nu_max);
   }
 
   void update_viscosity() {
     velocity_gradient();
-    const double tanphi = std::tan(s.cfg_.phi_deg * kPi / 180);
     for (int c : active_cells) {
-      const auto& g = G[std::size_t(c)].g;
-      double dd = 0;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-          const double d = 0.5 * (g[i][j] + g[j][i]);
-          dd += d * d;
-        }
-      const double sr = std::sqrt(2 * dd);
-      const double nu = tanphi * confining_pressure(c) / (s.cfg_.rho1 * std::max(sr, 1e-300));
-      s.nu1_[std::size_t(c)] = std::clamp(std::isfinite(nu) ? nu : s.cfg_.nu_max, s.cfg_.nu_min, s.cfg_.nu_max);
+      s.nu1_[std::size_t(c)] = coulomb_nu(confining_pressure(c), strain_rate(G[std::size_t(c)]));
       const double al = std::clamp(s.alpha_[std::size_t(c)], 0.0, 1.0);
       mu[std::size_t(c)] = al * s.cfg_.rho1 * s.nu1_[std::size_t(c)] + (1 - al) * s.cfg_.rho2 * s.cfg_.nu2;
     }
