@@ -114,13 +114,14 @@ struct VofConfig {
   /// The viscosity in the viscous term on walls and inflows:
   /// face (default): the granular phase's viscosity evaluated on the face, as OpenFOAM evaluates a
   /// strain-rate-dependent viscosity on a patch: the strain rate from the cell's velocity gradient
-  /// with its normal part replaced by the face's (U_b - U_P) / d, the pressure the face's (p_rgh of
-  /// the cell plus rho g.x of the face), the phase fraction the cell's. A stick wall then carries at
-  /// most the Coulomb stress tan(phi) p of the bed wherever the material at it yields (the
-  /// dissertation's "stick condition, i.e. bed friction equal to phi");
+  /// with its normal part replaced by the face's (U_b - U_P) / d, the pressure the face's (the
+  /// cell's p carried hydrostatically to the face), the phase fraction the face's (the cell's on a
+  /// wall, the inflow's on an inflow). A stick wall then carries at most the Coulomb stress
+  /// tan(phi) p of the bed wherever the material at it yields (the dissertation's "stick
+  /// condition, i.e. bed friction equal to phi"); the Coulomb slip wall keeps the cell's;
   /// cell: the cell's own viscosity (results versions up to 4). In a layer that slides over the
-  /// bed with little shear inside, the cell's strain rate is small, its viscosity large, and the
-  /// wall's shear many times the Coulomb stress: B2's toe stopped 6 cells short (validation.md).
+  /// bed with little shear inside, the cell's strain rate is about half the wall's, and the wall's
+  /// shear about twice the Coulomb stress: B2's toe stopped 6 cells short (validation.md).
   WallViscosity wall_viscosity = WallViscosity::face;
   int alpha_subcycles = 2;
   std::string pressure_pc = "gamg";  ///< "gamg" or "hypre" (BoomerAMG)
