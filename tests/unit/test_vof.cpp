@@ -272,12 +272,17 @@ TEST(VofSolver, CoulombFrictionBedLetsTheLayerSlideAtDelta) {
 // up to 4) it is larger: in a sliding plug the wall cell's strain rate, from the Gauss gradient
 // through its upper face, is about half the wall's, its viscosity twice the face's, and the stress
 // about 1.75 times the Coulomb stress here (estimated: twice, times the cell centre's 7/8 of the
-// bed pressure). So the layer keeps more of its speed with the face viscosity. Neither loses momentum at the rate its bed stress alone implies (a block under
-// Coulomb friction at phi: 0.5 - g tan(phi) 0.04 s = 0.245 m/s; the face viscosity's layer
-// keeps 0.35 m/s under PISO, 0.29 m/s with the consistent coupling): in the first 2.5 ms it loses a
-// twentieth of what its bed stress takes. More correctors bring it closer (20: 0.29 / 0.28 m/s),
-// as each is one sweep of the viscous coupling at the clip; the rest is not explained (docs/vof.md).
-double sliding_layer_speed(WallViscosity wall, bool consistent) {
+// bed pressure). So the layer keeps more of its speed with the face viscosity. Neither loses
+// momentum at the rate its bed stress implies within a step's correctors (a block under Coulomb
+// friction at phi: 0.5 - g tan(phi) 0.04 s = 0.245 m/s; the face viscosity's layer keeps 0.35 m/s
+// under PISO with 3 correctors): each corrector is one Jacobi sweep of the viscous coupling at the
+// clip, and the momentum balance lags the bed until they converge (docs/vof.md, "The PISO
+// correctors do not converge the stiff viscous coupling").
+struct SlidingLayer {
+  double speed = 0;          ///< the material's mean speed at 0.04 s (its momentum over its mass)
+  double lost_over_bed = 0;  ///< momentum lost over the Coulomb impulse of the bed under sliding cells
+};
+SlidingLayer sliding_layer(WallViscosity wall, bool consistent, int correctors = 3) {
   BlockSpec b;
   b.x1 = 1.0, b.y1 = 0.04, b.nx = 200, b.ny = 8, b.thickness = 0.005;
   Mesh m = block_mesh(b);
@@ -286,6 +291,7 @@ double sliding_layer_speed(WallViscosity wall, bool consistent) {
   c.phi_deg = 33;
   c.wall_viscosity = wall;
   c.consistent = c.momentum_predictor = consistent;
+  c.n_correctors = correctors;
   c.bc["bottom"].kind = Bc::wall;
   c.bc["left"].kind = Bc::wall;
   c.bc["right"].kind = Bc::wall;
@@ -299,18 +305,42 @@ double sliding_layer_speed(WallViscosity wall, bool consistent) {
     if (a[std::size_t(k)] > 0) u[std::size_t(k)] = Vec{0.5, 0, 0};
   }
   s.initialise(a, u);
-  s.run(0.04);
-  double q = 0, v = 0;  // the material's mean speed (its momentum over its mass)
-  for (int k = 0; k < m.cells(); ++k) {
-    q += s.alpha()[std::size_t(k)] * m.volume[std::size_t(k)] * s.velocity()[std::size_t(k)].x;
-    v += s.alpha()[std::size_t(k)] * m.volume[std::size_t(k)];
+  const double tan_phi = std::tan(33 * M_PI / 180), dy = 0.005, bed_area = 0.005 * 0.005;
+  auto momentum = [&](double* volume) {  // of both phases along x; the material's volume
+    double q = 0, v = 0;
+    for (int k = 0; k < m.cells(); ++k) {
+      const double al = s.alpha()[std::size_t(k)], V = m.volume[std::size_t(k)];
+      q += (c.rho1 * al + c.rho2 * (1 - al)) * V * s.velocity()[std::size_t(k)].x;
+      v += al * V;
+    }
+    if (volume) *volume = v;
+    return q;
+  };
+  const double q0 = momentum(nullptr);
+  double impulse = 0;  // tan(phi) times the bed pressure under the cells sliding faster than 1 mm/s, over the steps
+  while (s.time() < 0.04 - 1e-12) {
+    double force = 0;
+    for (int k = 0; k < m.cells(); ++k) {
+      if (m.centre[std::size_t(k)].y > dy) continue;
+      const double al = s.alpha()[std::size_t(k)], ux = s.velocity()[std::size_t(k)].x;
+      const double p_bed = s.pressure()[std::size_t(k)] + (c.rho1 * al + c.rho2 * (1 - al)) * 9.81 * dy / 2;
+      if (std::abs(ux) > 1e-3) force += tan_phi * p_bed * bed_area * (ux > 0 ? 1 : -1);
+    }
+    impulse += force * s.step().dt;
   }
-  return q / v;
+  SlidingLayer r;
+  double v = 0;
+  const double q = momentum(&v);
+  double qm = 0;  // the material's momentum (alpha-weighted) for its mean speed
+  for (int k = 0; k < m.cells(); ++k) qm += s.alpha()[std::size_t(k)] * m.volume[std::size_t(k)] * s.velocity()[std::size_t(k)].x;
+  r.speed = qm / v;
+  r.lost_over_bed = (q0 - q) / impulse;
+  return r;
 }
 
 TEST(VofSolver, StickWallCarriesTheCoulombStressWithTheFaceViscosity) {
   for (bool consistent : {false, true}) {
-    const double face = sliding_layer_speed(WallViscosity::face, consistent), cell = sliding_layer_speed(WallViscosity::cell, consistent);
+    const double face = sliding_layer(WallViscosity::face, consistent).speed, cell = sliding_layer(WallViscosity::cell, consistent).speed;
     std::printf("layer sliding at 0.5 m/s over a stick bed (phi 33 deg), speed at 0.04 s (%s): %.3f m/s (face viscosity), %.3f m/s "
                 "(cell viscosity); a block under Coulomb friction at phi: 0.245 m/s\n",
                 consistent ? "consistent" : "PISO", face, cell);
@@ -318,6 +348,19 @@ TEST(VofSolver, StickWallCarriesTheCoulombStressWithTheFaceViscosity) {
     EXPECT_GT(face, 0.245 - 0.02);  // never more than Coulomb friction at phi
     EXPECT_LT(face, 0.45);          // but it does hold it
   }
+}
+
+// The same layer's momentum against its bed's impulse: the correctors' lag (above) closes as they
+// converge the viscous coupling, so that the momentum lost approaches the Coulomb impulse of the bed
+// (measured: 0.61 with 3 correctors, 0.94 with 100, 0.965 with 1,000; docs/vof.md). A bed stress
+// that were not the Coulomb stress, or momentum made or lost elsewhere, shows as a ratio away from 1.
+TEST(VofSolver, CorrectorsConvergeTheSlidingLayersMomentumToItsBedImpulse) {
+  const auto few = sliding_layer(WallViscosity::face, false, 3), many = sliding_layer(WallViscosity::face, false, 100);
+  std::printf("sliding layer, momentum lost over the bed's Coulomb impulse: %.3f (3 correctors), %.3f (100); speed %.3f, %.3f m/s\n",
+              few.lost_over_bed, many.lost_over_bed, few.speed, many.speed);
+  EXPECT_GT(many.lost_over_bed, 0.9);
+  EXPECT_LT(many.lost_over_bed, 1.01);
+  EXPECT_GT(many.lost_over_bed, few.lost_over_bed + 0.2);
 }
 
 // The issue's B9 figures (below 1 mm/s after 1 s; within 3 deg of phi after failing) are checked on
