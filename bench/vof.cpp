@@ -1,7 +1,7 @@
 // Benchmark of the VOF engine on B2 at 0 deg (validation.md B2) to t = 1 s, the case the
 // dissertation timed: OpenFOAM's interFoam with the Coulomb viscosity took 80 s wall for 1677 steps
 // on 12,000 cells (2.5 mm, about 4 microseconds per cell and step, 53 % in the pressure solve).
-//   runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose harmonic|explicit|off]
+//   runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--outer N] [--transpose harmonic|explicit|off]
 //                    [--coupling piso|consistent] [--convection upwind|limited_linear]
 //                    [--coulomb-pressure total|excess] [--wall-viscosity face|cell]
 //                                          (default: 5 mm cells; --full: 2.5 mm, the dissertation's;
@@ -10,7 +10,8 @@
 //                                          --coupling: the pressure coupling, lab.pressure_coupling;
 //                                          --convection: the momentum's convection, lab.momentum_convection;
 //                                          --coulomb-pressure: the Coulomb viscosity's pressure, lab.coulomb_pressure;
-//                                          --wall-viscosity: the walls' viscosity, lab.wall_viscosity)
+//                                          --wall-viscosity: the walls' viscosity, lab.wall_viscosity;
+//                                          --outer: outer correctors per step, lab.outer_correctors)
 //   runout_bench_vof --b10 [--check] [--jobs N]  B10: column collapse for aspect ratios 0.5-6 (2.5 mm cells,
 //                                          scenarios/lab/b10-column-a*.json), normalised runout, rest
 //                                          time and the exponents of its growth
@@ -169,7 +170,7 @@ static int b6(bool full, bool check, int jobs) {
 
 static int usage() {
   std::fprintf(stderr,
-               "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--transpose harmonic|explicit|off] "
+               "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--outer N] [--transpose harmonic|explicit|off] "
                "[--coupling piso|consistent] [--convection upwind|limited_linear] [--coulomb-pressure total|excess] [--wall-viscosity face|cell] [--check] | --b1|--b2-inclined|--b3|--b4|--b5|--b8 "
                "[--check] | --b6|--b7 [--full] [--check] [--jobs N] | --b10 [--check] [--jobs N] | --b9 [--full] [--check] | --region\n");
   return 2;
@@ -208,7 +209,7 @@ int main(int argc, char** argv) {
   if (mode == "--region") return argc == 2 ? region() : usage();
   bool full = false, check = false;
   double end = 1.0, courant = 0;
-  int correctors = 0;
+  int correctors = 0, outer = 0;
   std::string transpose, coupling, convection, coulomb_pressure, wall_viscosity;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
@@ -217,6 +218,7 @@ int main(int argc, char** argv) {
     else if (a == "--end" && k + 1 < argc) end = std::atof(argv[++k]);
     else if (a == "--courant" && k + 1 < argc) courant = std::atof(argv[++k]);
     else if (a == "--correctors" && k + 1 < argc) correctors = std::atoi(argv[++k]);
+    else if (a == "--outer" && k + 1 < argc) outer = std::atoi(argv[++k]);
     else if (a == "--transpose" && k + 1 < argc) transpose = argv[++k];
     else if (a == "--coupling" && k + 1 < argc) coupling = argv[++k];
     else if (a == "--convection" && k + 1 < argc) convection = argv[++k];
@@ -234,7 +236,8 @@ int main(int argc, char** argv) {
   lab->set_write_interval_s(0);
   if (courant > 0) lab->set_max_courant(courant);
   if (correctors > 0) lab->set_correctors(correctors);
-  if (!transpose.empty() || !coupling.empty() || !convection.empty() || !coulomb_pressure.empty() || !wall_viscosity.empty()) {
+  if (outer > 0) lab->set_outer_correctors(outer);
+  if (!transpose.empty() || !coupling.empty() || !convection.empty() || !coulomb_pressure.empty() || !wall_viscosity.empty() || outer > 0) {
     if (!transpose.empty()) lab->set_viscous_transpose(transpose);
     if (!wall_viscosity.empty()) lab->set_wall_viscosity(wall_viscosity);
     if (!coulomb_pressure.empty()) lab->set_coulomb_pressure(coulomb_pressure);

@@ -456,6 +456,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   c.phi_deg = mat.phi_deg;
   c.max_co = c.max_alpha_co = L.max_courant();
   c.n_correctors = L.correctors();
+  c.n_outer_correctors = L.has_outer_correctors() ? L.outer_correctors() : 1;
   c.viscous_transpose = L.viscous_transpose() == "off"        ? vof::Transpose::off
                         : L.viscous_transpose() == "explicit" ? vof::Transpose::linear
                                                               : vof::Transpose::harmonic;  // the default

@@ -187,6 +187,10 @@ static ResolvedScenario resolve_lab(v1::Scenario s) {
   if (!(l->max_courant() > 0 && l->max_courant() <= 1)) bad("lab.max_courant", "must lie in (0, 1]");
   if (l->correctors() == 0) l->set_correctors(3);
   if (l->correctors() < 1 || l->correctors() > 50) bad("lab.correctors", "must lie in 1..50");
+  // One outer corrector, the default, stays unset (the scenario, its hash and its results as before).
+  if (l->has_outer_correctors() && (l->outer_correctors() < 1 || l->outer_correctors() > 20))
+    bad("lab.outer_correctors", "must lie in 1..20");
+  if (l->has_outer_correctors() && l->outer_correctors() == 1) l->clear_outer_correctors();
   if (l->pressure_coupling().empty()) l->set_pressure_coupling("piso");
   if (l->pressure_coupling() != "piso" && l->pressure_coupling() != "consistent")
     bad("lab.pressure_coupling", "unknown '" + l->pressure_coupling() + "' (valid: piso, consistent)");

@@ -1429,16 +1429,20 @@ StepStats VofSolver::step() {
   if (I.update_active(false)) I.make_pressure_system();
   st.active_cells = I.n_active;
   // 5-6. Momentum matrix and PISO correctors.
-  I.velocity_gradient();
   double t_p = 0;
   I.ksp_seconds = 0;
-  I.build_momentum(dt_);
-  if (cfg_.momentum_predictor) st.momentum_iterations = I.predict();
-  for (int k = 0; k < std::max(1, cfg_.n_correctors); ++k) {
-    I.compute_H();
-    const auto tp = clk::now();
-    st.pressure_iterations += I.pressure_correct(false, k > 0, k + 1 == std::max(1, cfg_.n_correctors));
-    t_p += std::chrono::duration<double>(clk::now() - tp).count();
+  const int n_outer = std::max(1, cfg_.n_outer_correctors), n_corr = std::max(1, cfg_.n_correctors);
+  for (int outer = 0; outer < n_outer; ++outer) {
+    if (outer > 0) I.update_viscosity();  // from the latest velocity and pressure (it takes the gradient)
+    else I.velocity_gradient();
+    I.build_momentum(dt_);
+    if (cfg_.momentum_predictor) st.momentum_iterations += I.predict();
+    for (int k = 0; k < n_corr; ++k) {
+      I.compute_H();
+      const auto tp = clk::now();
+      st.pressure_iterations += I.pressure_correct(false, k > 0, outer + 1 == n_outer && k + 1 == n_corr);
+      t_p += std::chrono::duration<double>(clk::now() - tp).count();
+    }
   }
   I.update_viscosity();
   // Diagnostics.

@@ -79,6 +79,13 @@ struct VofConfig {
   double dt_initial = 1e-4, dt_max = 1e-2;
   double c_alpha = 1.0;        ///< interface compression coefficient
   int n_correctors = 3;        ///< PISO correctors per step
+  /// Outer correctors per step (PIMPLE's nOuterCorrectors): the viscosity, the momentum matrix, the
+  /// momentum predictor and the correctors are repeated with the latest velocity and pressure, the
+  /// phase fraction kept. 1 (default) is PISO as interFoam runs it. The correctors alone do not
+  /// converge the viscous coupling where the Coulomb viscosity is at its clip (docs/vof.md, "The
+  /// PISO correctors do not converge the stiff viscous coupling"); with the momentum predictor the
+  /// outer correctors do.
+  int n_outer_correctors = 1;
   bool momentum_predictor = false;  ///< solve the momentum matrix before the correctors (see docs/vof.md)
   /// The pressure equation's coefficient: false: 1/A (PISO, interFoam); true: the consistent
   /// 1/(A - H1) of SIMPLEC (H1 the sum of the neighbour coefficients), so that in cells where the

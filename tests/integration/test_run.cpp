@@ -858,6 +858,41 @@ TEST(Scenarios, LabWallViscosityIsValidatedAndReachesTheRun) {
   EXPECT_GE(front[0], front[1] + 0.005);  // at least a cell further
 }
 
+// lab.outer_correctors: 1 by default (left unset, so that older scenarios keep their hash), 1-20
+// accepted, anything else named in the error; it reaches the run: on coarse B2 under the consistent
+// coupling, three outer correctors take more than one and a half times the pressure iterations of one
+// per step.
+TEST(Scenarios, LabOuterCorrectorsAreValidatedAndReachTheRun) {
+  const std::string head = R"({"engine": "vof", "lab": {"x_max": 1, "y_max": 1, "nx": 10, "ny": 10,
+      "fill": [{"x_max": 0.5, "y_max": 0.5}])";
+  auto with = [&](int n) { return jobs::parse_scenario_json(head + ", \"outer_correctors\": " + std::to_string(n) + "}}"); };
+  const auto plain = jobs::resolve_scenario(jobs::parse_scenario_json(head + "}}"), ".");
+  EXPECT_FALSE(plain.scenario.lab().has_outer_correctors());
+  EXPECT_EQ(jobs::scenario_hash(jobs::resolve_scenario(with(1), ".")), jobs::scenario_hash(plain));
+  const auto three = jobs::resolve_scenario(with(3), ".");
+  EXPECT_EQ(three.scenario.lab().outer_correctors(), 3);
+  EXPECT_NE(jobs::scenario_hash(three), jobs::scenario_hash(plain));
+  expect_resolve_error(with(0), {"lab.outer_correctors", "1..20"});
+  expect_resolve_error(with(21), {"lab.outer_correctors", "1..20"});
+  double its[2] = {0, 0}, steps[2] = {0, 0};
+  for (int k = 0; k < 2; ++k) {
+    auto r = coarse_b2(0.2);
+    auto* lab = r.scenario.mutable_lab();
+    lab->set_write_interval_s(0);
+    lab->set_pressure_coupling("consistent");
+    if (k == 1) lab->set_outer_correctors(3);
+    r = jobs::resolve_scenario(r.scenario, std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab");
+    TempDir d;
+    ASSERT_EQ(jobs::run_scenario(r, d.p.string()).stop, "end-time");
+    const std::string j = read_text(d / "run.json");
+    its[k] = json_number(j, "pressure_iterations");
+    steps[k] = json_number(j, "steps");
+  }
+  std::printf("coarse B2 to 0.2 s, consistent: %.0f pressure iterations in %.0f steps (1 outer corrector), %.0f in %.0f (3)\n", its[0], steps[0],
+              its[1], steps[1]);
+  EXPECT_GT(its[1] / steps[1], 1.5 * its[0] / steps[0]);  // measured 2.2 (later solves start nearer their answer)
+}
+
 // lab.pressure_preconditioner: "gamg" by default (left unset), "hypre" (BoomerAMG) gives the same
 // collapse (the last corrector's solve to the same tolerance), anything else is named in the error.
 TEST(Scenarios, LabPressurePreconditionerIsChosenByName) {

@@ -282,7 +282,7 @@ struct SlidingLayer {
   double speed = 0;          ///< the material's mean speed at 0.04 s (its momentum over its mass)
   double lost_over_bed = 0;  ///< momentum lost over the Coulomb impulse of the bed under sliding cells
 };
-SlidingLayer sliding_layer(WallViscosity wall, bool consistent, int correctors = 3) {
+SlidingLayer sliding_layer(WallViscosity wall, bool consistent, int correctors = 3, int outer = 1) {
   BlockSpec b;
   b.x1 = 1.0, b.y1 = 0.04, b.nx = 200, b.ny = 8, b.thickness = 0.005;
   Mesh m = block_mesh(b);
@@ -292,6 +292,7 @@ SlidingLayer sliding_layer(WallViscosity wall, bool consistent, int correctors =
   c.wall_viscosity = wall;
   c.consistent = c.momentum_predictor = consistent;
   c.n_correctors = correctors;
+  c.n_outer_correctors = outer;
   c.bc["bottom"].kind = Bc::wall;
   c.bc["left"].kind = Bc::wall;
   c.bc["right"].kind = Bc::wall;
@@ -361,6 +362,19 @@ TEST(VofSolver, CorrectorsConvergeTheSlidingLayersMomentumToItsBedImpulse) {
   EXPECT_GT(many.lost_over_bed, 0.9);
   EXPECT_LT(many.lost_over_bed, 1.01);
   EXPECT_GT(many.lost_over_bed, few.lost_over_bed + 0.2);
+}
+
+// Outer correctors with the momentum predictor (the consistent coupling) converge the coupling at a
+// fraction of the cost: measured 0.85 with one, 0.97 with two, 0.988 with three, 0.996 with ten, the
+// mean speed then 0.25 m/s, near the Coulomb block's 0.245 (the collapsing free ends carry less).
+TEST(VofSolver, OuterCorrectorsConvergeTheSlidingLayersMomentum) {
+  const auto one = sliding_layer(WallViscosity::face, true, 3, 1), three = sliding_layer(WallViscosity::face, true, 3, 3);
+  std::printf("sliding layer, consistent coupling, momentum lost over the bed's Coulomb impulse: %.3f (1 outer corrector), %.3f (3); "
+              "speed %.3f, %.3f m/s\n", one.lost_over_bed, three.lost_over_bed, one.speed, three.speed);
+  EXPECT_GT(three.lost_over_bed, 0.97);
+  EXPECT_LT(three.lost_over_bed, 1.01);
+  EXPECT_GT(three.lost_over_bed, one.lost_over_bed + 0.08);
+  EXPECT_NEAR(three.speed, 0.25, 0.01);
 }
 
 // The B9 figures (below 1 mm/s after 1 s; within 3 deg of phi after failing) are checked on
