@@ -1142,7 +1142,8 @@ struct VofSolver::Impl {
       // whenever the active region changes; in between, the last one preconditions the new matrix
       // (still symmetric positive definite).
       bool keep_pc = same;
-      if (!same && !initial && !system_fresh) keep_pc = ++steps_since_pc < std::max(1, s.cfg_.pressure_pc_refresh);
+      // (Counted per step: the outer correctors after a step's first keep it.)
+      if (!same && !initial && !system_fresh) keep_pc = later_outer || ++steps_since_pc < std::max(1, s.cfg_.pressure_pc_refresh);
       if (!keep_pc) steps_since_pc = 0;
       Mat Ap = A;
       if (closed) {
@@ -1248,6 +1249,7 @@ struct VofSolver::Impl {
   std::vector<Vec> U_old;
 
   int steps_since_pc = 0;
+  bool later_outer = false;  // in an outer corrector after the step's first
   double ksp_seconds = 0;  // time in KSPSolve since step() last took it
   std::vector<int> active_index;  // per cell: its row in the pressure system, -1 outside the active region
   std::vector<int> active_cells;  // the active region
@@ -1433,6 +1435,7 @@ StepStats VofSolver::step() {
   I.ksp_seconds = 0;
   const int n_outer = std::max(1, cfg_.n_outer_correctors), n_corr = std::max(1, cfg_.n_correctors);
   for (int outer = 0; outer < n_outer; ++outer) {
+    I.later_outer = outer > 0;
     if (outer > 0) I.update_viscosity();  // from the latest velocity and pressure (it takes the gradient)
     else I.velocity_gradient();
     I.build_momentum(dt_);
@@ -1444,6 +1447,7 @@ StepStats VofSolver::step() {
       t_p += std::chrono::duration<double>(clk::now() - tp).count();
     }
   }
+  I.later_outer = false;
   I.update_viscosity();
   // Diagnostics.
   st.alpha_min = 1e300;

@@ -149,8 +149,8 @@ struct VofError : std::runtime_error {
 /// Per-step solver statistics.
 struct StepStats {
   double t = 0, dt = 0, co = 0, alpha_co = 0, air_co = 0;  ///< Courant numbers: material, interface, air
-  int pressure_iterations = 0;  ///< summed over the correctors
-  int momentum_iterations = 0;  ///< of the predictor, both components
+  int pressure_iterations = 0;  ///< summed over the correctors (and outer correctors)
+  int momentum_iterations = 0;  ///< of the predictor, both components (summed over outer correctors)
   double seconds_pressure = 0, seconds_total = 0;  ///< the pressure correctors (assembly, solve, flux update); the step
   double seconds_pressure_solve = 0;  ///< of seconds_pressure, the time in PETSc's KSPSolve (preconditioner set-up included)
   double alpha_min = 0, alpha_max = 0;
