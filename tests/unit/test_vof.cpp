@@ -276,8 +276,9 @@ TEST(VofSolver, CoulombFrictionBedLetsTheLayerSlideAtDelta) {
 // momentum at the rate its bed stress implies within a step's correctors (a block under Coulomb
 // friction at phi: 0.5 - g tan(phi) 0.04 s = 0.245 m/s; the face viscosity's layer keeps 0.35 m/s
 // under PISO with 3 correctors): each corrector is one Jacobi sweep of the viscous coupling at the
-// clip, and the momentum balance lags the bed until they converge (docs/vof.md, "The PISO
-// correctors do not converge the stiff viscous coupling").
+// clip, and the viscosities and the transpose part stay those of the step's start, so the momentum
+// balance lags the bed until both converge (docs/vof.md, "The PISO correctors do not converge the
+// stiff viscous coupling").
 struct SlidingLayer {
   double speed = 0;          ///< the material's mean speed at 0.04 s (its momentum over its mass)
   double lost_over_bed = 0;  ///< momentum lost over the Coulomb impulse of the bed under sliding cells
@@ -307,35 +308,38 @@ SlidingLayer sliding_layer(WallViscosity wall, bool consistent, int correctors =
   }
   s.initialise(a, u);
   const double tan_phi = std::tan(33 * M_PI / 180), dy = 0.005, bed_area = 0.005 * 0.005;
-  auto momentum = [&](double* volume) {  // of both phases along x; the material's volume
-    double q = 0, v = 0;
-    for (int k = 0; k < m.cells(); ++k) {
-      const double al = s.alpha()[std::size_t(k)], V = m.volume[std::size_t(k)];
-      q += (c.rho1 * al + c.rho2 * (1 - al)) * V * s.velocity()[std::size_t(k)].x;
-      v += al * V;
-    }
-    if (volume) *volume = v;
-    return q;
+  auto rho = [&](double al) { return c.rho1 * al + c.rho2 * (1 - al); };
+  struct Sums {
+    double momentum = 0;           // of both phases along x
+    double material_momentum = 0;  // alpha-weighted, for the material's mean speed
+    double material_volume = 0;
   };
-  const double q0 = momentum(nullptr);
+  auto sums = [&] {
+    Sums r;
+    for (int k = 0; k < m.cells(); ++k) {
+      const double al = s.alpha()[std::size_t(k)], V = m.volume[std::size_t(k)], ux = s.velocity()[std::size_t(k)].x;
+      r.momentum += rho(al) * V * ux;
+      r.material_momentum += al * V * ux;
+      r.material_volume += al * V;
+    }
+    return r;
+  };
+  const double q0 = sums().momentum;
   double impulse = 0;  // tan(phi) times the bed pressure under the cells sliding faster than 1 mm/s, over the steps
   while (s.time() < 0.04 - 1e-12) {
     double force = 0;
     for (int k = 0; k < m.cells(); ++k) {
       if (m.centre[std::size_t(k)].y > dy) continue;
       const double al = s.alpha()[std::size_t(k)], ux = s.velocity()[std::size_t(k)].x;
-      const double p_bed = s.pressure()[std::size_t(k)] + (c.rho1 * al + c.rho2 * (1 - al)) * 9.81 * dy / 2;
+      const double p_bed = s.pressure()[std::size_t(k)] + rho(al) * 9.81 * dy / 2;
       if (std::abs(ux) > 1e-3) force += tan_phi * p_bed * bed_area * (ux > 0 ? 1 : -1);
     }
     impulse += force * s.step().dt;
   }
+  const Sums end = sums();
   SlidingLayer r;
-  double v = 0;
-  const double q = momentum(&v);
-  double qm = 0;  // the material's momentum (alpha-weighted) for its mean speed
-  for (int k = 0; k < m.cells(); ++k) qm += s.alpha()[std::size_t(k)] * m.volume[std::size_t(k)] * s.velocity()[std::size_t(k)].x;
-  r.speed = qm / v;
-  r.lost_over_bed = (q0 - q) / impulse;
+  r.speed = end.material_momentum / end.material_volume;
+  r.lost_over_bed = (q0 - end.momentum) / impulse;
   return r;
 }
 
