@@ -374,6 +374,7 @@ std::string scenario_hash(const ResolvedScenario& r) {
   s.mutable_dem()->clear_path();
   s.mutable_area_of_interest()->clear_path();
   for (auto& rel : *s.mutable_releases()) rel.clear_path();
+  s.clear_limits();  // a job's limits do not change what it computes
   std::string bytes;
   {
     google::protobuf::io::StringOutputStream so(&bytes);
