@@ -7,9 +7,13 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <csignal>
+#include <optional>
 
 #include "jobs/run.hpp"
 #include "jobs/scenario.hpp"
+#include "jobs/worker.hpp"
+#include "runout/v1/worker.pb.h"
 
 namespace fs = std::filesystem;
 
@@ -41,6 +45,8 @@ double epoch_of(const std::string& utc) {
 Scheduler::Scheduler(JobStore& store, SchedulerConfig cfg) : store_(store), cfg_(std::move(cfg)) {
   if (cfg_.workers < 1) cfg_.workers = 1;
   if (cfg_.threads_per_run <= 0) cfg_.threads_per_run = std::max(1, omp_get_num_procs() / cfg_.workers);
+  if (cfg_.worker_exe.empty()) cfg_.worker_exe = self_executable();
+  if (cfg_.max_crashes < 1) cfg_.max_crashes = 1;
   fs::create_directories(fs::path(cfg_.state_dir) / "results");
   fs::create_directories(fs::path(cfg_.state_dir) / "logs");
   fs::create_directories(fs::path(cfg_.state_dir) / "checkpoints");
@@ -73,7 +79,7 @@ std::string Scheduler::log_path(const std::string& id) const {
 
 void Scheduler::start() {
   const int n = store_.requeue_running(
-      "the server stopped during the run; queued to run again (a VOF run continues from its last checkpoint)");
+      "the server went down during the run; queued to run again (from its last checkpoint where it has one)");
   if (n) log("queued again " + std::to_string(n) + " job(s) left running by the previous server process");
   // Work in progress of a dead process is worthless: its jobs run again.
   std::error_code ec;
@@ -210,6 +216,59 @@ void Scheduler::worker_loop(int index) {
   }
 }
 
+std::string Scheduler::record_path(const std::string& id) const {
+  return (fs::path(cfg_.state_dir) / "logs" / (id + ".record.pb")).string();
+}
+
+void Scheduler::write_record(const StoredJob& j) const {
+  v1::JobRecord rec;
+  *rec.mutable_job() = j.job;
+  rec.mutable_job()->clear_transitions();
+  rec.mutable_job()->clear_progress();
+  rec.set_owner(j.owner);
+  *rec.mutable_scenario() = j.scenario;
+  const std::string path = record_path(j.job.id()), tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    if (!rec.SerializeToOstream(&f) || !f.flush()) throw std::runtime_error("cannot write the job's record " + path);
+  }
+  fs::rename(tmp, path);
+}
+
+std::string client_message(std::string msg, const std::string& state_dir, const std::vector<std::string>& data_roots) {
+  // Uploads are named by the file name the client sent.
+  const std::string up = (fs::path(state_dir) / "uploads").string() + "/";
+  for (std::size_t at; (at = msg.find(up)) != std::string::npos;) {
+    std::size_t end = at + up.size();
+    const std::size_t slash = msg.find('/', end);
+    if (slash == std::string::npos || slash - end != 64) {
+      msg.replace(at, up.size(), "");
+      continue;
+    }
+    msg.erase(at, slash + 1 - at);
+  }
+  for (const auto& root : data_roots) {
+    const std::string r = (fs::path(root) / "").string();
+    for (std::size_t at; !r.empty() && (at = msg.find(r)) != std::string::npos;) msg.erase(at, r.size());
+  }
+  return msg;
+}
+
+bool Scheduler::on_progress(const std::string& id, const v1::Progress& pr) {
+  bool go = true;
+  {
+    std::lock_guard lk(mu_);
+    auto& l = live_[id];
+    l.progress = pr;
+    l.running = true;
+    l.version = ++counter_;
+    versions_[id] = counter_;
+    go = !stopping_.load() && !cancel_.count(id);
+  }
+  change_cv_.notify_all();
+  return go;
+}
+
 void Scheduler::run_job(StoredJob sj) {
   const std::string id = sj.job.id(), hash = sj.job.scenario_hash();
   std::ofstream logf(log_path(id), std::ios::app);
@@ -226,7 +285,16 @@ void Scheduler::run_job(StoredJob sj) {
     versions_[id] = counter_;
   }
   change_cv_.notify_all();
-  auto end_live = [&] {
+  auto finish = [&](v1::JobState state, const std::string& reason, const std::string& error, std::int64_t bytes,
+                    bool crashed = false) {
+    try {
+      store_.transition(id, state, reason, error, bytes, crashed);
+    } catch (const std::exception& e) {
+      log("job " + id + ": recording '" + reason + "' failed: " + e.what());
+    }
+    say(state_name(state) + ": " + reason);  // (`runout serve --recover` reads these lines)
+    if (!error.empty()) say("error: " + error);
+    log("job " + id + ": " + state_name(state) + (error.empty() ? "" : " (" + error + ")"));
     {
       std::lock_guard lk(mu_);
       live_.erase(id);
@@ -234,27 +302,13 @@ void Scheduler::run_job(StoredJob sj) {
     }
     touch(id);
   };
-  auto finish = [&](v1::JobState state, const std::string& reason, const std::string& error, std::int64_t bytes) {
-    try {
-      store_.transition(id, state, reason, error, bytes);
-    } catch (const std::exception& e) {
-      log("job " + id + ": recording '" + reason + "' failed: " + e.what());
-    }
-    say(state_name(state) + ": " + reason + (error.empty() ? "" : ": " + error));
-    log("job " + id + ": " + state_name(state) + (error.empty() ? "" : " (" + error + ")"));
-    end_live();
-  };
-
-  const fs::path final_dir = results_dir(hash);
-  std::error_code ec;
-  // VOF runs keep a checkpoint (and their frames so far) in checkpoints/ID.h5 while they run, so
-  // that a job interrupted by the server stopping, or by its death, continues from there.
-  const std::string cp = checkpoint_path(id);
-  const bool had_checkpoint = fs::exists(cp, ec);
   auto finish_and_forget = [&](v1::JobState state, const std::string& reason, const std::string& error, std::int64_t bytes) {
     remove_checkpoint(id);
     finish(state, reason, error, bytes);
   };
+
+  const fs::path final_dir = results_dir(hash);
+  std::error_code ec;
   if (fs::exists(final_dir / "run.json", ec)) {
     finish_and_forget(v1::SUCCEEDED, "an identical scenario was computed before: its results answer this job", "",
                       folder_bytes(final_dir));
@@ -271,110 +325,179 @@ void Scheduler::run_job(StoredJob sj) {
     finish_and_forget(v1::CANCELLED, "cancelled by the client before the run started", "", 0);
     return;
   }
-  try {
-    ResolvedScenario r = resolve_scenario(sj.scenario, "/");
-    fs::create_directories(tmp);
-    RunOptions opt;
-    opt.progress_every = 20;
-    if (r.vof) {
-      opt.checkpoint_path = cp;
-      opt.checkpoint_interval_s = sj.scenario.lab().end_time_s() / 20;
-      if (had_checkpoint) {
-        opt.restart_path = cp;
-        say("continuing from its checkpoint");
-      }
+
+  // The task: every run keeps a checkpoint (and its frames so far) in checkpoints/ID.h5 while it
+  // runs, so that a job interrupted by the server stopping, by its death or by a crash of its worker
+  // continues from there.
+  v1::WorkerTask task;
+  task.set_job_id(id);
+  *task.mutable_scenario() = sj.scenario;
+  task.set_out_dir(tmp.string());
+  task.set_threads(cfg_.threads_per_run);
+  task.set_progress_interval_s(0.25);
+  const bool vof = sj.scenario.engine() == "vof";
+  const std::string cp = checkpoint_path(id);
+  {
+    task.set_checkpoint_path(cp);
+    const double t_end = vof ? sj.scenario.lab().end_time_s() : sj.scenario.numerics().end_time_s();
+    task.set_checkpoint_interval_s(t_end > 0 ? t_end / 20 : 0);
+    if (fs::exists(cp, ec)) {
+      task.set_restart_path(cp);
+      say("continuing from its checkpoint");
     }
-    const auto wall0 = std::chrono::steady_clock::now();
-    auto last_save = wall0;
-    const double t_end = r.config.time.t_end;
-    opt.progress = [&](const engine::Progress& p) {
-      v1::Progress pr;
-      pr.set_simulated_s(p.t);
-      pr.set_dt_s(p.dt);
-      pr.set_volume_m3(p.mass);
-      pr.set_max_speed_m_s(p.max_speed);
-      pr.set_active_fraction(p.active_fraction);
-      pr.set_end_time_s(t_end);
-      pr.set_steps(p.step);
-      const auto now = std::chrono::steady_clock::now();
-      const double wall = std::chrono::duration<double>(now - wall0).count();
-      pr.set_seconds_left(p.t > 0 ? wall * (t_end - p.t) / p.t : 0.0);
-      bool go = true;
-      {
-        std::lock_guard lk(mu_);
-        auto& l = live_[id];
-        l.progress = pr;
-        l.running = true;
-        l.version = ++counter_;
-        versions_[id] = counter_;
-        go = !stopping_.load() && !cancel_.count(id);
-      }
-      change_cv_.notify_all();
-      if (now - last_save > std::chrono::seconds(1)) {
-        last_save = now;
-        try {
-          if (store_.cancel_requested(id)) {
-            std::lock_guard lk(mu_);
-            cancel_.insert(id);
-            go = false;
-          }
-        } catch (...) {
-        }
-        try {
-          store_.save_progress(id, pr);
-        } catch (...) {
-        }
-        char b[200];
-        std::snprintf(b, sizeof b, "t = %.2f s, dt = %.4f s, volume = %.6g m3, max speed = %.2f m/s, active = %.1f %%", p.t,
-                      p.dt, p.mass, p.max_speed, 100 * p.active_fraction);
-        say(b);
-      }
-      return go;
-    };
-    RunSummary sum;
+  }
+  double wall_limit = cfg_.max_job_wall_s;
+  if (sj.scenario.limits().max_wall_s() > 0) wall_limit = std::min(wall_limit, sj.scenario.limits().max_wall_s());
+  std::int64_t mem_limit = cfg_.max_job_memory_bytes;
+  if (sj.scenario.limits().max_memory_bytes() > 0)
+    mem_limit = mem_limit > 0 ? std::min(mem_limit, sj.scenario.limits().max_memory_bytes()) : sj.scenario.limits().max_memory_bytes();
+  const auto grace = std::chrono::milliseconds(std::int64_t(1000 * cfg_.stop_grace_s));
+
+  for (int round = 0;; ++round) {
+    fs::remove_all(tmp, ec);
+    fs::create_directories(tmp, ec);
+    enum class Why { none, cancel, stop, wall, memory };
+    Why why = Why::none;
+    std::optional<v1::WorkerEvent> outcome;
+    WorkerExit ex;
     try {
-      sum = run_scenario(r, tmp.string(), opt);
-    } catch (const ScenarioError& e) {
-      if (opt.restart_path.empty()) throw;
-      // A checkpoint this build cannot continue (damaged, or from another build): from the start.
-      say(std::string("its checkpoint cannot be continued (") + e.what() + "); running again from the start");
-      log("job " + id + ": checkpoint refused (" + e.what() + "); running from the start");
-      remove_checkpoint(id);
-      fs::remove_all(tmp, ec);
-      fs::create_directories(tmp);
-      opt.restart_path.clear();
-      sum = run_scenario(r, tmp.string(), opt);
-    }
-    if (sum.stop == "cancelled") {
-      fs::remove_all(tmp, ec);
-      bool by_client = false;
-      {
-        std::lock_guard lk(mu_);
-        by_client = cancel_.count(id) > 0;
+      WorkerProcess w(cfg_.worker_exe, task, log_path(id));
+      say("worker process " + std::to_string(w.pid()));
+      const auto t0 = std::chrono::steady_clock::now();
+      auto last_check = t0, kill_at = t0;
+      while (!w.output_closed()) {
+        auto ev = w.next_event(std::chrono::milliseconds(100));
+        const auto now = std::chrono::steady_clock::now();
+        if (ev && ev->has_progress()) {
+          if (!on_progress(id, ev->progress()) && why == Why::none) {
+            std::lock_guard lk(mu_);
+            why = cancel_.count(id) ? Why::cancel : Why::stop;
+          }
+          if (now - last_check > std::chrono::seconds(1)) {
+            const auto& p = ev->progress();
+            try {
+              store_.save_progress(id, p);
+            } catch (...) {
+            }
+            char b[200];
+            std::snprintf(b, sizeof b, "t = %.3f s, dt = %.4g s, volume = %.6g m3, max speed = %.2f m/s, active = %.1f %%",
+                          p.simulated_s(), p.dt_s(), p.volume_m3(), p.max_speed_m_s(), 100 * p.active_fraction());
+            say(b);
+          }
+        } else if (ev) {
+          outcome = ev;
+        }
+        if (now - last_check > std::chrono::milliseconds(500)) {
+          last_check = now;
+          if (why == Why::none) {
+            bool cancel = false;
+            try {
+              cancel = store_.cancel_requested(id);
+            } catch (...) {
+            }
+            std::lock_guard lk(mu_);
+            if (cancel) cancel_.insert(id);
+            if (cancel_.count(id)) why = Why::cancel;
+            else if (stopping_) why = Why::stop;
+          }
+          if (why == Why::none && std::chrono::duration<double>(now - t0).count() > wall_limit) why = Why::wall;
+          if (why == Why::none && mem_limit > 0 && w.resident_bytes() > mem_limit) {
+            why = Why::memory;
+            w.signal(SIGKILL);  // memory is not given time
+          }
+        }
+        {
+          std::lock_guard lk(mu_);
+          if (why == Why::none && stopping_) why = Why::stop;
+          if (why == Why::none && cancel_.count(id)) why = Why::cancel;
+        }
+        if (why != Why::none && kill_at == t0) {
+          w.signal(SIGTERM);  // ends at the end of its step (a stop keeps a checkpoint)
+          kill_at = now + grace;
+        } else if (why != Why::none && now > kill_at) {
+          w.signal(SIGKILL);
+        }
       }
-      if (by_client)
-        finish_and_forget(v1::CANCELLED, "cancelled by the client at t = " + std::to_string(sum.t) + " s; no results kept", "", 0);
-      else if (r.vof)
-        finish(v1::QUEUED, "interrupted by the server stopping at t = " + std::to_string(sum.t) +
-                               " s; queued to continue from its checkpoint", "", 0);
-      else
-        finish(v1::QUEUED, "interrupted by the server stopping; queued to run again from the start", "", 0);
+      auto e = w.wait(grace + std::chrono::seconds(5));
+      if (!e) {
+        w.signal(SIGKILL);
+        e = w.wait(std::chrono::hours(1));
+      }
+      ex = *e;
+    } catch (const std::exception& e) {
+      fs::remove_all(tmp, ec);
+      finish_and_forget(v1::FAILED, "the worker process could not be started", e.what(), 0);
       return;
     }
-    fs::rename(tmp, final_dir, ec);
-    if (ec) {
-      // Another job with the same hash finished first: its (identical) results stand.
+    const std::string exit_text = ex.describe();
+    if (!(ex.exited && ex.code == 0)) say("worker process ended by " + exit_text);
+
+    if (why == Why::cancel) {
       fs::remove_all(tmp, ec);
-      if (!fs::exists(final_dir / "run.json")) throw std::runtime_error("cannot move the results into place");
+      const double t = outcome && outcome->has_interrupted() ? outcome->interrupted().simulated_s() : 0.0;
+      finish_and_forget(v1::CANCELLED, "cancelled by the client at t = " + std::to_string(t) + " s; no results kept", "", 0);
+      return;
     }
-    char b[300];
-    std::snprintf(b, sizeof b, "finished: %ld steps to t = %.1f s (stop: %s), affected area %.0f m2, runout %.0f m, max speed %.1f m/s",
-                  sum.steps, sum.t, sum.stop.c_str(), sum.affected_area_m2, sum.runout_m, sum.max_speed);
-    say(b);
-    finish_and_forget(v1::SUCCEEDED, "completed", "", folder_bytes(final_dir));
-  } catch (const std::exception& e) {
+    if (outcome && outcome->has_done()) {
+      fs::rename(tmp, final_dir, ec);
+      if (ec) {
+        // Another job with the same hash finished first: its (identical) results stand.
+        fs::remove_all(tmp, ec);
+        if (!fs::exists(final_dir / "run.json", ec)) {
+          finish_and_forget(v1::FAILED, "the run failed", "cannot move the results into place", 0);
+          return;
+        }
+      }
+      say("finished: " + outcome->done().summary());
+      finish_and_forget(v1::SUCCEEDED, "completed", "", folder_bytes(final_dir));
+      return;
+    }
     fs::remove_all(tmp, ec);
-    finish_and_forget(v1::FAILED, "the run failed", e.what(), 0);
+    if (why == Why::wall || why == Why::memory) {
+      char b[200];
+      if (why == Why::wall)
+        std::snprintf(b, sizeof b, "the run exceeded its wall-time limit of %.0f s and was stopped", wall_limit);
+      else
+        std::snprintf(b, sizeof b, "the run exceeded its memory limit of %.0f MiB and was stopped", double(mem_limit) / (1 << 20));
+      finish_and_forget(v1::FAILED, "stopped by a limit", b, 0);
+      return;
+    }
+    if (why == Why::stop || (outcome && outcome->has_interrupted())) {
+      const bool cp_now = outcome && outcome->has_interrupted() && outcome->interrupted().checkpoint_written();
+      const bool cp_any = cp_now || fs::exists(cp, ec);
+      char b[300];
+      std::snprintf(b, sizeof b, "interrupted by the server stopping%s; queued to %s", 
+                    cp_now ? (" at t = " + std::to_string(outcome->interrupted().simulated_s()) + " s").c_str() : "",
+                    cp_any ? "continue from its checkpoint" : "run again from the start");
+      finish(v1::QUEUED, b, "", 0);
+      return;
+    }
+    if (outcome && outcome->has_failed()) {
+      const auto& f = outcome->failed();
+      if (!task.restart_path().empty() && f.bad_input() && f.error().find("checkpoint") != std::string::npos && round == 0) {
+        // A checkpoint this build cannot continue (damaged, or from another build): from the start.
+        say("its checkpoint cannot be continued (" + f.error() + "); running again from the start");
+        log("job " + id + ": checkpoint refused (" + f.error() + "); running from the start");
+        remove_checkpoint(id);
+        task.clear_restart_path();
+        continue;
+      }
+      finish_and_forget(v1::FAILED, "the run failed", client_message(f.error(), cfg_.state_dir, cfg_.data_roots), 0);
+      return;
+    }
+    // No outcome: the worker process died of a signal nobody sent, or exited without a word.
+    const int crashes = sj.crashes + 1;
+    if (crashes >= cfg_.max_crashes) {
+      remove_checkpoint(id);
+      finish(v1::FAILED, "its worker process crashed",
+             "the job's worker process crashed (" + exit_text + ") in " + std::to_string(crashes) + " attempts", 0, true);
+      return;
+    }
+    finish(v1::QUEUED,
+           "its worker process crashed (" + exit_text + "); queued to run again (" + std::to_string(crashes) + " of " +
+               std::to_string(cfg_.max_crashes) + " crashes allowed)",
+           "", 0, true);
+    return;
   }
 }
 

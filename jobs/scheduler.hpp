@@ -1,12 +1,18 @@
 #pragma once
-// Workers that take queued jobs from the store and run them with the same run driver as `runout run`.
-// Results are written to results/<hash>.tmp-<job> and renamed to results/<hash> only when complete,
-// so a folder under results/ without ".tmp-" is always a whole result. Each job has a log
-// (logs/<job>.log) that keeps its progress and, when it fails, the error.
+// Worker slots that take queued jobs from the store and run each in a worker process of its own
+// (jobs/worker.hpp: the same run driver as `runout run`). Results are written to
+// results/<hash>.tmp-<job> and renamed to results/<hash> only when complete, so a folder under
+// results/ without ".tmp-" is always a whole result. Each job has a log (logs/<job>.log) that keeps
+// its progress and, when it fails, the error, and a record (logs/<job>.record.pb) from which
+// `runout serve --recover` rebuilds a lost store.
 //
-// Stopping: stop() interrupts running jobs through the run driver's progress hook and records them
-// as queued again; a server killed outright leaves them "running" in the store, and start() queues
-// them again. Runs are deterministic, so a job run again gives the result an uninterrupted run gives.
+// Stopping: stop() sends SIGTERM to every worker (it writes a checkpoint at the end of its step and
+// ends; after the grace time it is killed and continues from its last periodic checkpoint) and
+// records the jobs as queued again; a server killed outright takes its workers with it
+// (PR_SET_PDEATHSIG), leaves the jobs "running" in the store, and start() queues them again without
+// counting it against them. A job whose own worker dies of a signal the server did not send crashed:
+// it runs again, and fails after max_crashes such attempts. Continuation from a checkpoint is exact,
+// so a job run again gives the result an uninterrupted run gives.
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -30,7 +36,17 @@ struct SchedulerConfig {
   double retention_days = 0;        ///< finished results older than this are deleted; 0: kept
   std::int64_t retention_max_bytes = 0;  ///< oldest results deleted beyond this total; 0: no limit
   std::function<void(const std::string&)> log;  ///< server log lines (optional)
+  std::string worker_exe;           ///< the program run as `EXE worker`; default: this program
+  double max_job_wall_s = 86400;    ///< wall time of one attempt (a scenario's limits may lower it)
+  std::int64_t max_job_memory_bytes = 0;  ///< resident memory of a worker; 0: no limit
+  double stop_grace_s = 1;          ///< a stopped or cancelled worker is killed after this long
+  int max_crashes = 3;              ///< a job whose worker crashed this often fails
+  std::vector<std::string> data_roots;  ///< the server's data roots (left out of messages to clients)
 };
+
+/// A message for a client: the server's upload folders and data roots left out of the paths in it,
+/// so that a file is named as the client named it.
+std::string client_message(std::string msg, const std::string& state_dir, const std::vector<std::string>& data_roots);
 
 class Scheduler {
  public:
@@ -45,6 +61,9 @@ class Scheduler {
   void stop();
   /// A job was queued.
   void notify();
+  /// Write the job's record (logs/<job>.record.pb) for `runout serve --recover`.
+  void write_record(const StoredJob& job) const;
+  std::string record_path(const std::string& id) const;
   /// Ask a running job to stop; it ends as cancelled. false when it is not running here.
   bool cancel_running(const std::string& id);
 
@@ -72,6 +91,8 @@ class Scheduler {
  private:
   void worker_loop(int index);
   void run_job(StoredJob job);
+  /// Publish progress; false when the job should stop (cancel or server stop).
+  bool on_progress(const std::string& id, const v1::Progress& p);
   void log(const std::string& line) const;
 
   JobStore& store_;

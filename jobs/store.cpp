@@ -82,7 +82,7 @@ class Transaction {
 
 constexpr const char* kColumns =
     "id, owner, name, hash, request_id, state, created, updated, error, attempts, scenario, progress, result_bytes, "
-    "results_removed";
+    "results_removed, crashes";
 
 void add_transition(sqlite3* db, const std::string& id, v1::JobState s, const std::string& when, const std::string& reason) {
   Stmt(db, "INSERT INTO transitions(job, time, state, reason) VALUES (?, ?, ?, ?)")
@@ -138,7 +138,8 @@ JobStore::JobStore(const std::string& path) {
   }
   sqlite3_busy_timeout(db_, 10000);
   exec("PRAGMA journal_mode=WAL");
-  exec("PRAGMA synchronous=NORMAL");
+  // Every committed state change survives a power loss: the WAL is synced at each commit.
+  exec("PRAGMA synchronous=FULL");
   exec("PRAGMA foreign_keys=ON");
   exec(R"(CREATE TABLE IF NOT EXISTS jobs(
            seq INTEGER PRIMARY KEY AUTOINCREMENT,
@@ -181,6 +182,17 @@ JobStore::JobStore(const std::string& path) {
          "AND t.reason LIKE 'interrupted by the server stopping%')");
   }
   sqlite3_finalize(probe);
+  // ... and the count of the job's worker processes that crashed (died of a signal nobody sent).
+  probe = nullptr;
+  if (sqlite3_prepare_v2(db_, "SELECT crashes FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
+    exec("ALTER TABLE jobs ADD COLUMN crashes INTEGER NOT NULL DEFAULT 0");
+  sqlite3_finalize(probe);
+  exec(R"(CREATE TABLE IF NOT EXISTS uploads(
+           id TEXT NOT NULL,
+           owner TEXT NOT NULL,
+           bytes INTEGER NOT NULL,
+           time REAL NOT NULL,
+           PRIMARY KEY(id, owner));)");
 }
 
 JobStore::~JobStore() { sqlite3_close(db_); }
@@ -212,6 +224,7 @@ StoredJob JobStore::read_row(void* p) const {
   if (!prog.empty()) (void)j.job.mutable_progress()->ParseFromString(prog);
   j.job.set_result_bytes(st->i64(12));
   j.results_removed = st->i64(13) != 0;
+  j.crashes = int(st->i64(14));
   return j;
 }
 
@@ -241,6 +254,9 @@ SubmitOutcome JobStore::submit(const std::string& owner, const std::string& hash
     Stmt st(db_, (std::string("SELECT ") + kColumns + " FROM jobs WHERE owner = ? AND request_id = ?").c_str());
     st.bind(1, owner).bind(2, request_id);
     if (existing(st)) {
+      if (out.job.job.scenario_hash() != hash)
+        throw RequestIdConflict("request_id '" + request_id + "' was used for job " + out.job.job.id() +
+                                " with another scenario; use a new request id for a new scenario");
       tx.commit();
       return out;
     }
@@ -337,7 +353,7 @@ std::vector<StoredJob> JobStore::list(const std::string& owner, const std::vecto
       break;
     }
     out.push_back(read_row(&st));
-    last_seq = st.i64(14);
+    last_seq = st.i64(15);
   }
   for (auto& j : out) load_transitions(j);
   return out;
@@ -365,7 +381,7 @@ std::optional<StoredJob> JobStore::claim_next() {
 }
 
 void JobStore::transition(const std::string& id, v1::JobState state, const std::string& reason, const std::string& error,
-                          std::int64_t result_bytes) {
+                          std::int64_t result_bytes, bool crashed) {
   std::lock_guard lk(mu_);
   Transaction tx(db_);
   const std::string now = utc_now();
@@ -373,9 +389,9 @@ void JobStore::transition(const std::string& id, v1::JobState state, const std::
   // count towards the attempts a crashing job is allowed (requeue_running).
   Stmt up(db_,
           "UPDATE jobs SET state = ?, updated = ?, error = ?, result_bytes = CASE WHEN ? >= 0 THEN ? ELSE result_bytes END, "
-          "interrupted = interrupted + CASE WHEN ? = 1 AND state = 2 THEN 1 ELSE 0 END WHERE id = ?");
+          "interrupted = interrupted + CASE WHEN ? = 1 AND state = 2 THEN 1 ELSE 0 END, crashes = crashes + ? WHERE id = ?");
   up.bind(1, std::int64_t(state)).bind(2, now).bind(3, error).bind(4, result_bytes).bind(5, result_bytes)
-      .bind(6, std::int64_t(state)).bind(7, id).step();
+      .bind(6, std::int64_t(state)).bind(7, std::int64_t(crashed ? 1 : 0)).bind(8, id).step();
   add_transition(db_, id, state, now, reason);
   tx.commit();
 }
@@ -402,30 +418,26 @@ std::optional<StoredJob> JobStore::cancel(const std::string& id, const std::stri
   return get(id, owner);
 }
 
-int JobStore::requeue_running(const std::string& reason, int max_attempts) {
+int JobStore::requeue_running(const std::string& reason) {
   std::lock_guard lk(mu_);
   Transaction tx(db_);
   struct Row {
     std::string id;
-    std::int64_t attempts, cancel;
+    std::int64_t cancel;
   };
   std::vector<Row> rows;
   {
-    // Attempts that ended with the server going down (not those it interrupted cleanly).
-    Stmt st(db_, "SELECT id, attempts - interrupted, cancel_requested FROM jobs WHERE state = 2");
-    while (st.step()) rows.push_back({st.text(0), st.i64(1), st.i64(2)});
+    Stmt st(db_, "SELECT id, cancel_requested FROM jobs WHERE state = 2");
+    while (st.step()) rows.push_back({st.text(0), st.i64(1)});
   }
   const std::string now = utc_now();
   int queued = 0;
   for (const auto& r : rows) {
+    // The server went down, not the job (jobs run in processes of their own, which died with it):
+    // this does not count against the job.
     if (r.cancel) {
       Stmt(db_, "UPDATE jobs SET state = 5, updated = ? WHERE id = ?").bind(1, now).bind(2, r.id).step();
       add_transition(db_, r.id, v1::CANCELLED, now, "cancelled by the client; the server stopped before the run did");
-    } else if (r.attempts >= max_attempts) {
-      // A job that takes the server down with it must not do so for ever.
-      const std::string e = "the server went down during " + std::to_string(r.attempts) + " attempts of this job";
-      Stmt(db_, "UPDATE jobs SET state = 4, updated = ?, error = ? WHERE id = ?").bind(1, now).bind(2, e).bind(3, r.id).step();
-      add_transition(db_, r.id, v1::FAILED, now, e);
     } else {
       Stmt(db_, "UPDATE jobs SET state = 1, updated = ? WHERE id = ?").bind(1, now).bind(2, r.id).step();
       add_transition(db_, r.id, v1::QUEUED, now, reason);
@@ -485,6 +497,74 @@ void JobStore::mark_results_removed(const std::string& hash, const std::string& 
     add_transition(db_, id, v1::SUCCEEDED, now, reason);
   }
   tx.commit();
+}
+
+std::vector<StoredJob> JobStore::active_jobs() const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_, (std::string("SELECT ") + kColumns + " FROM jobs WHERE state IN (1, 2) ORDER BY seq").c_str());
+  std::vector<StoredJob> out;
+  while (st.step()) out.push_back(read_row(&st));
+  return out;
+}
+
+std::int64_t JobStore::job_count() const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_, "SELECT COUNT(*) FROM jobs");
+  st.step();
+  return st.i64(0);
+}
+
+void JobStore::insert_recovered(const StoredJob& j) {
+  std::lock_guard lk(mu_);
+  Transaction tx(db_);
+  std::string blob;
+  j.scenario.SerializeToString(&blob);
+  Stmt ins(db_,
+           "INSERT INTO jobs(id, owner, name, hash, request_id, state, created, updated, error, attempts, scenario, "
+           "result_bytes, results_removed) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  ins.bind(1, j.job.id()).bind(2, j.owner).bind(3, j.job.name()).bind(4, j.job.scenario_hash());
+  if (j.job.request_id().empty())
+    ins.null(5);
+  else
+    ins.bind(5, j.job.request_id());
+  ins.bind(6, std::int64_t(j.job.state())).bind(7, j.job.created_utc()).bind(8, j.job.updated_utc()).bind(9, j.job.error())
+      .bind(10, std::int64_t(j.job.attempts())).blob(11, blob).bind(12, j.job.result_bytes())
+      .bind(13, std::int64_t(j.results_removed ? 1 : 0));
+  ins.step();
+  for (const auto& t : j.job.transitions()) add_transition(db_, j.job.id(), t.state(), t.time_utc(), t.reason());
+  tx.commit();
+}
+
+void JobStore::record_upload(const std::string& owner, const std::string& id, std::int64_t bytes) {
+  std::lock_guard lk(mu_);
+  Stmt(db_, "INSERT OR REPLACE INTO uploads(id, owner, bytes, time) VALUES (?, ?, ?, ?)")
+      .bind(1, id)
+      .bind(2, owner)
+      .bind(3, bytes)
+      .bind(4, std::int64_t(std::time(nullptr)))
+      .step();
+}
+
+std::int64_t JobStore::upload_bytes(const std::string& owner) const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_, "SELECT COALESCE(SUM(bytes), 0) FROM uploads WHERE owner = ?");
+  st.bind(1, owner);
+  st.step();
+  return st.i64(0);
+}
+
+std::vector<std::string> JobStore::uploads_older_than(double cutoff_epoch_s) const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_, "SELECT id FROM uploads GROUP BY id HAVING MAX(time) < ?");
+  st.bind(1, std::int64_t(cutoff_epoch_s));
+  std::vector<std::string> out;
+  while (st.step()) out.push_back(st.text(0));
+  return out;
+}
+
+void JobStore::forget_upload(const std::string& id) {
+  std::lock_guard lk(mu_);
+  Stmt(db_, "DELETE FROM uploads WHERE id = ?").bind(1, id).step();
 }
 
 }  // namespace runout::jobs

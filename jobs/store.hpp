@@ -1,7 +1,9 @@
 #pragma once
 // The job store: every job, its state, its transitions (time and reason) and its last progress, in a
-// SQLite file (WAL mode) in the server's state directory. One connection, serialised by a mutex;
-// every state change is one transaction, so a process killed at any point leaves a consistent store.
+// SQLite file (WAL mode, synchronous=FULL: a committed change survives a power loss) in the server's
+// state directory. One connection, serialised by a mutex; every state change is one transaction, so
+// a process killed at any point leaves a consistent store. Uploads are recorded per client (quota,
+// garbage collection).
 // States: queued -> running -> succeeded | failed | cancelled; running -> queued when the server stops
 // or restarts during a run.
 #include <cstdint>
@@ -25,12 +27,17 @@ struct StoreError : std::runtime_error {
 struct QueueFull : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+/// A request id the client used before for another scenario.
+struct RequestIdConflict : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 struct StoredJob {
   v1::Job job;            ///< id, state, name, hash, times, error, progress, transitions, attempts
   std::string owner;      ///< the client (token) that submitted it
   v1::Scenario scenario;  ///< as resolved on the server (absolute input paths)
   bool results_removed = false;  ///< results deleted by the retention policy
+  int crashes = 0;               ///< attempts whose worker process died of a signal nobody sent
 };
 
 struct SubmitOutcome {
@@ -48,7 +55,8 @@ class JobStore {
 
   /// Queue a job, or return the existing one: the same owner's job with this request id, else the
   /// same owner's newest job with this scenario hash that did not fail or get cancelled. Throws
-  /// QueueFull when the owner already has `max_queued` queued or running jobs.
+  /// RequestIdConflict when the request id names a job of another scenario, QueueFull when the
+  /// owner already has `max_queued` queued or running jobs.
   SubmitOutcome submit(const std::string& owner, const std::string& hash, const std::string& request_id,
                        const v1::Scenario& scenario, int max_queued);
   /// The job with this id; with a non-empty owner only if it is that owner's.
@@ -58,16 +66,15 @@ class JobStore {
                               const std::string& page_token, std::string* next_page_token) const;
   /// The oldest queued job, now running (attempts + 1); nothing when the queue is empty.
   std::optional<StoredJob> claim_next();
-  /// Record a state change with its reason (and the error for failures).
+  /// Record a state change with its reason (and the error for failures); `crashed`: the attempt
+  /// ended because its worker process crashed (counted in StoredJob::crashes).
   void transition(const std::string& id, v1::JobState state, const std::string& reason, const std::string& error = "",
-                  std::int64_t result_bytes = -1);
+                  std::int64_t result_bytes = -1, bool crashed = false);
   /// Queued jobs become cancelled here; running ones are left for the worker (returns their state).
   std::optional<StoredJob> cancel(const std::string& id, const std::string& owner);
-  /// Jobs left running by a server that died: queued again (cancelled when the client had asked;
-  /// failed after `max_attempts` runs that ended with the server down, so that a job that kills
-  /// the server cannot do so for ever; runs the server interrupted cleanly do not count).
-  /// Returns how many were queued again.
-  int requeue_running(const std::string& reason, int max_attempts = 3);
+  /// Jobs left running by a server that went down: queued again (cancelled when the client had
+  /// asked). The server's death does not count against a job. Returns how many were queued again.
+  int requeue_running(const std::string& reason);
   /// Whether the client asked to cancel this (running) job.
   bool cancel_requested(const std::string& id) const;
   void save_progress(const std::string& id, const v1::Progress& p);
@@ -81,6 +88,22 @@ class JobStore {
   std::vector<Finished> finished_results() const;
   /// The results of this scenario hash were deleted (retention): every job with it says so.
   void mark_results_removed(const std::string& hash, const std::string& reason);
+
+  /// Queued and running jobs (their scenarios name the uploads still in use).
+  std::vector<StoredJob> active_jobs() const;
+  /// How many jobs the store holds.
+  std::int64_t job_count() const;
+  /// A job rebuilt by `runout serve --recover` (with its transitions), as it was.
+  void insert_recovered(const StoredJob& j);
+
+  /// An upload of `bytes` by this client (again: its time is renewed).
+  void record_upload(const std::string& owner, const std::string& id, std::int64_t bytes);
+  /// Bytes of the uploads this client holds.
+  std::int64_t upload_bytes(const std::string& owner) const;
+  /// Uploads whose newest record is older than `cutoff_epoch_s`.
+  std::vector<std::string> uploads_older_than(double cutoff_epoch_s) const;
+  /// Every record of an upload (it was removed).
+  void forget_upload(const std::string& id);
 
  private:
   StoredJob read_row(void* stmt) const;

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "jobs/worker.hpp"
 #include "service/cli/commands.hpp"
 
 namespace {
@@ -29,11 +30,14 @@ commands:
         (or CSV). Cases: A1 A2 A3 A4 A5 A6 A7 STRESS (default: all). --full adds the finest
         resolutions. --resolutions overrides a case's cell sizes in metres (A2: cells across the cap).
         Limiters: minmod (default), vanleer, superbee.
-  serve [--config FILE] [--listen HOST:PORT] [--state-dir DIR] [--data-root DIR]... [--tokens FILE]
+  serve [--recover] [--config FILE] [--listen HOST:PORT] [--state-dir DIR] [--data-root DIR]... [--tokens FILE]
         [--tls-cert FILE --tls-key FILE] [--workers N] [--threads-per-run N] [--log-file FILE]
         Run the gRPC batch server (runout.v1.Runout, health checking, reflection) until SIGINT or
         SIGTERM; options override the JSON configuration file (deploy/README.md lists every key).
-        Jobs left running by a killed server are queued again at the next start.
+        Each job runs in a worker process of its own; jobs left running by a killed server are
+        queued again at the next start. One server per state directory (a second one exits).
+        --recover rebuilds a missing, empty or damaged job store from the job records, logs and
+        results, then starts (docs/operations.md).
   submit SCENARIO.json [--wait] [--quiet] [--request-id ID] [--server-paths]
         Upload the scenario's input files and queue it; prints the job id and state. --wait follows
         the job to its end (progress on standard error). --server-paths sends the input paths as
@@ -88,6 +92,7 @@ int main(int argc, char** argv) {
     if (cmd == "verify") return runout::cli::verify(args);
     if (cmd == "version" || cmd == "--version") return runout::cli::version(args);
     if (cmd == "serve") return runout::cli::serve(args);
+    if (cmd == "worker") return runout::jobs::worker_main(0, 1);
     if (cmd == "submit") return runout::cli::submit(args);
     if (cmd == "status") return runout::cli::status(args);
     if (cmd == "watch") return runout::cli::watch(args);

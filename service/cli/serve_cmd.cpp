@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "jobs/state_dir.hpp"
 #include "service/cli/commands.hpp"
 #include "service/server/server.hpp"
 
@@ -14,7 +15,7 @@ namespace runout::cli {
 int serve(const std::vector<std::string>& args) {
   v1::ServerConfig file_cfg, cli_cfg;
   std::vector<std::string> roots;
-  bool have_roots = false;
+  bool have_roots = false, recover = false;
   for (std::size_t k = 0; k < args.size(); ++k) {
     const auto& a = args[k];
     const bool has_value = k + 1 < args.size();
@@ -28,6 +29,10 @@ int serve(const std::vector<std::string>& args) {
         return false;
       }
     };
+    if (a == "--recover") {
+      recover = true;
+      continue;
+    }
     if (a == "--config" || a == "--listen" || a == "--state-dir" || a == "--data-root" || a == "--tokens" ||
         a == "--tls-cert" || a == "--tls-key" || a == "--workers" || a == "--threads-per-run" || a == "--log-file") {
       if (!has_value) {
@@ -79,6 +84,19 @@ int serve(const std::vector<std::string>& args) {
     for (const auto& r : roots) cfg.add_data_roots(r);
   }
 
+  // A file-size limit makes writes fail (and say so), not the server die.
+  signal(SIGXFSZ, SIG_IGN);
+  signal(SIGPIPE, SIG_IGN);
+  if (recover) {
+    try {
+      const auto resolved = service::resolve_config(cfg);
+      const auto rep = jobs::recover_store(resolved.state_dir());
+      std::cerr << "runout serve: " << rep.text() << "\n";
+    } catch (const std::exception& e) {
+      std::cerr << "runout serve: --recover: " << e.what() << "\n";
+      return kBadInput;
+    }
+  }
   // Signals are taken by this thread only (sigwait below): block them before any thread starts.
   sigset_t set;
   sigemptyset(&set);

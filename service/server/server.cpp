@@ -6,12 +6,21 @@
 #include <grpcpp/health_check_service_interface.h>
 #include <gdal.h>
 #include <openssl/crypto.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
+#include <csignal>
+#include <cstring>
+#include <set>
+#include <ctime>
+#include <cmath>
+#include <thread>
 #include <condition_variable>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <mutex>
 #include <sstream>
@@ -20,6 +29,9 @@
 #include "jobs/scenario.hpp"
 #include "jobs/scheduler.hpp"
 #include "jobs/sha256.hpp"
+#include "jobs/state_dir.hpp"
+#include "jobs/worker.hpp"
+#include "runout/v1/worker.pb.h"
 #include "jobs/store.hpp"
 #include "runout/v1/service.grpc.pb.h"
 #include "terrain/terrain.hpp"
@@ -53,23 +65,31 @@ bool is_hex64(const std::string& s) {
 
 // Bearer tokens from a file: one per line, the token itself or "sha256:HEX"; '#' starts a comment
 // line. Only digests are kept; a presented token is hashed and compared with every digest in
-// constant time. The file is read again when it changes (token rotation without a restart).
+// constant time. The file is read again when it changes (token rotation without a restart; a change
+// is its size, times or inode). It fails closed: a file that cannot be read, holds no token or has a
+// malformed line makes every token invalid until it is fixed, and the log says why.
 class Tokens {
  public:
-  explicit Tokens(std::string path) : path_(std::move(path)) {
-    if (!path_.empty()) load();
+  Tokens(std::string path, std::function<void(const std::string&)> log) : path_(std::move(path)), log_(std::move(log)) {
+    if (!path_.empty()) {
+      std::lock_guard lk(mu_);
+      digests_ = parse();  // at the start a bad file is an error (ConfigError)
+      stamp_ = stamp();
+    }
   }
   bool enabled() const { return !path_.empty(); }
   /// The owner id of a token ("t" + 16 hex digits of its digest), or "" when it is not known.
   std::string owner_of(const std::string& token) {
     std::lock_guard lk(mu_);
-    std::error_code ec;
-    const auto mt = fs::last_write_time(path_, ec);
-    if (!ec && mt != mtime_) {
+    const std::string now = stamp();
+    if (now != stamp_) {
+      stamp_ = now;
       try {
-        load_locked();
-      } catch (const std::exception&) {
-        // keep the tokens we have; the server log says why on the next start
+        digests_ = parse();
+        if (log_) log_("tokens file '" + path_ + "' read again: " + std::to_string(digests_.size()) + " token(s)");
+      } catch (const std::exception& e) {
+        digests_.clear();  // fail closed
+        if (log_) log_(std::string("tokens file: ") + e.what() + "; no token is accepted until it is fixed");
       }
     }
     const auto d = digest_of(jobs::sha256_hex(token));
@@ -86,11 +106,14 @@ class Tokens {
   }
 
  private:
-  void load() {
-    std::lock_guard lk(mu_);
-    load_locked();
+  // What identifies the file's version: inode, size, modification and change times ("" when gone).
+  std::string stamp() const {
+    struct stat st {};
+    if (::stat(path_.c_str(), &st) != 0) return "";
+    return std::to_string(st.st_ino) + ":" + std::to_string(st.st_size) + ":" + std::to_string(st.st_mtim.tv_sec) + "." +
+           std::to_string(st.st_mtim.tv_nsec) + ":" + std::to_string(st.st_ctim.tv_sec) + "." + std::to_string(st.st_ctim.tv_nsec);
   }
-  void load_locked() {
+  std::vector<std::array<unsigned char, 32>> parse() const {
     std::ifstream in(path_);
     if (!in) throw ConfigError("tokens_file '" + path_ + "': cannot read it");
     std::vector<std::array<unsigned char, 32>> ds;
@@ -114,13 +137,12 @@ class Tokens {
       }
     }
     if (ds.empty()) throw ConfigError("tokens_file '" + path_ + "' holds no token");
-    digests_ = std::move(ds);
-    std::error_code ec;
-    mtime_ = fs::last_write_time(path_, ec);
+    return ds;
   }
   std::string path_;
+  std::function<void(const std::string&)> log_;
   std::vector<std::array<unsigned char, 32>> digests_;
-  fs::file_time_type mtime_{};
+  std::string stamp_;
   std::mutex mu_;
 };
 
@@ -156,6 +178,22 @@ v1::ServerConfig resolve_config(v1::ServerConfig c) {
   if (c.retention_days() < 0) throw ConfigError("retention_days: must be >= 0 (0: keep)");
   if (c.retention_max_bytes() < 0) throw ConfigError("retention_max_bytes: must be >= 0 (0: no limit)");
   if (c.tls_cert().empty() != c.tls_key().empty()) throw ConfigError("tls_cert and tls_key: give both or neither");
+  if (c.max_job_wall_s() == 0) c.set_max_job_wall_s(86400);
+  if (!(c.max_job_wall_s() > 0 && c.max_job_wall_s() <= 365 * 86400.0))
+    throw ConfigError("max_job_wall_s: must lie in (0, 31536000] s");
+  if (c.max_job_memory_bytes() == 0) {
+    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    if (pages > 0 && page > 0) c.set_max_job_memory_bytes(std::int64_t(pages) * page / std::max(1, c.workers()));
+  }
+  if (c.max_job_memory_bytes() < 0) throw ConfigError("max_job_memory_bytes: must be > 0");
+  if (c.upload_ttl_s() == 0) c.set_upload_ttl_s(3600);
+  if (!(c.upload_ttl_s() > 0 && std::isfinite(c.upload_ttl_s()))) throw ConfigError("upload_ttl_s: must be > 0 s");
+  if (c.max_upload_bytes_per_client() == 0) c.set_max_upload_bytes_per_client(std::int64_t(8) << 30);
+  if (c.max_upload_bytes_per_client() < 0) throw ConfigError("max_upload_bytes_per_client: must be > 0");
+  if (c.stop_grace_s() == 0) c.set_stop_grace_s(1);
+  if (!(c.stop_grace_s() > 0 && c.stop_grace_s() <= 600)) throw ConfigError("stop_grace_s: must lie in (0, 600] s");
+  if (c.max_crashes() == 0) c.set_max_crashes(3);
+  if (c.max_crashes() < 0 || c.max_crashes() > 100) throw ConfigError("max_crashes: must lie in 1..100");
   std::error_code ec;
   fs::create_directories(c.state_dir(), ec);
   if (ec) throw ConfigError("state_dir '" + c.state_dir() + "': " + ec.message());
@@ -181,12 +219,16 @@ v1::ServerConfig read_config_file(const std::string& path) {
 
 struct Server::Impl final : v1::Runout::Service {
   v1::ServerConfig cfg;
+  std::unique_ptr<jobs::StateLock> lock;
+  std::thread housekeeping;
+  std::condition_variable housekeeping_cv;
   std::unique_ptr<Tokens> tokens;
   std::unique_ptr<jobs::JobStore> store;
   std::unique_ptr<jobs::Scheduler> sched;
   std::unique_ptr<grpc::Server> server;
   int bound_port = 0;
   std::mutex log_mu;
+  std::mutex upload_mu;
   std::ofstream log_file;
   std::mutex stop_mu;
   std::condition_variable stop_cv;
@@ -269,39 +311,174 @@ struct Server::Impl final : v1::Runout::Service {
     return out;
   }
 
+  // The uploads a scenario names (their ids), from its resolved paths.
+  std::vector<std::string> uploads_of(const v1::Scenario& s) const {
+    std::vector<std::string> ids;
+    const std::string up = (fs::path(cfg.state_dir()) / "uploads").string() + "/";
+    auto take = [&](const std::string& p) {
+      if (p.rfind(up, 0) == 0) ids.push_back(p.substr(up.size(), 64));
+    };
+    take(s.dem().path());
+    take(s.area_of_interest().path());
+    for (const auto& r : s.releases()) take(r.path());
+    return ids;
+  }
+
+  // Remove uploads that no queued or running job uses: those given (a refused submission's), or
+  // all whose last use is older than the upload time-to-live.
+  void collect_uploads(const std::vector<std::string>& only = {}, bool all_old = false) {
+    std::lock_guard lk(upload_mu);
+    std::set<std::string> used;
+    for (const auto& j : store->active_jobs())
+      for (const auto& id : uploads_of(j.scenario)) used.insert(id);
+    std::set<std::string> drop(only.begin(), only.end());
+    const double cutoff = double(std::time(nullptr)) - cfg.upload_ttl_s();
+    if (all_old) {
+      for (const auto& id : store->uploads_older_than(cutoff)) drop.insert(id);
+      const auto all = store->uploads_older_than(1e18);
+      const std::set<std::string> recorded(all.begin(), all.end());
+      std::error_code ec;  // folders without a record (a store rebuilt by --recover): by their time
+      for (const auto& e : fs::directory_iterator(fs::path(cfg.state_dir()) / "uploads", ec)) {
+        const std::string id = e.path().filename().string();
+        if (!is_hex64(id) || recorded.count(id)) continue;
+        std::error_code ec2;
+        const auto mt = fs::last_write_time(e.path(), ec2);
+        const double age = std::chrono::duration<double>(fs::file_time_type::clock::now() - mt).count();
+        if (!ec2 && age > cfg.upload_ttl_s()) drop.insert(id);
+      }
+    }
+    for (const auto& id : drop) {
+      if (used.count(id)) continue;
+      std::error_code ec;
+      fs::remove_all(fs::path(cfg.state_dir()) / "uploads" / id, ec);
+      store->forget_upload(id);
+      log("upload " + id.substr(0, 12) + " removed (" + (all_old ? "unused for longer than the upload time-to-live" : "its submission was refused") + ")");
+    }
+  }
+
+  // Every check `runout run` makes, in a worker process of its own (a DEM that crashes or hangs
+  // GDAL takes only that process down): the inputs read, the grid or mesh built, one step run.
+  Status validate_in_worker(const v1::Scenario& s) {
+    const fs::path dir = fs::path(cfg.state_dir()) / "validate" / jobs::new_job_id();
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) return {StatusCode::INTERNAL, "cannot create a folder to check the scenario in: " + ec.message()};
+    v1::WorkerTask task;
+    task.set_job_id("validate");
+    *task.mutable_scenario() = s;
+    task.set_out_dir(dir.string());
+    task.set_threads(1);
+    task.set_validate_only(true);
+    Status st = Status::OK;
+    try {
+      jobs::WorkerProcess w(jobs::self_executable(), task, (dir / "validate.log").string());
+      std::optional<v1::WorkerEvent> outcome;
+      const auto t0 = std::chrono::steady_clock::now();
+      bool timed_out = false;
+      while (!w.output_closed()) {
+        auto ev = w.next_event(std::chrono::milliseconds(100));
+        if (ev && !ev->has_progress()) outcome = ev;
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (wall > kValidateSeconds || (cfg.max_job_memory_bytes() > 0 && w.resident_bytes() > cfg.max_job_memory_bytes())) {
+          timed_out = wall > kValidateSeconds;
+          w.signal(SIGKILL);
+          break;
+        }
+      }
+      auto ex = w.wait(std::chrono::seconds(10));
+      if (!ex) {
+        w.signal(SIGKILL);
+        ex = w.wait(std::chrono::seconds(60));
+      }
+      if (outcome && outcome->has_failed()) {
+        const std::string m = jobs::client_message(outcome->failed().error(), cfg.state_dir(),
+                                                   {cfg.data_roots().begin(), cfg.data_roots().end()});
+        st = outcome->failed().bad_input() ? Status(StatusCode::INVALID_ARGUMENT, m)
+                                           : Status(StatusCode::INVALID_ARGUMENT, "checking the scenario failed: " + m);
+      } else if (!outcome && timed_out) {
+        log("checking a scenario took longer than " + std::to_string(int(kValidateSeconds)) +
+            " s; accepted, its remaining checks run with the job");
+      } else if (!outcome) {
+        st = {StatusCode::INVALID_ARGUMENT, "checking the scenario's inputs ended the checking process (" +
+                                                (ex ? ex->describe() : std::string("no exit status")) +
+                                                "): the inputs cannot be read safely"};
+      }
+    } catch (const std::exception& e) {
+      st = {StatusCode::INTERNAL, std::string("cannot check the scenario: ") + e.what()};
+    }
+    fs::remove_all(dir, ec);
+    return st;
+  }
+
+  static constexpr double kValidateSeconds = 30;
+
   Status SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRequest* req, v1::Job* resp) override {
     std::string owner;
     if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
     if (!req->has_scenario()) return {StatusCode::INVALID_ARGUMENT, "scenario: missing"};
     if (req->request_id().size() > 200) return {StatusCode::INVALID_ARGUMENT, "request_id: longer than 200 characters"};
     v1::Scenario s = req->scenario();
-    if (auto st = resolve_input("dem.path", s.mutable_dem()->mutable_path()); !st.ok()) return st;
+    std::vector<std::string> uploads;  // of this submission: removed when it is refused
+    auto refuse = [&](Status st) {
+      if (!uploads.empty()) collect_uploads(uploads);
+      return st;
+    };
+    auto input = [&](const std::string& field, std::string* path) {
+      const bool upload = path->rfind("upload:", 0) == 0;
+      Status st = resolve_input(field, path);
+      if (st.ok() && upload) uploads.push_back(fs::path(*path).parent_path().filename().string());
+      return st;
+    };
+    if (auto st = input("dem.path", s.mutable_dem()->mutable_path()); !st.ok()) return refuse(st);
     if (s.has_area_of_interest())
-      if (auto st = resolve_input("area_of_interest.path", s.mutable_area_of_interest()->mutable_path()); !st.ok()) return st;
+      if (auto st = input("area_of_interest.path", s.mutable_area_of_interest()->mutable_path()); !st.ok()) return refuse(st);
     for (int k = 0; k < s.releases_size(); ++k)
-      if (auto st = resolve_input("releases[" + std::to_string(k) + "].path", s.mutable_releases(k)->mutable_path()); !st.ok())
-        return st;
+      if (auto st = input("releases[" + std::to_string(k) + "].path", s.mutable_releases(k)->mutable_path()); !st.ok())
+        return refuse(st);
+    // The job's limits: within the server's.
+    {
+      const auto& l = s.limits();
+      if (!(std::isfinite(l.max_wall_s()) && l.max_wall_s() >= 0 && l.max_wall_s() <= cfg.max_job_wall_s()))
+        return refuse({StatusCode::INVALID_ARGUMENT, "limits.max_wall_s: must lie in [0, " + jobs::json_number(cfg.max_job_wall_s()) +
+                                                         "] s (0: the server's limit), got " + jobs::json_number(l.max_wall_s())});
+      if (l.max_memory_bytes() < 0 || (cfg.max_job_memory_bytes() > 0 && l.max_memory_bytes() > cfg.max_job_memory_bytes()))
+        return refuse({StatusCode::INVALID_ARGUMENT, "limits.max_memory_bytes: must lie in [0, " +
+                                                         std::to_string(cfg.max_job_memory_bytes()) + "] (0: the server's limit), got " +
+                                                         std::to_string(l.max_memory_bytes())});
+    }
+    const std::vector<std::string> roots(cfg.data_roots().begin(), cfg.data_roots().end());
     std::string hash;
     try {
       const auto r = jobs::resolve_scenario(s, "/");
       hash = jobs::scenario_hash(r);
     } catch (const jobs::ScenarioError& e) {
-      return {StatusCode::INVALID_ARGUMENT, e.what()};
+      return refuse({StatusCode::INVALID_ARGUMENT, jobs::client_message(e.what(), cfg.state_dir(), roots)});
     } catch (const terrain::TerrainError& e) {
-      return {StatusCode::INVALID_ARGUMENT, e.what()};
+      return refuse({StatusCode::INVALID_ARGUMENT, jobs::client_message(e.what(), cfg.state_dir(), roots)});
     } catch (const std::exception& e) {
-      return {StatusCode::INTERNAL, std::string("validating the scenario failed: ") + e.what()};
+      return refuse({StatusCode::INTERNAL, std::string("validating the scenario failed: ") + e.what()});
     }
+    // Everything else `runout run` checks (unless these very inputs were computed before).
+    std::error_code ec;
+    if (!fs::exists(fs::path(sched->results_dir(hash)) / "run.json", ec))
+      if (auto st = validate_in_worker(s); !st.ok()) return refuse(st);
     try {
       const auto out = store->submit(owner, hash, req->request_id(), s, cfg.max_queued_per_client());
       *resp = with_live(out.job);
       if (out.created) {
+        try {
+          sched->write_record(out.job);
+        } catch (const std::exception& e) {
+          log("job " + resp->id() + ": " + e.what() + " (`runout serve --recover` cannot rebuild it)");
+        }
         log("job " + resp->id() + ": queued (" + owner + ", scenario " + hash.substr(0, 12) + ")");
         sched->touch(resp->id());
         sched->notify();
       }
+    } catch (const jobs::RequestIdConflict& e) {
+      return refuse({StatusCode::ALREADY_EXISTS, e.what()});
     } catch (const jobs::QueueFull& e) {
-      return {StatusCode::RESOURCE_EXHAUSTED, e.what()};
+      return refuse({StatusCode::RESOURCE_EXHAUSTED, e.what()});
     } catch (const std::exception& e) {
       return {StatusCode::INTERNAL, e.what()};
     }
@@ -342,6 +519,10 @@ struct Server::Impl final : v1::Runout::Service {
     if (j->job.state() == v1::RUNNING) {
       sched->cancel_running(req->id());
       log("job " + req->id() + ": cancel requested");
+    } else if (j->job.state() == v1::CANCELLED && !j->job.transitions().empty() &&
+               j->job.transitions(j->job.transitions_size() - 1).reason() == "cancelled by the client before it started") {
+      std::ofstream lg(sched->log_path(req->id()), std::ios::app);  // `runout serve --recover` reads it
+      lg << jobs::utc_now() << " cancelled: cancelled by the client before it started\n";
     }
     sched->touch(req->id());
     *resp = with_live(*j);
@@ -471,6 +652,7 @@ struct Server::Impl final : v1::Runout::Service {
     jobs::Sha256 set_hash;
     std::unique_ptr<jobs::Sha256> file_hash;
     std::int64_t bytes = 0;
+    const std::int64_t held = store->upload_bytes(owner);
     auto close_file = [&] {
       if (!current.empty()) {
         out.close();
@@ -495,22 +677,33 @@ struct Server::Impl final : v1::Runout::Service {
       bytes += std::int64_t(c.data().size());
       if (bytes > cfg.max_upload_bytes())
         return fail(StatusCode::RESOURCE_EXHAUSTED, "upload larger than the server's limit of " + std::to_string(cfg.max_upload_bytes()) + " bytes");
+      if (held + bytes > cfg.max_upload_bytes_per_client())
+        return fail(StatusCode::RESOURCE_EXHAUSTED,
+                    "this client's uploads would exceed its quota of " + std::to_string(cfg.max_upload_bytes_per_client()) +
+                        " bytes (uploads no queued or running job uses are removed after " + jobs::json_number(cfg.upload_ttl_s()) + " s)");
+      errno = 0;
       out.write(c.data().data(), std::streamsize(c.data().size()));
       file_hash->update(c.data());
-      if (!out) return fail(StatusCode::INTERNAL, "writing the upload failed");
+      if (!out)
+        return fail(errno == ENOSPC ? StatusCode::RESOURCE_EXHAUSTED : StatusCode::INTERNAL,
+                    std::string("writing the upload failed: ") + (errno ? std::strerror(errno) : "write error") +
+                        (errno == ENOSPC ? " (the server's disk is full)" : ""));
     }
     if (ctx->IsCancelled()) return fail(StatusCode::CANCELLED, "the client went away during the upload");
     if (names.empty()) return fail(StatusCode::INVALID_ARGUMENT, "empty upload");
     close_file();
     const std::string id = set_hash.hex();
     const fs::path dest = up / id;
+    std::lock_guard ulk(upload_mu);  // not while the collector decides
     if (fs::exists(dest, ec)) {
       fs::remove_all(tmp, ec);  // the same files were uploaded before
+      fs::last_write_time(dest, fs::file_time_type::clock::now(), ec);
     } else {
       fs::rename(tmp, dest, ec);
       if (ec && !fs::exists(dest)) return fail(StatusCode::INTERNAL, "storing the upload failed: " + ec.message());
       fs::remove_all(tmp, ec);
     }
+    store->record_upload(owner, id, bytes);
     resp->set_ref("upload:" + id + "/" + names.front());
     for (const auto& n : names) resp->add_files(n);
     resp->set_bytes(bytes);
@@ -529,12 +722,24 @@ void Server::start() {
     m.log_file.open(m.cfg.log_file(), std::ios::app);
     if (!m.log_file) throw ConfigError("log_file '" + m.cfg.log_file() + "': cannot open it");
   }
-  m.tokens = std::make_unique<Tokens>(m.cfg.tokens_file());
-  fs::create_directories(fs::path(m.cfg.state_dir()) / "uploads");
+  m.tokens = std::make_unique<Tokens>(m.cfg.tokens_file(), [&m](const std::string& l) { m.log(l); });
+  // One writer per state directory, for the server's life; then a store that does not forget.
   try {
-    m.store = std::make_unique<jobs::JobStore>((fs::path(m.cfg.state_dir()) / "jobs.db").string());
-  } catch (const std::exception& e) {
+    m.lock = std::make_unique<jobs::StateLock>(m.cfg.state_dir());
+    jobs::check_store(m.cfg.state_dir());
+  } catch (const jobs::StateError& e) {
     throw ConfigError(e.what());
+  }
+  fs::create_directories(fs::path(m.cfg.state_dir()) / "uploads");
+  {
+    std::error_code ec;  // checks of submissions cut off by a dead process
+    fs::remove_all(fs::path(m.cfg.state_dir()) / "validate", ec);
+  }
+  const std::string db = (fs::path(m.cfg.state_dir()) / "jobs.db").string();
+  try {
+    m.store = std::make_unique<jobs::JobStore>(db);
+  } catch (const std::exception& e) {
+    throw ConfigError(std::string(e.what()) + " (" + db + ")");
   }
   jobs::SchedulerConfig sc;
   sc.state_dir = m.cfg.state_dir();
@@ -543,6 +748,11 @@ void Server::start() {
   sc.retention_days = m.cfg.retention_days();
   sc.retention_max_bytes = m.cfg.retention_max_bytes();
   sc.log = [&m](const std::string& s) { m.log(s); };
+  sc.max_job_wall_s = m.cfg.max_job_wall_s();
+  sc.max_job_memory_bytes = m.cfg.max_job_memory_bytes();
+  sc.stop_grace_s = m.cfg.stop_grace_s();
+  sc.max_crashes = m.cfg.max_crashes();
+  sc.data_roots.assign(m.cfg.data_roots().begin(), m.cfg.data_roots().end());
   m.sched = std::make_unique<jobs::Scheduler>(*m.store, sc);
   {
     std::error_code ec;  // uploads cut off by a dead process
@@ -565,11 +775,30 @@ void Server::start() {
       m.log("warning: listening on " + m.cfg.listen() + " without tokens_file: anyone who reaches the port can submit jobs");
   }
   b.AddListeningPort(m.cfg.listen(), creds, &m.bound_port);
+  b.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);  // a port taken by another server is an error, not shared
   b.SetMaxReceiveMessageSize(m.cfg.max_message_bytes());
   b.SetMaxSendMessageSize(m.cfg.max_message_bytes());
   b.RegisterService(&m);
   m.server = b.BuildAndStart();
-  if (!m.server || m.bound_port == 0) throw ConfigError("listen: cannot listen on " + m.cfg.listen());
+  if (!m.server || m.bound_port == 0)
+    throw ConfigError("listen: cannot listen on " + m.cfg.listen() +
+                      " (the port is in use, the address is not this machine's, or the TLS certificate and key do not match)");
+  m.lock->set_listen(address());
+  m.housekeeping = std::thread([&m] {
+    const auto every = std::chrono::duration<double>(std::min(60.0, m.cfg.upload_ttl_s() / 4));
+    std::unique_lock lk(m.stop_mu);
+    while (!m.stopped) {
+      m.housekeeping_cv.wait_for(lk, every, [&] { return m.stopped; });
+      if (m.stopped) break;
+      lk.unlock();
+      try {
+        m.collect_uploads({}, true);
+      } catch (const std::exception& e) {
+        m.log(std::string("upload collection failed: ") + e.what());
+      }
+      lk.lock();
+    }
+  });
   m.server->GetHealthCheckService()->SetServingStatus(true);
   std::ofstream sj(fs::path(m.cfg.state_dir()) / "server.json.tmp");
   sj << "{\"listen\": \"" << address() << "\", \"pid\": " << getpid() << ", \"started_utc\": \"" << jobs::utc_now() << "\"}\n";
@@ -603,6 +832,8 @@ void Server::shutdown() {
     m.log("stopped");
   }
   m.stop_cv.notify_all();
+  m.housekeeping_cv.notify_all();
+  if (m.housekeeping.joinable()) m.housekeeping.join();
 }
 
 void Server::wait() {

@@ -1,0 +1,52 @@
+#pragma once
+// The server's state directory (jobs.db, results/, logs/, uploads/, checkpoints/): one writer at a
+// time, a store that never silently forgets, and the rebuilding of a lost store.
+#include <stdexcept>
+#include <string>
+
+namespace runout::jobs {
+
+struct StateError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// The exclusive lock of a state directory (an flock on STATE/server.lock), held for the life of
+/// this object; the operating system releases it when the process dies, however it dies. The lock
+/// file names the holder (pid, and its listen address once set), so that a second server can say
+/// who holds it.
+class StateLock {
+ public:
+  /// Throws StateError naming the holder when another process holds the lock.
+  explicit StateLock(const std::string& state_dir);
+  ~StateLock();
+  StateLock(const StateLock&) = delete;
+  StateLock& operator=(const StateLock&) = delete;
+  /// Record the address the holder listens on.
+  void set_listen(const std::string& address);
+
+ private:
+  int fd_ = -1;
+  std::string path_;
+};
+
+/// Check the job store before a server opens it. Throws StateError, saying what was found and how
+/// to recover, when STATE/jobs.db is missing or empty while results/ or logs/ hold earlier jobs,
+/// or when it is damaged (SQLite's quick_check fails or it is not a database).
+void check_store(const std::string& state_dir);
+
+struct RecoveryReport {
+  int records = 0;               ///< job records found (logs/JOB.record.pb)
+  int rebuilt = 0;               ///< jobs written to the new store
+  int succeeded = 0, failed = 0, cancelled = 0, queued = 0;
+  int results_missing = 0;       ///< succeeded jobs whose results are gone (marked removed)
+  int logs_without_record = 0;   ///< job logs with no record: not rebuilt
+  std::string moved_aside;       ///< where the damaged store was moved ("" when none was there)
+  std::string text() const;      ///< a summary for the operator
+};
+
+/// `runout serve --recover`: move a missing, empty or damaged store aside and rebuild one from the
+/// job records, their logs and the results. Throws StateError when the store is healthy (nothing to
+/// recover) or another server holds the state directory.
+RecoveryReport recover_store(const std::string& state_dir);
+
+}  // namespace runout::jobs

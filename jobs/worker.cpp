@@ -1,0 +1,313 @@
+#include "jobs/worker.hpp"
+
+#include <fcntl.h>
+#include <omp.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include "jobs/run.hpp"
+#include "jobs/scenario.hpp"
+#include "terrain/terrain.hpp"
+
+namespace runout::jobs {
+
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_stop(int) { g_stop = 1; }
+
+bool write_all(int fd, const char* p, std::size_t n) {
+  while (n > 0) {
+    const ssize_t w = ::write(fd, p, n);
+    if (w < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    p += w;
+    n -= std::size_t(w);
+  }
+  return true;
+}
+
+// One event: 4 bytes of length (little endian), then the message.
+bool send_event(int fd, const v1::WorkerEvent& ev) {
+  std::string body;
+  ev.SerializeToString(&body);
+  const auto n = std::uint32_t(body.size());
+  const char head[4] = {char(n & 255), char((n >> 8) & 255), char((n >> 16) & 255), char((n >> 24) & 255)};
+  return write_all(fd, head, 4) && write_all(fd, body.data(), body.size());
+}
+
+std::string signal_name(int sig) {
+  switch (sig) {
+    case SIGSEGV: return "SIGSEGV";
+    case SIGABRT: return "SIGABRT";
+    case SIGKILL: return "SIGKILL";
+    case SIGTERM: return "SIGTERM";
+    case SIGBUS: return "SIGBUS";
+    case SIGFPE: return "SIGFPE";
+    case SIGILL: return "SIGILL";
+    case SIGXFSZ: return "SIGXFSZ";
+    case SIGINT: return "SIGINT";
+    default: return "signal " + std::to_string(sig);
+  }
+}
+
+}  // namespace
+
+std::string WorkerExit::describe() const { return exited ? "exit status " + std::to_string(code) : signal_name(signal); }
+
+std::string self_executable() {
+  std::vector<char> b(4096);
+  const ssize_t n = readlink("/proc/self/exe", b.data(), b.size() - 1);
+  if (n <= 0) throw std::runtime_error("cannot find the program's own path (/proc/self/exe)");
+  return std::string(b.data(), std::size_t(n));
+}
+
+int worker_main(int in_fd, int out_fd) {
+  // Stray prints of libraries go to the log (standard error), never into the event stream.
+  const int events = dup(out_fd);
+  if (events < 0) return 3;
+  dup2(2, out_fd);
+  std::signal(SIGTERM, on_stop);
+  std::signal(SIGINT, on_stop);
+  std::signal(SIGPIPE, SIG_IGN);
+  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit makes writes fail (and the run report it), not the process die
+
+  std::string in;
+  {
+    char b[65536];
+    for (;;) {
+      const ssize_t n = ::read(in_fd, b, sizeof b);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      in.append(b, std::size_t(n));
+    }
+  }
+  v1::WorkerTask task;
+  auto failed = [&](const std::string& error, bool bad_input) {
+    v1::WorkerEvent ev;
+    ev.mutable_failed()->set_error(error);
+    ev.mutable_failed()->set_bad_input(bad_input);
+    return send_event(events, ev) ? 0 : 3;
+  };
+  if (!task.ParseFromString(in)) return failed("the worker received an unreadable task", false);
+  if (task.threads() > 0) omp_set_num_threads(task.threads());
+
+  try {
+    const ResolvedScenario r = resolve_scenario(task.scenario(), "/");
+    RunOptions opt;
+    opt.progress_every = 1;  // the stop flag is seen after every step
+    opt.checkpoint_path = task.checkpoint_path();
+    opt.checkpoint_interval_s = task.checkpoint_interval_s();
+    opt.restart_path = task.restart_path();
+    const double t_end = r.vof ? r.scenario.lab().end_time_s() : r.config.time.t_end;
+    const double every = task.progress_interval_s() > 0 ? task.progress_interval_s() : 0.5;
+    const auto wall0 = std::chrono::steady_clock::now();
+    auto last = wall0 - std::chrono::hours(1);
+    bool event_failed = false;
+    opt.progress = [&](const engine::Progress& p) {
+      if (task.validate_only()) return false;  // prepared and one step taken: every input check has run
+      const auto now = std::chrono::steady_clock::now();
+      if (std::chrono::duration<double>(now - last).count() >= every) {
+        last = now;
+        v1::WorkerEvent ev;
+        auto* pr = ev.mutable_progress();
+        pr->set_simulated_s(p.t);
+        pr->set_dt_s(p.dt);
+        pr->set_volume_m3(p.mass);
+        pr->set_max_speed_m_s(p.max_speed);
+        pr->set_active_fraction(p.active_fraction);
+        pr->set_end_time_s(t_end);
+        pr->set_steps(p.step);
+        const double wall = std::chrono::duration<double>(now - wall0).count();
+        pr->set_seconds_left(p.t > 0 ? wall * (t_end - p.t) / p.t : 0.0);
+        event_failed = event_failed || !send_event(events, ev);
+      }
+      return g_stop == 0 && !event_failed;
+    };
+    const RunSummary sum = run_scenario(r, task.out_dir(), opt);
+    v1::WorkerEvent ev;
+    if (sum.stop == "cancelled" && !task.validate_only()) {
+      ev.mutable_interrupted()->set_simulated_s(sum.t);
+      ev.mutable_interrupted()->set_checkpoint_written(!task.checkpoint_path().empty());
+    } else {
+      auto* d = ev.mutable_done();
+      d->set_steps(sum.steps);
+      d->set_simulated_s(sum.t);
+      d->set_stop(task.validate_only() ? "validated" : sum.stop);
+      char b[300];
+      std::snprintf(b, sizeof b, "%ld steps to t = %.3f s (stop: %s), affected area %.0f m2, runout %.0f m, max speed %.1f m/s",
+                    sum.steps, sum.t, sum.stop.c_str(), sum.affected_area_m2, sum.runout_m, sum.max_speed);
+      d->set_summary(b);
+    }
+    return send_event(events, ev) ? 0 : 3;
+  } catch (const ScenarioError& e) {
+    return failed(e.what(), true);
+  } catch (const terrain::TerrainError& e) {
+    return failed(e.what(), true);
+  } catch (const std::invalid_argument& e) {
+    return failed(e.what(), true);
+  } catch (const std::exception& e) {
+    return failed(e.what(), false);
+  }
+}
+
+WorkerProcess::WorkerProcess(const std::string& exe, const v1::WorkerTask& task, const std::string& log_path) {
+  std::signal(SIGPIPE, SIG_IGN);  // a worker that dies before reading its task must not take us down
+  int in[2], out[2];
+  if (pipe2(in, O_CLOEXEC) != 0) throw std::runtime_error(std::string("cannot start a worker: pipe: ") + std::strerror(errno));
+  if (pipe2(out, O_CLOEXEC) != 0) {
+    close(in[0]);
+    close(in[1]);
+    throw std::runtime_error(std::string("cannot start a worker: pipe: ") + std::strerror(errno));
+  }
+  const int log = ::open(log_path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
+  std::string a0 = exe, a1 = "worker";
+  char* argv[] = {a0.data(), a1.data(), nullptr};
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid == 0) {
+    // Only async-signal-safe calls from here to exec.
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (getppid() != parent) _exit(127);
+    dup2(in[0], 0);
+    dup2(out[1], 1);
+    if (log >= 0) dup2(log, 2);
+    close_range(3, ~0U, 0);
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);  // the server blocks SIGTERM/SIGINT in its threads
+    ::signal(SIGPIPE, SIG_DFL);
+    execv(argv[0], argv);
+    _exit(127);
+  }
+  const int err = errno;
+  close(in[0]);
+  close(out[1]);
+  if (log >= 0) close(log);
+  if (pid < 0) {
+    close(in[1]);
+    close(out[0]);
+    throw std::runtime_error(std::string("cannot start a worker: fork: ") + std::strerror(err));
+  }
+  pid_ = pid;
+  out_fd_ = out[0];
+  fcntl(out_fd_, F_SETFL, fcntl(out_fd_, F_GETFL) | O_NONBLOCK);
+  std::string body;
+  task.SerializeToString(&body);
+  (void)write_all(in[1], body.data(), body.size());  // a worker that died early is seen by wait()
+  close(in[1]);
+}
+
+WorkerProcess::~WorkerProcess() {
+  if (!reaped_ && pid_ > 0) {
+    ::kill(pid_, SIGKILL);
+    int st = 0;
+    while (waitpid(pid_, &st, 0) < 0 && errno == EINTR) {
+    }
+  }
+  if (out_fd_ >= 0) close(out_fd_);
+}
+
+bool WorkerProcess::fill(std::chrono::milliseconds timeout) {
+  if (closed_) return false;
+  pollfd p{out_fd_, POLLIN, 0};
+  const int r = poll(&p, 1, int(timeout.count()));
+  if (r <= 0) return false;
+  char b[65536];
+  bool got = false;
+  for (;;) {
+    const ssize_t n = ::read(out_fd_, b, sizeof b);
+    if (n > 0) {
+      buf_.append(b, std::size_t(n));
+      got = true;
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    if (n == 0) closed_ = true;
+    break;  // EAGAIN: all there is for now
+  }
+  return got;
+}
+
+std::optional<v1::WorkerEvent> WorkerProcess::next_event(std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    if (buf_.size() >= 4) {
+      const auto* u = reinterpret_cast<const unsigned char*>(buf_.data());
+      const std::size_t n = std::size_t(u[0]) | std::size_t(u[1]) << 8 | std::size_t(u[2]) << 16 | std::size_t(u[3]) << 24;
+      if (buf_.size() >= 4 + n) {
+        v1::WorkerEvent ev;
+        const bool ok = ev.ParseFromArray(buf_.data() + 4, int(n));
+        buf_.erase(0, 4 + n);
+        if (ok) return ev;
+        continue;  // a damaged event is skipped; the outcome decides
+      }
+    }
+    if (closed_) return std::nullopt;
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) return std::nullopt;
+    fill(left);
+  }
+}
+
+void WorkerProcess::signal(int sig) {
+  if (reaped_ || pid_ <= 0) return;
+  sent_ = true;
+  ::kill(pid_, sig);
+}
+
+void WorkerProcess::stop(std::chrono::milliseconds grace) {
+  signal(SIGTERM);
+  if (!wait(grace)) signal(SIGKILL);
+}
+
+std::optional<WorkerExit> WorkerProcess::wait(std::chrono::milliseconds timeout) {
+  if (reaped_) return exit_;
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    int st = 0;
+    const pid_t r = waitpid(pid_, &st, WNOHANG);
+    if (r == pid_) {
+      reaped_ = true;
+      exit_.exited = WIFEXITED(st);
+      exit_.code = exit_.exited ? WEXITSTATUS(st) : 0;
+      exit_.signal = WIFSIGNALED(st) ? WTERMSIG(st) : 0;
+      exit_.signal_ours = sent_ && (exit_.signal == SIGTERM || exit_.signal == SIGKILL);
+      return exit_;
+    }
+    if (r < 0 && errno != EINTR) {
+      reaped_ = true;  // not our child any more (cannot happen unless reaped elsewhere)
+      exit_.exited = true;
+      exit_.code = 127;
+      return exit_;
+    }
+    if (std::chrono::steady_clock::now() >= deadline) return std::nullopt;
+    // Drain the output meanwhile, so that a worker blocked on a full pipe can end.
+    if (!closed_) fill(std::chrono::milliseconds(20));
+    else std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
+std::int64_t WorkerProcess::resident_bytes() const {
+  std::ifstream f("/proc/" + std::to_string(pid_) + "/statm");
+  long size = 0, resident = 0;
+  if (!(f >> size >> resident)) return 0;
+  return std::int64_t(resident) * sysconf(_SC_PAGESIZE);
+}
+
+}  // namespace runout::jobs
