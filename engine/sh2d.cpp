@@ -88,7 +88,7 @@ void validate(const Terrain2D& t, const Sh2dConfig& cfg, const Sh2dState& s) {
       if (t.outside[k] && s.H[k] != 0) bad("initial depth must be 0 in cells outside the domain (cell " + std::to_string(k) + ")");
   }
   for (std::size_t k = 0; k < s.H.size(); ++k)
-    if (!(s.H[k] >= 0) || !std::isfinite(s.HU[k]) || !std::isfinite(s.HV[k]))
+    if (!(s.H[k] >= 0) || !std::isfinite(s.H[k]) || !std::isfinite(s.HU[k]) || !std::isfinite(s.HV[k]))
       bad("initial depth must be finite and >= 0 (cell " + std::to_string(k) + ")");
   if (!(cfg.time.cfl > 0 && cfg.time.cfl <= 0.5)) bad("CFL number must lie in (0, 0.5]");
   if (!(cfg.time.t_end >= 0)) bad("end time must be >= 0");
@@ -248,8 +248,11 @@ class Solver {
   }
 
   Sh2dResult run();
+  /// Take up a checkpoint's state (after construction from its depths and momenta).
+  void restore(const Sh2dCheckpoint& cp);
 
  private:
+  Sh2dCheckpoint checkpoint() const;
   std::size_t idx(int i, int j) const { return std::size_t(j) * nx_ + i; }
   void tile_range(int tt, int& i0, int& i1, int& j0, int& j1) const {
     const int ti = tt % ntx_, tj = tt / ntx_;
@@ -333,6 +336,11 @@ class Solver {
   std::vector<std::uint8_t> tile_wet_, active_flag_;
   std::vector<int> active_;
   HazardMaps hz_;
+  // The time loop's running figures (members so that a checkpoint can carry them).
+  double t_now_ = 0, active_sum_ = 0, next_snapshot_ = 0, last_snapshot_ = -1;
+  long steps_ = 0;
+  double cell_updates_ = 0, max_active_fraction_ = 0, ke_peak_ = 0, volume_initial_ = 0;
+  bool restored_ = false;
 };
 
 void Solver::tile_scan(int tt) {
@@ -348,7 +356,8 @@ void Solver::tile_scan(int tt) {
       const double w = geo_.bx[k] * U + geo_.by[k] * V, sp2 = U * U + V * V + w * w;
       mass += h;
       ke += 0.5 * h * sp2;
-      vmax = std::max(vmax, std::sqrt(sp2));
+      // The speed of flowing cells only, the same number as the maximum-speed map takes.
+      if (h * geo_.c[k] > cfg_.flow_threshold) vmax = std::max(vmax, h > cfg_.dry_depth ? m3(k, HU[k], HV[k]) / h : 0.0);
       rate = std::max(rate, std::abs(U) / t_.dx + std::abs(V) / t_.dy + Ps_[k] * std::sqrt(std::max(h, 0.0)));
       wet = wet || h > cfg_.activation_depth;
     }
@@ -779,10 +788,10 @@ void Solver::update(int tt, const TileWork& w, double t, double dt) {
         hz_.max_speed[k] = std::max(hz_.max_speed[k], sp);
         hz_.max_pressure[k] = std::max(hz_.max_pressure[k], cfg_.material.density * sp2);
         if (std::isnan(hz_.arrival_time[k])) hz_.arrival_time[k] = t + dt;
+        vmax = std::max(vmax, sp);  // reported speeds: flowing cells only, as in the map
       }
       mass += H;
-      ke += 0.5 * H * sp2;
-      vmax = std::max(vmax, sp);
+      ke += 0.5 * H * sp2;  // the stopping rule sees every cell
       rate = std::max(rate, std::abs(U) / t_.dx + std::abs(V) / t_.dy + w.Ps[q] * std::sqrt(H));
       wet = wet || H > cfg_.activation_depth;
     }
@@ -820,6 +829,90 @@ void Solver::step_tile(int tt, double t, double dt, TileWork& w) {
   update(tt, w, t, dt);
 }
 
+Sh2dCheckpoint Solver::checkpoint() const {
+  Sh2dCheckpoint cp;
+  cp.nx = nx_;
+  cp.ny = ny_;
+  cp.tile = T_;
+  cp.t = t_now_;
+  cp.steps = steps_;
+  cp.H = H_[cur_];
+  cp.HU = HU_[cur_];
+  cp.HV = HV_[cur_];
+  cp.U = U_[cur_];
+  cp.V = V_[cur_];
+  cp.hazard.max_depth = hz_.max_depth;
+  cp.hazard.max_speed = hz_.max_speed;
+  cp.hazard.max_pressure = hz_.max_pressure;
+  cp.hazard.arrival_time = hz_.arrival_time;
+  cp.tile_mass = tile_mass_;
+  cp.tile_ke = tile_ke_;
+  cp.tile_speed = tile_speed_;
+  cp.tile_rate = tile_rate_;
+  cp.tile_out = tile_out_;
+  cp.tile_travel = tile_travel_;
+  cp.tile_limited = tile_limited_;
+  cp.tile_wet = tile_wet_;
+  cp.tile_active = active_flag_;
+  cp.volume_initial = volume_initial_;
+  cp.kinetic_energy_peak = ke_peak_;
+  cp.cell_updates = cell_updates_;
+  cp.active_fraction_sum = active_sum_;
+  cp.max_active_fraction = max_active_fraction_;
+  cp.next_snapshot = next_snapshot_;
+  cp.last_snapshot = last_snapshot_;
+  return cp;
+}
+
+void Solver::restore(const Sh2dCheckpoint& cp) {
+  auto bad = [](const std::string& m) { throw std::invalid_argument("2D solver: checkpoint " + m); };
+  if (cp.nx != nx_ || cp.ny != ny_) bad("is of another grid");
+  if (cp.tile != T_) bad("was taken with another tile size");
+  auto cells = [&](const std::vector<double>& v) { return v.size() == n_; };
+  if (!cells(cp.U) || !cells(cp.V) || !cells(cp.hazard.max_depth) || !cells(cp.hazard.max_speed) ||
+      !cells(cp.hazard.max_pressure) || !cells(cp.hazard.arrival_time))
+    bad("is damaged (a field has the wrong size)");
+  const std::size_t nt = std::size_t(ntiles_);
+  if (cp.tile_mass.size() != nt || cp.tile_ke.size() != nt || cp.tile_speed.size() != nt || cp.tile_rate.size() != nt ||
+      cp.tile_out.size() != nt || cp.tile_travel.size() != nt || cp.tile_limited.size() != nt || cp.tile_wet.size() != nt ||
+      cp.tile_active.size() != nt)
+    bad("is damaged (a tile field has the wrong size)");
+  if (!(std::isfinite(cp.t) && cp.t >= 0) || cp.steps < 0) bad("is damaged (time or step count)");
+  // Both time levels hold the state: the level a step writes is never read before it is written,
+  // and inactive tiles hold the same in both (see rebuild_active).
+  cur_ = 0;
+  for (int b = 0; b < 2; ++b) {
+    U_[b] = cp.U;
+    V_[b] = cp.V;
+  }
+  hz_.max_depth = cp.hazard.max_depth;
+  hz_.max_speed = cp.hazard.max_speed;
+  hz_.max_pressure = cp.hazard.max_pressure;
+  hz_.arrival_time = cp.hazard.arrival_time;
+  tile_mass_ = cp.tile_mass;
+  tile_ke_ = cp.tile_ke;
+  tile_speed_ = cp.tile_speed;
+  tile_rate_ = cp.tile_rate;
+  tile_out_ = cp.tile_out;
+  tile_travel_ = cp.tile_travel;
+  tile_limited_ = cp.tile_limited;
+  tile_wet_ = cp.tile_wet;
+  active_flag_ = cp.tile_active;
+  active_.clear();
+  for (int tt = 0; tt < ntiles_; ++tt)
+    if (active_flag_[tt]) active_.push_back(tt);
+  t_now_ = cp.t;
+  steps_ = cp.steps;
+  volume_initial_ = cp.volume_initial;
+  ke_peak_ = cp.kinetic_energy_peak;
+  cell_updates_ = cp.cell_updates;
+  active_sum_ = cp.active_fraction_sum;
+  max_active_fraction_ = cp.max_active_fraction;
+  next_snapshot_ = cp.next_snapshot;
+  last_snapshot_ = cp.last_snapshot;
+  restored_ = true;
+}
+
 Sh2dResult Solver::run() {
   const auto wall0 = std::chrono::steady_clock::now();
   const auto& tc = cfg_.time;
@@ -831,26 +924,46 @@ Sh2dResult Solver::run() {
     return s;
   };
   const double cell_area = t_.dx * t_.dy;
-  d.volume_initial = sum_tiles(tile_mass_) * cell_area;
-  double t = 0, active_sum = 0;
+  if (!restored_) volume_initial_ = sum_tiles(tile_mass_) * cell_area;
+  double& t = t_now_;
   const auto loop0 = std::chrono::steady_clock::now();
   std::vector<TileWork> work(omp_get_max_threads());
   for (auto& w : work) w.reserve(T_);
   const bool snapshots = cfg_.snapshot && cfg_.snapshot_interval > 0;
-  double next_snapshot = 0, last_snapshot = -1;
   auto snapshot = [&] {
     cfg_.snapshot(t, Sh2dStateView{H_[cur_], HU_[cur_], HV_[cur_]});
-    last_snapshot = t;
-    while (next_snapshot <= t) next_snapshot += cfg_.snapshot_interval;
+    last_snapshot_ = t;
+    while (next_snapshot_ <= t) next_snapshot_ += cfg_.snapshot_interval;
   };
-  if (snapshots) snapshot();
-  while (t < tc.t_end) {
-    if (d.steps >= tc.max_steps) {
+  // Checkpoints are taken at step boundaries only: the first one at or after each multiple of the
+  // interval (steps are not shortened for them, so they change nothing).
+  const bool checkpoints = bool(cfg_.checkpoint);
+  const double cp_every = cfg_.checkpoint_interval > 0 ? cfg_.checkpoint_interval : 0.0;
+  double next_cp = cp_every > 0 ? cp_every * (std::floor(t / cp_every) + 1) : std::numeric_limits<double>::infinity();
+  auto not_finite = [&](const char* what) {
+    throw std::runtime_error("2D solver: the flow state became non-finite (NaN or infinite " + std::string(what) + ") at step " +
+                             std::to_string(steps_) + ", t = " + std::to_string(t) +
+                             " s: the release is far too thick or the numerics left their range");
+  };
+  const auto stop_rule = [&](double ke) {
+    return tc.stop_fraction > 0 && ke_peak_ > 0 && ke * cell_area < tc.stop_fraction * ke_peak_;
+  };
+  bool ran = true;
+  if (!restored_) {
+    if (snapshots) snapshot();
+  } else if (stop_rule(sum_tiles(tile_ke_))) {
+    // A checkpoint of a cancelled run is taken before the stopping rule looked at its last step.
+    d.stop = StopReason::kinetic_energy;
+    ran = false;
+  }
+  while (ran && t < tc.t_end) {
+    if (steps_ >= tc.max_steps) {
       d.stop = StopReason::max_steps;
       break;
     }
     double rate = 0;
     for (int tt : active_) rate = std::max(rate, tile_rate_[tt]);
+    if (!std::isfinite(rate)) not_finite("depth or momentum");
     double dt = rate > 0 ? tc.cfl / rate : tc.dt_max;
     dt = std::min({dt, tc.dt_max, tc.t_end - t});
     if (!(dt > 0) || !std::isfinite(dt)) dt = tc.t_end - t;
@@ -865,38 +978,54 @@ Sh2dResult Solver::run() {
     for (int a = 0; a < na; ++a) step_tile(active_[a], t, dt, work[omp_get_thread_num()]);
     cur_ = 1 - cur_;
     t += dt;
-    ++d.steps;
-    d.cell_updates += double(ncells);
+    ++steps_;
+    cell_updates_ += double(ncells);
     const double frac = double(ncells) / double(n_);
-    active_sum += frac;
-    d.max_active_fraction = std::max(d.max_active_fraction, frac);
+    active_sum_ += frac;
+    max_active_fraction_ = std::max(max_active_fraction_, frac);
     rebuild_active();
-    if (snapshots && t >= next_snapshot) snapshot();
+    // Cheap guard on the whole state: a NaN or infinite depth shows in the volume, a NaN or
+    // infinite momentum in the kinetic energy.
     const double ke = sum_tiles(tile_ke_);
-    d.kinetic_energy_peak = std::max(d.kinetic_energy_peak, ke * cell_area);
-    double vmax = 0;
-    for (int tt = 0; tt < ntiles_; ++tt) vmax = std::max(vmax, tile_speed_[tt]);
-    d.max_speed = std::max(d.max_speed, vmax);
-    if (tc.progress && d.steps % tc.progress_every == 0) {
-      Progress p{t, dt, sum_tiles(tile_mass_) * cell_area, vmax, ke * cell_area, frac, d.steps};
+    const double mass = sum_tiles(tile_mass_);
+    if (!std::isfinite(mass)) not_finite("depth");
+    if (!std::isfinite(ke)) not_finite("momentum");
+    if (snapshots && t >= next_snapshot_) snapshot();
+    ke_peak_ = std::max(ke_peak_, ke * cell_area);
+    if (tc.progress && steps_ % tc.progress_every == 0) {
+      double vmax = 0;
+      for (int tt = 0; tt < ntiles_; ++tt) vmax = std::max(vmax, tile_speed_[tt]);
+      Progress p{t, dt, mass * cell_area, vmax, ke * cell_area, frac, steps_};
       if (!tc.progress(p)) {
         d.stop = StopReason::cancelled;
+        if (checkpoints) cfg_.checkpoint(checkpoint());  // the run can continue from here
         break;
       }
     }
-    if (tc.stop_fraction > 0 && d.kinetic_energy_peak > 0 && ke * cell_area < tc.stop_fraction * d.kinetic_energy_peak) {
+    if (stop_rule(ke)) {
       d.stop = StopReason::kinetic_energy;
       break;
     }
+    if (checkpoints && t >= next_cp && t < tc.t_end) {
+      cfg_.checkpoint(checkpoint());
+      while (next_cp <= t) next_cp += cp_every;
+    }
   }
-  if (snapshots && last_snapshot != t) snapshot();  // the final state, unless just written
+  if (snapshots && last_snapshot_ != t) snapshot();  // the final state, unless just written
   d.loop_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loop0).count();
   d.t = t;
+  d.steps = steps_;
+  d.volume_initial = volume_initial_;
+  d.kinetic_energy_peak = ke_peak_;
+  d.cell_updates = cell_updates_;
+  d.max_active_fraction = max_active_fraction_;
   d.volume_final = sum_tiles(tile_mass_) * cell_area;
   d.volume_outflow = sum_tiles(tile_out_);
   d.mean_travel = d.volume_initial > 0 ? sum_tiles(tile_travel_) * cell_area / d.volume_initial : 0.0;
   for (int tt = 0; tt < ntiles_; ++tt) d.positivity_limited += tile_limited_[tt];
-  d.mean_active_fraction = d.steps > 0 ? active_sum / double(d.steps) : 0.0;
+  d.mean_active_fraction = steps_ > 0 ? active_sum_ / double(steps_) : 0.0;
+  // The reported maximum speed is the map's: flowing cells only.
+  for (std::size_t k = 0; k < n_; ++k) d.max_speed = std::max(d.max_speed, hz_.max_speed[k]);
   hz_.final_depth.resize(n_);
   for (std::size_t k = 0; k < n_; ++k) hz_.final_depth[k] = H_[cur_][k] * geo_.c[k];
   res.hazard = std::move(hz_);
@@ -912,6 +1041,14 @@ Sh2dResult Solver::run() {
 Sh2dResult run_sh2d(const Terrain2D& terrain, const Sh2dConfig& config, Sh2dState initial) {
   validate(terrain, config, initial);
   Solver s(terrain, config, std::move(initial));
+  return s.run();
+}
+
+Sh2dResult run_sh2d(const Terrain2D& terrain, const Sh2dConfig& config, const Sh2dCheckpoint& from) {
+  Sh2dState st{from.H, from.HU, from.HV};
+  validate(terrain, config, st);
+  Solver s(terrain, config, std::move(st));
+  s.restore(from);
   return s.run();
 }
 

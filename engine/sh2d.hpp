@@ -68,6 +68,15 @@ enum class Boundary2D { wall, outflow };
 inline constexpr NameTable<Boundary2D, 2> kBoundary2DNames{
     {{"wall", Boundary2D::wall}, {"outflow", Boundary2D::outflow}}};
 
+/// Hazard quantities accumulated in the time loop (normal depth, surface speed).
+struct HazardMaps {
+  std::vector<double> max_depth;     ///< [m], normal to the surface
+  std::vector<double> max_speed;     ///< [m/s]
+  std::vector<double> max_pressure;  ///< rho |u|^2 [Pa]
+  std::vector<double> arrival_time;  ///< [s], NaN where the threshold was never exceeded
+  std::vector<double> final_depth;   ///< [m], normal to the surface
+};
+
 /// Read-only view of the solver state, handed to a snapshot hook (valid during the call only).
 struct Sh2dStateView {
   const std::vector<double>& H;
@@ -78,6 +87,32 @@ struct Sh2dStateView {
 /// each multiple of `snapshot_interval`, and at the end of the run. Snapshots do not change the steps.
 using SnapshotHook = std::function<void(double t, const Sh2dStateView& state)>;
 
+/// Everything of a run that persists from one step to the next, taken between two steps: a run
+/// continued from it (run_sh2d with `from`) computes the same bits as the uninterrupted run.
+struct Sh2dCheckpoint {
+  int nx = 0, ny = 0, tile = 0;  ///< the grid and tile size it was taken on
+  double t = 0;
+  long steps = 0;
+  /// The state at t (H, momenta) and the velocities the scheme reconstructs from (kept, not
+  /// recomputed: U = HU * (1 / H) in the update differs from HU / H in the last bit).
+  std::vector<double> H, HU, HV, U, V;
+  HazardMaps hazard;  ///< max depth, speed, pressure, arrival time so far (final_depth empty)
+  /// Per tile: the sums of the last step that computed the tile (mass, kinetic energy, flowing
+  /// speed, CFL rate; a tile that becomes active again starts from its stored rate), the running
+  /// outflow, travel and positivity counts, whether it holds material and whether it is active.
+  std::vector<double> tile_mass, tile_ke, tile_speed, tile_rate, tile_out, tile_travel;
+  std::vector<long> tile_limited;
+  std::vector<std::uint8_t> tile_wet, tile_active;
+  double volume_initial = 0;       ///< [m^3]
+  double kinetic_energy_peak = 0;  ///< the stopping rule's peak [m^5/s^2]
+  double cell_updates = 0, active_fraction_sum = 0, max_active_fraction = 0;
+  double next_snapshot = 0, last_snapshot = -1;  ///< the time-series schedule
+};
+/// Called with a checkpoint at the end of the first step at or after each multiple of
+/// `checkpoint_interval` (steps are never shortened for it) and when the progress hook cancels the
+/// run (before the final snapshot of the cancelled run). Valid during the call only.
+using CheckpointHook = std::function<void(const Sh2dCheckpoint& cp)>;
+
 struct Sh2dConfig {
   Material material;
   Limiter limiter = Limiter::minmod;
@@ -87,9 +122,10 @@ struct Sh2dConfig {
   double gravity = 9.81;
   double dry_depth = 1e-8;          ///< volume per area below which velocity is zero [m]
   double activation_depth = 1e-9;   ///< a tile with any cell deeper than this is active [m]
-  /// Normal depth above which a cell counts as flowing [m]: its arrival time, and the maximum speed
-  /// and pressure maps (films thinner than this, which pure Coulomb friction lets slide on at speed,
-  /// are left out of the hazard maps; the maximum depth and the diagnostics see every cell).
+  /// Normal depth above which a cell counts as flowing [m]: its arrival time, the maximum speed
+  /// and pressure maps, and every reported speed (Sh2dDiagnostics::max_speed, Progress::max_speed).
+  /// Films thinner than this, which pure Coulomb friction lets slide on at speed, are left out; the
+  /// maximum depth, the volumes and the kinetic-energy stopping rule see every cell.
   double flow_threshold = 0.01;
   int tile = 32;                    ///< tile edge in cells
   bool curvature = true;            ///< the centrifugal part of the normal load raises friction
@@ -102,6 +138,8 @@ struct Sh2dConfig {
   bool track_travel = false;        ///< accumulate Sh2dDiagnostics::mean_travel (costs a sqrt per cell)
   double snapshot_interval = 0;     ///< [s]; 0: no snapshots
   SnapshotHook snapshot;            ///< optional
+  double checkpoint_interval = 0;   ///< [s] of simulated time; 0: checkpoints only when cancelled
+  CheckpointHook checkpoint;        ///< optional
 };
 
 /// Solver state: H = h / cos(theta) and the horizontal momentum H U, H V per horizontal area.
@@ -109,14 +147,6 @@ struct Sh2dState {
   std::vector<double> H, HU, HV;
 };
 
-/// Hazard quantities accumulated in the time loop (normal depth, surface speed).
-struct HazardMaps {
-  std::vector<double> max_depth;     ///< [m], normal to the surface
-  std::vector<double> max_speed;     ///< [m/s]
-  std::vector<double> max_pressure;  ///< rho |u|^2 [Pa]
-  std::vector<double> arrival_time;  ///< [s], NaN where the threshold was never exceeded
-  std::vector<double> final_depth;   ///< [m], normal to the surface
-};
 
 struct Sh2dDiagnostics {
   long steps = 0;
@@ -128,7 +158,9 @@ struct Sh2dDiagnostics {
   /// Mass-averaged horizontal distance travelled: (1/V0) * integral over time and area of H |U| [m]
   /// (only with Sh2dConfig::track_travel).
   double mean_travel = 0;
-  double max_speed = 0;                         ///< over the whole run [m/s]
+  /// Over the whole run, of cells deeper than Sh2dConfig::flow_threshold: the maximum of
+  /// HazardMaps::max_speed [m/s]. (Films thinner than the threshold are left out, as in the maps.)
+  double max_speed = 0;
   long positivity_limited = 0;                  ///< cell-steps whose outflow had to be limited
   double cell_updates = 0;                      ///< cells computed, summed over steps
   double mean_active_fraction = 0, max_active_fraction = 0;
@@ -159,7 +191,11 @@ Sh2dState state_from_normal_depth(const Terrain2D& terrain, const std::vector<do
 /// Normal depth h = H cos(theta) per cell.
 std::vector<double> normal_depth(const Terrain2D& terrain, const Sh2dState& s);
 
-/// Run the 2D solver. Throws std::invalid_argument naming the problem on inconsistent input.
+/// Run the 2D solver. Throws std::invalid_argument naming the problem on inconsistent input, and
+/// std::runtime_error when the state becomes non-finite (NaN or infinite depth or momentum).
 Sh2dResult run_sh2d(const Terrain2D& terrain, const Sh2dConfig& config, Sh2dState initial);
+/// Continue a run from a checkpoint taken by the same terrain and configuration (the end time, the
+/// checkpoint hook and interval may differ). Throws std::invalid_argument when it does not fit.
+Sh2dResult run_sh2d(const Terrain2D& terrain, const Sh2dConfig& config, const Sh2dCheckpoint& from);
 
 }  // namespace runout::engine

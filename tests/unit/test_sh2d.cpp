@@ -2,6 +2,7 @@
 #include <omp.h>
 
 #include <cmath>
+#include <limits>
 
 #include "engine/sh2d.hpp"
 
@@ -359,4 +360,162 @@ TEST(Sh2d, NormalDepthConventionOnASlope) {
   const auto s = state_from_normal_depth(t, std::vector<double>(25, 2.0));
   EXPECT_NEAR(s.H[12], 2.0 / std::cos(30 * kDeg), 1e-12);  // volume per horizontal area
   EXPECT_NEAR(normal_depth(t, s)[12], 2.0, 1e-12);
+}
+
+// Every reported speed takes the maps' flow threshold: the run's maximum is the maximum of the
+// maximum-speed map, and no progress report exceeds it, although thin films slide on faster.
+TEST(Sh2d, ReportedSpeedsAreThoseOfTheFlowingCells) {
+  const auto t = hillside(120, 60, 5.0, 35, 0.0);
+  auto cfg = coulomb(20, 40.0);
+  cfg.flow_threshold = 0.05;
+  const auto init = state_from_normal_depth(t, blob(t, 20, 30, 8, 2.0));
+  double progress_max = 0;
+  cfg.time.progress_every = 1;
+  cfg.time.progress = [&](const Progress& p) {
+    progress_max = std::max(progress_max, p.max_speed);
+    return true;
+  };
+  const auto r = run_sh2d(t, cfg, init);
+  double map_max = 0;
+  for (double v : r.hazard.max_speed) map_max = std::max(map_max, v);
+  EXPECT_GT(map_max, 5.0);
+  EXPECT_EQ(r.diag.max_speed, map_max);
+  EXPECT_LE(progress_max, map_max);
+  EXPECT_GT(progress_max, 0.5 * map_max);
+  // A threshold above every depth: nothing counts as flowing, nothing is reported.
+  cfg.flow_threshold = 100.0;
+  progress_max = 0;
+  const auto deep = run_sh2d(t, cfg, init);
+  EXPECT_EQ(deep.diag.max_speed, 0.0);
+  EXPECT_EQ(progress_max, 0.0);
+  EXPECT_EQ(deep.state.H, r.state.H);  // the flow itself is the same
+}
+
+// A state that becomes non-finite stops the run with an error instead of ending with infinities.
+TEST(Sh2d, NonFiniteStateFailsTheRun) {
+  const auto t = hillside(60, 40, 5.0, 30, 0.0);
+  auto cfg = coulomb(20, 20.0);
+  try {
+    run_sh2d(t, cfg, state_from_normal_depth(t, blob(t, 15, 20, 5, 1e300)));
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("non-finite"), std::string::npos) << e.what();
+  }
+  // An infinite initial depth is bad input.
+  auto init = state_from_normal_depth(t, blob(t, 15, 20, 5, 1.0));
+  init.H[20 * 60 + 15] = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(run_sh2d(t, cfg, init), std::invalid_argument);
+}
+
+namespace {
+void expect_same(const Sh2dResult& a, const Sh2dResult& b) {
+  EXPECT_EQ(a.diag.steps, b.diag.steps);
+  EXPECT_EQ(a.diag.t, b.diag.t);
+  EXPECT_EQ(a.diag.stop, b.diag.stop);
+  EXPECT_EQ(a.state.H, b.state.H);
+  EXPECT_EQ(a.state.HU, b.state.HU);
+  EXPECT_EQ(a.state.HV, b.state.HV);
+  EXPECT_EQ(a.hazard.max_depth, b.hazard.max_depth);
+  EXPECT_EQ(a.hazard.max_speed, b.hazard.max_speed);
+  EXPECT_EQ(a.hazard.max_pressure, b.hazard.max_pressure);
+  EXPECT_EQ(a.hazard.final_depth, b.hazard.final_depth);
+  ASSERT_EQ(a.hazard.arrival_time.size(), b.hazard.arrival_time.size());
+  for (std::size_t k = 0; k < a.hazard.arrival_time.size(); ++k)
+    ASSERT_TRUE(a.hazard.arrival_time[k] == b.hazard.arrival_time[k] ||
+                (std::isnan(a.hazard.arrival_time[k]) && std::isnan(b.hazard.arrival_time[k])))
+        << k;
+  EXPECT_EQ(a.diag.volume_initial, b.diag.volume_initial);
+  EXPECT_EQ(a.diag.volume_final, b.diag.volume_final);
+  EXPECT_EQ(a.diag.volume_outflow, b.diag.volume_outflow);
+  EXPECT_EQ(a.diag.kinetic_energy_peak, b.diag.kinetic_energy_peak);
+  EXPECT_EQ(a.diag.max_speed, b.diag.max_speed);
+  EXPECT_EQ(a.diag.positivity_limited, b.diag.positivity_limited);
+  EXPECT_EQ(a.diag.cell_updates, b.diag.cell_updates);
+  EXPECT_EQ(a.diag.mean_active_fraction, b.diag.mean_active_fraction);
+  EXPECT_EQ(a.diag.max_active_fraction, b.diag.max_active_fraction);
+  EXPECT_EQ(a.diag.mean_travel, b.diag.mean_travel);
+}
+}  // namespace
+
+// Checkpoints change nothing, and a run continued from any of them (periodic, or taken when the run
+// was cancelled) computes the bits of the uninterrupted run, snapshots included.
+TEST(Sh2d, ContinuedRunIsTheUninterruptedRun) {
+  auto t = hillside(150, 60, 4.0, 30, 0.0);
+  for (int j = 0; j < t.ny; ++j)  // flat run-out beyond x = 300 m
+    for (int i = 0; i < t.nx; ++i) {
+      auto& z = t.z[std::size_t(j) * t.nx + i];
+      z = std::max(z, t.z[std::size_t(j) * t.nx + 75]);
+    }
+  auto cfg = coulomb(25, 1000.0);
+  cfg.tile = 16;
+  cfg.time.stop_fraction = 0.01;
+  cfg.track_travel = true;
+  cfg.snapshot_interval = 5.0;
+  const auto init = state_from_normal_depth(t, blob(t, 20, 30, 8, 3.0));
+  std::vector<double> frames;
+  cfg.snapshot = [&](double time, const Sh2dStateView&) { frames.push_back(time); };
+  const auto plain = run_sh2d(t, cfg, init);
+  const auto plain_frames = frames;
+  ASSERT_EQ(plain.diag.stop, StopReason::kinetic_energy) << plain.diag.t;
+  ASSERT_GT(plain.diag.t, 20.0);
+  // With checkpoints every 4 s: the same bits.
+  // A continued run appends its frames to those written before the checkpoint was taken.
+  std::vector<Sh2dCheckpoint> cps;
+  std::vector<std::vector<double>> frames_at;
+  auto with = cfg;
+  with.checkpoint_interval = 4.0;
+  with.checkpoint = [&](const Sh2dCheckpoint& cp) {
+    cps.push_back(cp);
+    frames_at.push_back(frames);
+  };
+  frames.clear();
+  const auto checked = run_sh2d(t, with, init);
+  expect_same(plain, checked);
+  EXPECT_EQ(frames, plain_frames);
+  ASSERT_GE(cps.size(), 3u);
+  for (std::size_t k = 1; k < cps.size(); ++k) EXPECT_GE(cps[k].t, 4.0 * double(k + 1));
+  // Continued from a periodic one.
+  for (std::size_t c : {std::size_t(0), cps.size() / 2}) {
+    frames = frames_at[c];
+    const auto cont = run_sh2d(t, cfg, cps[c]);
+    expect_same(plain, cont);
+    EXPECT_EQ(frames, plain_frames) << "from t = " << cps[c].t;
+  }
+  // Cancelled at an arbitrary step (also one where the stopping rule ends the run), then continued.
+  for (long at : {37L, plain.diag.steps / 2 + 3, plain.diag.steps}) {
+    auto cut = cfg;
+    Sh2dCheckpoint taken;
+    cut.time.progress_every = 1;
+    cut.time.progress = [&](const Progress& p) { return p.step < at; };
+    std::vector<double> before;
+    cut.checkpoint = [&](const Sh2dCheckpoint& cp) {
+      taken = cp;
+      before = frames;
+    };
+    frames.clear();
+    const auto part = run_sh2d(t, cut, init);
+    ASSERT_EQ(part.diag.stop, StopReason::cancelled);
+    ASSERT_EQ(taken.steps, at);
+    frames = before;  // the cancelled run's own final frame came after the checkpoint
+    omp_set_num_threads(1);  // any thread count
+    const auto cont = run_sh2d(t, cfg, taken);
+    omp_set_num_threads(2);
+    expect_same(plain, cont);
+    EXPECT_EQ(frames, plain_frames) << "cancelled at step " << at;
+  }
+}
+
+TEST(Sh2d, CheckpointOfAnotherGridIsRefused) {
+  const auto t = hillside(60, 40, 5.0, 30, 0.0);
+  auto cfg = coulomb(20, 10.0);
+  Sh2dCheckpoint cp;
+  cfg.checkpoint_interval = 1.0;
+  cfg.checkpoint = [&](const Sh2dCheckpoint& c) { cp = c; };
+  run_sh2d(t, cfg, state_from_normal_depth(t, blob(t, 15, 20, 5, 2.0)));
+  ASSERT_GT(cp.steps, 0);
+  const auto other = hillside(61, 40, 5.0, 30, 0.0);
+  EXPECT_THROW(run_sh2d(other, coulomb(20, 10.0), cp), std::invalid_argument);
+  auto tiles = coulomb(20, 10.0);
+  tiles.tile = 16;
+  EXPECT_THROW(run_sh2d(t, tiles, cp), std::invalid_argument);
 }
