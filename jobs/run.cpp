@@ -136,6 +136,13 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
       sum.runout_m = std::max(sum.runout_m, std::hypot(grid.cx(i) - mx, grid.cy(j) - my));
     }
   sum.affected_area_m2 = double(affected) * grid.dx * grid.dx;
+  // The engine stops a run whose state turns non-finite; this guards what the records would say.
+  for (const auto& [name, v] : {std::pair<const char*, double>{"final volume", d.volume_final}, {"outflow volume", d.volume_outflow},
+                                {"maximum speed", d.max_speed}, {"maximum depth", sum.max_depth},
+                                {"kinetic-energy peak", d.kinetic_energy_peak}, {"runout", sum.runout_m}})
+    if (!std::isfinite(v))
+      throw std::runtime_error(std::string("the run's ") + name + " is not finite (" + json_number(v) +
+                               "): the flow state became NaN or infinite; no results written");
 
   // Outputs.
   const auto t2 = std::chrono::steady_clock::now();

@@ -1608,3 +1608,46 @@ TEST(Scenarios, LabB7WideChuteFlowsAroundTheTetrahedron) {
       "fill": [{"x_max": 0.5, "y_max": 0.5}], "obstacles": [{"shape": "cylinder", "radius": 0.1, "height": 0.1}]}})");
   expect_resolve_error(bad, {"lab.obstacles[0].shape"});
 }
+
+// Depth-averaged runs report the maps' maxima: run.json's, the summary's and the progress's
+// maximum speed take the flow threshold of outputs.flow_threshold_m, so run.json's figure is the
+// maximum of max_speed.tif (thin films sliding on faster are left out of both).
+TEST(DepthAveraged, ReportedMaximumSpeedIsTheMapsMaximum) {
+  TempDir d;
+  make_dem(d / "dem.tif", 120, 20.0, 35);
+  make_polygons(d / "rel.geojson", {square(500200, 5201000, 300)}, "EPSG:32632");
+  auto sc = base_scenario(d / "dem.tif", d / "rel.geojson");
+  auto r = jobs::resolve_scenario(sc, d.p.string());
+  fs::create_directories(d / "out");
+  jobs::RunOptions opt;
+  opt.progress_every = 1;
+  double progress_max = 0;
+  opt.progress = [&](const engine::Progress& p) {
+    progress_max = std::max(progress_max, p.max_speed);
+    return true;
+  };
+  const auto sum = jobs::run_scenario(r, d / "out", opt);
+  GDALDatasetUniquePtr ms(GDALDataset::Open((d / "out/max_speed.tif").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(ms);
+  std::vector<float> v(std::size_t(sum.nx) * sum.ny);
+  ASSERT_EQ(ms->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, sum.nx, sum.ny, v.data(), sum.nx, sum.ny, GDT_Float32, 0, 0), CE_None);
+  float raster_max = 0;
+  for (float x : v)
+    if (x != -9999.0f) raster_max = std::max(raster_max, x);
+  EXPECT_GT(raster_max, 10.0f);
+  EXPECT_EQ(float(sum.max_speed), raster_max);
+  EXPECT_NEAR(json_number(read_text(d / "out/run.json"), "max_speed_m_s"), sum.max_speed, 1e-9 * sum.max_speed);
+  EXPECT_LE(progress_max, sum.max_speed);
+  EXPECT_GT(progress_max, 0.5 * sum.max_speed);
+}
+
+// A run whose state turns non-finite fails with a message and writes no results.
+TEST(DepthAveraged, NonFiniteStateFailsTheRun) {
+  TempDir d;
+  make_dem(d / "dem.tif", 60, 20.0, 30);
+  make_polygons(d / "rel.geojson", {square(500200, 5200400, 200)}, "EPSG:32632");
+  auto sc = base_scenario(d / "dem.tif", d / "rel.geojson");
+  sc.mutable_releases(0)->set_thickness_m(1e300);
+  expect_error(sc, d, "non-finite");
+  EXPECT_FALSE(fs::exists(d / "err/run.json"));
+}
