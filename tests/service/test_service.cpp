@@ -21,81 +21,17 @@
 #include "jobs/store.hpp"
 #include <sqlite3.h>
 #include "service/client/client.hpp"
+#include "tests/support/server_process.hpp"
 
 namespace fs = std::filesystem;
 using namespace runout;
 using namespace std::chrono_literals;
+using runout::test_support::client_options;
+using runout::test_support::read_text;
+using runout::test_support::ServerProcess;
+using runout::test_support::TempDir;
 
 namespace {
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct TempDir {
-  fs::path p;
-  TempDir() {
-    static int n = 0;
-    p = fs::temp_directory_path() / ("runout-svc-" + std::to_string(getpid()) + "-" + std::to_string(n++));
-    fs::create_directories(p);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(p, ec);
-  }
-};
-
-// `runout serve` as a child process.
-class ServerProcess {
- public:
-  ServerProcess(const fs::path& state, std::vector<std::string> extra) : state_(state), extra_(std::move(extra)) { start(); }
-  ~ServerProcess() { stop(SIGTERM); }
-  void start() {
-    fs::remove(state_ / "server.json");
-    std::vector<std::string> args = {RUNOUT_BIN, "serve", "--listen", "127.0.0.1:0", "--state-dir", state_.string(),
-                                     "--log-file", (state_.parent_path() / "server.log").string()};
-    args.insert(args.end(), extra_.begin(), extra_.end());
-    pid_ = fork();
-    if (pid_ == 0) {
-      std::vector<char*> argv;
-      for (auto& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      if (!std::freopen("/dev/null", "w", stdout)) _exit(126);
-      execv(argv[0], argv.data());
-      _exit(127);
-    }
-    // The server writes server.json (atomically) once it listens.
-    for (int k = 0; k < 300 && !fs::exists(state_ / "server.json"); ++k) std::this_thread::sleep_for(50ms);
-    const std::string s = read_text(state_ / "server.json");
-    const auto a = s.find("\"listen\": \"") + 11;
-    address_ = s.substr(a, s.find('"', a) - a);
-  }
-  void stop(int sig) {
-    if (pid_ <= 0) return;
-    kill(pid_, sig);
-    int st = 0;
-    waitpid(pid_, &st, 0);
-    pid_ = -1;
-  }
-  const std::string& address() const { return address_; }
-
- private:
-  fs::path state_;
-  std::vector<std::string> extra_;
-  pid_t pid_ = -1;
-  std::string address_;
-};
-
-service::ClientOptions client_options(const std::string& address, const std::string& token) {
-  service::ClientOptions o;
-  o.server = address;
-  o.token = token;
-  o.watch_timeout_s = 240;  // a broken requeue fails the test instead of hanging it
-  return o;
-}
 
 // The In den Arelen test scenario (30 m) with its inputs named relative to the scenarios folder.
 v1::Scenario arelen(double end_time = 600, double stop_fraction = 0.01) {
@@ -182,7 +118,7 @@ TEST(Service, IdempotentResubmissionAndRequestIds) {
   ServerProcess srv(d.p / "state", {"--data-root", kScenarios});
   service::Client c(client_options(srv.address(), ""));
   // Held in the queue behind a long job, so that nothing finishes during the checks.
-  const auto blocker = c.submit(arelen(1e6, 0));
+  const auto blocker = c.submit(arelen(9e4, 0));
   const auto a = c.submit(arelen(500));
   const auto b = c.submit(arelen(500));
   EXPECT_EQ(a.id(), b.id());
@@ -224,7 +160,7 @@ TEST(Service, CancelWhileRunning) {
   TempDir d;
   ServerProcess srv(d.p / "state", {"--data-root", kScenarios});
   service::Client c(client_options(srv.address(), ""));
-  const auto j = c.submit(arelen(1e6, 0));  // runs until cancelled
+  const auto j = c.submit(arelen(9e4, 0));  // runs until cancelled
   for (int k = 0; k < 200; ++k) {
     const auto g = c.get(j.id());
     if (g.state() == v1::RUNNING && g.progress().steps() > 0) break;
@@ -311,11 +247,11 @@ TEST(Service, QueueLimitPerClient) {
   ServerProcess srv(d.p / "state", {"--config", (d.p / "server.json").string()});
   service::Client c(client_options(srv.address(), "alpha-token"));
   service::Client other(client_options(srv.address(), "beta-token"));
-  const auto a = c.submit(arelen(1e6, 0));
-  const auto b = c.submit(arelen(1e6 + 1, 0));
-  EXPECT_EQ(code_of([&] { c.submit(arelen(1e6 + 2, 0)); }), int(grpc::StatusCode::RESOURCE_EXHAUSTED));
+  const auto a = c.submit(arelen(9e4, 0));
+  const auto b = c.submit(arelen(9e4 + 1, 0));
+  EXPECT_EQ(code_of([&] { c.submit(arelen(9e4 + 2, 0)); }), int(grpc::StatusCode::RESOURCE_EXHAUSTED));
   // The limit is per client: another token still gets in.
-  const auto o = other.submit(arelen(1e6 + 3, 0));
+  const auto o = other.submit(arelen(9e4 + 3, 0));
   other.cancel(o.id());
   c.cancel(a.id());
   c.cancel(b.id());
@@ -374,7 +310,7 @@ TEST(Service, TerminatedServerRequeuesItsRunningJob) {
   {
     ServerProcess srv(d.p / "state", {"--data-root", kScenarios});
     service::Client c(client_options(srv.address(), ""));
-    id = c.submit(arelen(1e6, 0)).id();
+    id = c.submit(arelen(9e4, 0)).id();
     for (int k = 0; k < 200 && c.get(id).state() != v1::RUNNING; ++k) std::this_thread::sleep_for(25ms);
     srv.stop(SIGTERM);
   }
