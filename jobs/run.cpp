@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "engine/sh2d.hpp"
+#include "jobs/sh_checkpoint.hpp"
 #include "jobs/timeseries.hpp"
 #include "terrain/map.hpp"
 
@@ -91,15 +92,50 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   cfg.time.progress_every = opt.progress_every;
   sum.seconds_prepare = since(t0);
 
+  // Checkpoints: the solver's whole state between two steps, with the scenario's hash; the time
+  // series so far lies beside it (CHECKPOINT.timeseries.h5), so that a continued run's outputs are
+  // the whole run's.
+  const bool checkpoints = !opt.checkpoint_path.empty(), continued = !opt.restart_path.empty();
+  const std::string hash = checkpoints || continued ? scenario_hash(s) : std::string();
+  ShCheckpoint restart;
+  if (continued) {
+    restart = read_sh_checkpoint(opt.restart_path);
+    if (restart.scenario_hash != hash)
+      throw ScenarioError("checkpoint " + opt.restart_path + " belongs to another scenario (its scenario hash " +
+                          restart.scenario_hash.substr(0, 12) + "... is not this one's " + hash.substr(0, 12) + "...)");
+    if (restart.state.nx != t.nx || restart.state.ny != t.ny || restart.state.tile != cfg.tile)
+      throw ScenarioError("checkpoint " + opt.restart_path + " is of another grid");
+  }
+
   std::unique_ptr<TimeSeriesWriter> series;
   if (s.timeseries_interval > 0) {
-    series = std::make_unique<TimeSeriesWriter>(out_dir, grid, t);
+    series = continued ? std::make_unique<TimeSeriesWriter>(out_dir, grid, t, opt.restart_path + ".timeseries.h5", restart.timeseries_frames)
+                       : std::make_unique<TimeSeriesWriter>(out_dir, grid, t);
     cfg.snapshot_interval = s.timeseries_interval;
     cfg.snapshot = [&](double time, const engine::Sh2dStateView& v) { series->write(time, v); };
   }
+  if (checkpoints) {
+    cfg.checkpoint_interval = opt.checkpoint_interval_s;
+    cfg.checkpoint = [&](const engine::Sh2dCheckpoint& c) {
+      // The frames first: a checkpoint never refers to frames that are not beside it.
+      if (series) series->save_copy(opt.checkpoint_path + ".timeseries.h5");
+      write_sh_checkpoint(opt.checkpoint_path, hash, series ? series->frames() : 0, c);
+    };
+  }
   const auto t1 = std::chrono::steady_clock::now();
   const std::clock_t cpu0 = std::clock();
-  const auto res = engine::run_sh2d(t, cfg, engine::state_from_normal_depth(t, h0));
+  const double continued_from = continued ? restart.state.t : std::numeric_limits<double>::quiet_NaN();
+  engine::Sh2dResult res;
+  if (continued) {
+    try {
+      res = engine::run_sh2d(t, cfg, restart.state);
+    } catch (const std::invalid_argument& e) {  // the engine's checks of the checkpoint
+      throw ScenarioError("checkpoint " + opt.restart_path + ": " + e.what());
+    }
+  } else {
+    res = engine::run_sh2d(t, cfg, engine::state_from_normal_depth(t, h0));
+  }
+  restart.state = {};  // its fields are no longer needed
   sum.cpu_seconds = double(std::clock() - cpu0) / CLOCKS_PER_SEC;
   int frames = 0;
   if (series) frames = series->finish();
@@ -256,7 +292,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   r << "  \"mass_balance\": {\"volume_initial_m3\": " << json_number(d.volume_initial) << ", \"volume_final_m3\": " << json_number(d.volume_final)
     << ", \"volume_outflow_m3\": " << json_number(d.volume_outflow) << ", \"relative_error\": " << json_number(d.volume_error()) << "},\n";
   r << "  \"solver\": {\"steps\": " << d.steps << ", \"simulated_s\": " << json_number(d.t) << ", \"stop\": " << jstr(sum.stop)
-    << ", \"max_speed_m_s\": " << json_number(d.max_speed) << ", \"kinetic_energy_peak\": " << json_number(d.kinetic_energy_peak)
+    << ", \"continued_from_t_s\": " << json_number(continued_from) << ", \"max_speed_m_s\": " << json_number(d.max_speed) << ", \"kinetic_energy_peak\": " << json_number(d.kinetic_energy_peak)
     << ", \"positivity_limited\": " << d.positivity_limited << ", \"cell_updates\": " << json_number(d.cell_updates)
     << ", \"mean_active_fraction\": " << json_number(d.mean_active_fraction) << ", \"max_active_fraction\": " << json_number(d.max_active_fraction)
     << "},\n";

@@ -20,14 +20,18 @@ struct RunOptions {
   /// "03CoulombOnly"). Writes <release>_<id>_null_runout_pft.asc / _pfv.asc on the DEM's grid and
   /// iseesnow_<id>.csv.
   std::string iseesnow_id;
-  /// VOF runs: write checkpoints to this file (replaced each time) every lab.checkpoint_interval_s
-  /// of simulated time and when the run is cancelled; empty: none.
+  /// Write checkpoints to this file (replaced each time, atomically) every checkpoint interval of
+  /// simulated time and when the run is cancelled; empty: none. Both engines: VOF runs
+  /// (jobs/checkpoint.hpp, the frames so far in FILE.fields.h5) and depth-averaged runs
+  /// (jobs/sh_checkpoint.hpp, the time series so far in FILE.timeseries.h5).
   std::string checkpoint_path;
-  /// VOF runs: continue from this checkpoint instead of the initial state (same scenario; the end
-  /// time and the write and checkpoint intervals may differ).
+  /// Continue from this checkpoint instead of the initial state. VOF runs: same scenario but the end
+  /// time and the write and checkpoint intervals may differ. Depth-averaged runs: the same scenario
+  /// (jobs::scenario_hash); the continued run's outputs are the uninterrupted run's, bit for bit.
   std::string restart_path;
-  /// VOF runs with a checkpoint_path whose scenario sets no lab.checkpoint_interval_s: the interval
-  /// of simulated time to use instead (0: checkpoints only when the run is interrupted).
+  /// The interval of simulated time between checkpoints [s] for depth-averaged runs, and for VOF
+  /// runs whose scenario sets no lab.checkpoint_interval_s (0: checkpoints only when the run is
+  /// interrupted).
   double checkpoint_interval_s = 0;
 };
 

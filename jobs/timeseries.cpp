@@ -4,9 +4,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <stdexcept>
+
+#include "jobs/scenario.hpp"
 
 namespace runout::jobs {
 
@@ -61,6 +64,62 @@ TimeSeriesWriter::TimeSeriesWriter(const std::string& dir, const terrain::Grid& 
   m.dataset(m.file, "elevation", z);
   hid_t g = H5Gcreate2(m.file, "frames", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   H5Gclose(g);
+}
+
+TimeSeriesWriter::TimeSeriesWriter(const std::string& dir, const terrain::Grid& grid, const engine::Terrain2D& t,
+                                   const std::string& continue_from, int frames)
+    : impl_(std::make_unique<Impl>()) {
+  auto& m = *impl_;
+  m.dir = dir;
+  m.nx = grid.nx;
+  m.ny = grid.ny;
+  m.dx = grid.dx;
+  m.x0 = grid.x_min;
+  m.y0 = grid.y_min;
+  m.geo = engine::SurfaceGeometry::from(t);
+  const std::string path = dir + "/timeseries.h5";
+  std::lock_guard lk(hdf5_mutex());
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  if (!std::filesystem::is_regular_file(continue_from) || H5Fis_hdf5(continue_from.c_str()) <= 0)
+    throw ScenarioError("the checkpoint's time series " + continue_from + " is missing or not HDF5 (it is written beside the checkpoint)");
+  std::error_code ec;
+  std::filesystem::copy_file(continue_from, path, std::filesystem::copy_options::overwrite_existing, ec);
+  if (ec) throw std::runtime_error("time series: cannot copy " + continue_from + " to " + path + ": " + ec.message());
+  m.file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  if (m.file < 0) throw ScenarioError("the checkpoint's time series " + continue_from + ": cannot open it");
+  char name[32];
+  for (int f = 0; f < frames; ++f) {
+    std::snprintf(name, sizeof name, "frames/%05d", f);
+    double time = 0;
+    hid_t a = H5Lexists(m.file, name, H5P_DEFAULT) > 0 ? H5Aopen_by_name(m.file, name, "time", H5P_DEFAULT, H5P_DEFAULT) : -1;
+    const herr_t st = a < 0 ? -1 : H5Aread(a, H5T_NATIVE_DOUBLE, &time);
+    if (a >= 0) H5Aclose(a);
+    if (st < 0) throw ScenarioError("the checkpoint's time series " + continue_from + " lacks frame " + std::to_string(f));
+    m.times.push_back(time);
+  }
+  // Frames written after the checkpoint was taken (a run killed between the two writes) go.
+  for (int f = frames;; ++f) {
+    std::snprintf(name, sizeof name, "frames/%05d", f);
+    if (H5Lexists(m.file, name, H5P_DEFAULT) <= 0) break;
+    if (H5Ldelete(m.file, name, H5P_DEFAULT) < 0) throw std::runtime_error("time series: cannot drop frame " + std::string(name));
+  }
+}
+
+int TimeSeriesWriter::frames() const { return int(impl_->times.size()); }
+
+void TimeSeriesWriter::save_copy(const std::string& path) {
+  auto& m = *impl_;
+  const std::string tmp = path + ".part";
+  {
+    std::lock_guard lk(hdf5_mutex());
+    if (m.file < 0 || H5Fflush(m.file, H5F_SCOPE_GLOBAL) < 0) throw std::runtime_error("time series: cannot flush " + m.dir + "/timeseries.h5");
+    std::error_code ec;
+    std::filesystem::copy_file(m.dir + "/timeseries.h5", tmp, std::filesystem::copy_options::overwrite_existing, ec);
+    if (ec) throw std::runtime_error("time series: cannot copy the frames to " + tmp + ": " + ec.message());
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) throw std::runtime_error("time series: cannot move the frames into place at " + path + ": " + ec.message());
 }
 
 TimeSeriesWriter::~TimeSeriesWriter() {

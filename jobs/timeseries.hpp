@@ -18,6 +18,11 @@ class TimeSeriesWriter {
  public:
   /// Creates `<dir>/timeseries.h5` with the grid and the terrain. Throws std::runtime_error.
   TimeSeriesWriter(const std::string& dir, const terrain::Grid& grid, const engine::Terrain2D& terrain);
+  /// Continues the time series of an interrupted run: `<dir>/timeseries.h5` becomes a copy of
+  /// `continue_from` (a file save_copy wrote) with its first `frames` frames (later ones are
+  /// dropped), and the frames written next follow them. Throws ScenarioError when it lacks them.
+  TimeSeriesWriter(const std::string& dir, const terrain::Grid& grid, const engine::Terrain2D& terrain,
+                   const std::string& continue_from, int frames);
   ~TimeSeriesWriter();
   TimeSeriesWriter(const TimeSeriesWriter&) = delete;
   TimeSeriesWriter& operator=(const TimeSeriesWriter&) = delete;
@@ -26,6 +31,11 @@ class TimeSeriesWriter {
   void write(double t, const engine::Sh2dStateView& s);
   /// Close the HDF5 file and write `<dir>/timeseries.xmf`. Returns the number of frames.
   int finish();
+  /// Frames written so far.
+  int frames() const;
+  /// Put a copy of the frames so far at `path` (atomically: a temporary file renamed), for a
+  /// checkpoint taken now. Throws std::runtime_error.
+  void save_copy(const std::string& path);
 
  private:
   struct Impl;
