@@ -21,10 +21,13 @@ commands:
         into DIR. Results appear only when the run succeeded; an existing DIR is replaced only with
         --force. A progress line goes to standard error unless --quiet. --iseesnow also writes the
         ISeeSnow benchmark files (peak thickness/velocity ESRI ASCII on the DEM's grid, result CSV).
-        VOF runs (engine "vof"): --checkpoint writes the run's state to FILE every
-        lab.checkpoint_interval_s and when the run is interrupted (Ctrl-C, SIGTERM); --restart
-        continues from such a file exactly as the run would have gone on (its monitors travel in
-        FILE, its frames so far in FILE.fields.h5, so run.json and fields.h5 are the whole run's).
+        --checkpoint writes the run's state to FILE when the run is interrupted (Ctrl-C, SIGTERM)
+        and, for VOF runs (engine "vof"), every lab.checkpoint_interval_s; --restart continues from
+        such a file of the same scenario exactly as the run would have gone on. VOF runs: the
+        monitors travel in FILE, the frames so far in FILE.fields.h5, so run.json and fields.h5 are
+        the whole run's. Depth-averaged runs: the solver's whole state and hazard maps travel in
+        FILE, the time series so far in FILE.timeseries.h5; the continued run's outputs are the
+        uninterrupted run's, bit for bit (docs/engine.md).
   verify [CASE...] [--full] [--resolutions R1,R2,...] [--limiter NAME] [--csv] [--threads N]
         Run the verification cases against exact solutions and invariants and print a table
         (or CSV). Cases: A1 A2 A3 A4 A5 A6 A7 STRESS (default: all). --full adds the finest

@@ -100,10 +100,6 @@ int run(const std::vector<std::string>& args) {
     return kBadInput;
   }
 
-  if (!resolved.vof && !(checkpoint.empty() && restart.empty())) {
-    std::cerr << "runout run: --checkpoint and --restart apply to VOF runs (engine \"vof\") only\n";
-    return kUsage;
-  }
   // Results go to a temporary sibling directory first and appear under DIR only when complete.
   StagedOutput staged(dest);
   if (!staged.ok()) {
