@@ -11,7 +11,9 @@
 #include <openssl/evp.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <mutex>
@@ -436,6 +438,17 @@ double field_value(OGRFeature& f, const std::string& attr, const std::string& wh
     throw TerrainError(what + ": no attribute '" + attr + "' (attributes: " + (names.empty() ? "none" : names) + ")");
   }
   if (!f.IsFieldSetAndNotNull(idx)) throw TerrainError(what + ": attribute '" + attr + "' is empty");
+  const OGRFieldType type = f.GetFieldDefnRef(idx)->GetType();
+  if (type == OFTString) {  // GDAL reads a text that is not a number as 0
+    const std::string text = f.GetFieldAsString(idx);
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    while (end && *end && std::isspace(static_cast<unsigned char>(*end))) ++end;
+    if (text.empty() || end == text.c_str() || *end) throw TerrainError(what + ": attribute '" + attr + "' is not a number: '" + text + "'");
+    return v;
+  }
+  if (type != OFTInteger && type != OFTInteger64 && type != OFTReal)
+    throw TerrainError(what + ": attribute '" + attr + "' is not a number (" + OGRFieldDefn::GetFieldTypeName(type) + ")");
   return f.GetFieldAsDouble(idx);
 }
 
