@@ -307,12 +307,13 @@ int fetch(const std::vector<std::string>& args) {
     std::cerr << "runout fetch: usage: runout fetch JOB --out DIR [--force] [--server HOST:PORT] [--token TOKEN]\n";
     return kUsage;
   }
-  const fs::path dest = fs::absolute(out);
-  if (fs::exists(dest) && !force) {
-    std::cerr << "runout fetch: output directory '" << out << "' exists (use --force to replace it)\n";
+  // DIR: absent, or with --force a previous result or fetch (output_dir.hpp); never anything else.
+  const fs::path dest = output_path(out);
+  if (const auto why = check_output_dir(dest, force, out); !why.empty()) {
+    std::cerr << "runout fetch: " << why << "\n";
     return kOutput;
   }
-  StagedOutput staged(dest);
+  StagedOutput staged(dest, force);
   if (!staged.ok()) {
     std::cerr << "runout fetch: " << staged.error() << "\n";
     return kOutput;
@@ -337,6 +338,7 @@ int fetch(const std::vector<std::string>& args) {
       std::cerr << "runout fetch: " << staged.error() << "\n";
       return kOutput;
     }
+    if (!staged.note().empty()) std::cerr << "runout fetch: note: " << staged.note() << "\n";
     std::printf("%d file(s), %.2f MiB, checksums verified, in %s\n", files.files_size(), double(bytes) / (1 << 20),
                 dest.string().c_str());
     return j.state() == v1::SUCCEEDED ? kOk : code_of_state(j.state());

@@ -86,9 +86,10 @@ int run(const std::vector<std::string>& args) {
                  " [--checkpoint FILE] [--restart FILE]\n";
     return kUsage;
   }
-  const fs::path dest = fs::absolute(out);
-  if (fs::exists(dest) && !force) {
-    std::cerr << "runout run: output directory '" << out << "' exists (use --force to replace it)\n";
+  // DIR: absent, or with --force a previous result (output_dir.hpp); never anything else.
+  const fs::path dest = output_path(out);
+  if (const auto why = check_output_dir(dest, force, out); !why.empty()) {
+    std::cerr << "runout run: " << why << "\n";
     return kOutput;
   }
 
@@ -100,8 +101,17 @@ int run(const std::vector<std::string>& args) {
     return kBadInput;
   }
 
+  {  // A previous result that --force replaces must not hold what this run reads or writes.
+    std::vector<std::string> used = resolved.input_files;
+    for (const auto& f : {fs::absolute(scenario).string(), checkpoint, restart}) used.push_back(f);
+    if (const auto f = input_inside(dest, used); !f.empty()) {
+      std::cerr << "runout run: output directory '" << out << "' holds '" << f
+                << "', which this run needs: --force would delete it; choose another --out\n";
+      return kOutput;
+    }
+  }
   // Results go to a temporary sibling directory first and appear under DIR only when complete.
-  StagedOutput staged(dest);
+  StagedOutput staged(dest, force);
   if (!staged.ok()) {
     std::cerr << "runout run: " << staged.error() << "\n";
     return kOutput;
@@ -155,6 +165,7 @@ int run(const std::vector<std::string>& args) {
     std::cerr << "runout run: " << staged.error() << "\n";
     return kOutput;
   }
+  if (!staged.note().empty()) std::cerr << "runout run: note: " << staged.note() << "\n";
   if (!quiet && resolved.vof) {
     std::printf("mesh        %d x %d cells of %.4g m (plane, channel coordinates)\n", sum.nx, sum.ny, sum.dx);
     std::printf("run         %ld steps to t = %.3f s, %.2f s wall (solve %.2f, write %.2f)\n", sum.steps, sum.t,
