@@ -492,7 +492,8 @@ TEST(Reliability, CancelAndStopTakeEffectWithinASecond) {
   service::Client c(client_options(srv->address(), ""));
   const std::string id = c.submit(big).id();
   ASSERT_TRUE(wait_for([&] { return c.get(id).state() == v1::RUNNING && worker_pid(state, id) > 0; }, 60s));
-  std::this_thread::sleep_for(1500ms);
+  ASSERT_TRUE(wait_for([&] { return c.get(id).progress().steps() > 2; }, 60s));
+  EXPECT_EQ(c.get(id).progress().end_time_s(), 5) << "the progress names the lab's end time";
   auto t0 = std::chrono::steady_clock::now();
   c.cancel(id);
   ASSERT_TRUE(wait_for([&] { return c.get(id).state() == v1::CANCELLED; }, 10s));
@@ -746,4 +747,32 @@ TEST(Reliability, FuzzedScenariosNeitherCrashNorHangTheServer) {
               hangs, internal, summary.c_str());
   EXPECT_EQ(crashes, 0);
   EXPECT_EQ(hangs, 0);
+}
+
+// Uploads are bounded: a client's uploads beyond its quota are refused, and uploads that no queued
+// or running job uses are removed after the upload time-to-live.
+TEST(Reliability, UploadsHaveAQuotaAndAreCollected) {
+  TempDir d;
+  const fs::path cfg = d.p / "server.json";
+  std::ofstream(cfg) << R"({"upload_ttl_s": 1, "max_upload_bytes_per_client": 20000})";
+  const fs::path state = d.p / "state";
+  ServerProcess srv(state, {"--config", cfg.string()});
+  ASSERT_TRUE(srv.running()) << srv.errors();
+  service::Client c(client_options(srv.address(), ""));
+  const std::string dem = kScenarios + "/data/arelen/davos_srtm3.tif";  // 14 kB
+  const auto up = c.upload({dem});
+  EXPECT_EQ(up.ref().rfind("upload:", 0), 0u);
+  std::string m;
+  EXPECT_EQ(code_of([&] { c.upload({kScenarios + "/data/arelen/release.geojson", dem}); }, &m),
+            int(grpc::StatusCode::RESOURCE_EXHAUSTED));
+  EXPECT_NE(m.find("quota"), std::string::npos) << m;
+  auto count = [&] {
+    int n = 0;
+    for (const auto& e : fs::directory_iterator(state / "uploads")) n += e.path().filename().string()[0] != '.';
+    return n;
+  };
+  EXPECT_EQ(count(), 1);
+  EXPECT_TRUE(wait_for([&] { return count() == 0; }, 10s)) << "an unused upload outlived its time-to-live";
+  EXPECT_EQ(code_of([&] { c.upload({dem}); }), 0) << "the quota is free again";
+  std::printf("reliability: uploads: over-quota upload refused, unused uploads collected after their time-to-live\n");
 }
