@@ -18,8 +18,10 @@ commands:
         [--checkpoint FILE] [--restart FILE]
         Run a scenario (JSON form of runout.v1.Scenario, see README) and write the hazard rasters
         (COG GeoTIFF), the runout outline (GeoJSON in WGS84, GeoPackage) and the run record (run.json)
-        into DIR. Results appear only when the run succeeded; an existing DIR is replaced only with
-        --force. A progress line goes to standard error unless --quiet. --iseesnow also writes the
+        into DIR. Results appear only when the run succeeded. An existing DIR is replaced only with
+        --force and only when it holds a previous result (runout's run.json), once the new one is
+        complete; another folder, a file, a link, or the current directory (or one that holds it) is
+        never replaced. A progress line goes to standard error unless --quiet. --iseesnow also writes the
         ISeeSnow benchmark files (peak thickness/velocity ESRI ASCII on the DEM's grid, result CSV).
         --checkpoint writes the run's state to FILE when the run is interrupted (Ctrl-C, SIGTERM)
         and, for VOF runs (engine "vof"), every lab.checkpoint_interval_s; --restart continues from
@@ -52,7 +54,8 @@ commands:
   cancel JOB
         Cancel a queued or running job.
   fetch JOB --out DIR [--force]
-        Download a job's results (checksums verified) into DIR; for a failed job, its log.
+        Download a job's results (checksums verified) into DIR; for a failed job, its log. DIR as for
+        run: --force replaces a previous result or a previous fetch of a failed job (job.log alone).
   health
         Ask the server's standard health service (no token needed); exit 0 when serving.
   regress [--server HOST:PORT] [--out DIR] [--scenario FILE] [--reference DIR] [--accept --reason TEXT]
@@ -74,7 +77,7 @@ exit codes:
   2  bad command line (unknown command, option or name)
   3  internal error
   4  invalid scenario or input data (the message names the field or file); unknown job
-  5  run, fetch: output directory exists (use --force) or cannot be written
+  5  run, fetch: output directory exists (use --force), is not a previous result or cannot be written
   6  run: cancelled (interrupt); submit --wait, watch: the job was cancelled
   7  the server cannot be reached or refused the call (unknown token, queue limit, ...)
   8  submit --wait, watch, fetch: the job failed (its error is printed)
