@@ -57,10 +57,11 @@ std::string Scheduler::checkpoint_path(const std::string& id) const {
 }
 
 void Scheduler::remove_checkpoint(const std::string& id) const {
+  // The checkpoint and what lies beside it: its frames (.fields.h5, .timeseries.h5), parts (.part).
   std::error_code ec;
-  fs::remove(checkpoint_path(id), ec);
-  fs::remove(checkpoint_path(id) + ".fields.h5", ec);
-  fs::remove(checkpoint_path(id) + ".part", ec);
+  const std::string prefix = id + ".";
+  for (const auto& e : fs::directory_iterator(fs::path(cfg_.state_dir) / "checkpoints", ec))
+    if (e.path().filename().string().rfind(prefix, 0) == 0) fs::remove(e.path(), ec);
 }
 
 Scheduler::~Scheduler() { stop(); }
