@@ -336,12 +336,10 @@ void Scheduler::run_job(StoredJob sj) {
   task.set_out_dir(tmp.string());
   task.set_threads(cfg_.threads_per_run);
   task.set_progress_interval_s(0.25);
-  const bool vof = sj.scenario.engine() == "vof";
   const std::string cp = checkpoint_path(id);
   {
     task.set_checkpoint_path(cp);
-    const double t_end = vof ? sj.scenario.lab().end_time_s() : sj.scenario.numerics().end_time_s();
-    task.set_checkpoint_interval_s(t_end > 0 ? t_end / 20 : 0);
+    task.set_checkpoint_interval_s(-1);  // a twentieth of the end time (the worker knows it, defaults filled in)
     if (fs::exists(cp, ec)) {
       task.set_restart_path(cp);
       say("continuing from its checkpoint");
