@@ -37,6 +37,11 @@ std::string gdal_message() {
 
 std::string fmt(double v, int prec = 1) {
   std::ostringstream o;
+  if (std::abs(v) >= 1e9) {  // no 300-digit numbers in messages
+    o.precision(4);
+    o << v;
+    return o.str();
+  }
   o.setf(std::ios::fixed);
   o.precision(prec);
   o << v;
@@ -492,7 +497,8 @@ std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseR
           if (rq.thickness_attribute.empty()) throw TerrainError(what + ": no thickness (set thickness_m or thickness_attribute)");
           t = field_value(*f, rq.thickness_attribute, what);
         }
-        if (!(t > 0) || !std::isfinite(t)) throw TerrainError(what + ": thickness must be > 0 m, got " + fmt(t, 3));
+        // The same bound as the scenario's releases[].thickness_m (README, Valid ranges).
+        if (!(t > 0 && t <= 500)) throw TerrainError(what + ": thickness must be > 0 m and at most 500 m, got " + fmt(t, 3));
         double smin = rq.has_min_slope ? rq.min_slope : 0.0, smax = rq.has_max_slope ? rq.max_slope : 90.0;
         if (!rq.has_min_slope && !rq.min_slope_attribute.empty()) smin = field_value(*f, rq.min_slope_attribute, what);
         if (!rq.has_max_slope && !rq.max_slope_attribute.empty()) smax = field_value(*f, rq.max_slope_attribute, what);

@@ -203,14 +203,16 @@ v1::Scenario upload_inputs(Client& c, v1::Scenario s, const std::string& base_di
     if (path->empty() || path->rfind("upload:", 0) == 0) return;
     fs::path p = *path;
     if (p.is_relative()) p = fs::path(base_dir) / p;
-    if (!fs::is_regular_file(p))
-      throw RpcError(int(grpc::StatusCode::INVALID_ARGUMENT), "input '" + p.string() + "' does not exist or is not a file");
+    std::error_code ec;
+    if (!fs::is_regular_file(p, ec))  // (a symbolic link loop is an error code, not an exception)
+      throw RpcError(int(grpc::StatusCode::INVALID_ARGUMENT), "input '" + p.string() + "' does not exist or is not a file" +
+                                                                 (ec ? " (" + ec.message() + ")" : std::string()));
     std::vector<std::string> files = {p.string()};
     for (const char* ext : {".shx", ".dbf", ".prj", ".cpg", ".qix", ".aux.xml", ".hdr", ".tfw"}) {
       fs::path side = p;
       side.replace_extension(ext);
       if (std::string(ext) == ".aux.xml") side = p.string() + ".aux.xml";
-      if (side != p && fs::is_regular_file(side)) files.push_back(side.string());
+      if (side != p && fs::is_regular_file(side, ec)) files.push_back(side.string());
     }
     *path = c.upload(files).ref();
   };
