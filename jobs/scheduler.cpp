@@ -248,6 +248,12 @@ std::string client_message(std::string msg, const std::string& state_dir, const 
     }
     msg.erase(at, slash + 1 - at);
   }
+  // Files of the run itself are named by their name in the results.
+  const std::string res = (fs::path(state_dir) / "results").string() + "/";
+  for (std::size_t at; (at = msg.find(res)) != std::string::npos;) {
+    const std::size_t slash = msg.find('/', at + res.size());
+    msg.erase(at, slash == std::string::npos ? res.size() : slash + 1 - at);
+  }
   for (const auto& root : data_roots) {
     const std::string r = (fs::path(root) / "").string();
     for (std::size_t at; !r.empty() && (at = msg.find(r)) != std::string::npos;) msg.erase(at, r.size());

@@ -409,6 +409,7 @@ TEST(Reliability, FullDiskFailsTheJobNotTheServer) {
   const auto fail = c.watch(c.submit(big).id());
   EXPECT_EQ(fail.state(), v1::FAILED);
   EXPECT_FALSE(fail.error().empty());
+  EXPECT_EQ(fail.error().find((d.p / "state").string()), std::string::npos) << "names the server's folder: " << fail.error();
   const auto ok = c.watch(c.submit(arelen(15, 60)).id());
   EXPECT_EQ(ok.state(), v1::SUCCEEDED) << ok.error();
   const int st = srv.stop(SIGTERM);
