@@ -12,6 +12,7 @@
 
 #include "jobs/run.hpp"
 #include "jobs/scenario.hpp"
+#include "jobs/state_dir.hpp"
 #include "jobs/worker.hpp"
 #include "runout/v1/worker.pb.h"
 
@@ -20,14 +21,6 @@ namespace fs = std::filesystem;
 namespace runout::jobs {
 
 namespace {
-
-std::int64_t folder_bytes(const fs::path& p) {
-  std::int64_t n = 0;
-  std::error_code ec;
-  for (auto it = fs::recursive_directory_iterator(p, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
-    if (it->is_regular_file(ec)) n += std::int64_t(it->file_size(ec));
-  return n;
-}
 
 // Seconds since the epoch of "YYYY-MM-DDTHH:MM:SS(.mmm)Z"; 0 when unreadable.
 double epoch_of(const std::string& utc) {
@@ -318,7 +311,7 @@ void Scheduler::run_job(StoredJob sj) {
   std::error_code ec;
   if (fs::exists(final_dir / "run.json", ec)) {
     finish_and_forget(v1::SUCCEEDED, "an identical scenario was computed before: its results answer this job", "",
-                      folder_bytes(final_dir));
+                      folder_bytes(final_dir.string()));
     return;
   }
   const fs::path tmp = fs::path(final_dir.string() + ".tmp-" + id);
@@ -454,7 +447,7 @@ void Scheduler::run_job(StoredJob sj) {
         }
       }
       say("finished: " + outcome->done().summary());
-      finish_and_forget(v1::SUCCEEDED, "completed", "", folder_bytes(final_dir));
+      finish_and_forget(v1::SUCCEEDED, "completed", "", folder_bytes(final_dir.string()));
       return;
     }
     fs::remove_all(tmp, ec);

@@ -86,15 +86,15 @@ v1::JobState state_of(const std::string& word) {
   return v1::JOB_STATE_UNSPECIFIED;
 }
 
-std::int64_t folder_bytes(const fs::path& p) {
+}  // namespace
+
+std::int64_t folder_bytes(const std::string& path) {
   std::int64_t n = 0;
   std::error_code ec;
-  for (auto it = fs::recursive_directory_iterator(p, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
+  for (auto it = fs::recursive_directory_iterator(path, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
     if (it->is_regular_file(ec)) n += std::int64_t(it->file_size(ec));
   return n;
 }
-
-}  // namespace
 
 StateLock::StateLock(const std::string& state_dir) : path_((fs::path(state_dir) / "server.lock").string()) {
   fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
@@ -231,7 +231,7 @@ RecoveryReport recover_store(const std::string& state_dir) {
     if (j.job.state() == v1::SUCCEEDED) {
       const fs::path res = state / "results" / j.job.scenario_hash();
       if (fs::exists(res / "run.json", ec)) {
-        j.job.set_result_bytes(folder_bytes(res));
+        j.job.set_result_bytes(folder_bytes(res.string()));
       } else {
         j.results_removed = true;
         ++rep.results_missing;

@@ -1,6 +1,7 @@
 #pragma once
 // The server's state directory (jobs.db, results/, logs/, uploads/, checkpoints/): one writer at a
 // time, a store that never silently forgets, and the rebuilding of a lost store.
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -9,6 +10,9 @@ namespace runout::jobs {
 struct StateError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+/// Bytes of the regular files below a folder (0 when it cannot be read).
+std::int64_t folder_bytes(const std::string& path);
 
 /// The exclusive lock of a state directory (an flock on STATE/server.lock), held for the life of
 /// this object; the operating system releases it when the process dies, however it dies. The lock
