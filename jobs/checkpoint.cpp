@@ -12,7 +12,9 @@ namespace runout::jobs {
 
 namespace {
 
-constexpr const char* kFormat = "runout VOF checkpoint 2";  // 2: with the run's monitor series
+// 3: with the pressure solver's cross-step state (the operators its preconditioner was built from),
+// without which a continued run is not the uninterrupted run bit for bit.
+constexpr const char* kFormat = "runout VOF checkpoint 3";
 
 void put_attr_string(hid_t loc, const char* name, const std::string& v) {
   hid_t t = H5Tcopy(H5T_C_S1);
@@ -98,6 +100,12 @@ void write_checkpoint(const std::string& path, const LabCheckpoint& cp) {
       put_doubles(f, "U", U, 3);
       std::vector<double> act(s.active_cells.begin(), s.active_cells.end());
       put_doubles(f, "active_cells", act);
+      // The pressure solver's state (integers as doubles: exact far beyond any mesh's size).
+      put_doubles(f, "pressure_pc_counters", {double(s.steps_since_pc), double(s.pc_builds)});
+      put_doubles(f, "pressure_pc_rows", std::vector<double>(s.pc_rows.begin(), s.pc_rows.end()));
+      put_doubles(f, "pressure_pc_cols", std::vector<double>(s.pc_cols.begin(), s.pc_cols.end()));
+      put_doubles(f, "pressure_pc_first_values", s.pc_first_values);
+      put_doubles(f, "pressure_pc_values", s.pc_values);
       hid_t g = H5Gcreate2(f, "series", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
       if (g < 0) throw std::runtime_error("checkpoint: cannot write the series");
       try {
@@ -159,6 +167,14 @@ LabCheckpoint read_checkpoint(const std::string& path) {
     if (U.size() % 3) throw ScenarioError("checkpoint " + path + ": damaged (U)");
     for (std::size_t i = 0; i + 2 < U.size(); i += 3) s.U.push_back({U[i], U[i + 1], U[i + 2]});
     for (double a : get<double>(f, "active_cells", H5T_NATIVE_DOUBLE, path)) s.active_cells.push_back(int(a));
+    const auto pcc = get<double>(f, "pressure_pc_counters", H5T_NATIVE_DOUBLE, path);
+    if (pcc.size() != 2) throw ScenarioError("checkpoint " + path + ": damaged (pressure_pc_counters)");
+    s.steps_since_pc = int(pcc[0]);
+    s.pc_builds = int(pcc[1]);
+    for (double v : get<double>(f, "pressure_pc_rows", H5T_NATIVE_DOUBLE, path)) s.pc_rows.push_back(int(v));
+    for (double v : get<double>(f, "pressure_pc_cols", H5T_NATIVE_DOUBLE, path)) s.pc_cols.push_back(int(v));
+    s.pc_first_values = get<double>(f, "pressure_pc_first_values", H5T_NATIVE_DOUBLE, path);
+    s.pc_values = get<double>(f, "pressure_pc_values", H5T_NATIVE_DOUBLE, path);
     if (H5Lexists(f, "series", H5P_DEFAULT) <= 0) throw ScenarioError("checkpoint " + path + ": damaged (no series)");
     hid_t g = H5Gopen2(f, "series", H5P_DEFAULT);
     H5G_info_t info;

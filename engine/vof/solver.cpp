@@ -1,6 +1,7 @@
 #include "engine/vof/solver.hpp"
 
 #include <petscksp.h>
+#include <signal.h>
 
 #include <algorithm>
 #include <chrono>
@@ -20,15 +21,26 @@ void petsc_check(PetscErrorCode e, const char* what) {
   if (e) throw VofError(std::string("PETSc: ") + what + " failed (error " + std::to_string(int(e)) + ")");
 }
 
-// PETSc (and with it MPI) is started once per process, on first use.
+// PETSc (and with it MPI) is started once per process, on first use. Signals stay the program's
+// business (a worker's or a CLI run's SIGTERM/SIGINT handler stops the run at the end of a step
+// with a checkpoint; a server ignores SIGPIPE): PETSc's own handlers are removed, and since removing
+// them leaves the default dispositions, the ones the program had set are put back.
 void petsc_init() {
   static std::once_flag once;
   std::call_once(once, [] {
     PetscBool started = PETSC_FALSE;
     PetscInitialized(&started);
     if (!started) {
+      std::vector<struct sigaction> before(NSIG);
+      for (int sig = 1; sig < NSIG; ++sig) sigaction(sig, nullptr, &before[std::size_t(sig)]);
       petsc_check(PetscInitializeNoArguments(), "PetscInitialize");
-      PetscPopSignalHandler();  // signals stay the program's business (a server, a CLI run)
+      PetscPopSignalHandler();
+      for (int sig = 1; sig < NSIG; ++sig) {
+        if (sig == SIGKILL || sig == SIGSTOP || sig == SIGCHLD) continue;
+        struct sigaction now{};
+        if (sigaction(sig, nullptr, &now) != 0) continue;
+        if (now.sa_handler != before[std::size_t(sig)].sa_handler) sigaction(sig, &before[std::size_t(sig)], nullptr);
+      }
     }
   });
 }
@@ -68,6 +80,12 @@ struct VofSolver::Impl {
   Mat Mu = nullptr;
   ::Vec xu = nullptr, bu = nullptr;  // the momentum predictor's vectors (every cell)
   Mat Apin = nullptr;  // closed domains: the pressure matrix with cell 0 pinned
+  // Copies of the operators the pressure preconditioner was built from, at the current pressure
+  // solver's latest build and at its first (nullptr: none built yet), and the number of builds. A
+  // checkpoint carries them, so that restore() builds the preconditioner the uninterrupted run
+  // keeps using until its next refresh (remember_pc).
+  Mat Apc = nullptr, Apc_first = nullptr;
+  int pc_builds = 0;
   KSP kspU = nullptr;
   std::vector<std::array<double, 6>> recon_inv;  // inverse of sum Sf Sf / |Sf|: xx, xy, xz, yy, yz, zz
 
@@ -85,6 +103,8 @@ struct VofSolver::Impl {
     if (kspU) KSPDestroy(&kspU);
     if (Mu) MatDestroy(&Mu);
     if (Apin) MatDestroy(&Apin);
+    if (Apc) MatDestroy(&Apc);
+    if (Apc_first) MatDestroy(&Apc_first);
     if (A) MatDestroy(&A);
     if (x) VecDestroy(&x);
     if (b) VecDestroy(&b);
@@ -960,10 +980,110 @@ struct VofSolver::Impl {
     petsc_check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
   }
 
+  // Keep copies of the operators the pressure preconditioner was built from: the first build of
+  // this system's solver and the latest. PETSc's GAMG keeps the prolongators of its first build
+  // and later builds only form the coarse operators anew (Galerkin), so the preconditioner in use
+  // depends on both.
+  void remember_pc(Mat Ap) {
+    if (!Apc_first) petsc_check(MatDuplicate(Ap, MAT_COPY_VALUES, &Apc_first), "MatDuplicate");
+    if (Apc) MatDestroy(&Apc);
+    petsc_check(MatDuplicate(Ap, MAT_COPY_VALUES, &Apc), "MatDuplicate");
+    ++pc_builds;
+  }
+
+  // The pressure solver's cross-step state for a checkpoint: the refresh counter and the operators
+  // the preconditioner was built from (compressed rows; both share the active region's structure).
+  void save_pc(VofState& st) const {
+    st.steps_since_pc = steps_since_pc;
+    st.pc_builds = pc_builds > 1 ? 2 : pc_builds;
+    st.pc_rows.clear();
+    st.pc_cols.clear();
+    st.pc_first_values.clear();
+    st.pc_values.clear();
+    if (!Apc) return;
+    PetscInt n = 0;
+    petsc_check(MatGetSize(Apc, &n, nullptr), "MatGetSize");
+    st.pc_rows.push_back(0);
+    for (PetscInt i = 0; i < n; ++i) {
+      PetscInt nc1 = 0, nc0 = 0;
+      const PetscInt *c1 = nullptr, *c0 = nullptr;
+      const PetscScalar *v1 = nullptr, *v0 = nullptr;
+      petsc_check(MatGetRow(Apc, i, &nc1, &c1, &v1), "MatGetRow");
+      petsc_check(MatGetRow(Apc_first, i, &nc0, &c0, &v0), "MatGetRow");
+      const bool same = nc0 == nc1 && std::equal(c0, c0 + nc0, c1);
+      for (PetscInt k = 0; same && k < nc1; ++k) {
+        st.pc_cols.push_back(int(c1[k]));
+        st.pc_values.push_back(double(v1[k]));
+        st.pc_first_values.push_back(double(v0[k]));
+      }
+      petsc_check(MatRestoreRow(Apc_first, i, &nc0, &c0, &v0), "MatRestoreRow");
+      petsc_check(MatRestoreRow(Apc, i, &nc1, &c1, &v1), "MatRestoreRow");
+      if (!same) throw VofError("state: the pressure preconditioner's operators differ in structure");
+      st.pc_rows.push_back(int(st.pc_cols.size()));
+    }
+  }
+
+  // Set the pressure operator's values from compressed rows (the structure the active region's
+  // system has) and assemble it.
+  void set_operator(Mat M, const VofState& st, const std::vector<double>& values) {
+    for (int i = 0; i < n_active; ++i) {
+      const int k0 = st.pc_rows[std::size_t(i)], k1 = st.pc_rows[std::size_t(i) + 1];
+      if (k0 < 0 || k1 < k0 || std::size_t(k1) > st.pc_cols.size()) throw VofError("restore: the checkpoint's pressure operator is damaged");
+      for (int k = k0; k < k1; ++k) {
+        const PetscInt r0 = i, c0 = st.pc_cols[std::size_t(k)];
+        if (c0 < 0 || c0 >= n_active) throw VofError("restore: the checkpoint's pressure operator is damaged");
+        const PetscScalar v = values[std::size_t(k)];
+        if (MatSetValues(M, 1, &r0, 1, &c0, &v, INSERT_VALUES))
+          throw VofError("restore: the checkpoint's pressure operator does not fit the active region's system");
+      }
+    }
+    petsc_check(MatAssemblyBegin(M, MAT_FINAL_ASSEMBLY), "MatAssembly");
+    petsc_check(MatAssemblyEnd(M, MAT_FINAL_ASSEMBLY), "MatAssembly");
+  }
+
+  // After make_pressure_system() for the restored region: the refresh counter, and the
+  // preconditioner built as the run that wrote the checkpoint built it (from the operator of the
+  // solver's first build, then, if it was rebuilt since, from the latest one), placed where that
+  // run had it (A, or Apin in a closed domain), so that the following steps, which reassemble the
+  // operator and keep or refresh the preconditioner, are that run's.
+  void restore_pc(const VofState& st) {
+    steps_since_pc = st.steps_since_pc;
+    if (st.pc_builds <= 0) return;  // none built yet: the system stays fresh
+    if (st.pc_rows.size() != std::size_t(n_active) + 1 || st.pc_cols.size() != st.pc_values.size() ||
+        st.pc_first_values.size() != st.pc_values.size() || st.pc_rows.back() != int(st.pc_cols.size()))
+      throw VofError("restore: the checkpoint's pressure operator does not match its active region");
+    const bool closed = !has_dirichlet && n_active == nc;  // the preconditioner was built from Apin
+    for (int build = 0; build < std::min(st.pc_builds, 2); ++build) {
+      const auto& values = build == 0 ? st.pc_first_values : st.pc_values;
+      Mat Ap = A;
+      if (closed) {
+        if (!Apin) {
+          set_operator(A, st, values);
+          petsc_check(MatDuplicate(A, MAT_COPY_VALUES, &Apin), "MatDuplicate");
+        } else {
+          set_operator(Apin, st, values);
+        }
+        Ap = Apin;
+      } else {
+        set_operator(A, st, values);
+      }
+      petsc_check(KSPSetOperators(ksp, Ap, Ap), "KSPSetOperators");
+      petsc_check(KSPSetReusePreconditioner(ksp, PETSC_FALSE), "KSPSetReusePreconditioner");
+      petsc_check(KSPSetUp(ksp), "KSPSetUp");  // what KSPSolve does before it iterates
+      petsc_check(KSPSetUpOnBlocks(ksp), "KSPSetUpOnBlocks");
+      remember_pc(Ap);
+    }
+    pc_builds = st.pc_builds;
+    system_fresh = false;
+  }
+
   // (Re)create the pressure system for the current active region.
   void make_pressure_system() {
     if (A) MatDestroy(&A);
     if (Apin) MatDestroy(&Apin);
+    if (Apc) MatDestroy(&Apc);
+    if (Apc_first) MatDestroy(&Apc_first);
+    pc_builds = 0;
     for (::Vec* v : {&x, &b, &r, &dx})
       if (*v) VecDestroy(v);
     std::vector<PetscInt> nnz(std::size_t(std::max(1, n_active)), 1);
@@ -1165,6 +1285,7 @@ struct VofSolver::Impl {
       system_fresh = false;
       petsc_check(KSPSetReusePreconditioner(ksp, keep_pc ? PETSC_TRUE : PETSC_FALSE), "KSPSetReusePreconditioner");
       timed_solve(Ap);
+      if (!keep_pc) remember_pc(Ap);
       KSPConvergedReason reason;
       KSPGetConvergedReason(ksp, &reason);
       PetscInt k = 0;
@@ -1176,6 +1297,7 @@ struct VofSolver::Impl {
         petsc_check(VecSet(dx, 0.0), "VecSet");
         petsc_check(KSPSetReusePreconditioner(ksp, PETSC_FALSE), "KSPSetReusePreconditioner");
         timed_solve(Ap);
+        remember_pc(Ap);
         KSPGetConvergedReason(ksp, &reason);
         KSPGetIterationNumber(ksp, &k);
         its += k;
@@ -1336,8 +1458,8 @@ void VofSolver::initialise(const std::vector<double>& alpha, const std::vector<V
 
 const std::vector<double>& VofSolver::granular_flux() const { return impl_->alpha_phi; }
 
-VofState VofSolver::state() {
-  auto& I = *impl_;
+VofState VofSolver::state() const {
+  const auto& I = *impl_;
   VofState st;
   st.t = t_;
   st.dt = dt_;
@@ -1349,7 +1471,7 @@ VofState VofSolver::state() {
   st.phi = phi_;
   st.U = U_;
   st.active_cells = I.active_cells;
-  I.make_pressure_system();  // as restore() does
+  I.save_pc(st);
   return st;
 }
 
@@ -1388,6 +1510,7 @@ void VofSolver::restore(const VofState& st) {
   U_ = st.U;
   I.mu = st.mu;
   I.make_pressure_system();
+  I.restore_pc(st);
 }
 
 StepStats VofSolver::step() {

@@ -160,13 +160,22 @@ struct StepStats {
   int active_cells = 0;         ///< cells in the active region (the pressure system's size)
 };
 
-/// Everything a run needs to continue from a moment (a checkpoint). A run restored from it takes
-/// exactly the steps the original takes after state() (bit for bit on the same build and machine).
+/// Everything a run needs to continue from a moment (a checkpoint): the fields and the solver's
+/// state carried from step to step. A run restored from it takes exactly the steps the original
+/// takes after state() (bit for bit on the same build and machine).
 struct VofState {
   double t = 0, dt = 0;
   std::vector<double> alpha, p_rgh, p, nu1, mu, phi;
   std::vector<Vec> U;
   std::vector<int> active_cells;  ///< the active region (it depends on the run's history)
+  /// The pressure preconditioner: steps since it was last built (VofConfig::pressure_pc_refresh),
+  /// how often the current pressure solver has built it (0, 1, or 2 for more), and the operators it
+  /// was built from at the first and at the latest build, in compressed rows over the active
+  /// region's cells (GAMG keeps the first build's prolongators). restore() builds the same
+  /// preconditioner from them.
+  int steps_since_pc = 0, pc_builds = 0;
+  std::vector<int> pc_rows, pc_cols;
+  std::vector<double> pc_first_values, pc_values;
 };
 
 class VofSolver {
@@ -178,9 +187,8 @@ class VofSolver {
 
   /// Initial state: alpha per cell (velocity zero unless set); computes the hydrostatic pressure.
   void initialise(const std::vector<double>& alpha, const std::vector<Vec>& U = {});
-  /// The state for a checkpoint. The next step then starts from freshly built pressure solvers, as a
-  /// restored run's first step does, so that both continue identically.
-  VofState state();
+  /// The state for a checkpoint; taking it changes nothing in the run.
+  VofState state() const;
   /// Continue from a checkpoint (in place of initialise()); sizes must match the mesh.
   void restore(const VofState& st);
   /// One time step of the length chosen by the Courant control.
