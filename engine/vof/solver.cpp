@@ -1258,7 +1258,8 @@ struct VofSolver::Impl {
       petsc_check(VecAYPX(r, -1.0, b), "VecAYPX");  // r = b - A x
       petsc_check(VecSet(dx, 0.0), "VecSet");
       const bool same = (reuse || pass > 0) && !system_fresh;  // passes of the initial solve share the matrix too
-      // The preconditioner (the multigrid hierarchy) is rebuilt every pressure_pc_refresh steps and
+      // The preconditioner is rebuilt every pressure_pc_refresh steps (GAMG: the coarse operators
+      // from the current matrix, with the prolongators of the solver's first build) and made anew
       // whenever the active region changes; in between, the last one preconditions the new matrix
       // (still symmetric positive definite).
       bool keep_pc = same;
