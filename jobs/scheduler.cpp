@@ -1,6 +1,8 @@
 #include "jobs/scheduler.hpp"
 
+#include <fcntl.h>
 #include <omp.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -72,8 +74,13 @@ std::string Scheduler::log_path(const std::string& id) const {
 }
 
 void Scheduler::start() {
+  std::vector<JobStore::Change> changed;
   const int n = store_.requeue_running(
-      "the server went down during the run; queued to run again (from its last checkpoint where it has one)");
+      "the server went down during the run; queued to run again (from its last checkpoint where it has one)", &changed);
+  for (const auto& c : changed) {  // each job's log keeps its history (`runout serve --recover` reads it)
+    std::ofstream lg(log_path(c.id), std::ios::app);
+    lg << utc_now() << " " << state_name(c.state) << ": " << c.reason << "\n";
+  }
   if (n) log("queued again " + std::to_string(n) + " job(s) left running by the previous server process");
   // Work in progress of a dead process is worthless: its jobs run again.
   std::error_code ec;
@@ -173,6 +180,7 @@ void Scheduler::apply_retention() {
     const bool over = cfg_.retention_max_bytes > 0 && total > cfg_.retention_max_bytes;
     if (!old && !over) continue;
     std::error_code ec;
+    std::lock_guard results_lk(results_mu_);  // not while a job answers from them or moves its own in
     fs::remove_all(results_dir(f.hash), ec);
     total -= f.bytes;
     store_.mark_results_removed(f.hash, old ? "results removed by the retention policy (older than " +
@@ -203,10 +211,32 @@ void Scheduler::worker_loop(int index) {
       work_cv_.wait_for(lk, std::chrono::seconds(2), [&] { return stopping_.load() || work_seq_ != seen; });
       const bool due = std::chrono::steady_clock::now() - last_retention_ > std::chrono::hours(1);
       lk.unlock();
-      if (due) apply_retention();
+      if (due) {
+        try {
+          apply_retention();
+        } catch (const std::exception& e) {
+          log(std::string("retention failed: ") + e.what());
+        }
+      }
       continue;
     }
-    run_job(std::move(*job));
+    // Nothing may end this thread: a job that throws is recorded as failed (when the store can).
+    const std::string id = job->job.id();
+    try {
+      run_job(std::move(*job));
+    } catch (const std::exception& e) {
+      log("job " + id + ": " + e.what());
+      try {
+        store_.transition(id, v1::FAILED, "the job system failed", e.what());
+      } catch (...) {
+      }
+      {
+        std::lock_guard lk(mu_);
+        live_.erase(id);
+        cancel_.erase(id);
+      }
+      touch(id);
+    }
   }
 }
 
@@ -222,11 +252,19 @@ void Scheduler::write_record(const StoredJob& j) const {
   rec.set_owner(j.owner);
   *rec.mutable_scenario() = j.scenario;
   const std::string path = record_path(j.job.id()), tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    if (!rec.SerializeToOstream(&f) || !f.flush()) throw std::runtime_error("cannot write the job's record " + path);
+  std::string bytes;
+  rec.SerializeToString(&bytes);
+  // Written, synced and renamed, and the folder synced: a record survives a power loss as the store does.
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw std::runtime_error("cannot write the job's record " + path);
+  bool ok = ::write(fd, bytes.data(), bytes.size()) == ssize_t(bytes.size()) && ::fsync(fd) == 0;
+  ok = ::close(fd) == 0 && ok;
+  if (!ok || std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error("cannot write the job's record " + path);
+  const int dir = ::open((fs::path(cfg_.state_dir) / "logs").c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir >= 0) {
+    ::fsync(dir);
+    ::close(dir);
   }
-  fs::rename(tmp, path);
 }
 
 std::string client_message(std::string msg, const std::string& state_dir, const std::vector<std::string>& data_roots) {
@@ -251,6 +289,9 @@ std::string client_message(std::string msg, const std::string& state_dir, const 
     const std::string r = (fs::path(root) / "").string();
     for (std::size_t at; !r.empty() && (at = msg.find(r)) != std::string::npos;) msg.erase(at, r.size());
   }
+  // Anything else of the state directory by its place in it (checkpoints/..., validate/...).
+  const std::string st = (fs::path(state_dir) / "").string();
+  for (std::size_t at; (at = msg.find(st)) != std::string::npos;) msg.erase(at, st.size());
   return msg;
 }
 
@@ -309,14 +350,23 @@ void Scheduler::run_job(StoredJob sj) {
 
   const fs::path final_dir = results_dir(hash);
   std::error_code ec;
-  if (fs::exists(final_dir / "run.json", ec)) {
-    finish_and_forget(v1::SUCCEEDED, "an identical scenario was computed before: its results answer this job", "",
-                      folder_bytes(final_dir.string()));
-    return;
+  {
+    std::unique_lock results_lk(results_mu_);  // not while retention removes results
+    if (fs::exists(final_dir / "run.json", ec)) {
+      const auto bytes = folder_bytes(final_dir.string());
+      results_lk.unlock();
+      finish_and_forget(v1::SUCCEEDED, "an identical scenario was computed before: its results answer this job", "", bytes);
+      return;
+    }
   }
   const fs::path tmp = fs::path(final_dir.string() + ".tmp-" + id);
   fs::remove_all(tmp, ec);
-  bool cancelled_early = store_.cancel_requested(id);
+  bool cancelled_early = false;
+  try {
+    cancelled_early = store_.cancel_requested(id);
+  } catch (const std::exception& e) {
+    log("job " + id + ": the job store failed: " + e.what());
+  }
   {
     std::lock_guard lk(mu_);
     cancelled_early = cancelled_early || cancel_.count(id) > 0;
@@ -362,16 +412,20 @@ void Scheduler::run_job(StoredJob sj) {
       WorkerProcess w(cfg_.worker_exe, task, log_path(id));
       say("worker process " + std::to_string(w.pid()));
       const auto t0 = std::chrono::steady_clock::now();
-      auto last_check = t0, kill_at = t0;
-      while (!w.output_closed()) {
+      auto last_check = t0, kill_at = t0, last_saved = t0;
+      for (;;) {
+        // Every event the worker wrote is read, also after its output closed (the outcome may be
+        // the last of several events that arrived at once).
         auto ev = w.next_event(std::chrono::milliseconds(100));
+        if (!ev && w.output_closed()) break;
         const auto now = std::chrono::steady_clock::now();
         if (ev && ev->has_progress()) {
           if (!on_progress(id, ev->progress()) && why == Why::none) {
             std::lock_guard lk(mu_);
             why = cancel_.count(id) ? Why::cancel : Why::stop;
           }
-          if (now - last_check > std::chrono::seconds(1)) {
+          if (now - last_saved > std::chrono::seconds(1)) {
+            last_saved = now;
             const auto& p = ev->progress();
             try {
               store_.save_progress(id, p);
@@ -429,14 +483,19 @@ void Scheduler::run_job(StoredJob sj) {
     }
     const std::string exit_text = ex.describe();
     if (!(ex.exited && ex.code == 0)) say("worker process ended by " + exit_text);
+    {
+      std::lock_guard lk(mu_);  // a stop that came while the worker was ending
+      if (why == Why::none && stopping_) why = Why::stop;
+    }
 
-    if (why == Why::cancel) {
+    if (why == Why::cancel && !(outcome && outcome->has_done())) {
       fs::remove_all(tmp, ec);
       const double t = outcome && outcome->has_interrupted() ? outcome->interrupted().simulated_s() : 0.0;
       finish_and_forget(v1::CANCELLED, "cancelled by the client at t = " + std::to_string(t) + " s; no results kept", "", 0);
       return;
     }
     if (outcome && outcome->has_done()) {
+      std::unique_lock results_lk(results_mu_);  // not while retention removes results
       fs::rename(tmp, final_dir, ec);
       if (ec) {
         // Another job with the same hash finished first: its (identical) results stand.
@@ -446,8 +505,10 @@ void Scheduler::run_job(StoredJob sj) {
           return;
         }
       }
+      const auto bytes = folder_bytes(final_dir.string());
+      results_lk.unlock();
       say("finished: " + outcome->done().summary());
-      finish_and_forget(v1::SUCCEEDED, "completed", "", folder_bytes(final_dir.string()));
+      finish_and_forget(v1::SUCCEEDED, "completed", "", bytes);
       return;
     }
     fs::remove_all(tmp, ec);
@@ -474,13 +535,19 @@ void Scheduler::run_job(StoredJob sj) {
       const auto& f = outcome->failed();
       if (!task.restart_path().empty() && f.bad_input() && f.error().find("checkpoint") != std::string::npos && round == 0) {
         // A checkpoint this build cannot continue (damaged, or from another build): from the start.
-        say("its checkpoint cannot be continued (" + f.error() + "); running again from the start");
+        say("its checkpoint cannot be continued (" + client_message(f.error(), cfg_.state_dir, cfg_.data_roots) +
+            "); running again from the start");
         log("job " + id + ": checkpoint refused (" + f.error() + "); running from the start");
         remove_checkpoint(id);
         task.clear_restart_path();
         continue;
       }
       finish_and_forget(v1::FAILED, "the run failed", client_message(f.error(), cfg_.state_dir, cfg_.data_roots), 0);
+      return;
+    }
+    if (!ex.exited && (ex.signal == SIGTERM || ex.signal == SIGINT || ex.signal == SIGHUP)) {
+      // Stopped from outside (an operator's signal to the worker): not the job's fault.
+      finish(v1::QUEUED, "its worker process was stopped from outside (" + exit_text + "); queued to run again", "", 0);
       return;
     }
     // No outcome: the worker process died of a signal nobody sent, or exited without a word.

@@ -109,6 +109,7 @@ class Scheduler {
   std::uint64_t work_seq_ = 0;  // bumped by notify(): work may be waiting
   std::chrono::steady_clock::time_point last_retention_{};  // guarded by mu_
   std::mutex retention_mu_;
+  std::mutex results_mu_;  // results/<hash> folders: moved in, answered from, removed
 };
 
 }  // namespace runout::jobs

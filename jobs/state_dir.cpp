@@ -37,8 +37,10 @@ Earlier earlier_jobs(const fs::path& state) {
   std::error_code ec;
   for (const auto& d : fs::directory_iterator(state / "results", ec))
     if (d.path().filename().string().find(".tmp-") == std::string::npos) ++e.results;
-  for (const auto& d : fs::directory_iterator(state / "logs", ec))
-    if (d.path().extension() == ".log") ++e.logs;
+  for (const auto& d : fs::directory_iterator(state / "logs", ec)) {
+    const std::string n = d.path().filename().string();
+    if (d.path().extension() == ".log" || (n.size() > 10 && n.substr(n.size() - 10) == ".record.pb")) ++e.logs;
+  }
   return e;
 }
 
@@ -136,7 +138,7 @@ void check_store(const std::string& state_dir) {
   std::string found;
   if (e.results || e.logs)
     found = ", but the state directory holds " + std::to_string(e.results) + " result folder(s) and " + std::to_string(e.logs) +
-            " job log(s) of earlier jobs";
+            " job log(s) or record(s) of earlier jobs";
   throw StateError("job store '" + db.string() + "' " + problem + found +
                    (missing_or_empty ? ": starting would forget those jobs" : "") +
                    ". To rebuild the store from the job records, logs and results, run `runout serve --recover` with the "
@@ -144,6 +146,7 @@ void check_store(const std::string& state_dir) {
 }
 
 std::string RecoveryReport::text() const {
+  if (healthy) return "the job store is healthy: nothing to recover";
   std::ostringstream o;
   o << "recovered the job store: " << rebuilt << " job(s) rebuilt from " << records << " record(s) (" << succeeded << " succeeded, "
     << failed << " failed, " << cancelled << " cancelled, " << queued << " queued to run again)";
@@ -153,17 +156,114 @@ std::string RecoveryReport::text() const {
   return o.str();
 }
 
-RecoveryReport recover_store(const std::string& state_dir) {
+// "2026-11-23T06:30:04.123Z": the time stamp the job system writes (a line without one is not ours).
+bool is_stamp(const std::string& t) {
+  if (t.size() != 24 || t[4] != '-' || t[7] != '-' || t[10] != 'T' || t[13] != ':' || t[16] != ':' || t[19] != '.' || t[23] != 'Z')
+    return false;
+  for (int k : {0, 1, 2, 3, 5, 6, 8, 9, 11, 12, 14, 15, 17, 18, 20, 21, 22})
+    if (!std::isdigit(static_cast<unsigned char>(t[std::size_t(k)]))) return false;
+  return true;
+}
+
+RecoveryReport recover_store(const std::string& state_dir, const StateLock& held) {
+  (void)held;
   const fs::path state(state_dir), db = state / "jobs.db";
-  StateLock lock(state_dir);
-  const std::string problem = store_problem(db);
-  if (problem.empty())
-    throw StateError("job store '" + db.string() + "' is healthy: nothing to recover (start the server without --recover)");
   RecoveryReport rep;
+  const std::string problem = store_problem(db);
+  if (problem.empty()) {
+    rep.healthy = true;
+    return rep;
+  }
   std::error_code ec;
+  // Built beside the store and moved into place when complete.
+  const fs::path building = state / "jobs.db.recovering";
+  for (const char* side : {"", "-wal", "-shm", "-journal"}) fs::remove(building.string() + side, ec);
+  {
+    JobStore store(building.string());
+    const fs::path logs = state / "logs";
+    for (const auto& e : fs::directory_iterator(logs, ec)) {
+      const std::string name = e.path().filename().string();
+      if (e.path().extension() == ".log") {
+        if (!fs::exists(logs / (e.path().stem().string() + ".record.pb"), ec)) ++rep.logs_without_record;
+        continue;
+      }
+      if (name.size() < 10 || name.substr(name.size() - 10) != ".record.pb") continue;
+      v1::JobRecord rec;
+      const std::string stem = name.substr(0, name.size() - 10);
+      if (!rec.ParseFromString(read_file(e.path())) || rec.job().id() != stem || rec.job().scenario_hash().size() != 64 ||
+          rec.owner().empty())
+        continue;  // not a whole record of this job (cut short, or not ours)
+      ++rep.records;
+      StoredJob j;
+      j.job = rec.job();
+      j.owner = rec.owner();
+      j.scenario = rec.scenario();
+      const std::string id = j.job.id();
+      // The history from the job's log: "TIME attempt N: started ...", "TIME STATE: reason", "TIME error: ...".
+      auto add = [&](v1::JobState s, const std::string& when, const std::string& reason) {
+        auto* t = j.job.add_transitions();
+        t->set_state(s);
+        t->set_time_utc(when);
+        t->set_reason(reason);
+        j.job.set_state(s);
+        j.job.set_updated_utc(when);
+      };
+      add(v1::QUEUED, j.job.created_utc(), "submitted");
+      std::ifstream in(logs / (id + ".log"));
+      std::string line;
+      int attempts = 0;
+      while (std::getline(in, line)) {
+        const auto sp = line.find(' ');
+        if (sp == std::string::npos) continue;
+        const std::string when = line.substr(0, sp), text = line.substr(sp + 1);
+        if (!is_stamp(when)) continue;  // the worker's own output (libraries' messages), not the job system's
+        if (text.rfind("attempt ", 0) == 0 && text.find(": started") != std::string::npos) {
+          ++attempts;
+          add(v1::RUNNING, when, "started (attempt " + std::to_string(attempts) + ")");
+          continue;
+        }
+        if (text.rfind("error: ", 0) == 0) {
+          j.job.set_error(text.substr(7));
+          continue;
+        }
+        const auto colon = text.find(": ");
+        if (colon == std::string::npos) continue;
+        const v1::JobState s = state_of(text.substr(0, colon));
+        if (s == v1::JOB_STATE_UNSPECIFIED) continue;
+        if (s != v1::FAILED) j.job.clear_error();
+        if (text.find(": its worker process crashed") != std::string::npos) ++j.crashes;
+        add(s, when, text.substr(colon + 2));
+      }
+      j.job.set_attempts(attempts);
+      const std::string now = utc_now();
+      if (j.job.state() == v1::RUNNING)
+        add(v1::QUEUED, now, "the job store was rebuilt while it ran; queued to run again (from its last checkpoint where it has one)");
+      if (j.job.state() == v1::SUCCEEDED) {
+        const fs::path res = state / "results" / j.job.scenario_hash();
+        if (fs::exists(res / "run.json", ec)) {
+          j.job.set_result_bytes(folder_bytes(res.string()));
+        } else {
+          j.results_removed = true;
+          ++rep.results_missing;
+        }
+      }
+      add(j.job.state(), now, "rebuilt by runout serve --recover from the job's record and log");
+      try {
+        store.insert_recovered(j);
+      } catch (const std::exception&) {
+        continue;  // a duplicate record (cannot happen: one file per id)
+      }
+      ++rep.rebuilt;
+      switch (j.job.state()) {
+        case v1::SUCCEEDED: ++rep.succeeded; break;
+        case v1::FAILED: ++rep.failed; break;
+        case v1::CANCELLED: ++rep.cancelled; break;
+        default: ++rep.queued; break;
+      }
+    }
+  }  // the new store is closed (its WAL folded in)
   if (fs::exists(db, ec)) {
-    const std::string stamp = utc_now();
-    rep.moved_aside = db.string() + ".damaged-" + stamp;
+    rep.moved_aside = db.string() + ".damaged-" + utc_now();
     fs::rename(db, rep.moved_aside, ec);
     if (ec) throw StateError("cannot move the damaged store aside: " + ec.message());
   }
@@ -174,83 +274,8 @@ RecoveryReport recover_store(const std::string& state_dir) {
       else fs::remove(p, ec);
     }
   }
-  JobStore store(db.string());
-  const fs::path logs = state / "logs";
-  for (const auto& e : fs::directory_iterator(logs, ec)) {
-    const std::string name = e.path().filename().string();
-    if (e.path().extension() == ".log") {
-      if (!fs::exists(logs / (e.path().stem().string() + ".record.pb"), ec)) ++rep.logs_without_record;
-      continue;
-    }
-    if (name.size() < 10 || name.substr(name.size() - 10) != ".record.pb") continue;
-    v1::JobRecord rec;
-    if (!rec.ParseFromString(read_file(e.path()))) continue;
-    ++rep.records;
-    StoredJob j;
-    j.job = rec.job();
-    j.owner = rec.owner();
-    j.scenario = rec.scenario();
-    const std::string id = j.job.id();
-    // The history from the job's log: "TIME attempt N: started ...", "TIME STATE: reason", "TIME error: ...".
-    auto add = [&](v1::JobState s, const std::string& when, const std::string& reason) {
-      auto* t = j.job.add_transitions();
-      t->set_state(s);
-      t->set_time_utc(when);
-      t->set_reason(reason);
-      j.job.set_state(s);
-      j.job.set_updated_utc(when);
-    };
-    add(v1::QUEUED, j.job.created_utc(), "submitted");
-    std::ifstream in(logs / (id + ".log"));
-    std::string line;
-    int attempts = 0;
-    while (std::getline(in, line)) {
-      const auto sp = line.find(' ');
-      if (sp == std::string::npos) continue;
-      const std::string when = line.substr(0, sp), text = line.substr(sp + 1);
-      if (text.rfind("attempt ", 0) == 0 && text.find(": started") != std::string::npos) {
-        ++attempts;
-        add(v1::RUNNING, when, "started (attempt " + std::to_string(attempts) + ")");
-        continue;
-      }
-      if (text.rfind("error: ", 0) == 0) {
-        j.job.set_error(text.substr(7));
-        continue;
-      }
-      const auto colon = text.find(": ");
-      if (colon == std::string::npos) continue;
-      const v1::JobState s = state_of(text.substr(0, colon));
-      if (s == v1::JOB_STATE_UNSPECIFIED) continue;
-      if (s != v1::FAILED) j.job.clear_error();
-      add(s, when, text.substr(colon + 2));
-    }
-    j.job.set_attempts(attempts);
-    const std::string now = utc_now();
-    if (j.job.state() == v1::RUNNING)
-      add(v1::QUEUED, now, "the job store was rebuilt while it ran; queued to run again (from its last checkpoint where it has one)");
-    if (j.job.state() == v1::SUCCEEDED) {
-      const fs::path res = state / "results" / j.job.scenario_hash();
-      if (fs::exists(res / "run.json", ec)) {
-        j.job.set_result_bytes(folder_bytes(res.string()));
-      } else {
-        j.results_removed = true;
-        ++rep.results_missing;
-      }
-    }
-    add(j.job.state(), now, "rebuilt by runout serve --recover from the job's record and log");
-    try {
-      store.insert_recovered(j);
-    } catch (const std::exception&) {
-      continue;  // a duplicate record (cannot happen: one file per id)
-    }
-    ++rep.rebuilt;
-    switch (j.job.state()) {
-      case v1::SUCCEEDED: ++rep.succeeded; break;
-      case v1::FAILED: ++rep.failed; break;
-      case v1::CANCELLED: ++rep.cancelled; break;
-      default: ++rep.queued; break;
-    }
-  }
+  fs::rename(building, db, ec);
+  if (ec) throw StateError("cannot move the rebuilt store into place: " + ec.message());
   return rep;
 }
 

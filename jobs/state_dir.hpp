@@ -45,12 +45,14 @@ struct RecoveryReport {
   int results_missing = 0;       ///< succeeded jobs whose results are gone (marked removed)
   int logs_without_record = 0;   ///< job logs with no record: not rebuilt
   std::string moved_aside;       ///< where the damaged store was moved ("" when none was there)
+  bool healthy = false;          ///< the store was usable: nothing was done
   std::string text() const;      ///< a summary for the operator
 };
 
 /// `runout serve --recover`: move a missing, empty or damaged store aside and rebuild one from the
-/// job records, their logs and the results. Throws StateError when the store is healthy (nothing to
-/// recover) or another server holds the state directory.
-RecoveryReport recover_store(const std::string& state_dir);
+/// job records, their logs and the results (built beside it and moved into place when complete, so
+/// an interrupted recovery leaves no half store). A healthy store is left as it is (healthy = true).
+/// The caller holds the state directory's lock (`held`), so no server starts meanwhile.
+RecoveryReport recover_store(const std::string& state_dir, const StateLock& held);
 
 }  // namespace runout::jobs

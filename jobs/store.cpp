@@ -187,6 +187,11 @@ JobStore::JobStore(const std::string& path) {
   if (sqlite3_prepare_v2(db_, "SELECT crashes FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
     exec("ALTER TABLE jobs ADD COLUMN crashes INTEGER NOT NULL DEFAULT 0");
   sqlite3_finalize(probe);
+  // ... and the digest of the request that created a job (a retry must send the same).
+  probe = nullptr;
+  if (sqlite3_prepare_v2(db_, "SELECT request_hash FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
+    exec("ALTER TABLE jobs ADD COLUMN request_hash TEXT");
+  sqlite3_finalize(probe);
   exec(R"(CREATE TABLE IF NOT EXISTS uploads(
            id TEXT NOT NULL,
            owner TEXT NOT NULL,
@@ -240,7 +245,7 @@ void JobStore::load_transitions(StoredJob& j) const {
 }
 
 SubmitOutcome JobStore::submit(const std::string& owner, const std::string& hash, const std::string& request_id,
-                               const v1::Scenario& scenario, int max_queued) {
+                               const v1::Scenario& scenario, int max_queued, const std::string& request_hash) {
   std::lock_guard lk(mu_);
   Transaction tx(db_);
   SubmitOutcome out;
@@ -284,14 +289,18 @@ SubmitOutcome JobStore::submit(const std::string& owner, const std::string& hash
   std::string blob;
   scenario.SerializeToString(&blob);
   Stmt ins(db_,
-           "INSERT INTO jobs(id, owner, name, hash, request_id, state, created, updated, scenario) "
-           "VALUES (?, ?, ?, ?, ?, 1, ?, ?, ?)");
+           "INSERT INTO jobs(id, owner, name, hash, request_id, state, created, updated, scenario, request_hash) "
+           "VALUES (?, ?, ?, ?, ?, 1, ?, ?, ?, ?)");
   ins.bind(1, id).bind(2, owner).bind(3, scenario.name()).bind(4, hash);
   if (request_id.empty())
     ins.null(5);
   else
     ins.bind(5, request_id);
   ins.bind(6, now).bind(7, now).blob(8, blob);
+  if (request_hash.empty())
+    ins.null(9);
+  else
+    ins.bind(9, request_hash);
   ins.step();
   add_transition(db_, id, v1::QUEUED, now, "submitted");
   tx.commit();
@@ -418,7 +427,7 @@ std::optional<StoredJob> JobStore::cancel(const std::string& id, const std::stri
   return get(id, owner);
 }
 
-int JobStore::requeue_running(const std::string& reason) {
+int JobStore::requeue_running(const std::string& reason, std::vector<Change>* changed) {
   std::lock_guard lk(mu_);
   Transaction tx(db_);
   struct Row {
@@ -436,11 +445,14 @@ int JobStore::requeue_running(const std::string& reason) {
     // The server went down, not the job (jobs run in processes of their own, which died with it):
     // this does not count against the job.
     if (r.cancel) {
+      const char* why = "cancelled by the client; the server stopped before the run did";
       Stmt(db_, "UPDATE jobs SET state = 5, updated = ? WHERE id = ?").bind(1, now).bind(2, r.id).step();
-      add_transition(db_, r.id, v1::CANCELLED, now, "cancelled by the client; the server stopped before the run did");
+      add_transition(db_, r.id, v1::CANCELLED, now, why);
+      if (changed) changed->push_back({r.id, v1::CANCELLED, why});
     } else {
       Stmt(db_, "UPDATE jobs SET state = 1, updated = ? WHERE id = ?").bind(1, now).bind(2, r.id).step();
       add_transition(db_, r.id, v1::QUEUED, now, reason);
+      if (changed) changed->push_back({r.id, v1::QUEUED, reason});
       ++queued;
     }
   }
@@ -521,7 +533,7 @@ void JobStore::insert_recovered(const StoredJob& j) {
   j.scenario.SerializeToString(&blob);
   Stmt ins(db_,
            "INSERT INTO jobs(id, owner, name, hash, request_id, state, created, updated, error, attempts, scenario, "
-           "result_bytes, results_removed) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+           "result_bytes, results_removed, crashes) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   ins.bind(1, j.job.id()).bind(2, j.owner).bind(3, j.job.name()).bind(4, j.job.scenario_hash());
   if (j.job.request_id().empty())
     ins.null(5);
@@ -529,7 +541,7 @@ void JobStore::insert_recovered(const StoredJob& j) {
     ins.bind(5, j.job.request_id());
   ins.bind(6, std::int64_t(j.job.state())).bind(7, j.job.created_utc()).bind(8, j.job.updated_utc()).bind(9, j.job.error())
       .bind(10, std::int64_t(j.job.attempts())).blob(11, blob).bind(12, j.job.result_bytes())
-      .bind(13, std::int64_t(j.results_removed ? 1 : 0));
+      .bind(13, std::int64_t(j.results_removed ? 1 : 0)).bind(14, std::int64_t(j.crashes));
   ins.step();
   for (const auto& t : j.job.transitions()) add_transition(db_, j.job.id(), t.state(), t.time_utc(), t.reason());
   tx.commit();
@@ -560,6 +572,26 @@ std::vector<std::string> JobStore::uploads_older_than(double cutoff_epoch_s) con
   std::vector<std::string> out;
   while (st.step()) out.push_back(st.text(0));
   return out;
+}
+
+std::optional<std::pair<StoredJob, std::string>> JobStore::find_request(const std::string& owner,
+                                                                       const std::string& request_id) const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_, (std::string("SELECT ") + kColumns + ", COALESCE(request_hash, '') FROM jobs WHERE owner = ? AND request_id = ?").c_str());
+  st.bind(1, owner).bind(2, request_id);
+  if (!st.step()) return std::nullopt;
+  std::pair<StoredJob, std::string> out{read_row(&st), st.text(15)};
+  load_transitions(out.first);
+  return out;
+}
+
+bool JobStore::forget_upload(const std::string& id, const std::string& owner) {
+  std::lock_guard lk(mu_);
+  Stmt(db_, "DELETE FROM uploads WHERE id = ? AND owner = ?").bind(1, id).bind(2, owner).step();
+  Stmt st(db_, "SELECT COUNT(*) FROM uploads WHERE id = ?");
+  st.bind(1, id);
+  st.step();
+  return st.i64(0) > 0;
 }
 
 void JobStore::forget_upload(const std::string& id) {

@@ -58,7 +58,10 @@ class JobStore {
   /// RequestIdConflict when the request id names a job of another scenario, QueueFull when the
   /// owner already has `max_queued` queued or running jobs.
   SubmitOutcome submit(const std::string& owner, const std::string& hash, const std::string& request_id,
-                       const v1::Scenario& scenario, int max_queued);
+                       const v1::Scenario& scenario, int max_queued, const std::string& request_hash = "");
+  /// The owner's job with this request id, and the digest of the request that created it ("" for
+  /// jobs stored before it was kept).
+  std::optional<std::pair<StoredJob, std::string>> find_request(const std::string& owner, const std::string& request_id) const;
   /// The job with this id; with a non-empty owner only if it is that owner's.
   std::optional<StoredJob> get(const std::string& id, const std::string& owner = "") const;
   /// The owner's jobs, newest first, filtered by state (empty: all); `page_token` from the previous page.
@@ -73,8 +76,14 @@ class JobStore {
   /// Queued jobs become cancelled here; running ones are left for the worker (returns their state).
   std::optional<StoredJob> cancel(const std::string& id, const std::string& owner);
   /// Jobs left running by a server that went down: queued again (cancelled when the client had
-  /// asked). The server's death does not count against a job. Returns how many were queued again.
-  int requeue_running(const std::string& reason);
+  /// asked). The server's death does not count against a job. Returns how many were queued again;
+  /// `changed` (optional) receives each job's id, new state and reason.
+  struct Change {
+    std::string id;
+    v1::JobState state;
+    std::string reason;
+  };
+  int requeue_running(const std::string& reason, std::vector<Change>* changed = nullptr);
   /// Whether the client asked to cancel this (running) job.
   bool cancel_requested(const std::string& id) const;
   void save_progress(const std::string& id, const v1::Progress& p);
@@ -104,6 +113,8 @@ class JobStore {
   std::vector<std::string> uploads_older_than(double cutoff_epoch_s) const;
   /// Every record of an upload (it was removed).
   void forget_upload(const std::string& id);
+  /// This client's record of an upload; returns whether any client still holds one.
+  bool forget_upload(const std::string& id, const std::string& owner);
 
  private:
   StoredJob read_row(void* stmt) const;

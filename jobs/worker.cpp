@@ -27,6 +27,7 @@ namespace runout::jobs {
 namespace {
 
 volatile std::sig_atomic_t g_stop = 0;
+constexpr std::size_t kMaxEventBytes = 64u << 20;
 extern "C" void on_stop(int) { g_stop = 1; }
 
 bool write_all(int fd, const char* p, std::size_t n) {
@@ -71,10 +72,9 @@ std::string signal_name(int sig) {
 std::string WorkerExit::describe() const { return exited ? "exit status " + std::to_string(code) : signal_name(signal); }
 
 std::string self_executable() {
-  std::vector<char> b(4096);
-  const ssize_t n = readlink("/proc/self/exe", b.data(), b.size() - 1);
-  if (n <= 0) throw std::runtime_error("cannot find the program's own path (/proc/self/exe)");
-  return std::string(b.data(), std::size_t(n));
+  // The link itself, not where it points: exec of it starts this very program even after its file
+  // was replaced or removed by an upgrade (the path would then read "... (deleted)").
+  return "/proc/self/exe";
 }
 
 int worker_main(int in_fd, int out_fd) {
@@ -184,10 +184,12 @@ WorkerProcess::WorkerProcess(const std::string& exe, const v1::WorkerTask& task,
     // Only async-signal-safe calls from here to exec.
     prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (getppid() != parent) _exit(127);
+    setpgid(0, 0);  // a terminal's Ctrl-C or a signal to the server's group reaches the server, which decides
     dup2(in[0], 0);
     dup2(out[1], 1);
     if (log >= 0) dup2(log, 2);
-    close_range(3, ~0U, 0);
+    if (close_range(3, ~0U, 0) != 0)
+      for (int fd = 3; fd < 4096; ++fd) close(fd);
     sigset_t none;
     sigemptyset(&none);
     sigprocmask(SIG_SETMASK, &none, nullptr);  // the server blocks SIGTERM/SIGINT in its threads
@@ -207,10 +209,29 @@ WorkerProcess::WorkerProcess(const std::string& exe, const v1::WorkerTask& task,
   pid_ = pid;
   out_fd_ = out[0];
   fcntl(out_fd_, F_SETFL, fcntl(out_fd_, F_GETFL) | O_NONBLOCK);
-  std::string body;
-  task.SerializeToString(&body);
-  (void)write_all(in[1], body.data(), body.size());  // a worker that died early is seen by wait()
-  close(in[1]);
+  // The task goes in as the worker reads it (a task can be larger than the pipe's buffer, and a
+  // worker that never reads must not block us): what does not fit now is written by fill().
+  in_fd_ = in[1];
+  fcntl(in_fd_, F_SETFL, fcntl(in_fd_, F_GETFL) | O_NONBLOCK);
+  task.SerializeToString(&pending_in_);
+  feed();
+}
+
+void WorkerProcess::feed() {
+  while (in_fd_ >= 0 && !pending_in_.empty()) {
+    const ssize_t w = ::write(in_fd_, pending_in_.data(), pending_in_.size());
+    if (w > 0) {
+      pending_in_.erase(0, std::size_t(w));
+      continue;
+    }
+    if (w < 0 && errno == EINTR) continue;
+    if (w < 0 && errno == EAGAIN) return;
+    pending_in_.clear();  // the worker is gone: wait() tells
+  }
+  if (in_fd_ >= 0 && pending_in_.empty()) {
+    close(in_fd_);
+    in_fd_ = -1;
+  }
 }
 
 WorkerProcess::~WorkerProcess() {
@@ -221,13 +242,16 @@ WorkerProcess::~WorkerProcess() {
     }
   }
   if (out_fd_ >= 0) close(out_fd_);
+  if (in_fd_ >= 0) close(in_fd_);
 }
 
 bool WorkerProcess::fill(std::chrono::milliseconds timeout) {
   if (closed_) return false;
-  pollfd p{out_fd_, POLLIN, 0};
-  const int r = poll(&p, 1, int(timeout.count()));
+  pollfd p[2] = {{out_fd_, POLLIN, 0}, {in_fd_, POLLOUT, 0}};
+  const int r = poll(p, in_fd_ >= 0 ? 2 : 1, int(timeout.count()));
   if (r <= 0) return false;
+  if (in_fd_ >= 0 && p[1].revents) feed();
+  if (!p[0].revents) return false;
   char b[65536];
   bool got = false;
   for (;;) {
@@ -250,6 +274,11 @@ std::optional<v1::WorkerEvent> WorkerProcess::next_event(std::chrono::millisecon
     if (buf_.size() >= 4) {
       const auto* u = reinterpret_cast<const unsigned char*>(buf_.data());
       const std::size_t n = std::size_t(u[0]) | std::size_t(u[1]) << 8 | std::size_t(u[2]) << 16 | std::size_t(u[3]) << 24;
+      if (n > kMaxEventBytes) {  // not our protocol: nothing more can be read from this stream
+        buf_.clear();
+        closed_ = true;
+        return std::nullopt;
+      }
       if (buf_.size() >= 4 + n) {
         v1::WorkerEvent ev;
         const bool ok = ev.ParseFromArray(buf_.data() + 4, int(n));

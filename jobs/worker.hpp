@@ -24,7 +24,8 @@ namespace runout::jobs {
 /// writes events to `out_fd`. Returns the process's exit status (0 when an outcome was written).
 int worker_main(int in_fd, int out_fd);
 
-/// The path of the running program (/proc/self/exe), the default worker executable.
+/// The running program ("/proc/self/exe"), the default worker executable: exec of the link starts
+/// this very program even after an upgrade replaced its file.
 std::string self_executable();
 
 /// How a worker process ended.
@@ -64,8 +65,11 @@ class WorkerProcess {
 
  private:
   bool fill(std::chrono::milliseconds timeout);
+  void feed();  ///< write what it can of the task to the worker's standard input
   pid_t pid_ = -1;
   int out_fd_ = -1;
+  int in_fd_ = -1;
+  std::string pending_in_;
   bool closed_ = false;
   bool reaped_ = false;
   bool sent_ = false;

@@ -1,5 +1,7 @@
 // runout serve: the gRPC batch server in the foreground until SIGINT or SIGTERM.
+#include <fcntl.h>
 #include <pthread.h>
+#include <unistd.h>
 #include <signal.h>
 
 #include <iostream>
@@ -84,19 +86,12 @@ int serve(const std::vector<std::string>& args) {
     for (const auto& r : roots) cfg.add_data_roots(r);
   }
 
+  // Standard input, output and error open (a closed one would be reused by a pipe to a worker).
+  for (int fd = 0; fd <= 2; ++fd)
+    if (fcntl(fd, F_GETFD) < 0) open("/dev/null", fd == 0 ? O_RDONLY : O_WRONLY);
   // A file-size limit makes writes fail (and say so), not the server die.
   signal(SIGXFSZ, SIG_IGN);
   signal(SIGPIPE, SIG_IGN);
-  if (recover) {
-    try {
-      const auto resolved = service::resolve_config(cfg);
-      const auto rep = jobs::recover_store(resolved.state_dir());
-      std::cerr << "runout serve: " << rep.text() << "\n";
-    } catch (const std::exception& e) {
-      std::cerr << "runout serve: --recover: " << e.what() << "\n";
-      return kBadInput;
-    }
-  }
   // Signals are taken by this thread only (sigwait below): block them before any thread starts.
   sigset_t set;
   sigemptyset(&set);
@@ -105,7 +100,9 @@ int serve(const std::vector<std::string>& args) {
   pthread_sigmask(SIG_BLOCK, &set, nullptr);
   try {
     service::Server server(cfg);
+    server.set_recover(recover);
     server.start();
+    if (recover) std::cerr << "runout serve: " << server.recovery_report() << std::endl;
     std::cout << "runout server listening on " << server.address() << std::endl;
     int sig = 0;
     sigwait(&set, &sig);

@@ -1,5 +1,7 @@
 #include "service/server/server.hpp"
 
+#include <google/protobuf/io/coded_stream.h>
+#include <google/protobuf/io/zero_copy_stream_impl_lite.h>
 #include <google/protobuf/util/json_util.h>
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/grpcpp.h>
@@ -22,6 +24,7 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <map>
 #include <mutex>
 #include <sstream>
 
@@ -220,6 +223,8 @@ v1::ServerConfig read_config_file(const std::string& path) {
 struct Server::Impl final : v1::Runout::Service {
   v1::ServerConfig cfg;
   std::unique_ptr<jobs::StateLock> lock;
+  bool recover = false;    // rebuild a lost store at start (`runout serve --recover`)
+  std::string recovery;    // what the rebuilding did
   std::thread housekeeping;
   std::condition_variable housekeeping_cv;
   std::unique_ptr<Tokens> tokens;
@@ -229,6 +234,10 @@ struct Server::Impl final : v1::Runout::Service {
   int bound_port = 0;
   std::mutex log_mu;
   std::mutex upload_mu;
+  std::map<std::string, int> uploads_in_flight;  // guarded by upload_mu
+  std::mutex validate_mu;
+  std::condition_variable validate_cv;
+  int validating = 0;
   std::ofstream log_file;
   std::mutex stop_mu;
   std::condition_variable stop_cv;
@@ -295,7 +304,6 @@ struct Server::Impl final : v1::Runout::Service {
   // Only formats that cannot point at other files or URLs (no VRT, no /vsi paths inside).
   Status allowed_format(const std::string& field, const std::string& path) {
     static const char* const kAllowed[] = {"GTiff", "COG", "AAIGrid", "SRTMHGT", "EHdr", "GeoJSON", "ESRI Shapefile", "GPKG", nullptr};
-    GDALAllRegister();
     GDALDriverH d = GDALIdentifyDriverEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_VECTOR, kAllowed, nullptr);
     if (!d)
       return {StatusCode::INVALID_ARGUMENT, field + ": '" + fs::path(path).filename().string() +
@@ -324,16 +332,23 @@ struct Server::Impl final : v1::Runout::Service {
     return ids;
   }
 
-  // Remove uploads that no queued or running job uses: those given (a refused submission's), or
-  // all whose last use is older than the upload time-to-live.
-  void collect_uploads(const std::vector<std::string>& only = {}, bool all_old = false) {
+  // Remove uploads that nothing uses: no queued or running job, no submission in progress. `owner`
+  // given: the uploads of that client's refused submission (its record of them is dropped, and a
+  // folder goes only when no client holds a record of it); else all whose last use is older than
+  // the upload time-to-live.
+  void collect_uploads(const std::vector<std::string>& only = {}, const std::string& owner = "") {
     std::lock_guard lk(upload_mu);
     std::set<std::string> used;
     for (const auto& j : store->active_jobs())
       for (const auto& id : uploads_of(j.scenario)) used.insert(id);
-    std::set<std::string> drop(only.begin(), only.end());
-    const double cutoff = double(std::time(nullptr)) - cfg.upload_ttl_s();
-    if (all_old) {
+    for (const auto& [id, n] : uploads_in_flight)
+      if (n > 0) used.insert(id);
+    std::set<std::string> drop;
+    if (!owner.empty()) {
+      for (const auto& id : only)
+        if (!store->forget_upload(id, owner)) drop.insert(id);
+    } else {
+      const double cutoff = double(std::time(nullptr)) - cfg.upload_ttl_s();
       for (const auto& id : store->uploads_older_than(cutoff)) drop.insert(id);
       const auto all = store->uploads_older_than(1e18);
       const std::set<std::string> recorded(all.begin(), all.end());
@@ -352,8 +367,43 @@ struct Server::Impl final : v1::Runout::Service {
       std::error_code ec;
       fs::remove_all(fs::path(cfg.state_dir()) / "uploads" / id, ec);
       store->forget_upload(id);
-      log("upload " + id.substr(0, 12) + " removed (" + (all_old ? "unused for longer than the upload time-to-live" : "its submission was refused") + ")");
+      log("upload " + id.substr(0, 12) + " removed (" +
+          (owner.empty() ? "unused for longer than the upload time-to-live" : "its submission was refused") + ")");
     }
+  }
+
+  // Uploads a submission in progress uses: not collected meanwhile.
+  struct InFlight {
+    Impl& m;
+    std::vector<std::string> ids;
+    void take(const std::string& id) {
+      std::lock_guard lk(m.upload_mu);
+      ++m.uploads_in_flight[id];
+      ids.push_back(id);
+    }
+    void release() {
+      std::lock_guard lk(m.upload_mu);
+      for (const auto& id : ids)
+        if (--m.uploads_in_flight[id] <= 0) m.uploads_in_flight.erase(id);
+      ids.clear();
+    }
+    ~InFlight() { release(); }
+  };
+
+  // At most this many checks of submissions at once (each a process that may use a job's memory).
+  bool enter_validation() {
+    std::unique_lock lk(validate_mu);
+    const int limit = std::max(2, cfg.workers());
+    if (!validate_cv.wait_for(lk, std::chrono::seconds(60), [&] { return validating < limit; })) return false;
+    ++validating;
+    return true;
+  }
+  void leave_validation() {
+    {
+      std::lock_guard lk(validate_mu);
+      --validating;
+    }
+    validate_cv.notify_one();
   }
 
   // Every check `runout run` makes, in a worker process of its own (a DEM that crashes or hangs
@@ -374,13 +424,15 @@ struct Server::Impl final : v1::Runout::Service {
       jobs::WorkerProcess w(jobs::self_executable(), task, (dir / "validate.log").string());
       std::optional<v1::WorkerEvent> outcome;
       const auto t0 = std::chrono::steady_clock::now();
-      bool timed_out = false;
-      while (!w.output_closed()) {
+      bool timed_out = false, too_big = false;
+      for (;;) {  // every event, also those read with the end of the output
         auto ev = w.next_event(std::chrono::milliseconds(100));
+        if (!ev && w.output_closed()) break;
         if (ev && !ev->has_progress()) outcome = ev;
         const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         if (wall > kValidateSeconds || (cfg.max_job_memory_bytes() > 0 && w.resident_bytes() > cfg.max_job_memory_bytes())) {
           timed_out = wall > kValidateSeconds;
+          too_big = !timed_out;
           w.signal(SIGKILL);
           break;
         }
@@ -398,6 +450,12 @@ struct Server::Impl final : v1::Runout::Service {
       } else if (!outcome && timed_out) {
         log("checking a scenario took longer than " + std::to_string(int(kValidateSeconds)) +
             " s; accepted, its remaining checks run with the job");
+      } else if (!outcome && too_big) {
+        st = {StatusCode::INVALID_ARGUMENT, "checking the scenario needed more than the server's memory limit for a job (" +
+                                                std::to_string(cfg.max_job_memory_bytes() >> 20) + " MiB): coarsen it"};
+      } else if (!outcome && ex && ex->exited && ex->code == 127) {
+        log("cannot start a worker process (" + jobs::self_executable() + " worker): exit status 127");
+        st = {StatusCode::INTERNAL, "the server cannot start its worker processes (its log says more)"};
       } else if (!outcome) {
         st = {StatusCode::INVALID_ARGUMENT, "checking the scenario's inputs ended the checking process (" +
                                                 (ex ? ex->describe() : std::string("no exit status")) +
@@ -417,14 +475,41 @@ struct Server::Impl final : v1::Runout::Service {
     if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
     if (!req->has_scenario()) return {StatusCode::INVALID_ARGUMENT, "scenario: missing"};
     if (req->request_id().size() > 200) return {StatusCode::INVALID_ARGUMENT, "request_id: longer than 200 characters"};
+    // A retry (the same request id) is answered before anything else, by the digest of the request.
+    std::string request_hash;
+    {
+      std::string bytes;
+      google::protobuf::io::StringOutputStream so(&bytes);
+      google::protobuf::io::CodedOutputStream co(&so);
+      co.SetSerializationDeterministic(true);
+      req->scenario().SerializeToCodedStream(&co);
+      co.Trim();
+      request_hash = jobs::sha256_hex(bytes);
+    }
+    if (!req->request_id().empty()) {
+      try {
+        if (const auto prior = store->find_request(owner, req->request_id()); prior && !prior->second.empty()) {
+          if (prior->second != request_hash)
+            return {StatusCode::ALREADY_EXISTS, "request_id '" + req->request_id() + "' was used for job " + prior->first.job.id() +
+                                                    " with another scenario; use a new request id for a new scenario"};
+          *resp = with_live(prior->first);
+          return Status::OK;
+        }
+      } catch (const std::exception& e) {
+        return {StatusCode::INTERNAL, std::string("the job store failed: ") + e.what()};
+      }
+    }
     v1::Scenario s = req->scenario();
     std::vector<std::string> uploads;  // of this submission: removed when it is refused
+    InFlight in_flight{*this, {}};
     auto refuse = [&](Status st) {
-      if (!uploads.empty()) collect_uploads(uploads);
+      in_flight.release();
+      if (!uploads.empty()) collect_uploads(uploads, owner);
       return st;
     };
     auto input = [&](const std::string& field, std::string* path) {
       const bool upload = path->rfind("upload:", 0) == 0;
+      if (upload) in_flight.take(path->substr(7, 64));  // before it is looked at: not collected meanwhile
       Status st = resolve_input(field, path);
       if (st.ok() && upload) uploads.push_back(fs::path(*path).parent_path().filename().string());
       return st;
@@ -456,14 +541,19 @@ struct Server::Impl final : v1::Runout::Service {
     } catch (const terrain::TerrainError& e) {
       return refuse({StatusCode::INVALID_ARGUMENT, jobs::client_message(e.what(), cfg.state_dir(), roots)});
     } catch (const std::exception& e) {
-      return refuse({StatusCode::INTERNAL, std::string("validating the scenario failed: ") + e.what()});
+      return refuse({StatusCode::INTERNAL, "validating the scenario failed: " + jobs::client_message(e.what(), cfg.state_dir(), roots)});
     }
     // Everything else `runout run` checks (unless these very inputs were computed before).
     std::error_code ec;
-    if (!fs::exists(fs::path(sched->results_dir(hash)) / "run.json", ec))
-      if (auto st = validate_in_worker(s); !st.ok()) return refuse(st);
+    if (!fs::exists(fs::path(sched->results_dir(hash)) / "run.json", ec)) {
+      if (!enter_validation())
+        return refuse({StatusCode::RESOURCE_EXHAUSTED, "the server is checking too many submissions at once; try again"});
+      const Status st = validate_in_worker(s);
+      leave_validation();
+      if (!st.ok()) return refuse(st);
+    }
     try {
-      const auto out = store->submit(owner, hash, req->request_id(), s, cfg.max_queued_per_client());
+      const auto out = store->submit(owner, hash, req->request_id(), s, cfg.max_queued_per_client(), request_hash);
       *resp = with_live(out.job);
       if (out.created) {
         try {
@@ -480,7 +570,7 @@ struct Server::Impl final : v1::Runout::Service {
     } catch (const jobs::QueueFull& e) {
       return refuse({StatusCode::RESOURCE_EXHAUSTED, e.what()});
     } catch (const std::exception& e) {
-      return {StatusCode::INTERNAL, e.what()};
+      return {StatusCode::INTERNAL, jobs::client_message(e.what(), cfg.state_dir(), roots)};
     }
     return Status::OK;
   }
@@ -556,6 +646,14 @@ struct Server::Impl final : v1::Runout::Service {
     }
   }
 
+  // A job's log as its client sees it: the server's folders left out of the paths in it.
+  std::string public_log(const std::string& id) {
+    std::ifstream in(sched->log_path(id), std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return jobs::client_message(ss.str(), cfg.state_dir(), {cfg.data_roots().begin(), cfg.data_roots().end()});
+  }
+
   // The files of a job the client may download: the results of a succeeded job, and its log.
   std::vector<v1::ResultFile> result_files(const jobs::StoredJob& j) {
     std::vector<v1::ResultFile> out;
@@ -575,7 +673,7 @@ struct Server::Impl final : v1::Runout::Service {
     if (fs::exists(lg, ec)) {
       v1::ResultFile f;
       f.set_name("job.log");
-      f.set_bytes(std::int64_t(fs::file_size(lg, ec)));
+      f.set_bytes(std::int64_t(public_log(j.job.id()).size()));
       out.push_back(f);
     }
     return out;
@@ -605,12 +703,20 @@ struct Server::Impl final : v1::Runout::Service {
                 "job " + j->job.id() + " is " + jobs::state_name(j->job.state()) + ": only job.log can be fetched"};
       return {StatusCode::NOT_FOUND, "job " + j->job.id() + " has no result '" + req->name() + "'"};
     }
-    const fs::path p = req->name() == "job.log" ? fs::path(sched->log_path(j->job.id()))
-                                                : fs::path(sched->results_dir(j->job.scenario_hash())) / req->name();
-    std::ifstream in(p, std::ios::binary);
-    if (!in) return {StatusCode::INTERNAL, "cannot read result '" + req->name() + "'"};
-    std::error_code ec;
-    const auto total = std::int64_t(fs::file_size(p, ec));
+    std::unique_ptr<std::istream> src;
+    std::int64_t total = 0;
+    if (req->name() == "job.log") {
+      const std::string text = public_log(j->job.id());
+      total = std::int64_t(text.size());
+      src = std::make_unique<std::istringstream>(text);
+    } else {
+      const fs::path p = fs::path(sched->results_dir(j->job.scenario_hash())) / req->name();
+      src = std::make_unique<std::ifstream>(p, std::ios::binary);
+      if (!*src) return {StatusCode::INTERNAL, "cannot read result '" + req->name() + "'"};
+      std::error_code ec;
+      total = std::int64_t(fs::file_size(p, ec));
+    }
+    auto& in = *src;
     jobs::Sha256 h;
     std::string buf(256 << 10, '\0');  // well below the smallest message limit
     std::int64_t offset = 0;
@@ -723,9 +829,16 @@ void Server::start() {
     if (!m.log_file) throw ConfigError("log_file '" + m.cfg.log_file() + "': cannot open it");
   }
   m.tokens = std::make_unique<Tokens>(m.cfg.tokens_file(), [&m](const std::string& l) { m.log(l); });
-  // One writer per state directory, for the server's life; then a store that does not forget.
+  GDALAllRegister();  // once, before any call: registering from handler threads at once is not safe
+  // One writer per state directory, for the server's life; then a store that does not forget (or,
+  // asked to, one rebuilt under the same lock).
   try {
     m.lock = std::make_unique<jobs::StateLock>(m.cfg.state_dir());
+    if (m.recover) {
+      const auto rep = jobs::recover_store(m.cfg.state_dir(), *m.lock);
+      m.recovery = rep.text();
+      m.log(m.recovery);
+    }
     jobs::check_store(m.cfg.state_dir());
   } catch (const jobs::StateError& e) {
     throw ConfigError(e.what());
@@ -792,7 +905,7 @@ void Server::start() {
       if (m.stopped) break;
       lk.unlock();
       try {
-        m.collect_uploads({}, true);
+        m.collect_uploads();
       } catch (const std::exception& e) {
         m.log(std::string("upload collection failed: ") + e.what());
       }
@@ -807,6 +920,10 @@ void Server::start() {
   m.log("runout server listening on " + address() + " (state " + m.cfg.state_dir() + ", " + std::to_string(m.cfg.workers()) +
         " worker(s), " + (m.tokens->enabled() ? "tokens" : "no authentication") + (m.cfg.tls_cert().empty() ? "" : ", TLS") + ")");
 }
+
+void Server::set_recover(bool on) { impl_->recover = on; }
+
+const std::string& Server::recovery_report() const { return impl_->recovery; }
 
 int Server::port() const { return impl_->bound_port; }
 

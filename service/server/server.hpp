@@ -28,6 +28,11 @@ class Server {
   /// Open the store, queue again what a previous process left running, start the workers, listen.
   /// Writes <state_dir>/server.json with the address and pid. Throws ConfigError on failure.
   void start();
+  /// Before start(): rebuild a missing, empty or damaged job store (jobs::recover_store) under the
+  /// state directory's lock, then start as usual.
+  void set_recover(bool on);
+  /// What the rebuilding did ("" when not asked).
+  const std::string& recovery_report() const;
   /// The port actually bound (when the configuration asked for port 0).
   int port() const;
   std::string address() const;
