@@ -777,3 +777,22 @@ TEST(Reliability, UploadsHaveAQuotaAndAreCollected) {
   EXPECT_EQ(code_of([&] { c.upload({dem}); }), 0) << "the quota is free again";
   std::printf("reliability: uploads: over-quota upload refused, unused uploads collected after their time-to-live\n");
 }
+
+// An upgrade that replaces the server's program file while it runs (as a package manager does)
+// does not stop it from starting workers: they are the running program, not the file's new content.
+TEST(Reliability, ReplacedProgramFileStillRunsJobs) {
+  TempDir d;
+  const fs::path bin = d.p / "runout";
+  fs::copy_file(RUNOUT_BIN, bin);
+  fs::permissions(bin, fs::perms::owner_all);
+  ServerOptions o;
+  o.binary = bin.string();
+  ServerProcess srv(d.p / "state", {"--data-root", kScenarios}, o);
+  ASSERT_TRUE(srv.running()) << srv.errors();
+  fs::remove(bin);  // the upgrade: the old file is gone (a new one would take its name)
+  std::ofstream(bin) << "#!/bin/sh\nexit 1\n";
+  service::Client c(client_options(srv.address(), ""));
+  const auto fin = c.watch(c.submit(arelen(15, 60)).id());
+  EXPECT_EQ(fin.state(), v1::SUCCEEDED) << fin.error();
+  std::printf("reliability: program file replaced while serving: jobs still checked and run by the running program\n");
+}

@@ -44,6 +44,7 @@ struct ServerOptions {
   std::int64_t file_size_limit = 0;  ///< RLIMIT_FSIZE of the server (and its workers); 0: none
   bool expect_listening = true;      ///< false: the server is expected to refuse to start
   std::string listen = "127.0.0.1:0";
+  std::string binary = RUNOUT_BIN;   ///< the program to start
 };
 
 // `runout serve` as a child process; its standard error goes to STATE/../server.err.
@@ -57,7 +58,7 @@ class ServerProcess {
   void start() {
     fs::create_directories(state_.parent_path());
     fs::remove(state_ / "server.json");
-    std::vector<std::string> args = {RUNOUT_BIN, "serve", "--listen", opt_.listen, "--state-dir", state_.string(),
+    std::vector<std::string> args = {opt_.binary, "serve", "--listen", opt_.listen, "--state-dir", state_.string(),
                                      "--log-file", (state_.parent_path() / "server.log").string()};
     args.insert(args.end(), extra_.begin(), extra_.end());
     const std::string err = (state_.parent_path() / "server.err").string();
