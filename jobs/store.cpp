@@ -511,6 +511,13 @@ void JobStore::mark_results_removed(const std::string& hash, const std::string& 
   tx.commit();
 }
 
+bool JobStore::has_hash(const std::string& hash) const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_, "SELECT 1 FROM jobs WHERE hash = ? LIMIT 1");
+  st.bind(1, hash);
+  return st.step();
+}
+
 std::vector<StoredJob> JobStore::active_jobs() const {
   std::lock_guard lk(mu_);
   Stmt st(db_, (std::string("SELECT ") + kColumns + " FROM jobs WHERE state IN (1, 2) ORDER BY seq").c_str());

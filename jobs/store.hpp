@@ -98,6 +98,8 @@ class JobStore {
   /// The results of this scenario hash were deleted (retention): every job with it says so.
   void mark_results_removed(const std::string& hash, const std::string& reason);
 
+  /// Whether any job of this scenario hash was accepted before (its inputs passed the checks).
+  bool has_hash(const std::string& hash) const;
   /// Queued and running jobs (their scenarios name the uploads still in use).
   std::vector<StoredJob> active_jobs() const;
   /// How many jobs the store holds.

@@ -543,9 +543,15 @@ struct Server::Impl final : v1::Runout::Service {
     } catch (const std::exception& e) {
       return refuse({StatusCode::INTERNAL, "validating the scenario failed: " + jobs::client_message(e.what(), cfg.state_dir(), roots)});
     }
-    // Everything else `runout run` checks (unless these very inputs were computed before).
+    // Everything else `runout run` checks (unless these very inputs were accepted or computed before:
+    // the hash covers the scenario and the content of every input).
     std::error_code ec;
-    if (!fs::exists(fs::path(sched->results_dir(hash)) / "run.json", ec)) {
+    bool known = fs::exists(fs::path(sched->results_dir(hash)) / "run.json", ec);
+    try {
+      known = known || store->has_hash(hash);
+    } catch (const std::exception&) {
+    }
+    if (!known) {
       if (!enter_validation())
         return refuse({StatusCode::RESOURCE_EXHAUSTED, "the server is checking too many submissions at once; try again"});
       const Status st = validate_in_worker(s);
