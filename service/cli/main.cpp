@@ -62,6 +62,9 @@ commands:
         The In den Arelen regression: run the scenario through the service (an embedded server on
         127.0.0.1 unless --server), compare with the accepted reference, write report.md with the
         map and a difference map; exit 1 on a regression. --accept makes this run the reference.
+  worker
+        (Started by the server, not by hand.) Run one job handed over on standard input and report
+        on standard output (service/proto/runout/v1/worker.proto; docs/operations.md).
   version
         Print the program version and the versions of the libraries it links.
   help
