@@ -796,3 +796,29 @@ TEST(Reliability, ReplacedProgramFileStillRunsJobs) {
   EXPECT_EQ(fin.state(), v1::SUCCEEDED) << fin.error();
   std::printf("reliability: program file replaced while serving: jobs still checked and run by the running program\n");
 }
+
+// Three kills of the server while the same job runs (the OOM killer, an operator, a power cut):
+// the job still succeeds, since the server's death never counts against it.
+TEST(Reliability, ThreeKillsDuringOneJobNeverFailIt) {
+  TempDir d;
+  const fs::path state = d.p / "state";
+  const std::vector<std::string> args = {"--data-root", kScenarios, "--threads-per-run", "1"};
+  std::string id;
+  for (int kill = 0; kill <= 3; ++kill) {
+    ServerProcess srv(state, args);
+    ASSERT_TRUE(srv.running()) << srv.errors();
+    service::Client c(client_options(srv.address(), ""));
+    if (id.empty()) id = c.submit(arelen(15, 600), "three-kills").id();
+    if (kill == 3) {
+      const auto fin = c.watch(id);
+      EXPECT_EQ(fin.state(), v1::SUCCEEDED) << fin.error();
+      EXPECT_GE(fin.attempts(), 4);
+      std::printf("reliability: 3 kills -9 during one job: %s after %d attempts\n", jobs::state_name(fin.state()).c_str(),
+                  fin.attempts());
+      break;
+    }
+    ASSERT_TRUE(wait_for([&] { return c.get(id).state() == v1::RUNNING && c.get(id).progress().steps() > 0; }, 30s))
+        << "kill " << kill;
+    srv.stop(SIGKILL);
+  }
+}
