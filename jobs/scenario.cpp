@@ -647,7 +647,7 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   return r;
 }
 
-std::string scenario_hash(const ResolvedScenario& r) {
+std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version, int vof_version) {
   v1::Scenario s = r.scenario;
   s.mutable_dem()->clear_path();
   s.mutable_area_of_interest()->clear_path();
@@ -663,8 +663,9 @@ std::string scenario_hash(const ResolvedScenario& r) {
   Sha256 h;
   h.update("runout.v1.Scenario\n");
   h.update(bytes);
-  // What a VOF run's results contain, by version (kVofResultsVersion).
-  if (r.vof) h.update("\nvof results " + std::to_string(kVofResultsVersion));
+  // What the engine's results contain, by version (kVofResultsVersion, kDepthAveragedResultsVersion).
+  if (r.vof) h.update("\nvof results " + std::to_string(vof_version));
+  else h.update("\ndepth-averaged results " + std::to_string(depth_averaged_version));
   for (const auto& f : r.input_files) {
     h.update("\n");
     h.update(fs::path(f).extension().string());

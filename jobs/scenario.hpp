@@ -41,10 +41,17 @@ struct ResolvedScenario {
 /// are not covered); Scenarios.VofHashCarriesTheResultsVersion pins a hash that a bump changes.
 inline constexpr int kVofResultsVersion = 5;
 
-/// SHA-256 of a resolved scenario: its message with the input paths left out, and the content of
-/// every input file; for VOF scenarios also the version of what their results contain. Two
-/// scenarios with the same hash compute the same result.
-std::string scenario_hash(const ResolvedScenario& r);
+/// The version of what a depth-averaged run's results contain (rasters, outline, run.json, time
+/// series) for an unchanged scenario; the same rule as kVofResultsVersion (1: run.json's and the
+/// summary's maximum speed is the maximum of max_speed.tif, the flowing cells'). The test
+/// Scenarios.HashCarriesEachEnginesResultsVersion pins a hash that a bump changes.
+inline constexpr int kDepthAveragedResultsVersion = 1;
+
+/// SHA-256 of a resolved scenario: its message with the input paths and the job limits left out,
+/// the content of every input file, and the version of what its engine's results contain. Two
+/// scenarios with the same hash compute the same result. The versions are parameters for tests.
+std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version = kDepthAveragedResultsVersion,
+                          int vof_version = kVofResultsVersion);
 
 /// The raster names an output list may hold.
 const std::vector<std::string>& raster_names();

@@ -1378,6 +1378,23 @@ TEST(Scenarios, VofHashCarriesTheResultsVersion) {
   EXPECT_EQ(jobs::scenario_hash(b2), "a38f746bab4bc82dbfaab751dbc7ffe85e00c1fab242f39fd65431650ef35b31");
 }
 
+// Each engine's results version is in its scenarios' hashes, and only in its own: a change of what
+// the depth-averaged engine computes cannot be answered from results cached before it.
+TEST(Scenarios, HashCarriesEachEnginesResultsVersion) {
+  const auto sh = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/tests/data/arelen-30m.json");
+  const auto vof = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json");
+  ASSERT_FALSE(sh.vof);
+  ASSERT_TRUE(vof.vof);
+  const int d = jobs::kDepthAveragedResultsVersion, v = jobs::kVofResultsVersion;
+  EXPECT_NE(jobs::scenario_hash(sh, d + 1, v), jobs::scenario_hash(sh, d, v));
+  EXPECT_EQ(jobs::scenario_hash(sh, d, v + 1), jobs::scenario_hash(sh, d, v));
+  EXPECT_NE(jobs::scenario_hash(vof, d, v + 1), jobs::scenario_hash(vof, d, v));
+  EXPECT_EQ(jobs::scenario_hash(vof, d + 1, v), jobs::scenario_hash(vof, d, v));
+  // Pinned, as the VOF one is (record the new value when kDepthAveragedResultsVersion is bumped or
+  // the scenario file or its data change; this is version 1's).
+  EXPECT_EQ(jobs::scenario_hash(sh), "b79ba8d82b044ce12b85c695d027d55f6cb74d4b910f18a7b4d18c0bdfb90509");
+}
+
 // The figures that VOF results version kVofResultsVersion gives for twelve short coarse runs: B2
 // (PISO; once more with lab.coulomb_pressure "excess", once with the linear face viscosity in the
 // viscous stress's transpose part, once with the walls' viscosity the cell's), B3 (the consistent coupling, the gate monitor; once more with limited-linear convection
