@@ -1,0 +1,109 @@
+// The bundled depth-averaged scenarios, coarsened: In den Arelen, Wolfsgruben and the ISeeSnow cases.
+#include "tests/support/run_helpers.hpp"
+
+using namespace runout::test_support::run;
+
+TEST(Scenarios, InDenArelenReachesTheValleyFloor) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/in-den-arelen.json");
+  r.dem.resolution = 30;  // coarser than the scenario's 10 m, to stay fast
+  TempDir d;
+  const auto sum = jobs::run_scenario(r, d.p.string());
+  EXPECT_EQ(sum.crs, "EPSG:32632");
+  EXPECT_LT(sum.volume_error, 1e-12);
+  EXPECT_NEAR(sum.release_volume_m3, 2.9e5, 0.5e5);
+  check_outputs(d, sum, "WGS 84 / UTM zone 32N");
+  EXPECT_TRUE(fs::exists(d / "outline.geojson"));
+  // (Pure Coulomb friction with delta = 15 deg lets thin layers slide on over the long slopes above
+  // 15 deg, so at 30 m the run may end by the end time rather than the kinetic-energy rule.)
+  // The flow reaches the farmhouse (46.8367 N, 9.8539 E).
+  GDALDatasetUniquePtr md(GDALDataset::Open((d / "max_depth.tif").c_str(), GDAL_OF_RASTER));
+  OGRSpatialReference ll;
+  ll.importFromEPSG(4326);
+  ll.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  OGRSpatialReference utm = *md->GetSpatialRef();
+  utm.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  std::unique_ptr<OGRCoordinateTransformation> ct(OGRCreateCoordinateTransformation(&ll, &utm));
+  double x = 9.8539, y = 46.8367;
+  ct->Transform(1, &x, &y);
+  double gt[6];
+  md->GetGeoTransform(gt);
+  const int i = int((x - gt[0]) / gt[1]), rr = int((y - gt[3]) / gt[5]);
+  float v = 0;
+  ASSERT_EQ(md->GetRasterBand(1)->RasterIO(GF_Read, i, rr, 1, 1, &v, 1, 1, GDT_Float32, 0, 0), CE_None);
+  EXPECT_GT(v, 0.01f);
+}
+
+TEST(Scenarios, WolfsgrubenRunsInTheDemCrs) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/wolfsgruben.json");
+  r.dem.resolution = 20;  // coarser than the DEM's 5 m, to stay fast
+  r.timeseries_interval = 0;
+  TempDir d;
+  const auto sum = jobs::run_scenario(r, d.p.string());
+  EXPECT_EQ(sum.crs, "MGI / Austria Lambert");
+  EXPECT_LT(sum.volume_error, 1e-12);
+  check_outputs(d, sum, "MGI / Austria Lambert");
+  EXPECT_NEAR(sum.release_area_m2, 135185, 0.05 * 135185);  // AvaFrame's projected release area
+  EXPECT_GT(sum.runout_m, 1000);
+  EXPECT_LT(sum.max_speed, 150);  // bounded (the curvature bound; without it this terrain ran away)
+}
+
+// The three ISeeSnow cases (validation.md A8), computed coarser than their 5 m DEMs to stay fast; the
+// export is still on the DEM's own 5 m grid and extent.
+TEST(Scenarios, IseesnowIdealizedTopo) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/iseesnow-idealized.json");
+  r.dem.resolution = 10;
+  TempDir d;
+  jobs::RunOptions opt;
+  opt.iseesnow_id = "01IdealizedTopo";
+  const auto sum = jobs::run_scenario(r, d.p.string(), opt);
+  EXPECT_EQ(sum.crs, "local metres");
+  EXPECT_EQ(sum.nx, 502);
+  EXPECT_LT(sum.volume_error, 1e-12);
+  EXPECT_EQ(sum.volume_outflow, 0);
+  EXPECT_EQ(sum.stop, "kinetic-energy");
+  // 1.5 m normal to the surface over the 296.5 m x 139.8 m release rectangle (mean slope about 34 deg):
+  // 71,960 m3 on the DEM's 5 m cells.
+  EXPECT_NEAR(sum.release_volume_m3, 71960, 0.05 * 71960);
+  EXPECT_GT(sum.runout_m, 1500);
+  EXPECT_LT(sum.max_speed, 60);  // Voellmy xi = 2000 bounds the speed well below free fall
+  check_outputs(d, sum, "local metres");
+  EXPECT_FALSE(fs::exists(d / "outline.geojson"));  // no geographic position
+  check_iseesnow(d, "release1HS", "01IdealizedTopo",
+                 std::string(RUNOUT_SOURCE_DIR) + "/scenarios/data/iseesnow/idealized/DEM_IdealizedTopo.tif",
+                 sum.volume_initial);
+}
+
+TEST(Scenarios, IseesnowCoulombOnlyRunsFurtherThanVoellmy) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/iseesnow-coulomb.json");
+  r.dem.resolution = 10;
+  TempDir d;
+  jobs::RunOptions opt;
+  opt.iseesnow_id = "03CoulombOnly";
+  const auto sum = jobs::run_scenario(r, d.p.string(), opt);
+  EXPECT_LT(sum.volume_error, 1e-12);
+  // Without turbulent drag the flow is faster and longer than IdealizedTopo's (same terrain and release):
+  // the energy line of mu = 0.4 from about 1400 m of drop.
+  EXPECT_GT(sum.max_speed, 80);
+  EXPECT_GT(sum.runout_m, 2500);
+  check_outputs(d, sum, "local metres");
+  check_iseesnow(d, "release1HS", "03CoulombOnly",
+                 std::string(RUNOUT_SOURCE_DIR) + "/scenarios/data/iseesnow/idealized/DEM_IdealizedTopo.tif",
+                 sum.volume_initial);
+}
+
+TEST(Scenarios, IseesnowRealTopo) {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/iseesnow-realtopo.json");
+  r.dem.resolution = 15;
+  TempDir d;
+  jobs::RunOptions opt;
+  opt.iseesnow_id = "02RealTopo";
+  const auto sum = jobs::run_scenario(r, d.p.string(), opt);
+  EXPECT_EQ(sum.crs, "MGI / Austria Lambert");
+  EXPECT_LT(sum.volume_error, 1e-12);
+  EXPECT_NEAR(sum.release_area_m2, 135185, 0.1 * 135185);
+  EXPECT_GT(sum.runout_m, 1000);
+  check_outputs(d, sum, "MGI / Austria Lambert");
+  check_iseesnow(d, "relWog", "02RealTopo",
+                 std::string(RUNOUT_SOURCE_DIR) + "/scenarios/data/iseesnow/realtopo/DEM_RealTopo.tif",
+                 sum.volume_initial);
+}

@@ -1,0 +1,186 @@
+// Depth-averaged runs through the run driver: reported maxima, non-finite states, checkpoints and
+// exact continuation.
+#include "tests/support/run_helpers.hpp"
+
+using namespace runout::test_support::run;
+
+// Depth-averaged runs report the maps' maxima: run.json's, the summary's and the progress's
+// maximum speed take the flow threshold of outputs.flow_threshold_m, so run.json's figure is the
+// maximum of max_speed.tif (thin films sliding on faster are left out of both).
+TEST(DepthAveraged, ReportedMaximumSpeedIsTheMapsMaximum) {
+  TempDir d;
+  make_dem(d / "dem.tif", 120, 20.0, 35);
+  make_polygons(d / "rel.geojson", {square(500200, 5201000, 300)}, "EPSG:32632");
+  auto sc = base_scenario(d / "dem.tif", d / "rel.geojson");
+  auto r = jobs::resolve_scenario(sc, d.p.string());
+  fs::create_directories(d / "out");
+  jobs::RunOptions opt;
+  opt.progress_every = 1;
+  double progress_max = 0;
+  opt.progress = [&](const engine::Progress& p) {
+    progress_max = std::max(progress_max, p.max_speed);
+    return true;
+  };
+  const auto sum = jobs::run_scenario(r, d / "out", opt);
+  GDALDatasetUniquePtr ms(GDALDataset::Open((d / "out/max_speed.tif").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(ms);
+  std::vector<float> v(std::size_t(sum.nx) * sum.ny);
+  ASSERT_EQ(ms->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, sum.nx, sum.ny, v.data(), sum.nx, sum.ny, GDT_Float32, 0, 0), CE_None);
+  float raster_max = 0;
+  for (float x : v)
+    if (x != -9999.0f) raster_max = std::max(raster_max, x);
+  EXPECT_GT(raster_max, 10.0f);
+  EXPECT_EQ(float(sum.max_speed), raster_max);
+  EXPECT_NEAR(json_number(read_text(d / "out/run.json"), "max_speed_m_s"), sum.max_speed, 1e-9 * sum.max_speed);
+  EXPECT_LE(progress_max, sum.max_speed);
+  EXPECT_GT(progress_max, 0.5 * sum.max_speed);
+}
+
+// A run whose state turns non-finite fails with a message and writes no results.
+TEST(DepthAveraged, NonFiniteStateFailsTheRun) {
+  TempDir d;
+  make_dem(d / "dem.tif", 60, 20.0, 30);
+  make_polygons(d / "rel.geojson", {square(500200, 5200400, 200)}, "EPSG:32632");
+  auto r = jobs::resolve_scenario(base_scenario(d / "dem.tif", d / "rel.geojson"), d.p.string());
+  r.config.gravity = 1e306;  // past the scenario's checks: the first step's momenta overflow
+  fs::create_directories(d / "out");
+  try {
+    jobs::run_scenario(r, d / "out");
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("non-finite"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(d / "out/run.json"));
+}
+
+namespace {
+
+bool same_bytes(const std::string& a, const std::string& b) {
+  const std::string x = read_text(a), y = read_text(b);
+  return !x.empty() && x == y;
+}
+
+// run.json without what may differ between a run and its continuation: the creation time, the
+// timings and where it was continued from.
+std::string run_record_figures(const std::string& path) {
+  std::string j = read_text(path);
+  for (const char* key : {"\"created_utc\": ", "\"timings_s\": ", "\"continued_from_t_s\": "}) {
+    const auto k = j.find(key);
+    if (k == std::string::npos) continue;
+    const auto e = j.find_first_of(",\n", j[k + std::strlen(key)] == '{' ? j.find('}', k) : k);
+    j.erase(k, e - k);
+  }
+  return j;
+}
+
+// Two runs' outputs are the same bits: every raster, the outline, the time series' frames (depth,
+// speed) and XDMF, and run.json's figures.
+void expect_same_outputs(const std::string& a, const std::string& b) {
+  for (const char* f : {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "arrival_time.tif", "outline.geojson",
+                        "timeseries.xmf"})
+    EXPECT_TRUE(same_bytes(a + "/" + f, b + "/" + f)) << f;
+  EXPECT_EQ(run_record_figures(a + "/run.json"), run_record_figures(b + "/run.json"));
+  const int frames = int(json_number(read_text(a + "/run.json"), "timeseries_frames"));
+  EXPECT_EQ(frames, int(json_number(read_text(b + "/run.json"), "timeseries_frames")));
+  for (int f = 0; f < frames; ++f)
+    for (const char* q : {"depth", "speed"}) {
+      char sub[64];
+      std::snprintf(sub, sizeof sub, "://frames/%05d/%s", f, q);
+      std::vector<float> v[2];
+      for (int k = 0; k < 2; ++k) {
+        GDALDatasetUniquePtr ds(GDALDataset::Open(("HDF5:\"" + (k ? b : a) + "/timeseries.h5\"" + sub).c_str(), GDAL_OF_RASTER));
+        ASSERT_TRUE(ds) << sub;
+        const int nx = ds->GetRasterXSize(), ny = ds->GetRasterYSize();
+        v[k].resize(std::size_t(nx) * ny);
+        ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, nx, ny, v[k].data(), nx, ny, GDT_Float32, 0, 0), CE_None);
+      }
+      ASSERT_EQ(v[0].size(), v[1].size()) << sub;
+      EXPECT_EQ(std::memcmp(v[0].data(), v[1].data(), v[0].size() * sizeof(float)), 0) << sub;
+    }
+}
+
+jobs::ResolvedScenario arelen_30m_short() {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/tests/data/arelen-30m.json");
+  r.scenario.mutable_numerics()->set_end_time_s(150);
+  r.config.time.t_end = 150;
+  r.scenario.mutable_outputs()->set_timeseries_interval_s(20);
+  r.timeseries_interval = 20;
+  return r;
+}
+
+}  // namespace
+
+// Depth-averaged checkpoints: writing them changes nothing, and a run stopped at an arbitrary step
+// (through the progress hook, as Ctrl-C does) and continued from its checkpoint writes the outputs of
+// the uninterrupted run, bit for bit, time series included.
+TEST(DepthAveraged, ContinuedRunWritesTheUninterruptedRunsOutputs) {
+  const auto r = arelen_30m_short();
+  TempDir d;
+  for (const char* o : {"whole", "checked", "part", "continued"}) fs::create_directories(d / o);
+  const auto whole = jobs::run_scenario(r, d / "whole");
+  ASSERT_EQ(whole.stop, "end-time");
+  jobs::RunOptions opt;
+  opt.checkpoint_path = d / "every.h5";
+  opt.checkpoint_interval_s = 30;
+  jobs::run_scenario(r, d / "checked", opt);
+  expect_same_outputs(d / "whole", d / "checked");
+  EXPECT_TRUE(fs::exists(d / "every.h5"));
+  EXPECT_TRUE(fs::exists(d / "every.h5.timeseries.h5"));
+  // Stopped at step 401, then continued from there (the checkpoint replaced by the continued run's).
+  jobs::RunOptions cut;
+  cut.checkpoint_path = d / "cut.h5";
+  cut.progress_every = 1;
+  cut.progress = [](const engine::Progress& p) { return p.step < 401; };
+  const auto part = jobs::run_scenario(r, d / "part", cut);
+  ASSERT_EQ(part.stop, "cancelled");
+  ASSERT_EQ(part.steps, 401);
+  jobs::RunOptions cont;
+  cont.restart_path = d / "cut.h5";
+  cont.checkpoint_path = d / "cut.h5";
+  const auto continued = jobs::run_scenario(r, d / "continued", cont);
+  EXPECT_EQ(continued.steps, whole.steps);
+  expect_same_outputs(d / "whole", d / "continued");
+  EXPECT_NEAR(json_number(read_text(d / "continued/run.json"), "continued_from_t_s"), part.t, 1e-6 * part.t);
+  EXPECT_NE(read_text(d / "whole/run.json").find("\"continued_from_t_s\": null"), std::string::npos);
+  // Continued again from the last periodic checkpoint of the run with checkpoints.
+  fs::remove_all(d / "continued");
+  fs::create_directories(d / "continued");
+  jobs::RunOptions again;
+  again.restart_path = d / "every.h5";
+  jobs::run_scenario(r, d / "continued", again);
+  expect_same_outputs(d / "whole", d / "continued");
+}
+
+// A checkpoint belongs to its scenario: another scenario's, a missing one and a file that is no
+// checkpoint are refused with a ScenarioError naming the file.
+TEST(DepthAveraged, CheckpointOfAnotherScenarioIsRefused) {
+  auto r = arelen_30m_short();
+  r.config.time.t_end = 20;
+  r.scenario.mutable_numerics()->set_end_time_s(20);
+  TempDir d;
+  fs::create_directories(d / "a");
+  fs::create_directories(d / "b");
+  jobs::RunOptions opt;
+  opt.checkpoint_path = d / "cp.h5";
+  opt.checkpoint_interval_s = 5;
+  jobs::run_scenario(r, d / "a", opt);
+  ASSERT_TRUE(fs::exists(d / "cp.h5"));
+  auto other = r;
+  other.scenario.mutable_material()->set_bed_friction_deg(16);
+  other.config.material.delta = 16 * M_PI / 180;
+  auto expect_refused = [&](const jobs::ResolvedScenario& sc, const std::string& path, const std::string& needle) {
+    jobs::RunOptions o;
+    o.restart_path = path;
+    try {
+      jobs::run_scenario(sc, d / "b", o);
+      ADD_FAILURE() << "no error for " << path;
+    } catch (const jobs::ScenarioError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(d / "b/run.json"));
+  };
+  expect_refused(other, d / "cp.h5", "another scenario");
+  expect_refused(r, d / "missing.h5", "no such file");
+  expect_refused(r, d / "a/run.json", "not an HDF5 file");
+}

@@ -1,0 +1,363 @@
+// Terrain: the terrain pipeline (DEM preparation, reprojection, releases, the area of interest) and
+// the depth-averaged run driver on synthetic inputs made here with GDAL.
+#include "tests/support/run_helpers.hpp"
+
+using namespace runout::test_support::run;
+
+TEST(Terrain, SyntheticSlopeRunsAndWritesEveryOutput) {
+  TempDir d;
+  make_dem(d / "dem.tif", 120, 20.0, 30);
+  make_polygons(d / "rel.geojson", {square(500200, 5201000, 300)}, "EPSG:32632");
+  auto sc = base_scenario(d / "dem.tif", d / "rel.geojson");
+  sc.mutable_outputs()->set_timeseries_interval_s(10);
+  auto r = jobs::resolve_scenario(sc, d.p.string());
+  fs::create_directories(d / "out");
+  const auto sum = jobs::run_scenario(r, d / "out");
+  EXPECT_EQ(sum.crs, "EPSG:32632");
+  EXPECT_NEAR(sum.release_area_m2, 300.0 * 300.0, 4 * 20 * 300.0);
+  EXPECT_LT(sum.volume_error, 1e-12);
+  EXPECT_GT(sum.runout_m, 500.0);
+  for (const char* f : {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "arrival_time.tif",
+                        "outline.geojson", "outline.gpkg", "run.json", "map.png", "timeseries.h5", "timeseries.xmf"})
+    EXPECT_TRUE(fs::exists(fs::path(d / "out") / f)) << f;
+  GDALDatasetUniquePtr png(GDALDataset::Open((d / "out/map.png").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(png);
+  EXPECT_EQ(png->GetRasterCount(), 3);
+  EXPECT_GE(png->GetRasterXSize(), 2 * 120);  // the grid (2400 m / 20 m) upscaled twice, plus the legend
+  GDALDatasetUniquePtr md(GDALDataset::Open((d / "out/max_depth.tif").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(md);
+  EXPECT_EQ(md->GetRasterBand(1)->GetRasterDataType(), GDT_Float32);
+  int has = 0;
+  EXPECT_EQ(md->GetRasterBand(1)->GetNoDataValue(&has), -9999.0);
+  EXPECT_TRUE(has);
+  EXPECT_STREQ(md->GetSpatialRef()->GetAuthorityCode(nullptr), "32632");
+  EXPECT_STREQ(md->GetMetadataItem("LAYOUT", "IMAGE_STRUCTURE"), "COG");
+  // The outline is a valid polygon in WGS84 whose area matches the affected area.
+  GDALDatasetUniquePtr ol(GDALDataset::Open((d / "out/outline.geojson").c_str(), GDAL_OF_VECTOR));
+  ASSERT_TRUE(ol);
+  double area = 0;
+  for (auto& f : ol->GetLayer(0)) {
+    ASSERT_TRUE(f->GetGeometryRef()->IsValid());
+    area += f->GetFieldAsDouble("area_m2");
+    OGREnvelope e;
+    f->GetGeometryRef()->getEnvelope(&e);
+    EXPECT_GT(e.MinX, 8.9);  // lon/lat around 9 E, 47 N
+    EXPECT_LT(e.MaxX, 9.2);
+    EXPECT_GT(e.MinY, 46.8);
+  }
+  EXPECT_NEAR(area, sum.affected_area_m2, 1e-6 * area);
+  std::ifstream rec(d / "out/run.json");
+  std::stringstream ss;
+  ss << rec.rdbuf();
+  EXPECT_NE(ss.str().find("\"sha256\""), std::string::npos);
+  EXPECT_NE(ss.str().find("\"mass_balance\""), std::string::npos);
+  // One XDMF frame per 10 s of simulated time, plus the first and the last; HDF5 readable by GDAL.
+  std::ifstream xmf(d / "out/timeseries.xmf");
+  std::stringstream xs;
+  xs << xmf.rdbuf();
+  int frames = 0;
+  for (std::size_t p = xs.str().find("<Time "); p != std::string::npos; p = xs.str().find("<Time ", p + 1)) ++frames;
+  EXPECT_GE(frames, int(sum.t / 10) + 1);
+  EXPECT_LE(frames, int(sum.t / 10) + 2);
+  GDALDatasetUniquePtr f0(GDALDataset::Open(("HDF5:\"" + d / "out/timeseries.h5" + "\"://frames/00000/depth").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(f0);
+  EXPECT_EQ(f0->GetRasterXSize(), 120);  // 2400 m of DEM at 20 m
+}
+
+TEST(Terrain, ReleaseInWgs84AndInUtmGiveTheSameGrid) {
+  TempDir d;
+  make_dem(d / "dem.tif", 80, 25.0, 30);
+  const std::vector<std::pair<double, double>> utm = {{500300, 5200500}, {500700, 5200520}, {500650, 5200900}, {500280, 5200850}, {500300, 5200500}};
+  OGRSpatialReference u, ll;
+  u.importFromEPSG(32632);
+  ll.importFromEPSG(4326);
+  u.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  ll.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  std::unique_ptr<OGRCoordinateTransformation> ct(OGRCreateCoordinateTransformation(&u, &ll));
+  auto geo = utm;
+  for (auto& p : geo) ct->Transform(1, &p.first, &p.second);
+  make_polygons(d / "utm.geojson", {utm}, "EPSG:32632");
+  make_polygons(d / "ll.geojson", {geo}, "EPSG:4326");
+  terrain::DemRequest rq;
+  rq.dem_path = d / "dem.tif";
+  rq.resolution = 10;
+  const auto g = terrain::prepare_grid(rq);
+  terrain::ReleaseRequest a, b;
+  a.path = d / "utm.geojson";
+  b.path = d / "ll.geojson";
+  a.has_thickness = b.has_thickness = true;
+  a.thickness = b.thickness = 1.5;
+  const auto ha = terrain::rasterize_releases(g, {a}), hb = terrain::rasterize_releases(g, {b});
+  EXPECT_EQ(ha, hb);
+  long cells = 0;
+  for (double v : ha) cells += v > 0;
+  EXPECT_GT(cells, 1000);
+}
+
+TEST(Terrain, SlopeWindowAndVerticalThickness) {
+  TempDir d;
+  make_dem(d / "dem.tif", 100, 20.0, 35);
+  // Half on the 35 degree slope, half on the flat valley floor (x > 0.6 * 2000 m).
+  make_polygons(d / "rel.geojson", {square(501000, 5200800, 400)}, "EPSG:32632");
+  terrain::DemRequest rq;
+  rq.dem_path = d / "dem.tif";
+  rq.resolution = 20;
+  const auto g = terrain::prepare_grid(rq);
+  const auto slope = terrain::slope_deg(g);
+  terrain::ReleaseRequest r;
+  r.path = d / "rel.geojson";
+  r.has_thickness = true;
+  r.thickness = 2.0;
+  r.vertical = true;
+  r.has_min_slope = true;
+  r.min_slope = 28;
+  r.has_max_slope = true;
+  r.max_slope = 50;
+  terrain::ReleaseReport rep;
+  const auto h = terrain::rasterize_releases(g, {r}, &rep);
+  long kept = 0;
+  for (std::size_t k = 0; k < h.size(); ++k)
+    if (h[k] > 0) {
+      ++kept;
+      EXPECT_GE(slope[k], 28.0);
+      EXPECT_NEAR(h[k], 2.0 * std::cos(slope[k] * M_PI / 180), 1e-12);
+    }
+  EXPECT_GT(kept, 50);
+  EXPECT_LT(kept, 400 / 20 * 400 / 20);
+  EXPECT_EQ(rep.cells, kept);
+}
+
+TEST(Terrain, SelfIntersectingPolygonIsRepairedAndSaid) {
+  TempDir d;
+  make_dem(d / "dem.tif", 80, 25.0, 30);
+  // A bow tie.
+  make_polygons(d / "bow.geojson", {{{500300, 5200500}, {500700, 5200900}, {500700, 5200500}, {500300, 5200900}, {500300, 5200500}}},
+                "EPSG:32632");
+  terrain::DemRequest rq;
+  rq.dem_path = d / "dem.tif";
+  rq.resolution = 25;
+  const auto g = terrain::prepare_grid(rq);
+  terrain::ReleaseRequest r;
+  r.path = d / "bow.geojson";
+  r.has_thickness = true;
+  r.thickness = 1;
+  terrain::ReleaseReport rep;
+  const auto h = terrain::rasterize_releases(g, {r}, &rep);
+  ASSERT_EQ(rep.notes.size(), 1u);
+  EXPECT_NE(rep.notes[0].find("repaired"), std::string::npos);
+  EXPECT_GT(rep.cells, 50);
+}
+
+TEST(Terrain, BadInputNamesWhatIsWrong) {
+  TempDir d;
+  make_dem(d / "dem.tif", 60, 25.0, 30);
+  make_dem(d / "nocrs.asc", 60, 25.0, 30, "", false);
+  make_polygons(d / "rel.geojson", {square(500300, 5200500, 300)}, "EPSG:32632");
+  make_polygons(d / "far.geojson", {square(600000, 5300000, 300)}, "EPSG:32632");
+  make_polygons(d / "neg.geojson", {square(500300, 5200500, 300)}, "EPSG:32632", R"(,"t":-1)");
+  auto expect = [&](const v1::Scenario& s, const std::string& needle) { expect_error(s, d, needle); };
+  auto s = base_scenario("missing.tif", "rel.geojson");
+  expect(s, "dem.path: file");
+  expect(base_scenario("nocrs.asc", "rel.geojson"), "has no CRS and none is given");
+  s = base_scenario("nocrs.asc", "rel.geojson");
+  s.mutable_dem()->set_crs("EPSG:32632");
+  EXPECT_NO_THROW(jobs::resolve_scenario(s, d.p.string()));
+  expect(base_scenario("dem.tif", "far.geojson"), "lies outside the grid");
+  s = base_scenario("dem.tif", "neg.geojson");
+  s.mutable_releases(0)->clear_thickness_m();
+  s.mutable_releases(0)->set_thickness_attribute("t");
+  expect(s, "thickness must be > 0 m");
+  s = base_scenario("dem.tif", "rel.geojson");
+  s.mutable_releases(0)->set_thickness_m(-2);
+  expect(s, "releases[0].thickness_m: must be > 0 m");
+  s = base_scenario("dem.tif", "rel.geojson");
+  s.mutable_material()->set_bed_friction_deg(95);
+  expect(s, "material.bed_friction_deg: must lie in [0, 90)");
+  s = base_scenario("dem.tif", "rel.geojson");
+  s.mutable_numerics()->set_limiter("vanLeer");
+  expect(s, "numerics.limiter: unknown value 'vanLeer' (valid: minmod, vanleer, superbee)");
+  s = base_scenario("dem.tif", "rel.geojson");
+  s.mutable_numerics()->set_scheme("weno5");
+  expect(s, "numerics.scheme: unknown value 'weno5' (valid: noc-tvd)");
+  s = base_scenario("dem.tif", "rel.geojson");
+  s.mutable_material()->set_rheology("bingham");
+  expect(s, "valid: coulomb, voellmy");
+  s = base_scenario("dem.tif", "rel.geojson", 1.0);
+  expect(s, "finer than a tenth of the DEM's resolution");
+  s = base_scenario("dem.tif", "rel.geojson");
+  s.mutable_releases(0)->set_min_slope_deg(60);
+  s.mutable_releases(0)->set_max_slope_deg(70);
+  expect(s, "no cell has a slope within [60.0, 70.0] deg");
+  s = base_scenario("dem.tif", "rel.geojson");
+  s.mutable_outputs()->add_rasters("max_height");
+  expect(s, "outputs.rasters: unknown 'max_height'");
+  EXPECT_THROW(jobs::parse_scenario_json(R"({"dem": {"path": "x"}, "relases": []})"), jobs::ScenarioError);
+}
+
+TEST(Terrain, DemGapsAndTheAreaPolygonAreOutsideTheDomain) {
+  TempDir d;
+  // A 2.4 km slope with a gap in the DEM right below the release; the area of interest leaves out
+  // the northern third.
+  make_dem(d / "dem.tif", 120, 20.0, 30, "EPSG:32632", true, 40, 55);
+  make_polygons(d / "rel.geojson", {square(500250, 5201050, 300)}, "EPSG:32632");
+  make_polygons(d / "aoi.geojson", {{{500000, 5200000}, {502400, 5200000}, {502400, 5201600}, {500000, 5201600}, {500000, 5200000}}},
+                "EPSG:32632");
+  auto sc = base_scenario(d / "dem.tif", d / "rel.geojson");
+  sc.mutable_area_of_interest()->set_path(d / "aoi.geojson");
+  auto r = jobs::resolve_scenario(sc, d.p.string());
+  fs::create_directories(d / "out");
+  const auto sum = jobs::run_scenario(r, d / "out");
+  EXPECT_GT(sum.volume_outflow, 0.01 * sum.volume_initial);  // material ran into the gap
+  EXPECT_LT(sum.volume_error, 1e-12);
+  std::ifstream rec(d / "out/run.json");
+  std::stringstream ss;
+  ss << rec.rdbuf();
+  EXPECT_NE(ss.str().find("\"cells_without_data\": 600"), std::string::npos) << ss.str().substr(0, 2000);  // 15 x 40 cells
+  EXPECT_EQ(ss.str().find("\"cells_outside_area\": 0,"), std::string::npos);
+  // The gap (DEM rows 40-79 = grid rows 0-39 of the clipped grid, columns 40-54) is nodata in the rasters.
+  GDALDatasetUniquePtr md(GDALDataset::Open((d / "out/max_depth.tif").c_str(), GDAL_OF_RASTER));
+  float v = 0;
+  ASSERT_EQ(md->GetRasterBand(1)->RasterIO(GF_Read, 45, 20, 1, 1, &v, 1, 1, GDT_Float32, 0, 0), CE_None);
+  EXPECT_EQ(v, -9999.0f);
+}
+
+TEST(Terrain, TheDemsOwnGridIsUsedAsItIs) {
+  TempDir d;
+  make_dem(d / "dem.tif", 90, 7.5, 30);  // cells of 7.5 m: not a round size
+  terrain::DemRequest rq;
+  rq.dem_path = d / "dem.tif";
+  rq.target_crs = "dem";
+  const auto g = terrain::prepare_grid(rq);
+  EXPECT_EQ(g.nx, 90);
+  EXPECT_EQ(g.ny, 90);
+  EXPECT_EQ(g.dx, 7.5);
+  EXPECT_EQ(g.x_min, 500000.0);
+  GDALDatasetUniquePtr ds(GDALDataset::Open((d / "dem.tif").c_str(), GDAL_OF_RASTER));
+  float z = 0;
+  ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 10, 20, 1, 1, &z, 1, 1, GDT_Float32, 0, 0), CE_None);
+  EXPECT_EQ(g.z[std::size_t(90 - 1 - 20) * 90 + 10], double(z));  // values unchanged (no resampling)
+  // With an area of interest: a window of whole DEM cells.
+  make_polygons(d / "aoi.geojson", {square(500100, 5200100, 300)}, "EPSG:32632");
+  rq.aoi_path = d / "aoi.geojson";
+  const auto w = terrain::prepare_grid(rq);
+  EXPECT_EQ(w.dx, 7.5);
+  EXPECT_NEAR(std::fmod(w.x_min - 500000.0, 7.5), 0.0, 1e-9);
+  EXPECT_LE(w.x_min, 500100.0);
+  EXPECT_GE(w.x_min + w.nx * w.dx, 500400.0);
+}
+
+// A shapefile without .prj holding one polygon.
+void make_shapefile(const std::string& path, const std::vector<std::pair<double, double>>& ring_pts) {
+  auto* drv = GetGDALDriverManager()->GetDriverByName("ESRI Shapefile");
+  GDALDatasetUniquePtr ds(drv->Create(path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+  auto* layer = ds->CreateLayer("rel", nullptr, wkbPolygon, nullptr);
+  OGRFeature f(layer->GetLayerDefn());
+  OGRPolygon p;
+  OGRLinearRing ring;
+  for (const auto& v : ring_pts) ring.addPoint(v.first, v.second);
+  p.addRing(&ring);
+  f.SetGeometry(&p);
+  ASSERT_EQ(layer->CreateFeature(&f), OGRERR_NONE);
+}
+
+TEST(Terrain, LocalCrsForTerrainWithoutGeoreference) {
+  TempDir d;
+  make_dem(d / "dem.asc", 80, 5.0, 30, "", false);  // synthetic, no CRS at all
+  make_shapefile(d / "rel.shp", square(500050, 5200250, 60));
+  auto sc = base_scenario(d / "dem.asc", d / "rel.shp");
+  sc.mutable_grid()->set_resolution_m(0);
+  sc.mutable_dem()->set_crs("local");
+  sc.mutable_releases(0)->set_crs("local");
+  auto r = jobs::resolve_scenario(sc, d.p.string());
+  fs::create_directories(d / "out");
+  const auto sum = jobs::run_scenario(r, d / "out");
+  EXPECT_EQ(sum.crs, "local metres");
+  EXPECT_EQ(sum.nx, 80);
+  EXPECT_EQ(sum.dx, 5.0);
+  EXPECT_LT(sum.volume_error, 1e-12);
+  EXPECT_TRUE(fs::exists(d / "out/max_depth.tif"));
+  EXPECT_TRUE(fs::exists(d / "out/outline.gpkg"));
+  EXPECT_FALSE(fs::exists(d / "out/outline.geojson"));
+  ASSERT_EQ(sum.notes.size(), 1u);
+  // The ISeeSnow export: on the DEM's own grid, named after the release and the simulation id.
+  fs::create_directories(d / "out2");
+  jobs::RunOptions opt;
+  opt.iseesnow_id = "03CoulombOnly";
+  jobs::run_scenario(r, d / "out2", opt);
+  for (const char* f : {"rel_03CoulombOnly_null_runout_pft.asc", "rel_03CoulombOnly_null_runout_pfv.asc",
+                        "rel_03CoulombOnly_null_runout.txt", "iseesnow_03CoulombOnly.csv"})
+    EXPECT_TRUE(fs::exists(fs::path(d / "out2") / f)) << f;
+  GDALDatasetUniquePtr pft(GDALDataset::Open((d / "out2/rel_03CoulombOnly_null_runout_pft.asc").c_str(), GDAL_OF_RASTER));
+  GDALDatasetUniquePtr dem(GDALDataset::Open((d / "dem.asc").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(pft && dem);
+  EXPECT_EQ(pft->GetRasterXSize(), dem->GetRasterXSize());
+  double a[6], b[6];
+  pft->GetGeoTransform(a);
+  dem->GetGeoTransform(b);
+  for (int q = 0; q < 6; ++q) EXPECT_NEAR(a[q], b[q], 1e-6);
+  double mx = 0;
+  std::vector<float> v(std::size_t(80) * 80);
+  ASSERT_EQ(pft->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, 80, 80, v.data(), 80, 80, GDT_Float32, 0, 0), CE_None);
+  for (float x : v) mx = std::max(mx, double(x));
+  EXPECT_NEAR(mx, sum.max_depth, 1e-3);  // the same cells: nothing resampled
+  std::ifstream csv(d / "out2/iseesnow_03CoulombOnly.csv");
+  std::string header, row;
+  std::getline(csv, header);
+  std::getline(csv, row);
+  EXPECT_EQ(header, ",testCase,computation duration (CPU) [s],avalanche flow time [s],volume at t0 [m3],"
+                    "volume at tFinal [m3],spatial resolution x [m],spatial resolution y [m],number of particles");
+  EXPECT_EQ(row.rfind("3,CoulombOnly,", 0), 0u) << row;
+  EXPECT_NE(row.find(",5,5,"), std::string::npos) << row;
+  // A local DEM is resampled in its own frame, and cannot be related to a georeferenced release.
+  sc.mutable_grid()->set_resolution_m(10);
+  auto coarse = jobs::resolve_scenario(sc, d.p.string());
+  fs::create_directories(d / "out3");
+  const auto sum10 = jobs::run_scenario(coarse, d / "out3");
+  EXPECT_EQ(sum10.nx, 40);
+  EXPECT_EQ(sum10.dx, 10.0);
+  EXPECT_EQ(sum10.crs, "local metres");
+  EXPECT_NEAR(sum10.release_area_m2, sum.release_area_m2, 0.35 * sum.release_area_m2);
+  sc.mutable_grid()->set_resolution_m(0);
+  sc.mutable_releases(0)->set_crs("EPSG:32632");
+  expect_error(sc, d, "a local CRS cannot be related to EPSG:32632");
+}
+
+TEST(Terrain, ReleaseWithoutCrsNeedsOne) {
+  TempDir d;
+  make_dem(d / "dem.tif", 80, 25.0, 30);
+  make_shapefile(d / "rel.shp", square(500300, 5200500, 300));
+  ASSERT_FALSE(fs::exists(d / "rel.prj"));
+  terrain::DemRequest rq;
+  rq.dem_path = d / "dem.tif";
+  rq.resolution = 25;
+  const auto g = terrain::prepare_grid(rq);
+  terrain::ReleaseRequest r;
+  r.path = d / "rel.shp";
+  r.has_thickness = true;
+  r.thickness = 1;
+  try {
+    terrain::rasterize_releases(g, {r});
+    ADD_FAILURE();
+  } catch (const terrain::TerrainError& e) {
+    EXPECT_NE(std::string(e.what()).find("has no CRS and none is given"), std::string::npos) << e.what();
+  }
+  r.crs = "EPSG:32632";
+  terrain::ReleaseReport rep;
+  terrain::rasterize_releases(g, {r}, &rep);
+  EXPECT_EQ(rep.cells, 12 * 12);
+}
+
+TEST(Terrain, GridOverTheMemoryBudgetIsRefused) {
+  TempDir d;
+  make_dem(d / "dem.tif", 400, 100.0, 20);  // 40 km square
+  terrain::DemRequest rq;
+  rq.dem_path = d / "dem.tif";
+  rq.resolution = 10;  // 16 million cells
+  rq.memory_budget_bytes = 1e9;
+  try {
+    terrain::prepare_grid(rq);
+    FAIL();
+  } catch (const terrain::TerrainError& e) {
+    EXPECT_NE(std::string(e.what()).find("exceeds the memory budget"), std::string::npos) << e.what();
+  }
+}

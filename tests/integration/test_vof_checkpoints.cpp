@@ -1,0 +1,162 @@
+// VOF checkpoints: runs continued from any checkpoint are the uninterrupted run, bit for bit
+// (docs/vof.md, "Checkpoints").
+#include "tests/support/run_helpers.hpp"
+
+using namespace runout::test_support::run;
+
+namespace {
+// Two VOF runs' fields.h5 hold the same datasets with the same bits and the same frame times.
+void expect_same_vof_fields(const std::string& a, const std::string& b) {
+  GDALAllRegister();
+  GDALDatasetUniquePtr fa(GDALDataset::Open((a + "/fields.h5").c_str(), GDAL_OF_RASTER));
+  GDALDatasetUniquePtr fb(GDALDataset::Open((b + "/fields.h5").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(fa && fb) << a << " " << b;
+  auto list = [](GDALDataset& ds, const char* domain, bool names_only) {
+    std::vector<std::string> v;
+    for (char** m = ds.GetMetadata(domain); m && *m; ++m) {
+      std::string e = *m;
+      if (names_only) {
+        if (e.find("_NAME=") == std::string::npos) continue;
+        e = e.substr(e.find("://") + 3);  // the dataset's path in the file
+      }
+      v.push_back(e);
+    }
+    return v;
+  };
+  EXPECT_EQ(list(*fa, "", false), list(*fb, "", false));  // the frames' times
+  const auto names = list(*fa, "SUBDATASETS", true);
+  ASSERT_EQ(names, list(*fb, "SUBDATASETS", true));
+  ASSERT_GT(names.size(), 5u);
+  for (const auto& n : names) {
+    std::vector<double> v[2];
+    for (int k = 0; k < 2; ++k) {
+      GDALDatasetUniquePtr ds(GDALDataset::Open(("HDF5:\"" + (k ? b : a) + "/fields.h5\"://" + n).c_str(), GDAL_OF_RASTER));
+      ASSERT_TRUE(ds) << n;
+      const int nx = ds->GetRasterXSize(), ny = ds->GetRasterYSize(), nb = ds->GetRasterCount();
+      v[k].resize(std::size_t(nx) * ny * nb);
+      for (int band = 1; band <= nb; ++band)
+        ASSERT_EQ(ds->GetRasterBand(band)->RasterIO(GF_Read, 0, 0, nx, ny, v[k].data() + std::size_t(band - 1) * nx * ny, nx, ny, GDT_Float64,
+                                                    0, 0),
+                  CE_None);
+    }
+    ASSERT_EQ(v[0].size(), v[1].size()) << n;
+    EXPECT_EQ(std::memcmp(v[0].data(), v[1].data(), v[0].size() * sizeof(double)), 0) << n << " differs";
+  }
+}
+// run.json of a VOF run without what may differ between a continued run and the uninterrupted one:
+// the timings and the time it was continued from.
+std::string vof_record(const std::string& dir) {
+  std::string j = read_text(dir + "/run.json");
+  const auto t = j.find("\"timings_s\"");
+  if (t != std::string::npos) j.erase(t);
+  const auto c = j.find("\"continued_from_t_s\": ");
+  if (c != std::string::npos) j.erase(c, j.find_first_of(",}\n", c) - c);
+  return j;
+}
+void expect_same_vof_outputs(const std::string& a, const std::string& b) {
+  expect_same_vof_fields(a, b);
+  EXPECT_EQ(vof_record(a), vof_record(b));
+}
+
+// A VOF scenario run in every way a run can go: without checkpoints; with checkpoints every
+// `every` s; stopped after `stop_step` steps through the progress hook (as SIGTERM and Ctrl-C stop
+// it), its checkpoint written there, and continued from it (writing its own checkpoints to the same
+// file); continued again from the last checkpoint that continued run wrote; and continued from the
+// last periodic checkpoint of the run with checkpoints. Each writes the outputs of the run without
+// checkpoints, bit for bit.
+void expect_exact_vof_continuation(const jobs::ResolvedScenario& r, double every, long stop_step) {
+  TempDir d;
+  for (const char* o : {"whole", "checked", "part", "continued", "again", "periodic"}) fs::create_directories(d / o);
+  const auto whole = jobs::run_scenario(r, d / "whole");
+  ASSERT_EQ(whole.stop, "end-time");
+  ASSERT_GT(whole.steps, stop_step + 10);
+  jobs::RunOptions checked;
+  checked.checkpoint_path = d / "every.h5";
+  checked.checkpoint_interval_s = every;
+  EXPECT_EQ(jobs::run_scenario(r, d / "checked", checked).steps, whole.steps);
+  ASSERT_TRUE(fs::exists(d / "every.h5"));
+  expect_same_vof_outputs(d / "whole", d / "checked");
+  jobs::RunOptions cut;
+  cut.checkpoint_path = d / "cut.h5";
+  cut.checkpoint_interval_s = every;
+  cut.progress_every = 1;
+  cut.progress = [stop_step](const engine::Progress& p) { return p.step < stop_step; };
+  const auto part = jobs::run_scenario(r, d / "part", cut);
+  ASSERT_EQ(part.stop, "cancelled");
+  ASSERT_EQ(part.steps, stop_step);
+  jobs::RunOptions cont;
+  cont.restart_path = d / "cut.h5";
+  cont.checkpoint_path = d / "cut.h5";
+  cont.checkpoint_interval_s = every;
+  EXPECT_EQ(jobs::run_scenario(r, d / "continued", cont).steps, whole.steps);
+  expect_same_vof_outputs(d / "whole", d / "continued");
+  EXPECT_NEAR(json_number(read_text(d / "continued/run.json"), "continued_from_t_s"), part.t, 1e-9);
+  jobs::RunOptions again;
+  again.restart_path = d / "cut.h5";  // the continued run's last periodic checkpoint
+  EXPECT_EQ(jobs::run_scenario(r, d / "again", again).steps, whole.steps);
+  expect_same_vof_outputs(d / "whole", d / "again");
+  EXPECT_GT(json_number(read_text(d / "again/run.json"), "continued_from_t_s"), part.t);
+  jobs::RunOptions periodic;
+  periodic.restart_path = d / "every.h5";
+  EXPECT_EQ(jobs::run_scenario(r, d / "periodic", periodic).steps, whole.steps);
+  expect_same_vof_outputs(d / "whole", d / "periodic");
+}
+}  // namespace
+
+// The coarse B2 collapse under PISO (the default), stopped at an arbitrary step.
+TEST(Scenarios, VofRunContinuedFromAnyCheckpointIsTheUninterruptedRun) {
+  expect_exact_vof_continuation(coarse_b2(0.3), 0.3 / 7, 137);
+}
+
+// The same under the consistent pressure coupling with two outer correctors (the momentum predictor
+// and its solver).
+TEST(Scenarios, VofRunContinuedFromAnyCheckpointIsTheUninterruptedRunConsistentCoupling) {
+  auto r = coarse_b2(0.25);
+  auto* lab = r.scenario.mutable_lab();
+  lab->set_pressure_coupling("consistent");
+  lab->set_outer_correctors(2);
+  r = jobs::resolve_scenario(r.scenario, std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab");
+  expect_exact_vof_continuation(r, 0.25 / 6, 101);
+}
+
+// A 3D block (the B2 column on 1.5 cm cells, three cells across).
+TEST(Scenarios, VofRunContinuedFromAnyCheckpointIsTheUninterruptedRun3d) {
+  auto r = coarse_b2(0.15);
+  auto* lab = r.scenario.mutable_lab();
+  lab->set_nx(30);
+  lab->set_ny(10);
+  lab->set_nz(3);
+  lab->set_z_min(0);
+  lab->set_z_max(0.045);
+  lab->set_write_interval_s(0.05);
+  r = jobs::resolve_scenario(r.scenario, std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab");
+  expect_exact_vof_continuation(r, 0.15 / 5, 53);
+}
+
+// A checkpoint of an earlier format (without the pressure solver's state) is refused by name, so
+// that the service runs such a job again from the start.
+TEST(Scenarios, VofCheckpointOfAnEarlierFormatIsRefused) {
+  auto r = coarse_b2(0.1);
+  TempDir d;
+  fs::create_directories(d / "a");
+  fs::create_directories(d / "b");
+  jobs::RunOptions o;
+  o.checkpoint_path = d / "cp.h5";
+  o.checkpoint_interval_s = 0.05;
+  ASSERT_EQ(jobs::run_scenario(r, d / "a", o).stop, "end-time");
+  std::string bytes = read_text(d / "cp.h5");
+  const std::string now = "runout VOF checkpoint 3", old = "runout VOF checkpoint 2";
+  const auto at = bytes.find(now);
+  ASSERT_NE(at, std::string::npos);
+  bytes.replace(at, now.size(), old);
+  std::ofstream(d / "cp.h5", std::ios::binary | std::ios::trunc) << bytes;
+  jobs::RunOptions cont;
+  cont.restart_path = d / "cp.h5";
+  try {
+    jobs::run_scenario(r, d / "b", cont);
+    FAIL() << "a checkpoint of format 2 was accepted";
+  } catch (const jobs::ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("another build"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("from the start"), std::string::npos) << e.what();
+  }
+}
