@@ -13,6 +13,7 @@ endif()
 find_package(PROJ CONFIG REQUIRED)
 find_package(GTest REQUIRED)
 find_package(benchmark REQUIRED)
+find_package(CLI11 CONFIG REQUIRED)  # the command-line parser of `runout` (header-only)
 
 pkg_check_modules(PETSC REQUIRED IMPORTED_TARGET PETSc)
 # HDF5: the MPI build, the same one PETSc links against, so one process never loads two HDF5s.

@@ -10,6 +10,7 @@ RUNOUT_PACKAGES=(
   libsqlite3-dev libssl-dev openssl
   libcairo2-dev fonts-dejavu-core
   libgtest-dev libgmock-dev libbenchmark-dev
+  libcli11-dev
 )
 
 runout_install_deps() {

@@ -1,6 +1,7 @@
 // Client commands: submit, status, watch, cancel, fetch, health. Each talks to a server given by
 // --server HOST:PORT (or RUNOUT_SERVER) with the bearer token of --token / --token-file (or
 // RUNOUT_TOKEN).
+#include <CLI/CLI.hpp>
 #include <grpcpp/grpcpp.h>
 #include <unistd.h>
 
@@ -23,45 +24,6 @@ namespace fs = std::filesystem;
 namespace runout::cli {
 
 namespace {
-
-struct Common {
-  service::ClientOptions opt;
-  std::vector<std::string> rest;  // positional arguments and command options
-};
-
-// Takes the connection options out of `args`; returns false (after a message) on a bad one.
-bool parse_common(const std::string& cmd, const std::vector<std::string>& args, Common* c) {
-  if (const char* s = std::getenv("RUNOUT_SERVER")) c->opt.server = s;
-  if (const char* t = std::getenv("RUNOUT_TOKEN")) c->opt.token = t;
-  for (std::size_t k = 0; k < args.size(); ++k) {
-    const auto& a = args[k];
-    if (a == "--server" || a == "--token" || a == "--token-file" || a == "--tls-ca") {
-      if (k + 1 >= args.size()) {
-        std::cerr << "runout " << cmd << ": " << a << " needs a value\n";
-        return false;
-      }
-      const std::string v = args[++k];
-      if (a == "--server") c->opt.server = v;
-      if (a == "--token") c->opt.token = v;
-      if (a == "--tls-ca") c->opt.tls_ca = v;
-      if (a == "--token-file") {
-        std::ifstream in(v);
-        std::string t;
-        if (!in || !std::getline(in, t)) {
-          std::cerr << "runout " << cmd << ": --token-file '" << v << "': cannot read a token from it\n";
-          return false;
-        }
-        while (!t.empty() && (t.back() == '\r' || t.back() == ' ' || t.back() == '\t')) t.pop_back();
-        c->opt.token = t;
-      }
-    } else if (a == "--tls") {
-      c->opt.tls = true;
-    } else {
-      c->rest.push_back(a);
-    }
-  }
-  return true;
-}
 
 // The exit code of a failed call.
 int code_of(const service::RpcError& e) {
@@ -133,35 +95,64 @@ void print_job(const v1::Job& j) {
 
 }  // namespace
 
+void add_connection_options(CLI::App& app, service::ClientOptions& opt, Connection& c, bool server_env) {
+  auto* server = app.add_option("--server", opt.server,
+                                server_env ? "The server (default $RUNOUT_SERVER, else 127.0.0.1:50051)"
+                                           : "A running server to use instead of an embedded one")
+                     ->type_name("HOST:PORT");
+  if (server_env) server->envname("RUNOUT_SERVER");
+  app.add_option("--token", opt.token, "Bearer token (default $RUNOUT_TOKEN)")->type_name("TOKEN")->envname("RUNOUT_TOKEN");
+  app.add_option("--token-file", c.token_file, "Read the bearer token from the first line of FILE")->type_name("FILE");
+  app.add_option("--tls-ca", opt.tls_ca, "TLS, with the PEM certificate of the CA that signed the server's")
+      ->type_name("FILE");
+  app.add_flag("--tls", opt.tls, "TLS, with the system's root certificates");
+}
+
+int finish_connection_options(const CLI::App& app, service::ClientOptions& opt, const Connection& c) {
+  if (!app.count("--token-file")) return -1;
+  std::ifstream in(c.token_file);
+  std::string t;
+  if (!in || !std::getline(in, t))
+    return usage_error(app.get_name(), "--token-file '" + c.token_file + "': cannot read a token from it");
+  while (!t.empty() && (t.back() == '\r' || t.back() == ' ' || t.back() == '\t')) t.pop_back();
+  opt.token = t;
+  return -1;
+}
+
+namespace {
+
+// A client command's parser: its description and the connection options.
+struct ClientApp {
+  CLI::App app;
+  service::ClientOptions opt;
+  Connection conn;
+  ClientApp(const std::string& description, const std::string& name) : app(description, name) {
+    prepare(app);
+    add_connection_options(app, opt, conn, true);
+  }
+  int parse(const std::vector<std::string>& args) {
+    if (const int rc = parse_args(app, args); rc >= 0) return rc;
+    return finish_connection_options(app, opt, conn);
+  }
+};
+
+}  // namespace
+
 int submit(const std::vector<std::string>& args) {
-  Common c;
-  if (!parse_common("submit", args, &c)) return kUsage;
+  ClientApp c("Upload the scenario's input files and queue it; prints the job id and state.", "runout submit");
   std::string file, request_id;
   bool wait = false, server_paths = false, quiet = false;
-  for (std::size_t k = 0; k < c.rest.size(); ++k) {
-    const auto& a = c.rest[k];
-    if (a == "--wait") {
-      wait = true;
-    } else if (a == "--quiet") {
-      quiet = true;
-    } else if (a == "--server-paths") {
-      server_paths = true;
-    } else if (a == "--request-id" && k + 1 < c.rest.size()) {
-      request_id = c.rest[++k];
-    } else if (!a.empty() && a[0] == '-') {
-      std::cerr << "runout submit: unknown option '" << a << "' (see runout help)\n";
-      return kUsage;
-    } else if (file.empty()) {
-      file = a;
-    } else {
-      std::cerr << "runout submit: one scenario per call ('" << file << "', '" << a << "')\n";
-      return kUsage;
-    }
-  }
-  if (file.empty()) {
-    std::cerr << "runout submit: usage: runout submit SCENARIO.json [--wait] [--request-id ID] [--server-paths] [--server HOST:PORT] [--token TOKEN]\n";
-    return kUsage;
-  }
+  c.app.add_option("SCENARIO.json", file, "The scenario file (required)");
+  c.app.add_flag("--wait", wait, "Follow the job to its end (progress on standard error); exit as watch does");
+  c.app.add_flag("--quiet", quiet, "With --wait: no progress lines");
+  c.app.add_option("--request-id", request_id, "Idempotency key: a repeated submission with it answers the same job")
+      ->type_name("ID");
+  c.app.add_flag("--server-paths", server_paths,
+                 "Send the input paths as they are, for files inside the server's data roots (no upload)");
+  if (const int rc = c.parse(args); rc >= 0) return rc;
+  if (file.empty())
+    return usage_error("runout submit", "usage: runout submit SCENARIO.json [--wait] [--quiet] [--request-id ID] "
+                                        "[--server-paths] (see runout submit --help)");
   v1::Scenario s;
   try {
     std::ifstream in(file);
@@ -194,28 +185,23 @@ int submit(const std::vector<std::string>& args) {
 }
 
 int status(const std::vector<std::string>& args) {
-  Common c;
-  if (!parse_common("status", args, &c)) return kUsage;
+  ClientApp c("One job in detail (state history, error), or the list of this client's jobs and their disk use.",
+              "runout status");
   std::vector<v1::JobState> states;
+  std::vector<std::string> words;
   std::string id;
-  for (std::size_t k = 0; k < c.rest.size(); ++k) {
-    const auto& a = c.rest[k];
-    if (a == "--state" && k + 1 < c.rest.size()) {
-      const std::string v = c.rest[++k];
-      v1::JobState s = v1::JOB_STATE_UNSPECIFIED;
-      for (auto t : {v1::QUEUED, v1::RUNNING, v1::SUCCEEDED, v1::FAILED, v1::CANCELLED})
-        if (service::state_word(t) == v) s = t;
-      if (s == v1::JOB_STATE_UNSPECIFIED) {
-        std::cerr << "runout status: unknown state '" << v << "' (valid: queued, running, succeeded, failed, cancelled)\n";
-        return kUsage;
-      }
-      states.push_back(s);
-    } else if (!a.empty() && a[0] == '-') {
-      std::cerr << "runout status: unknown option '" << a << "' (see runout help)\n";
-      return kUsage;
-    } else {
-      id = a;
-    }
+  c.app.add_option("JOB", id, "The job (default: list the jobs)");
+  c.app.add_option("--state", words, "List only jobs in this state: queued, running, succeeded, failed, cancelled (repeat for more)")
+      ->type_name("STATE")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  if (const int rc = c.parse(args); rc >= 0) return rc;
+  for (const auto& v : words) {
+    v1::JobState s = v1::JOB_STATE_UNSPECIFIED;
+    for (auto t : {v1::QUEUED, v1::RUNNING, v1::SUCCEEDED, v1::FAILED, v1::CANCELLED})
+      if (service::state_word(t) == v) s = t;
+    if (s == v1::JOB_STATE_UNSPECIFIED)
+      return usage_error("runout status", "unknown state '" + v + "' (valid: queued, running, succeeded, failed, cancelled)");
+    states.push_back(s);
   }
   try {
     service::Client client(c.opt);
@@ -248,15 +234,14 @@ int status(const std::vector<std::string>& args) {
 }
 
 int watch(const std::vector<std::string>& args) {
-  Common c;
-  if (!parse_common("watch", args, &c)) return kUsage;
-  if (c.rest.size() != 1 || c.rest[0].empty() || c.rest[0][0] == '-') {
-    std::cerr << "runout watch: usage: runout watch JOB [--server HOST:PORT] [--token TOKEN]\n";
-    return kUsage;
-  }
+  ClientApp c("Follow a job's progress until it ends (exit 0 succeeded, 6 cancelled, 8 failed).", "runout watch");
+  std::string id;
+  c.app.add_option("JOB", id, "The job (required)");
+  if (const int rc = c.parse(args); rc >= 0) return rc;
+  if (id.empty()) return usage_error("runout watch", "usage: runout watch JOB (see runout watch --help)");
   try {
     service::Client client(c.opt);
-    const auto j = follow(client, c.rest[0], false);
+    const auto j = follow(client, id, false);
     std::printf("%s %s\n", j.id().c_str(), service::state_word(j.state()).c_str());
     if (!j.error().empty()) std::cerr << "runout watch: job " << j.id() << " failed: " << j.error() << "\n";
     return code_of_state(j.state());
@@ -267,15 +252,14 @@ int watch(const std::vector<std::string>& args) {
 }
 
 int cancel(const std::vector<std::string>& args) {
-  Common c;
-  if (!parse_common("cancel", args, &c)) return kUsage;
-  if (c.rest.size() != 1 || c.rest[0].empty() || c.rest[0][0] == '-') {
-    std::cerr << "runout cancel: usage: runout cancel JOB [--server HOST:PORT] [--token TOKEN]\n";
-    return kUsage;
-  }
+  ClientApp c("Cancel a queued or running job.", "runout cancel");
+  std::string id;
+  c.app.add_option("JOB", id, "The job (required)");
+  if (const int rc = c.parse(args); rc >= 0) return rc;
+  if (id.empty()) return usage_error("runout cancel", "usage: runout cancel JOB (see runout cancel --help)");
   try {
     service::Client client(c.opt);
-    const auto j = client.cancel(c.rest[0]);
+    const auto j = client.cancel(id);
     std::printf("%s %s%s\n", j.id().c_str(), service::state_word(j.state()).c_str(),
                 j.state() == v1::RUNNING ? " (cancel requested; it stops at its next progress point)" : "");
     return kOk;
@@ -286,27 +270,18 @@ int cancel(const std::vector<std::string>& args) {
 }
 
 int fetch(const std::vector<std::string>& args) {
-  Common c;
-  if (!parse_common("fetch", args, &c)) return kUsage;
+  ClientApp c("Download a job's results (checksums verified) into DIR; for a failed job, its log.", "runout fetch");
   std::string id, out;
   bool force = false;
-  for (std::size_t k = 0; k < c.rest.size(); ++k) {
-    const auto& a = c.rest[k];
-    if (a == "--out" && k + 1 < c.rest.size()) {
-      out = c.rest[++k];
-    } else if (a == "--force") {
-      force = true;
-    } else if (!a.empty() && a[0] == '-') {
-      std::cerr << "runout fetch: unknown option '" << a << "' (see runout help)\n";
-      return kUsage;
-    } else {
-      id = a;
-    }
-  }
-  if (id.empty() || out.empty()) {
-    std::cerr << "runout fetch: usage: runout fetch JOB --out DIR [--force] [--server HOST:PORT] [--token TOKEN]\n";
-    return kUsage;
-  }
+  c.app.add_option("JOB", id, "The job (required)");
+  c.app.add_option("--out", out,
+                   "Result directory (required); as for runout run, it must not exist, or hold a previous result or a "
+                   "previous fetch of a failed job (job.log alone) to be replaced with --force")
+      ->type_name("DIR");
+  c.app.add_flag("--force", force, "Replace DIR when it holds a previous result or fetch (see --out)");
+  if (const int rc = c.parse(args); rc >= 0) return rc;
+  if (id.empty() || out.empty())
+    return usage_error("runout fetch", "usage: runout fetch JOB --out DIR [--force] (see runout fetch --help)");
   // DIR: absent, or with --force a previous result or fetch (output_dir.hpp); never anything else.
   const fs::path dest = output_path(out);
   if (const auto why = check_output_dir(dest, force, out); !why.empty()) {
@@ -349,12 +324,9 @@ int fetch(const std::vector<std::string>& args) {
 }
 
 int health(const std::vector<std::string>& args) {
-  Common c;
-  if (!parse_common("health", args, &c)) return kUsage;
-  if (!c.rest.empty()) {
-    std::cerr << "runout health: unknown argument '" << c.rest[0] << "'\n";
-    return kUsage;
-  }
+  ClientApp c("Ask the server's standard health service (no token needed); exit 0 when serving, 7 otherwise.",
+              "runout health");
+  if (const int rc = c.parse(args); rc >= 0) return rc;
   try {
     service::Client client(c.opt);
     const bool ok = client.healthy();

@@ -3,6 +3,13 @@
 #include <string>
 #include <vector>
 
+namespace CLI {
+class App;
+}
+namespace runout::service {
+struct ClientOptions;
+}
+
 namespace runout::cli {
 
 /// Exit codes (documented in `runout --help`).
@@ -30,5 +37,26 @@ int fetch(const std::vector<std::string>& args);
 int health(const std::vector<std::string>& args);
 int regress(const std::vector<std::string>& args);
 std::string version_report();
+
+// The command line of every command is parsed with CLI11 (CLI/CLI.hpp), one CLI::App per command,
+// named "runout <command>" (main.cpp).
+
+/// Settings every command's parser shares; call before adding options.
+void prepare(CLI::App& app);
+/// Parses `args` (the words after the command's name). Returns -1 when the command goes on, else
+/// its exit code: kOk after --help (the options on standard output), kUsage after a bad command
+/// line ("runout <command>: <message>" on standard error).
+int parse_args(CLI::App& app, const std::vector<std::string>& args);
+/// Prints "<name>: <message>" on standard error; returns kUsage.
+int usage_error(const std::string& name, const std::string& message);
+
+/// The connection options of the client commands (--server, --token, --token-file, --tls-ca,
+/// --tls). `server_env`: --server defaults to $RUNOUT_SERVER; --token always to $RUNOUT_TOKEN.
+struct Connection {
+  std::string token_file;
+};
+void add_connection_options(CLI::App& app, service::ClientOptions& opt, Connection& c, bool server_env);
+/// After parsing: reads --token-file. Returns -1 or, after a message, kUsage.
+int finish_connection_options(const CLI::App& app, service::ClientOptions& opt, const Connection& c);
 
 }  // namespace runout::cli

@@ -1,6 +1,11 @@
 // runout: hazard mapping for rapid granular flows. Thin command-line front end over the libraries.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
 #include <exception>
 #include <iostream>
+#include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -11,7 +16,7 @@ namespace {
 
 const char* kHelp = R"(runout - hazard mapping for rapid granular flows (depth-averaged Savage-Hutter engine)
 
-usage: runout <command> [options]
+usage: runout <command> [options]      (runout <command> --help: the command's options in detail)
 
 commands:
   run SCENARIO.json --out DIR [--force] [--quiet] [--threads N] [--iseesnow SIMULATION_ID]
@@ -67,8 +72,8 @@ commands:
         on standard output (service/proto/runout/v1/worker.proto; docs/operations.md).
   version
         Print the program version and the versions of the libraries it links.
-  help
-        Print this text.
+  help [COMMAND]
+        Print this text, or COMMAND's options (as runout COMMAND --help).
 
   The client commands (submit, status, watch, cancel, fetch, health, regress) take
   --server HOST:PORT (default $RUNOUT_SERVER or 127.0.0.1:50051), --token TOKEN or --token-file FILE
@@ -88,32 +93,109 @@ exit codes:
 
 }  // namespace
 
+namespace runout::cli {
+namespace {
+
+// CLI11's formatter with the option descriptions wrapped at 100 columns.
+class WrappingFormatter : public CLI::Formatter {
+ public:
+  std::string make_option_desc(const CLI::Option* opt) const override {
+    const std::string& text = opt->get_description();
+    const std::size_t width = 100 - get_column_width();
+    std::string out, line, word;
+    std::istringstream words(text);
+    while (words >> word) {
+      if (!line.empty() && line.size() + 1 + word.size() > width) {
+        out += line + "\n";
+        line.clear();
+      }
+      line += (line.empty() ? "" : " ") + word;
+    }
+    return out + line;
+  }
+};
+
+}  // namespace
+
+void prepare(CLI::App& app) {
+  app.formatter(std::make_shared<WrappingFormatter>());
+  // As before CLI11: an option given twice takes its last value (--data-root, --state collect all).
+  app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
+  app.get_formatter()->column_width(32);
+  app.set_help_flag("-h,--help", "Print this command's options and exit");
+}
+
+int usage_error(const std::string& name, const std::string& message) {
+  std::cerr << name << ": " << message << "\n";
+  return kUsage;
+}
+
+int parse_args(CLI::App& app, const std::vector<std::string>& args) {
+  const std::string name = app.get_name();
+  // Unknown words are reported here, in one shape, rather than by CLI11's ExtrasError.
+  app.allow_extras();
+  std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 takes them last first
+  try {
+    app.parse(reversed);
+  } catch (const CLI::CallForHelp&) {
+    std::cout << app.help();
+    return kOk;
+  } catch (const CLI::ParseError& e) {
+    return usage_error(name, e.what());
+  }
+  for (const auto& a : app.remaining()) {
+    if (a.size() > 1 && a[0] == '-')
+      return usage_error(name, "unknown option '" + a + "' (see " + name + " --help)");
+    return usage_error(name, "unexpected argument '" + a + "' (see " + name + " --help)");
+  }
+  return -1;
+}
+
+namespace {
+
+// `runout worker`: no options; standard input and output are the worker protocol's, so nothing is
+// printed on standard output unless --help is asked for by hand.
+int worker(const std::vector<std::string>& args) {
+  CLI::App app{"(Started by the server, not by hand.) Run one job handed over on standard input and report on\n"
+               "standard output (service/proto/runout/v1/worker.proto; docs/operations.md). Takes no options.",
+               "runout worker"};
+  prepare(app);
+  if (const int rc = parse_args(app, args); rc >= 0) return rc;
+  return runout::jobs::worker_main(0, 1);
+}
+
+}  // namespace
+}  // namespace runout::cli
+
 int main(int argc, char** argv) {
+  namespace cli = runout::cli;
   std::vector<std::string> args(argv + 1, argv + argc);
-  if (args.empty() || args[0] == "help" || args[0] == "--help" || args[0] == "-h") {
+  if (args.size() == 2 && args[0] == "help" && args[1] != "help") {
+    args = {args[1], "--help"};  // runout help COMMAND: as runout COMMAND --help
+  } else if (args.empty() || args[0] == "help" || args[0] == "--help" || args[0] == "-h") {
+    if (args.size() > 1) {
+      std::cerr << "runout help: takes at most one command (runout help COMMAND: that command's options)\n";
+      return cli::kUsage;
+    }
     std::cout << kHelp;
-    return args.empty() ? runout::cli::kUsage : runout::cli::kOk;
+    return args.empty() ? cli::kUsage : cli::kOk;
   }
   const std::string cmd = args[0];
   args.erase(args.begin());
+  using Command = int (*)(const std::vector<std::string>&);
+  const std::pair<const char*, Command> commands[] = {
+      {"run", cli::run},       {"verify", cli::verify}, {"serve", cli::serve},   {"submit", cli::submit},
+      {"status", cli::status}, {"watch", cli::watch},   {"cancel", cli::cancel}, {"fetch", cli::fetch},
+      {"health", cli::health}, {"regress", cli::regress}, {"version", cli::version}, {"--version", cli::version},
+      {"worker", cli::worker}};
   try {
-    if (cmd == "run") return runout::cli::run(args);
-    if (cmd == "verify") return runout::cli::verify(args);
-    if (cmd == "version" || cmd == "--version") return runout::cli::version(args);
-    if (cmd == "serve") return runout::cli::serve(args);
-    if (cmd == "worker") return runout::jobs::worker_main(0, 1);
-    if (cmd == "submit") return runout::cli::submit(args);
-    if (cmd == "status") return runout::cli::status(args);
-    if (cmd == "watch") return runout::cli::watch(args);
-    if (cmd == "cancel") return runout::cli::cancel(args);
-    if (cmd == "fetch") return runout::cli::fetch(args);
-    if (cmd == "health") return runout::cli::health(args);
-    if (cmd == "regress") return runout::cli::regress(args);
+    for (const auto& [name, fn] : commands)
+      if (cmd == name) return fn(args);
     std::cerr << "runout: unknown command '" << cmd
               << "' (valid: run, verify, serve, submit, status, watch, cancel, fetch, health, regress, version, help)\n";
-    return runout::cli::kUsage;
+    return cli::kUsage;
   } catch (const std::exception& e) {
     std::cerr << "runout: internal error: " << e.what() << "\n";
-    return runout::cli::kInternal;
+    return cli::kInternal;
   }
 }

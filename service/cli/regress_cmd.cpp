@@ -1,4 +1,5 @@
 // runout regress: the nightly In den Arelen regression through the service (validation.md C1).
+#include <CLI/CLI.hpp>
 #include <unistd.h>
 
 #include <chrono>
@@ -24,52 +25,24 @@ namespace runout::cli {
 
 int regress(const std::vector<std::string>& args) {
   service::ClientOptions opt;
-  bool remote = false, accept = false;
+  Connection conn;
+  bool accept = false;
   std::string out, reason, scenario = std::string(RUNOUT_SOURCE_DIR) + "/scenarios/in-den-arelen.json",
                            reference = std::string(RUNOUT_SOURCE_DIR) + "/regression/in-den-arelen";
-  if (const char* t = std::getenv("RUNOUT_TOKEN")) opt.token = t;
-  for (std::size_t k = 0; k < args.size(); ++k) {
-    const auto& a = args[k];
-    if (a == "--accept") {
-      accept = true;
-      continue;
-    }
-    if (a == "--tls") {
-      opt.tls = true;
-      continue;
-    }
-    if (k + 1 >= args.size()) {
-      std::cerr << "runout regress: " << (a[0] == '-' ? a + " needs a value" : "unknown argument '" + a + "'") << "\n";
-      return kUsage;
-    }
-    const std::string v = args[++k];
-    if (a == "--server") {
-      opt.server = v;
-      remote = true;
-    } else if (a == "--token") {
-      opt.token = v;
-    } else if (a == "--token-file") {
-      std::ifstream in(v);
-      if (!in || !std::getline(in, opt.token)) {
-        std::cerr << "runout regress: --token-file '" << v << "': cannot read a token from it\n";
-        return kUsage;
-      }
-      while (!opt.token.empty() && (opt.token.back() == '\r' || opt.token.back() == ' ')) opt.token.pop_back();
-    } else if (a == "--tls-ca") {
-      opt.tls_ca = v;
-    } else if (a == "--out") {
-      out = v;
-    } else if (a == "--scenario") {
-      scenario = v;
-    } else if (a == "--reference") {
-      reference = v;
-    } else if (a == "--reason") {
-      reason = v;
-    } else {
-      std::cerr << "runout regress: unknown option '" << a << "' (see runout help)\n";
-      return kUsage;
-    }
-  }
+  CLI::App app{"The In den Arelen regression: run the scenario through the service (an embedded server on 127.0.0.1\n"
+               "unless --server), compare with the accepted reference, write report.md with the map and a difference\n"
+               "map. Exit 1 on a regression.",
+               "runout regress"};
+  prepare(app);
+  add_connection_options(app, opt, conn, false);
+  app.add_option("--out", out, "Report folder (default runs/regress-YYYYMMDD-HHMMSS)")->type_name("DIR");
+  app.add_option("--scenario", scenario, "The scenario (default: scenarios/in-den-arelen.json of the source tree)")->type_name("FILE");
+  app.add_option("--reference", reference, "The accepted reference (default: regression/in-den-arelen of the source tree)")->type_name("DIR");
+  app.add_flag("--accept", accept, "Make this run the reference (needs --reason)");
+  app.add_option("--reason", reason, "Why this run becomes the reference (recorded with it)")->type_name("TEXT");
+  if (const int rc = parse_args(app, args); rc >= 0) return rc;
+  if (const int rc = finish_connection_options(app, opt, conn); rc >= 0) return rc;
+  const bool remote = app.count("--server") > 0;
   if (accept && reason.empty()) {
     std::cerr << "runout regress: --accept needs --reason TEXT (why this run becomes the reference)\n";
     return kUsage;

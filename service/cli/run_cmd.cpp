@@ -1,4 +1,5 @@
 // `runout run SCENARIO.json --out DIR`: one scenario, locally, with a progress line.
+#include <CLI/CLI.hpp>
 #include <omp.h>
 #include <unistd.h>
 
@@ -26,65 +27,64 @@ extern "C" void on_interrupt(int) { g_interrupted = true; }
 }  // namespace
 
 int run(const std::vector<std::string>& args) {
-  std::string scenario, out, iseesnow, checkpoint, restart;
+  std::string scenario, out, iseesnow, checkpoint, restart, threads;
   bool force = false, quiet = false;
-  for (std::size_t k = 0; k < args.size(); ++k) {
-    const auto& a = args[k];
-    if (a == "--iseesnow") {
-      if (k + 1 >= args.size()) {
-        std::cerr << "runout run: --iseesnow needs the simulation id (e.g. 03CoulombOnly)\n";
-        return kUsage;
-      }
-      iseesnow = args[++k];
-      if (iseesnow.empty() || iseesnow.find_first_of("_/\\ .") != std::string::npos) {
-        std::cerr << "runout run: --iseesnow '" << iseesnow
-                  << "': the simulation id names files and may not be empty or hold '_', '/', '\\', '.' or spaces"
-                     " (the benchmark's ids: 01IdealizedTopo, 02RealTopo, 03CoulombOnly)\n";
-        return kUsage;
-      }
-    } else if (a == "--checkpoint" || a == "--restart") {
-      if (k + 1 >= args.size() || args[k + 1].empty()) {
-        std::cerr << "runout run: " << a << " needs a file\n";
-        return kUsage;
-      }
-      (a == "--checkpoint" ? checkpoint : restart) = fs::absolute(args[++k]).string();
-    } else if (a == "--out" || a == "--threads") {
-      if (k + 1 >= args.size()) {
-        std::cerr << "runout run: " << a << " needs a value\n";
-        return kUsage;
-      }
-      if (a == "--out") {
-        out = args[++k];
-      } else {
-        int n = 0;
-        try {
-          n = std::stoi(args[++k]);
-        } catch (...) {
-        }
-        if (n < 1) {
-          std::cerr << "runout run: --threads takes a positive integer\n";
-          return kUsage;
-        }
-        omp_set_num_threads(n);
-      }
-    } else if (a == "--force") {
-      force = true;
-    } else if (a == "--quiet") {
-      quiet = true;
-    } else if (!a.empty() && a[0] == '-') {
-      std::cerr << "runout run: unknown option '" << a << "' (see runout help)\n";
-      return kUsage;
-    } else if (scenario.empty()) {
-      scenario = a;
-    } else {
-      std::cerr << "runout run: more than one scenario given ('" << scenario << "', '" << a << "')\n";
-      return kUsage;
+  CLI::App app{"Run a scenario (JSON form of runout.v1.Scenario, see README) and write the hazard rasters (COG\n"
+               "GeoTIFF), the runout outline (GeoJSON in WGS84, GeoPackage) and the run record (run.json) into DIR.\n"
+               "Results appear only when the run succeeded. A progress line goes to standard error unless --quiet.",
+               "runout run"};
+  prepare(app);
+  app.add_option("SCENARIO.json", scenario, "The scenario file (required)");
+  app.add_option("--out", out,
+                 "Result directory (required). It must not exist; an existing DIR is replaced only with --force and "
+                 "only when it holds a previous result (runout's run.json), once the new one is complete; another "
+                 "folder, a file, a link, or the current directory (or one that holds it) is never replaced")
+      ->type_name("DIR");
+  app.add_flag("--force", force, "Replace DIR when it holds a previous result (see --out)");
+  app.add_flag("--quiet", quiet, "No progress line and no summary");
+  app.add_option("--threads", threads, "OpenMP threads (a positive integer; default: all cores)")->type_name("N");
+  app.add_option("--iseesnow", iseesnow,
+                 "Also write the ISeeSnow benchmark files (peak thickness/velocity ESRI ASCII on the DEM's grid, result "
+                 "CSV) for this simulation id (01IdealizedTopo, 02RealTopo, 03CoulombOnly)")
+      ->type_name("SIMULATION_ID");
+  app.add_option("--checkpoint", checkpoint,
+                 "Write the run's state to FILE when the run is interrupted (Ctrl-C, SIGTERM) and, for VOF runs (engine "
+                 "\"vof\"), every lab.checkpoint_interval_s. VOF runs: the monitors travel in FILE, the frames so far in "
+                 "FILE.fields.h5. Depth-averaged runs: the solver's whole state and hazard maps travel in FILE, the time "
+                 "series so far in FILE.timeseries.h5")
+      ->type_name("FILE");
+  app.add_option("--restart", restart,
+                 "Continue from a --checkpoint FILE of the same scenario exactly as the run would have gone on (run.json "
+                 "and fields.h5 are the whole run's; depth-averaged runs: the uninterrupted run's outputs, bit for bit)")
+      ->type_name("FILE");
+  if (const int rc = parse_args(app, args); rc >= 0) return rc;
+  if (app.count("--iseesnow") &&
+      (iseesnow.empty() || iseesnow.find_first_of("_/\\ .") != std::string::npos)) {
+    std::cerr << "runout run: --iseesnow '" << iseesnow
+              << "': the simulation id names files and may not be empty or hold '_', '/', '\\', '.' or spaces"
+                 " (the benchmark's ids: 01IdealizedTopo, 02RealTopo, 03CoulombOnly)\n";
+    return kUsage;
+  }
+  for (auto* f : {&checkpoint, &restart}) {
+    if (app.count(f == &checkpoint ? "--checkpoint" : "--restart") && f->empty())
+      return usage_error("runout run", std::string(f == &checkpoint ? "--checkpoint" : "--restart") + " needs a file");
+    if (!f->empty()) *f = fs::absolute(*f).string();
+  }
+  if (app.count("--threads")) {
+    int n = 0;
+    try {
+      std::size_t used = 0;
+      n = std::stoi(threads, &used);
+      if (used != threads.size()) n = 0;
+    } catch (...) {
     }
+    if (n < 1) return usage_error("runout run", "--threads takes a positive integer, got '" + threads + "'");
+    omp_set_num_threads(n);
   }
   if (scenario.empty() || out.empty()) {
-    std::cerr << "runout run: usage: runout run SCENARIO.json --out DIR [--force] [--quiet] [--threads N]"
-                 " [--checkpoint FILE] [--restart FILE]\n";
-    return kUsage;
+    return usage_error("runout run",
+                       "usage: runout run SCENARIO.json --out DIR [--force] [--quiet] [--threads N] [--iseesnow "
+                       "SIMULATION_ID] [--checkpoint FILE] [--restart FILE] (see runout run --help)");
   }
   // DIR: absent, or with --force a previous result (output_dir.hpp); never anything else.
   const fs::path dest = output_path(out);

@@ -1,4 +1,5 @@
 // runout serve: the gRPC batch server in the foreground until SIGINT or SIGTERM.
+#include <CLI/CLI.hpp>
 #include <fcntl.h>
 #include <pthread.h>
 #include <unistd.h>
@@ -17,67 +18,64 @@ namespace runout::cli {
 int serve(const std::vector<std::string>& args) {
   v1::ServerConfig file_cfg, cli_cfg;
   std::vector<std::string> roots;
-  bool have_roots = false, recover = false;
-  for (std::size_t k = 0; k < args.size(); ++k) {
-    const auto& a = args[k];
-    const bool has_value = k + 1 < args.size();
-    auto value = [&]() -> std::string { return args[++k]; };
-    auto number = [&](const std::string& v, int* out) {
-      try {
-        std::size_t used = 0;
-        *out = std::stoi(v, &used);
-        return used == v.size();
-      } catch (...) {
-        return false;
-      }
-    };
-    if (a == "--recover") {
-      recover = true;
-      continue;
+  bool recover = false;
+  std::string config, listen, state_dir, tokens, tls_cert, tls_key, log_file, workers, threads_per_run;
+  CLI::App app{"Run the gRPC batch server (runout.v1.Runout, health checking, reflection) until SIGINT or SIGTERM.\n"
+               "Options override the JSON configuration file (deploy/README.md lists every key). Each job runs in a\n"
+               "worker process of its own; jobs left running by a killed server are queued again at the next start.\n"
+               "One server per state directory (a second one exits).",
+               "runout serve"};
+  prepare(app);
+  app.add_flag("--recover", recover,
+               "Rebuild a missing, empty or damaged job store from the job records, logs and results, then start "
+               "(docs/operations.md)");
+  app.add_option("--config", config, "JSON configuration file (runout.v1.ServerConfig)")->type_name("FILE");
+  app.add_option("--listen", listen, "Address to listen on (default 127.0.0.1:50051; port 0: any free port)")->type_name("HOST:PORT");
+  app.add_option("--state-dir", state_dir, "The job store, uploads, logs and results (default ./runout-state)")->type_name("DIR");
+  app.add_option("--data-root", roots, "A folder whose files scenarios may name by path (repeat for more; replaces the file's list)")
+      ->type_name("DIR")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  app.add_option("--tokens", tokens, "The clients' bearer tokens, one per line, plain or sha256:HEX (none: no authentication)")->type_name("FILE");
+  app.add_option("--tls-cert", tls_cert, "PEM certificate: serve TLS (with --tls-key)")->type_name("FILE");
+  app.add_option("--tls-key", tls_key, "PEM private key of --tls-cert")->type_name("FILE");
+  app.add_option("--workers", workers, "Jobs run at a time, a positive integer (default 1)")->type_name("N");
+  app.add_option("--threads-per-run", threads_per_run, "OpenMP threads of each job, a positive integer (default: cores / workers)")->type_name("N");
+  app.add_option("--log-file", log_file, "The server's log (default: standard error)")->type_name("FILE");
+  if (const int rc = parse_args(app, args); rc >= 0) return rc;
+  auto number = [&](const char* flag, const std::string& v, int* out) {
+    try {
+      std::size_t used = 0;
+      *out = std::stoi(v, &used);
+      if (used == v.size() && *out >= 1) return true;
+    } catch (...) {
     }
-    if (a == "--config" || a == "--listen" || a == "--state-dir" || a == "--data-root" || a == "--tokens" ||
-        a == "--tls-cert" || a == "--tls-key" || a == "--workers" || a == "--threads-per-run" || a == "--log-file") {
-      if (!has_value) {
-        std::cerr << "runout serve: " << a << " needs a value\n";
-        return kUsage;
-      }
-      const std::string v = value();
-      int n = 0;
-      if (a == "--config") {
-        try {
-          file_cfg = service::read_config_file(v);
-        } catch (const std::exception& e) {
-          std::cerr << "runout serve: " << e.what() << "\n";
-          return kBadInput;
-        }
-      } else if (a == "--listen") {
-        cli_cfg.set_listen(v);
-      } else if (a == "--state-dir") {
-        cli_cfg.set_state_dir(v);
-      } else if (a == "--data-root") {
-        roots.push_back(v);
-        have_roots = true;
-      } else if (a == "--tokens") {
-        cli_cfg.set_tokens_file(v);
-      } else if (a == "--tls-cert") {
-        cli_cfg.set_tls_cert(v);
-      } else if (a == "--tls-key") {
-        cli_cfg.set_tls_key(v);
-      } else if (a == "--log-file") {
-        cli_cfg.set_log_file(v);
-      } else if (!number(v, &n) || n < 1) {
-        std::cerr << "runout serve: " << a << " takes a positive integer, got '" << v << "'\n";
-        return kUsage;
-      } else if (a == "--workers") {
-        cli_cfg.set_workers(n);
-      } else {
-        cli_cfg.set_threads_per_run(n);
-      }
-    } else {
-      std::cerr << "runout serve: unknown option '" << a << "' (see runout help)\n";
-      return kUsage;
+    usage_error("runout serve", std::string(flag) + " takes a positive integer, got '" + v + "'");
+    return false;
+  };
+  int n = 0;
+  if (app.count("--workers")) {
+    if (!number("--workers", workers, &n)) return kUsage;
+    cli_cfg.set_workers(n);
+  }
+  if (app.count("--threads-per-run")) {
+    if (!number("--threads-per-run", threads_per_run, &n)) return kUsage;
+    cli_cfg.set_threads_per_run(n);
+  }
+  if (app.count("--listen")) cli_cfg.set_listen(listen);
+  if (app.count("--state-dir")) cli_cfg.set_state_dir(state_dir);
+  if (app.count("--tokens")) cli_cfg.set_tokens_file(tokens);
+  if (app.count("--tls-cert")) cli_cfg.set_tls_cert(tls_cert);
+  if (app.count("--tls-key")) cli_cfg.set_tls_key(tls_key);
+  if (app.count("--log-file")) cli_cfg.set_log_file(log_file);
+  if (app.count("--config")) {
+    try {
+      file_cfg = service::read_config_file(config);
+    } catch (const std::exception& e) {
+      std::cerr << "runout serve: " << e.what() << "\n";
+      return kBadInput;
     }
   }
+  const bool have_roots = app.count("--data-root") > 0;
   // Command-line options override the file.
   v1::ServerConfig cfg = file_cfg;
   cfg.MergeFrom(cli_cfg);

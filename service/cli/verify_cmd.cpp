@@ -1,4 +1,5 @@
 // `runout verify`: run the verification cases and print a table or CSV.
+#include <CLI/CLI.hpp>
 #include <omp.h>
 
 #include <cmath>
@@ -47,66 +48,52 @@ bool parse_list(const std::string& s, std::vector<double>& out) {
 int verify(const std::vector<std::string>& args) {
   ver::Options opt;
   bool csv = false;
-  std::vector<std::string> cases;
+  std::vector<std::string> names, cases;
+  std::string resolutions, limiter, threads;
   const auto valid = ver::case_ids();
-  for (std::size_t k = 0; k < args.size(); ++k) {
-    const std::string& a = args[k];
-    auto value = [&](const char* flag) -> const std::string* {
-      if (k + 1 >= args.size()) {
-        std::cerr << "runout verify: " << flag << " needs a value\n";
-        return nullptr;
-      }
-      return &args[++k];
-    };
-    if (a == "--full") {
-      opt.full = true;
-    } else if (a == "--csv") {
-      csv = true;
-    } else if (a == "--resolutions") {
-      const std::string* v = value("--resolutions");
-      if (!v) return kUsage;
-      if (!parse_list(*v, opt.resolutions)) {
-        std::cerr << "runout verify: --resolutions takes positive numbers separated by commas, got '" << *v << "'\n";
-        return kUsage;
-      }
-    } else if (a == "--limiter") {
-      const std::string* v = value("--limiter");
-      if (!v) return kUsage;
-      try {
-        opt.limiter = engine::parse_name(engine::kLimiterNames, "limiter", *v);
-      } catch (const std::exception& e) {
-        std::cerr << "runout verify: " << e.what() << "\n";
-        return kUsage;
-      }
-    } else if (a == "--threads") {
-      const std::string* v = value("--threads");
-      if (!v) return kUsage;
-      int n = 0;
-      try {
-        n = std::stoi(*v);
-      } catch (...) {
-      }
-      if (n < 1) {
-        std::cerr << "runout verify: --threads takes a positive integer, got '" << *v << "'\n";
-        return kUsage;
-      }
-      omp_set_num_threads(n);
-    } else if (!a.empty() && a[0] == '-') {
-      std::cerr << "runout verify: unknown option '" << a << "' (see runout help)\n";
-      return kUsage;
-    } else {
-      std::string id = a;
-      for (auto& c : id) c = char(std::toupper(static_cast<unsigned char>(c)));
-      bool known = false;
-      for (const auto& v : valid) known = known || v == id;
-      if (!known) {
-        std::string list;
-        for (const auto& v : valid) list += (list.empty() ? "" : ", ") + v;
-        std::cerr << "runout verify: unknown case '" << a << "' (valid: " << list << ")\n";
-        return kUsage;
-      }
-      cases.push_back(id);
+  std::string list;
+  for (const auto& v : valid) list += (list.empty() ? "" : ", ") + v;
+  CLI::App app{"Run the verification cases against exact solutions and invariants and print a table (or CSV).\n"
+               "Exit 1 when a figure lies outside its tolerance.",
+               "runout verify"};
+  prepare(app);
+  app.add_option("CASE", names, "Cases to run (default: all): " + list)->type_name("CASE...");
+  app.add_flag("--full", opt.full, "Add the finest resolutions");
+  app.add_option("--resolutions", resolutions,
+                 "Override a case's cell sizes in metres, positive numbers separated by commas (A2: cells across the "
+                 "cap)")
+      ->type_name("R1,R2,...");
+  app.add_option("--limiter", limiter, "Slope limiter: minmod (default), vanleer, superbee")->type_name("NAME");
+  app.add_flag("--csv", csv, "Print CSV instead of the table (no progress lines)");
+  app.add_option("--threads", threads, "OpenMP threads (a positive integer; default: all cores)")->type_name("N");
+  if (const int rc = parse_args(app, args); rc >= 0) return rc;
+  if (app.count("--resolutions") && !parse_list(resolutions, opt.resolutions))
+    return usage_error("runout verify", "--resolutions takes positive numbers separated by commas, got '" + resolutions + "'");
+  if (app.count("--limiter")) {
+    try {
+      opt.limiter = engine::parse_name(engine::kLimiterNames, "limiter", limiter);
+    } catch (const std::exception& e) {
+      return usage_error("runout verify", e.what());
     }
+  }
+  if (app.count("--threads")) {
+    int n = 0;
+    try {
+      std::size_t used = 0;
+      n = std::stoi(threads, &used);
+      if (used != threads.size()) n = 0;
+    } catch (...) {
+    }
+    if (n < 1) return usage_error("runout verify", "--threads takes a positive integer, got '" + threads + "'");
+    omp_set_num_threads(n);
+  }
+  for (const auto& a : names) {
+    std::string id = a;
+    for (auto& c : id) c = char(std::toupper(static_cast<unsigned char>(c)));
+    bool known = false;
+    for (const auto& v : valid) known = known || v == id;
+    if (!known) return usage_error("runout verify", "unknown case '" + a + "' (valid: " + list + ")");
+    cases.push_back(id);
   }
   if (cases.empty()) cases = valid;
 

@@ -1,4 +1,5 @@
 // Versions of the program and of every library it links (also a link check of the dependencies).
+#include <CLI/CLI.hpp>
 #include <H5public.h>
 #include <gdal.h>
 #include <google/protobuf/stubs/common.h>
@@ -32,10 +33,9 @@ std::string version_report() {
 }
 
 int version(const std::vector<std::string>& args) {
-  if (!args.empty()) {
-    std::cerr << "runout version: takes no arguments\n";
-    return kUsage;
-  }
+  CLI::App app{"Print the program version and the versions of the libraries it links.", "runout version"};
+  prepare(app);
+  if (const int rc = parse_args(app, args); rc >= 0) return rc;
   std::cout << version_report();
   return kOk;
 }
