@@ -10,6 +10,7 @@
 #include "engine/sh1d.hpp"
 #include "engine/sh2d.hpp"
 #include "engine/verification/exact.hpp"
+#include "engine/verification/vof_cases.hpp"
 
 namespace runout::engine::verification {
 namespace {
@@ -704,6 +705,10 @@ const CaseEntry kCases[] = {
     {"A7", "energy line: alpha angle equals delta for pure Coulomb friction, 2D and curved 1D", case_a7},
     {"STRESS", "randomised terrain, friction, depths, resolutions and CFL: no NaN, no negative depth, no mass drift",
      case_stress},
+    {"V1", "VOF engine: plane Couette flow of a Newtonian fluid, steady linear profile", case_v1},
+    {"V2", "VOF engine: plane Poiseuille flow of a Newtonian fluid down an inclined channel, parabolic profile", case_v2},
+    {"V3", "VOF engine: granular layer under air at rest in a closed box, hydrostatic pressure, no spurious currents", case_v3},
+    {"V4", "VOF engine: start-up of plane Couette flow from rest (series solution)", case_v4},
 };
 
 }  // namespace

@@ -1,0 +1,16 @@
+#pragma once
+// Verification cases V1-V4 of the VOF engine (engine/vof/, docs/verification.md): Newtonian flows
+// with exact solutions (plane Couette, plane Poiseuille, Couette's start-up) and a two-layer column
+// at rest (hydrostatic pressure, no spurious currents). Same rows and registry as A1-A7 (cases.cpp).
+#include <vector>
+
+#include "engine/verification/cases.hpp"
+
+namespace runout::engine::verification {
+
+std::vector<Row> case_v1(const Options& o);  ///< plane Couette flow, steady
+std::vector<Row> case_v2(const Options& o);  ///< plane Poiseuille flow down an inclined channel
+std::vector<Row> case_v3(const Options& o);  ///< still two-layer column in a closed box
+std::vector<Row> case_v4(const Options& o);  ///< start-up of plane Couette flow (transient)
+
+}  // namespace runout::engine::verification
