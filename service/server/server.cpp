@@ -37,6 +37,8 @@
 #include "runout/v1/worker.pb.h"
 #include "jobs/store.hpp"
 #include "runout/v1/service.grpc.pb.h"
+#include "service/server/inputs.hpp"
+#include "service/server/tokens.hpp"
 #include "terrain/terrain.hpp"
 
 namespace fs = std::filesystem;
@@ -48,177 +50,7 @@ namespace {
 using grpc::Status;
 using grpc::StatusCode;
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ConfigError("cannot read '" + path + "'");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::array<unsigned char, 32> digest_of(const std::string& hex) {
-  std::array<unsigned char, 32> d{};
-  for (std::size_t k = 0; k < 32; ++k) d[k] = static_cast<unsigned char>(std::stoi(hex.substr(2 * k, 2), nullptr, 16));
-  return d;
-}
-
-bool is_hex64(const std::string& s) {
-  return s.size() == 64 && s.find_first_not_of("0123456789abcdefABCDEF") == std::string::npos;
-}
-
-// Bearer tokens from a file: one per line, the token itself or "sha256:HEX"; '#' starts a comment
-// line. Only digests are kept; a presented token is hashed and compared with every digest in
-// constant time. The file is read again when it changes (token rotation without a restart; a change
-// is its size, times or inode). It fails closed: a file that cannot be read, holds no token or has a
-// malformed line makes every token invalid until it is fixed, and the log says why.
-class Tokens {
- public:
-  Tokens(std::string path, std::function<void(const std::string&)> log) : path_(std::move(path)), log_(std::move(log)) {
-    if (!path_.empty()) {
-      std::lock_guard lk(mu_);
-      digests_ = parse();  // at the start a bad file is an error (ConfigError)
-      stamp_ = stamp();
-    }
-  }
-  bool enabled() const { return !path_.empty(); }
-  /// The owner id of a token ("t" + 16 hex digits of its digest), or "" when it is not known.
-  std::string owner_of(const std::string& token) {
-    std::lock_guard lk(mu_);
-    const std::string now = stamp();
-    if (now != stamp_) {
-      stamp_ = now;
-      try {
-        digests_ = parse();
-        if (log_) log_("tokens file '" + path_ + "' read again: " + std::to_string(digests_.size()) + " token(s)");
-      } catch (const std::exception& e) {
-        digests_.clear();  // fail closed
-        if (log_) log_(std::string("tokens file: ") + e.what() + "; no token is accepted until it is fixed");
-      }
-    }
-    const auto d = digest_of(jobs::sha256_hex(token));
-    bool found = false;
-    for (const auto& k : digests_) found |= CRYPTO_memcmp(k.data(), d.data(), d.size()) == 0;
-    if (!found) return "";
-    static const char* hex = "0123456789abcdef";
-    std::string o = "t";
-    for (int k = 0; k < 8; ++k) {
-      o += hex[d[k] >> 4];
-      o += hex[d[k] & 15];
-    }
-    return o;
-  }
-
- private:
-  // What identifies the file's version: inode, size, modification and change times ("" when gone).
-  std::string stamp() const {
-    struct stat st {};
-    if (::stat(path_.c_str(), &st) != 0) return "";
-    return std::to_string(st.st_ino) + ":" + std::to_string(st.st_size) + ":" + std::to_string(st.st_mtim.tv_sec) + "." +
-           std::to_string(st.st_mtim.tv_nsec) + ":" + std::to_string(st.st_ctim.tv_sec) + "." + std::to_string(st.st_ctim.tv_nsec);
-  }
-  std::vector<std::array<unsigned char, 32>> parse() const {
-    std::ifstream in(path_);
-    if (!in) throw ConfigError("tokens_file '" + path_ + "': cannot read it");
-    std::vector<std::array<unsigned char, 32>> ds;
-    std::string line;
-    int n = 0;
-    while (std::getline(in, line)) {
-      ++n;
-      while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t')) line.pop_back();
-      std::size_t b = line.find_first_not_of(" \t");
-      if (b == std::string::npos || line[b] == '#') continue;
-      line = line.substr(b);
-      if (line.rfind("sha256:", 0) == 0) {
-        const std::string h = line.substr(7);
-        if (!is_hex64(h))
-          throw ConfigError("tokens_file '" + path_ + "' line " + std::to_string(n) + ": sha256: needs 64 hex digits");
-        std::string lower = h;
-        for (auto& c : lower) c = char(std::tolower(static_cast<unsigned char>(c)));
-        ds.push_back(digest_of(lower));
-      } else {
-        ds.push_back(digest_of(jobs::sha256_hex(line)));
-      }
-    }
-    if (ds.empty()) throw ConfigError("tokens_file '" + path_ + "' holds no token");
-    return ds;
-  }
-  std::string path_;
-  std::function<void(const std::string&)> log_;
-  std::vector<std::array<unsigned char, 32>> digests_;
-  std::string stamp_;
-  std::mutex mu_;
-};
-
-bool plain_name(const std::string& n) {
-  if (n.empty() || n.size() > 200 || n[0] == '.') return false;
-  return n.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789._-") == std::string::npos;
-}
-
-bool inside(const fs::path& p, const fs::path& root) {
-  auto r = root.begin(), q = p.begin();
-  for (; r != root.end(); ++r, ++q) {
-    if (r->empty()) continue;  // a trailing separator
-    if (q == p.end() || *q != *r) return false;
-  }
-  return true;
-}
-
 }  // namespace
-
-v1::ServerConfig resolve_config(v1::ServerConfig c) {
-  if (c.listen().empty()) c.set_listen("127.0.0.1:50051");
-  if (c.listen().find(':') == std::string::npos) throw ConfigError("listen: '" + c.listen() + "' is not HOST:PORT");
-  if (c.state_dir().empty()) c.set_state_dir("runout-state");
-  if (c.workers() == 0) c.set_workers(1);
-  if (c.workers() < 0 || c.workers() > 256) throw ConfigError("workers: must lie in 1..256, got " + std::to_string(c.workers()));
-  if (c.threads_per_run() < 0) throw ConfigError("threads_per_run: must be >= 0 (0: cores / workers)");
-  if (c.max_queued_per_client() == 0) c.set_max_queued_per_client(100);
-  if (c.max_queued_per_client() < 0) throw ConfigError("max_queued_per_client: must be > 0");
-  if (c.max_upload_bytes() == 0) c.set_max_upload_bytes(std::int64_t(2) << 30);
-  if (c.max_upload_bytes() < 0) throw ConfigError("max_upload_bytes: must be > 0");
-  if (c.max_message_bytes() == 0) c.set_max_message_bytes(16 << 20);
-  if (c.max_message_bytes() < (1 << 20)) throw ConfigError("max_message_bytes: must be at least 1048576");
-  if (c.retention_days() < 0) throw ConfigError("retention_days: must be >= 0 (0: keep)");
-  if (c.retention_max_bytes() < 0) throw ConfigError("retention_max_bytes: must be >= 0 (0: no limit)");
-  if (c.tls_cert().empty() != c.tls_key().empty()) throw ConfigError("tls_cert and tls_key: give both or neither");
-  if (c.max_job_wall_s() == 0) c.set_max_job_wall_s(86400);
-  if (!(c.max_job_wall_s() > 0 && c.max_job_wall_s() <= 365 * 86400.0))
-    throw ConfigError("max_job_wall_s: must lie in (0, 31536000] s");
-  if (c.max_job_memory_bytes() == 0) {
-    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-    if (pages > 0 && page > 0) c.set_max_job_memory_bytes(std::int64_t(pages) * page / std::max(1, c.workers()));
-  }
-  if (c.max_job_memory_bytes() < 0) throw ConfigError("max_job_memory_bytes: must be > 0");
-  if (c.upload_ttl_s() == 0) c.set_upload_ttl_s(3600);
-  if (!(c.upload_ttl_s() > 0 && std::isfinite(c.upload_ttl_s()))) throw ConfigError("upload_ttl_s: must be > 0 s");
-  if (c.max_upload_bytes_per_client() == 0) c.set_max_upload_bytes_per_client(std::int64_t(8) << 30);
-  if (c.max_upload_bytes_per_client() < 0) throw ConfigError("max_upload_bytes_per_client: must be > 0");
-  if (c.stop_grace_s() == 0) c.set_stop_grace_s(1);
-  if (!(c.stop_grace_s() > 0 && c.stop_grace_s() <= 600)) throw ConfigError("stop_grace_s: must lie in (0, 600] s");
-  if (c.max_crashes() == 0) c.set_max_crashes(3);
-  if (c.max_crashes() < 0 || c.max_crashes() > 100) throw ConfigError("max_crashes: must lie in 1..100");
-  std::error_code ec;
-  fs::create_directories(c.state_dir(), ec);
-  if (ec) throw ConfigError("state_dir '" + c.state_dir() + "': " + ec.message());
-  c.set_state_dir(fs::canonical(c.state_dir()).string());
-  for (int k = 0; k < c.data_roots_size(); ++k) {
-    const fs::path p = c.data_roots(k);
-    if (!fs::is_directory(p, ec)) throw ConfigError("data_roots: '" + p.string() + "' is not a folder");
-    c.set_data_roots(k, fs::canonical(p).string());
-  }
-  for (const auto* f : {&c.tokens_file(), &c.tls_cert(), &c.tls_key()})
-    if (!f->empty() && !fs::is_regular_file(*f, ec)) throw ConfigError("'" + *f + "' does not exist or is not a file");
-  return c;
-}
-
-v1::ServerConfig read_config_file(const std::string& path) {
-  v1::ServerConfig c;
-  google::protobuf::util::JsonParseOptions o;
-  o.ignore_unknown_fields = false;
-  const auto st = google::protobuf::util::JsonStringToMessage(read_text(path), &c, o);
-  if (!st.ok()) throw ConfigError("configuration '" + path + "': " + std::string(st.message()));
-  return c;
-}
 
 struct Server::Impl final : v1::Runout::Service {
   v1::ServerConfig cfg;
@@ -261,54 +93,6 @@ struct Server::Impl final : v1::Runout::Service {
     if (v.rfind("Bearer ", 0) != 0) return {StatusCode::UNAUTHENTICATED, "the authorization metadata must read 'Bearer TOKEN'"};
     *owner = tokens->owner_of(v.substr(7));
     if (owner->empty()) return {StatusCode::UNAUTHENTICATED, "unknown bearer token"};
-    return Status::OK;
-  }
-
-  // A scenario's input path on this server: an uploaded file or a file inside a data root.
-  Status resolve_input(const std::string& field, std::string* path) {
-    const std::string p = *path;
-    if (p.empty()) return Status::OK;  // the scenario's own check names what is missing
-    if (p.rfind("upload:", 0) == 0) {
-      const std::string ref = p.substr(7);
-      const auto slash = ref.find('/');
-      const std::string id = ref.substr(0, slash), name = slash == std::string::npos ? "" : ref.substr(slash + 1);
-      if (!is_hex64(id) || !plain_name(name))
-        return {StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' is not an upload reference (upload:ID/NAME)"};
-      const fs::path f = fs::path(cfg.state_dir()) / "uploads" / id / name;
-      if (!fs::is_regular_file(f)) return {StatusCode::NOT_FOUND, field + ": no upload '" + p + "' on this server"};
-      *path = f.string();
-      return allowed_format(field, *path);
-    }
-    for (const auto& part : fs::path(p))
-      if (part == "..") return {StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' may not contain '..'"};
-    if (cfg.data_roots().empty())
-      return {StatusCode::INVALID_ARGUMENT,
-              field + ": '" + p + "': this server has no data roots; upload the file (runout submit does) and use its upload: reference"};
-    // One answer for every refusal, so that it tells nothing about files outside the roots.
-    const Status refused{StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' is not a readable file inside the server's data roots"};
-    std::error_code ec;
-    for (const auto& root : cfg.data_roots()) {
-      const fs::path cand = (fs::path(p).is_absolute() ? fs::path(p) : fs::path(root) / p).lexically_normal();
-      if (!inside(cand, root)) continue;  // checked before the file system is asked anything
-      const fs::path real = fs::canonical(cand, ec);  // symbolic links resolved
-      if (ec) continue;
-      bool ok = false;
-      for (const auto& r : cfg.data_roots()) ok |= inside(real, r);
-      if (!ok || !fs::is_regular_file(real, ec)) return refused;
-      *path = real.string();
-      return allowed_format(field, *path);
-    }
-    return refused;
-  }
-
-  // Only formats that cannot point at other files or URLs (no VRT, no /vsi paths inside).
-  Status allowed_format(const std::string& field, const std::string& path) {
-    static const char* const kAllowed[] = {"GTiff", "COG", "AAIGrid", "SRTMHGT", "EHdr", "GeoJSON", "ESRI Shapefile", "GPKG", nullptr};
-    GDALDriverH d = GDALIdentifyDriverEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_VECTOR, kAllowed, nullptr);
-    if (!d)
-      return {StatusCode::INVALID_ARGUMENT, field + ": '" + fs::path(path).filename().string() +
-                                                "' is not in a format this server reads (GeoTIFF, ESRI ASCII grid, SRTM .hgt, "
-                                                "EHdr, GeoJSON, Shapefile, GeoPackage)"};
     return Status::OK;
   }
 
@@ -406,69 +190,6 @@ struct Server::Impl final : v1::Runout::Service {
     validate_cv.notify_one();
   }
 
-  // Every check `runout run` makes, in a worker process of its own (a DEM that crashes or hangs
-  // GDAL takes only that process down): the inputs read, the grid or mesh built, one step run.
-  Status validate_in_worker(const v1::Scenario& s) {
-    const fs::path dir = fs::path(cfg.state_dir()) / "validate" / jobs::new_job_id();
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) return {StatusCode::INTERNAL, "cannot create a folder to check the scenario in: " + ec.message()};
-    v1::WorkerTask task;
-    task.set_job_id("validate");
-    *task.mutable_scenario() = s;
-    task.set_out_dir(dir.string());
-    task.set_threads(1);
-    task.set_validate_only(true);
-    Status st = Status::OK;
-    try {
-      jobs::WorkerProcess w(jobs::self_executable(), task, (dir / "validate.log").string());
-      std::optional<v1::WorkerEvent> outcome;
-      const auto t0 = std::chrono::steady_clock::now();
-      bool timed_out = false, too_big = false;
-      for (;;) {  // every event, also those read with the end of the output
-        auto ev = w.next_event(std::chrono::milliseconds(100));
-        if (!ev && w.output_closed()) break;
-        if (ev && !ev->has_progress()) outcome = ev;
-        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        if (wall > kValidateSeconds || (cfg.max_job_memory_bytes() > 0 && w.resident_bytes() > cfg.max_job_memory_bytes())) {
-          timed_out = wall > kValidateSeconds;
-          too_big = !timed_out;
-          w.signal(SIGKILL);
-          break;
-        }
-      }
-      auto ex = w.wait(std::chrono::seconds(10));
-      if (!ex) {
-        w.signal(SIGKILL);
-        ex = w.wait(std::chrono::seconds(60));
-      }
-      if (outcome && outcome->has_failed()) {
-        const std::string m = jobs::client_message(outcome->failed().error(), cfg.state_dir(),
-                                                   {cfg.data_roots().begin(), cfg.data_roots().end()});
-        st = outcome->failed().bad_input() ? Status(StatusCode::INVALID_ARGUMENT, m)
-                                           : Status(StatusCode::INVALID_ARGUMENT, "checking the scenario failed: " + m);
-      } else if (!outcome && timed_out) {
-        log("checking a scenario took longer than " + std::to_string(int(kValidateSeconds)) +
-            " s; accepted, its remaining checks run with the job");
-      } else if (!outcome && too_big) {
-        st = {StatusCode::INVALID_ARGUMENT, "checking the scenario needed more than the server's memory limit for a job (" +
-                                                std::to_string(cfg.max_job_memory_bytes() >> 20) + " MiB): coarsen it"};
-      } else if (!outcome && ex && ex->exited && ex->code == 127) {
-        log("cannot start a worker process (" + jobs::self_executable() + " worker): exit status 127");
-        st = {StatusCode::INTERNAL, "the server cannot start its worker processes (its log says more)"};
-      } else if (!outcome) {
-        st = {StatusCode::INVALID_ARGUMENT, "checking the scenario's inputs ended the checking process (" +
-                                                (ex ? ex->describe() : std::string("no exit status")) +
-                                                "): the inputs cannot be read safely"};
-      }
-    } catch (const std::exception& e) {
-      st = {StatusCode::INTERNAL, std::string("cannot check the scenario: ") + e.what()};
-    }
-    fs::remove_all(dir, ec);
-    return st;
-  }
-
-  static constexpr double kValidateSeconds = 30;
 
   Status SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRequest* req, v1::Job* resp) override {
     std::string owner;
@@ -510,7 +231,7 @@ struct Server::Impl final : v1::Runout::Service {
     auto input = [&](const std::string& field, std::string* path) {
       const bool upload = path->rfind("upload:", 0) == 0;
       if (upload) in_flight.take(path->substr(7, 64));  // before it is looked at: not collected meanwhile
-      Status st = resolve_input(field, path);
+      Status st = resolve_input(cfg, field, path);
       if (st.ok() && upload) uploads.push_back(fs::path(*path).parent_path().filename().string());
       return st;
     };
@@ -554,7 +275,7 @@ struct Server::Impl final : v1::Runout::Service {
     if (!known) {
       if (!enter_validation())
         return refuse({StatusCode::RESOURCE_EXHAUSTED, "the server is checking too many submissions at once; try again"});
-      const Status st = validate_in_worker(s);
+      const Status st = check_in_worker(cfg, s, [this](const std::string& l) { log(l); });
       leave_validation();
       if (!st.ok()) return refuse(st);
     }
