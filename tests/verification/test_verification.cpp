@@ -1,6 +1,7 @@
 // Every verification case of `runout verify` at its default resolutions: each row within tolerance.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "engine/verification/cases.hpp"
@@ -40,4 +41,15 @@ TEST(VerificationHarness, ConvergenceOrdersAreReported) {
       EXPECT_GT(r.order, 0.7);
     }
   }
+}
+
+// The VOF engine's cases (vof_cases.cpp) are in the same list, after the depth-averaged ones, with
+// their descriptions (`runout verify` lists and dispatches them from it).
+TEST(VerificationHarness, VofCasesAreListed) {
+  const auto ids = ver::case_ids();
+  for (const char* id : {"V1", "V2", "V3", "V4"}) {
+    EXPECT_NE(std::find(ids.begin(), ids.end(), id), ids.end()) << id;
+    EXPECT_NE(ver::describe(id).find("VOF"), std::string::npos) << id;
+  }
+  EXPECT_EQ(ids.front(), "A1");
 }
