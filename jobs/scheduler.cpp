@@ -310,57 +310,88 @@ bool Scheduler::on_progress(const std::string& id, const v1::Progress& pr) {
   return go;
 }
 
-void Scheduler::run_job(StoredJob sj) {
-  const std::string id = sj.job.id(), hash = sj.job.scenario_hash();
-  std::ofstream logf(log_path(id), std::ios::app);
-  auto say = [&](const std::string& line) {
+// One job's run on this server: its log, its paths and limits, and how it is recorded.
+struct Scheduler::JobContext {
+  Scheduler& s;
+  StoredJob sj;
+  std::string id, hash;
+  std::ofstream logf;
+  fs::path final_dir, tmp;
+  std::string cp;
+  double wall_limit = 0;
+  std::int64_t mem_limit = 0;
+  std::chrono::milliseconds grace{1000};
+
+  JobContext(Scheduler& sched, StoredJob job) : s(sched), sj(std::move(job)), id(sj.job.id()), hash(sj.job.scenario_hash()) {
+    logf.open(s.log_path(id), std::ios::app);
+    final_dir = s.results_dir(hash);
+    tmp = fs::path(final_dir.string() + ".tmp-" + id);
+    cp = s.checkpoint_path(id);
+    wall_limit = s.cfg_.max_job_wall_s;
+    if (sj.scenario.limits().max_wall_s() > 0) wall_limit = std::min(wall_limit, sj.scenario.limits().max_wall_s());
+    mem_limit = s.cfg_.max_job_memory_bytes;
+    if (sj.scenario.limits().max_memory_bytes() > 0)
+      mem_limit = mem_limit > 0 ? std::min(mem_limit, sj.scenario.limits().max_memory_bytes()) : sj.scenario.limits().max_memory_bytes();
+    grace = std::chrono::milliseconds(std::int64_t(1000 * s.cfg_.stop_grace_s));
+  }
+  void say(const std::string& line) {
     logf << utc_now() << " " << line << "\n";
     logf.flush();
-  };
-  say("attempt " + std::to_string(sj.job.attempts()) + ": started (scenario " + hash.substr(0, 12) + ", " +
-      std::to_string(cfg_.threads_per_run) + " threads)");
-  log("job " + id + ": started");
-  {
-    std::lock_guard lk(mu_);
-    live_[id] = Live{sj.job.progress(), ++counter_, true};
-    versions_[id] = counter_;
   }
-  change_cv_.notify_all();
-  auto finish = [&](v1::JobState state, const std::string& reason, const std::string& error, std::int64_t bytes,
-                    bool crashed = false) {
+  void finish(v1::JobState state, const std::string& reason, const std::string& error, std::int64_t bytes, bool crashed = false) {
     try {
-      store_.transition(id, state, reason, error, bytes, crashed);
+      s.store_.transition(id, state, reason, error, bytes, crashed);
     } catch (const std::exception& e) {
-      log("job " + id + ": recording '" + reason + "' failed: " + e.what());
+      s.log("job " + id + ": recording '" + reason + "' failed: " + e.what());
     }
     say(state_name(state) + ": " + reason);  // (`runout serve --recover` reads these lines)
     if (!error.empty()) say("error: " + error);
-    log("job " + id + ": " + state_name(state) + (error.empty() ? "" : " (" + error + ")"));
+    s.log("job " + id + ": " + state_name(state) + (error.empty() ? "" : " (" + error + ")"));
     {
-      std::lock_guard lk(mu_);
-      live_.erase(id);
-      cancel_.erase(id);
+      std::lock_guard lk(s.mu_);
+      s.live_.erase(id);
+      s.cancel_.erase(id);
     }
-    touch(id);
-  };
-  auto finish_and_forget = [&](v1::JobState state, const std::string& reason, const std::string& error, std::int64_t bytes) {
-    remove_checkpoint(id);
+    s.touch(id);
+  }
+  void finish_and_forget(v1::JobState state, const std::string& reason, const std::string& error, std::int64_t bytes) {
+    s.remove_checkpoint(id);
     finish(state, reason, error, bytes);
-  };
+  }
+};
 
-  const fs::path final_dir = results_dir(hash);
+// What one worker process of a job did.
+struct Scheduler::Attempt {
+  enum class Why { none, cancel, stop, wall, memory };
+  Why why = Why::none;                    // why we ended it (none: it ended by itself)
+  std::optional<v1::WorkerEvent> outcome;  // its outcome event, when it sent one
+  WorkerExit exit;
+  std::string start_error;  // it could not be started
+};
+
+void Scheduler::run_job(StoredJob job) {
+  JobContext jc(*this, std::move(job));
+  const std::string& id = jc.id;
+  jc.say("attempt " + std::to_string(jc.sj.job.attempts()) + ": started (scenario " + jc.hash.substr(0, 12) + ", " +
+         std::to_string(cfg_.threads_per_run) + " threads)");
+  log("job " + id + ": started");
+  {
+    std::lock_guard lk(mu_);
+    live_[id] = Live{jc.sj.job.progress(), ++counter_, true};
+    versions_[id] = counter_;
+  }
+  change_cv_.notify_all();
   std::error_code ec;
   {
     std::unique_lock results_lk(results_mu_);  // not while retention removes results
-    if (fs::exists(final_dir / "run.json", ec)) {
-      const auto bytes = folder_bytes(final_dir.string());
+    if (fs::exists(jc.final_dir / "run.json", ec)) {
+      const auto bytes = folder_bytes(jc.final_dir.string());
       results_lk.unlock();
-      finish_and_forget(v1::SUCCEEDED, "an identical scenario was computed before: its results answer this job", "", bytes);
+      jc.finish_and_forget(v1::SUCCEEDED, "an identical scenario was computed before: its results answer this job", "", bytes);
       return;
     }
   }
-  const fs::path tmp = fs::path(final_dir.string() + ".tmp-" + id);
-  fs::remove_all(tmp, ec);
+  fs::remove_all(jc.tmp, ec);
   bool cancelled_early = false;
   try {
     cancelled_early = store_.cancel_requested(id);
@@ -372,198 +403,198 @@ void Scheduler::run_job(StoredJob sj) {
     cancelled_early = cancelled_early || cancel_.count(id) > 0;
   }
   if (cancelled_early) {
-    finish_and_forget(v1::CANCELLED, "cancelled by the client before the run started", "", 0);
+    jc.finish_and_forget(v1::CANCELLED, "cancelled by the client before the run started", "", 0);
     return;
   }
-
   // The task: every run keeps a checkpoint (and its frames so far) in checkpoints/ID.h5 while it
   // runs, so that a job interrupted by the server stopping, by its death or by a crash of its worker
   // continues from there.
   v1::WorkerTask task;
   task.set_job_id(id);
-  *task.mutable_scenario() = sj.scenario;
-  task.set_out_dir(tmp.string());
+  *task.mutable_scenario() = jc.sj.scenario;
+  task.set_out_dir(jc.tmp.string());
   task.set_threads(cfg_.threads_per_run);
   task.set_progress_interval_s(0.25);
-  const std::string cp = checkpoint_path(id);
-  {
-    task.set_checkpoint_path(cp);
-    task.set_checkpoint_interval_s(-1);  // a twentieth of the end time (the worker knows it, defaults filled in)
-    if (fs::exists(cp, ec)) {
-      task.set_restart_path(cp);
-      say("continuing from its checkpoint");
-    }
+  task.set_checkpoint_path(jc.cp);
+  task.set_checkpoint_interval_s(-1);  // a twentieth of the end time (the worker knows it, defaults filled in)
+  if (fs::exists(jc.cp, ec)) {
+    task.set_restart_path(jc.cp);
+    jc.say("continuing from its checkpoint");
   }
-  double wall_limit = cfg_.max_job_wall_s;
-  if (sj.scenario.limits().max_wall_s() > 0) wall_limit = std::min(wall_limit, sj.scenario.limits().max_wall_s());
-  std::int64_t mem_limit = cfg_.max_job_memory_bytes;
-  if (sj.scenario.limits().max_memory_bytes() > 0)
-    mem_limit = mem_limit > 0 ? std::min(mem_limit, sj.scenario.limits().max_memory_bytes()) : sj.scenario.limits().max_memory_bytes();
-  const auto grace = std::chrono::milliseconds(std::int64_t(1000 * cfg_.stop_grace_s));
-
   for (int round = 0;; ++round) {
-    fs::remove_all(tmp, ec);
-    fs::create_directories(tmp, ec);
-    enum class Why { none, cancel, stop, wall, memory };
-    Why why = Why::none;
-    std::optional<v1::WorkerEvent> outcome;
-    WorkerExit ex;
-    try {
-      WorkerProcess w(cfg_.worker_exe, task, log_path(id));
-      say("worker process " + std::to_string(w.pid()));
-      const auto t0 = std::chrono::steady_clock::now();
-      auto last_check = t0, kill_at = t0, last_saved = t0;
-      for (;;) {
-        // Every event the worker wrote is read, also after its output closed (the outcome may be
-        // the last of several events that arrived at once).
-        auto ev = w.next_event(std::chrono::milliseconds(100));
-        if (!ev && w.output_closed()) break;
-        const auto now = std::chrono::steady_clock::now();
-        if (ev && ev->has_progress()) {
-          if (!on_progress(id, ev->progress()) && why == Why::none) {
-            std::lock_guard lk(mu_);
-            why = cancel_.count(id) ? Why::cancel : Why::stop;
-          }
-          if (now - last_saved > std::chrono::seconds(1)) {
-            last_saved = now;
-            const auto& p = ev->progress();
-            try {
-              store_.save_progress(id, p);
-            } catch (...) {
-            }
-            char b[200];
-            std::snprintf(b, sizeof b, "t = %.3f s, dt = %.4g s, volume = %.6g m3, max speed = %.2f m/s, active = %.1f %%",
-                          p.simulated_s(), p.dt_s(), p.volume_m3(), p.max_speed_m_s(), 100 * p.active_fraction());
-            say(b);
-          }
-        } else if (ev) {
-          outcome = ev;
-        }
-        if (now - last_check > std::chrono::milliseconds(500)) {
-          last_check = now;
-          if (why == Why::none) {
-            bool cancel = false;
-            try {
-              cancel = store_.cancel_requested(id);
-            } catch (...) {
-            }
-            std::lock_guard lk(mu_);
-            if (cancel) cancel_.insert(id);
-            if (cancel_.count(id)) why = Why::cancel;
-            else if (stopping_) why = Why::stop;
-          }
-          if (why == Why::none && std::chrono::duration<double>(now - t0).count() > wall_limit) why = Why::wall;
-          if (why == Why::none && mem_limit > 0 && w.resident_bytes() > mem_limit) {
-            why = Why::memory;
-            w.signal(SIGKILL);  // memory is not given time
-          }
-        }
-        {
-          std::lock_guard lk(mu_);
-          if (why == Why::none && stopping_) why = Why::stop;
-          if (why == Why::none && cancel_.count(id)) why = Why::cancel;
-        }
-        if (why != Why::none && kill_at == t0) {
-          w.signal(SIGTERM);  // ends at the end of its step (a stop keeps a checkpoint)
-          kill_at = now + grace;
-        } else if (why != Why::none && now > kill_at) {
-          w.signal(SIGKILL);
-        }
-      }
-      auto e = w.wait(grace + std::chrono::seconds(5));
-      if (!e) {
-        w.signal(SIGKILL);
-        e = w.wait(std::chrono::hours(1));
-      }
-      ex = *e;
-    } catch (const std::exception& e) {
-      fs::remove_all(tmp, ec);
-      finish_and_forget(v1::FAILED, "the worker process could not be started", e.what(), 0);
-      return;
-    }
-    const std::string exit_text = ex.describe();
-    if (!(ex.exited && ex.code == 0)) say("worker process ended by " + exit_text);
-    {
-      std::lock_guard lk(mu_);  // a stop that came while the worker was ending
-      if (why == Why::none && stopping_) why = Why::stop;
-    }
-
-    if (why == Why::cancel && !(outcome && outcome->has_done())) {
-      fs::remove_all(tmp, ec);
-      const double t = outcome && outcome->has_interrupted() ? outcome->interrupted().simulated_s() : 0.0;
-      finish_and_forget(v1::CANCELLED, "cancelled by the client at t = " + std::to_string(t) + " s; no results kept", "", 0);
-      return;
-    }
-    if (outcome && outcome->has_done()) {
-      std::unique_lock results_lk(results_mu_);  // not while retention removes results
-      fs::rename(tmp, final_dir, ec);
-      if (ec) {
-        // Another job with the same hash finished first: its (identical) results stand.
-        fs::remove_all(tmp, ec);
-        if (!fs::exists(final_dir / "run.json", ec)) {
-          finish_and_forget(v1::FAILED, "the run failed", "cannot move the results into place", 0);
-          return;
-        }
-      }
-      const auto bytes = folder_bytes(final_dir.string());
-      results_lk.unlock();
-      say("finished: " + outcome->done().summary());
-      finish_and_forget(v1::SUCCEEDED, "completed", "", bytes);
-      return;
-    }
-    fs::remove_all(tmp, ec);
-    if (why == Why::wall || why == Why::memory) {
-      char b[200];
-      if (why == Why::wall)
-        std::snprintf(b, sizeof b, "the run exceeded its wall-time limit of %.0f s and was stopped", wall_limit);
-      else
-        std::snprintf(b, sizeof b, "the run exceeded its memory limit of %.0f MiB and was stopped", double(mem_limit) / (1 << 20));
-      finish_and_forget(v1::FAILED, "stopped by a limit", b, 0);
-      return;
-    }
-    if (why == Why::stop || (outcome && outcome->has_interrupted())) {
-      const bool cp_now = outcome && outcome->has_interrupted() && outcome->interrupted().checkpoint_written();
-      const bool cp_any = cp_now || fs::exists(cp, ec);
-      char b[300];
-      std::snprintf(b, sizeof b, "interrupted by the server stopping%s; queued to %s", 
-                    cp_now ? (" at t = " + std::to_string(outcome->interrupted().simulated_s()) + " s").c_str() : "",
-                    cp_any ? "continue from its checkpoint" : "run again from the start");
-      finish(v1::QUEUED, b, "", 0);
-      return;
-    }
-    if (outcome && outcome->has_failed()) {
-      const auto& f = outcome->failed();
-      if (!task.restart_path().empty() && f.bad_input() && f.error().find("checkpoint") != std::string::npos && round == 0) {
-        // A checkpoint this build cannot continue (damaged, or from another build): from the start.
-        say("its checkpoint cannot be continued (" + client_message(f.error(), cfg_.state_dir, cfg_.data_roots) +
-            "); running again from the start");
-        log("job " + id + ": checkpoint refused (" + f.error() + "); running from the start");
-        remove_checkpoint(id);
-        task.clear_restart_path();
-        continue;
-      }
-      finish_and_forget(v1::FAILED, "the run failed", client_message(f.error(), cfg_.state_dir, cfg_.data_roots), 0);
-      return;
-    }
-    if (!ex.exited && (ex.signal == SIGTERM || ex.signal == SIGINT || ex.signal == SIGHUP)) {
-      // Stopped from outside (an operator's signal to the worker): not the job's fault.
-      finish(v1::QUEUED, "its worker process was stopped from outside (" + exit_text + "); queued to run again", "", 0);
-      return;
-    }
-    // No outcome: the worker process died of a signal nobody sent, or exited without a word.
-    const int crashes = sj.crashes + 1;
-    if (crashes >= cfg_.max_crashes) {
-      remove_checkpoint(id);
-      finish(v1::FAILED, "its worker process crashed",
-             "the job's worker process crashed (" + exit_text + ") in " + std::to_string(crashes) + " attempts", 0, true);
-      return;
-    }
-    finish(v1::QUEUED,
-           "its worker process crashed (" + exit_text + "); queued to run again (" + std::to_string(crashes) + " of " +
-               std::to_string(cfg_.max_crashes) + " crashes allowed)",
-           "", 0, true);
-    return;
+    fs::remove_all(jc.tmp, ec);
+    fs::create_directories(jc.tmp, ec);
+    const Attempt a = supervise(jc, task);
+    if (!conclude(jc, task, a, round)) return;
   }
+}
+
+Scheduler::Attempt Scheduler::supervise(JobContext& jc, const v1::WorkerTask& task) {
+  using Why = Attempt::Why;
+  const std::string& id = jc.id;
+  Attempt a;
+  try {
+    WorkerProcess w(cfg_.worker_exe, task, log_path(id));
+    jc.say("worker process " + std::to_string(w.pid()));
+    const auto t0 = std::chrono::steady_clock::now();
+    auto last_check = t0, kill_at = t0, last_saved = t0;
+    for (;;) {
+      // Every event the worker wrote is read, also after its output closed (the outcome may be
+      // the last of several events that arrived at once).
+      auto ev = w.next_event(std::chrono::milliseconds(100));
+      if (!ev && w.output_closed()) break;
+      const auto now = std::chrono::steady_clock::now();
+      if (ev && ev->has_progress()) {
+        if (!on_progress(id, ev->progress()) && a.why == Why::none) {
+          std::lock_guard lk(mu_);
+          a.why = cancel_.count(id) ? Why::cancel : Why::stop;
+        }
+        if (now - last_saved > std::chrono::seconds(1)) {
+          last_saved = now;
+          const auto& p = ev->progress();
+          try {
+            store_.save_progress(id, p);
+          } catch (...) {
+          }
+          char b[200];
+          std::snprintf(b, sizeof b, "t = %.3f s, dt = %.4g s, volume = %.6g m3, max speed = %.2f m/s, active = %.1f %%",
+                        p.simulated_s(), p.dt_s(), p.volume_m3(), p.max_speed_m_s(), 100 * p.active_fraction());
+          jc.say(b);
+        }
+      } else if (ev) {
+        a.outcome = ev;
+      }
+      if (now - last_check > std::chrono::milliseconds(500)) {
+        last_check = now;
+        if (a.why == Why::none) {
+          bool cancel = false;
+          try {
+            cancel = store_.cancel_requested(id);
+          } catch (...) {
+          }
+          std::lock_guard lk(mu_);
+          if (cancel) cancel_.insert(id);
+        }
+        if (a.why == Why::none && std::chrono::duration<double>(now - t0).count() > jc.wall_limit) a.why = Why::wall;
+        if (a.why == Why::none && jc.mem_limit > 0 && w.resident_bytes() > jc.mem_limit) {
+          a.why = Why::memory;
+          w.signal(SIGKILL);  // memory is not given time
+        }
+      }
+      {
+        std::lock_guard lk(mu_);
+        if (a.why == Why::none && cancel_.count(id)) a.why = Why::cancel;
+        if (a.why == Why::none && stopping_) a.why = Why::stop;
+      }
+      if (a.why != Why::none && kill_at == t0) {
+        w.signal(SIGTERM);  // ends at the end of its step (a stop keeps a checkpoint)
+        kill_at = now + jc.grace;
+      } else if (a.why != Why::none && now > kill_at) {
+        w.signal(SIGKILL);
+      }
+    }
+    auto e = w.wait(jc.grace + std::chrono::seconds(5));
+    if (!e) {
+      w.signal(SIGKILL);
+      e = w.wait(std::chrono::hours(1));
+    }
+    a.exit = *e;
+  } catch (const std::exception& e) {
+    a.start_error = e.what();
+  }
+  return a;
+}
+
+bool Scheduler::conclude(JobContext& jc, v1::WorkerTask& task, const Attempt& a, int round) {
+  using Why = Attempt::Why;
+  std::error_code ec;
+  if (!a.start_error.empty()) {
+    fs::remove_all(jc.tmp, ec);
+    jc.finish_and_forget(v1::FAILED, "the worker process could not be started", a.start_error, 0);
+    return false;
+  }
+  const std::string exit_text = a.exit.describe();
+  if (!(a.exit.exited && a.exit.code == 0)) jc.say("worker process ended by " + exit_text);
+  Why why = a.why;
+  {
+    std::lock_guard lk(mu_);  // a stop that came while the worker was ending
+    if (why == Why::none && stopping_) why = Why::stop;
+  }
+  const auto& outcome = a.outcome;
+  if (why == Why::cancel && !(outcome && outcome->has_done())) {
+    fs::remove_all(jc.tmp, ec);
+    const double t = outcome && outcome->has_interrupted() ? outcome->interrupted().simulated_s() : 0.0;
+    jc.finish_and_forget(v1::CANCELLED, "cancelled by the client at t = " + std::to_string(t) + " s; no results kept", "", 0);
+    return false;
+  }
+  if (outcome && outcome->has_done()) {
+    std::unique_lock results_lk(results_mu_);  // not while retention removes results
+    fs::rename(jc.tmp, jc.final_dir, ec);
+    if (ec) {
+      // Another job with the same hash finished first: its (identical) results stand.
+      fs::remove_all(jc.tmp, ec);
+      if (!fs::exists(jc.final_dir / "run.json", ec)) {
+        jc.finish_and_forget(v1::FAILED, "the run failed", "cannot move the results into place", 0);
+        return false;
+      }
+    }
+    const auto bytes = folder_bytes(jc.final_dir.string());
+    results_lk.unlock();
+    jc.say("finished: " + outcome->done().summary());
+    jc.finish_and_forget(v1::SUCCEEDED, "completed", "", bytes);
+    return false;
+  }
+  fs::remove_all(jc.tmp, ec);
+  if (why == Why::wall || why == Why::memory) {
+    char b[200];
+    if (why == Why::wall)
+      std::snprintf(b, sizeof b, "the run exceeded its wall-time limit of %.0f s and was stopped", jc.wall_limit);
+    else
+      std::snprintf(b, sizeof b, "the run exceeded its memory limit of %.0f MiB and was stopped", double(jc.mem_limit) / (1 << 20));
+    jc.finish_and_forget(v1::FAILED, "stopped by a limit", b, 0);
+    return false;
+  }
+  if (why == Why::stop || (outcome && outcome->has_interrupted())) {
+    const bool cp_now = outcome && outcome->has_interrupted() && outcome->interrupted().checkpoint_written();
+    const bool cp_any = cp_now || fs::exists(jc.cp, ec);
+    jc.finish(v1::QUEUED, std::string("interrupted by the server stopping") +
+                              (cp_now ? " at t = " + std::to_string(outcome->interrupted().simulated_s()) + " s" : "") +
+                              "; queued to " + (cp_any ? "continue from its checkpoint" : "run again from the start"),
+              "", 0);
+    return false;
+  }
+  if (outcome && outcome->has_failed()) {
+    const auto& f = outcome->failed();
+    if (!task.restart_path().empty() && f.bad_input() && f.error().find("checkpoint") != std::string::npos && round == 0) {
+      // A checkpoint this build cannot continue (damaged, or from another build): from the start.
+      jc.say("its checkpoint cannot be continued (" + client_message(f.error(), cfg_.state_dir, cfg_.data_roots) +
+             "); running again from the start");
+      log("job " + jc.id + ": checkpoint refused (" + f.error() + "); running from the start");
+      remove_checkpoint(jc.id);
+      task.clear_restart_path();
+      return true;
+    }
+    jc.finish_and_forget(v1::FAILED, "the run failed", client_message(f.error(), cfg_.state_dir, cfg_.data_roots), 0);
+    return false;
+  }
+  if (!a.exit.exited && (a.exit.signal == SIGTERM || a.exit.signal == SIGINT || a.exit.signal == SIGHUP)) {
+    // Stopped from outside (an operator's signal to the worker): not the job's fault.
+    jc.finish(v1::QUEUED, "its worker process was stopped from outside (" + exit_text + "); queued to run again", "", 0);
+    return false;
+  }
+  // No outcome: the worker process died of a signal nobody sent, or exited without a word.
+  const int crashes = jc.sj.crashes + 1;
+  if (crashes >= cfg_.max_crashes) {
+    remove_checkpoint(jc.id);
+    jc.finish(v1::FAILED, "its worker process crashed",
+              "the job's worker process crashed (" + exit_text + ") in " + std::to_string(crashes) + " attempts", 0, true);
+    return false;
+  }
+  jc.finish(v1::QUEUED,
+            "its worker process crashed (" + exit_text + "); queued to run again (" + std::to_string(crashes) + " of " +
+                std::to_string(cfg_.max_crashes) + " crashes allowed)",
+            "", 0, true);
+  return false;
 }
 
 }  // namespace runout::jobs

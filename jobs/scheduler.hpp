@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "jobs/store.hpp"
+#include "runout/v1/worker.pb.h"
 
 namespace runout::jobs {
 
@@ -90,7 +91,13 @@ class Scheduler {
 
  private:
   void worker_loop(int index);
+  struct JobContext;  // one job's run: its log, paths, limits and how it is recorded
+  struct Attempt;     // what one worker process of a job did
   void run_job(StoredJob job);
+  /// Run the task in a worker process and follow it to its end (progress, cancel, stop, limits).
+  Attempt supervise(JobContext& jc, const v1::WorkerTask& task);
+  /// Record what an ended attempt means for the job; true: run it again at once.
+  bool conclude(JobContext& jc, v1::WorkerTask& task, const Attempt& a, int round);
   /// Publish progress; false when the job should stop (cancel or server stop).
   bool on_progress(const std::string& id, const v1::Progress& p);
   void log(const std::string& line) const;
