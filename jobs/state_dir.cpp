@@ -157,12 +157,73 @@ std::string RecoveryReport::text() const {
 }
 
 // "2026-11-23T06:30:04.123Z": the time stamp the job system writes (a line without one is not ours).
-bool is_stamp(const std::string& t) {
+static bool is_stamp(const std::string& t) {
   if (t.size() != 24 || t[4] != '-' || t[7] != '-' || t[10] != 'T' || t[13] != ':' || t[16] != ':' || t[19] != '.' || t[23] != 'Z')
     return false;
   for (int k : {0, 1, 2, 3, 5, 6, 8, 9, 11, 12, 14, 15, 17, 18, 20, 21, 22})
     if (!std::isdigit(static_cast<unsigned char>(t[std::size_t(k)]))) return false;
   return true;
+}
+
+// A job as its record and its log tell it: "TIME attempt N: started ...", "TIME STATE: reason",
+// "TIME error: ..." (lines without the job system's time stamp are the worker's own output).
+static StoredJob rebuild_job(const v1::JobRecord& rec, const fs::path& state, RecoveryReport& rep) {
+  const fs::path logs = state / "logs";
+  std::error_code ec;
+  StoredJob j;
+  j.job = rec.job();
+  j.owner = rec.owner();
+  j.scenario = rec.scenario();
+  const std::string id = j.job.id();
+  auto add = [&](v1::JobState s, const std::string& when, const std::string& reason) {
+    auto* t = j.job.add_transitions();
+    t->set_state(s);
+    t->set_time_utc(when);
+    t->set_reason(reason);
+    j.job.set_state(s);
+    j.job.set_updated_utc(when);
+  };
+  add(v1::QUEUED, j.job.created_utc(), "submitted");
+  std::ifstream in(logs / (id + ".log"));
+  std::string line;
+  int attempts = 0;
+  while (std::getline(in, line)) {
+    const auto sp = line.find(' ');
+    if (sp == std::string::npos) continue;
+    const std::string when = line.substr(0, sp), text = line.substr(sp + 1);
+    if (!is_stamp(when)) continue;  // the worker's own output (libraries' messages), not the job system's
+    if (text.rfind("attempt ", 0) == 0 && text.find(": started") != std::string::npos) {
+      ++attempts;
+      add(v1::RUNNING, when, "started (attempt " + std::to_string(attempts) + ")");
+      continue;
+    }
+    if (text.rfind("error: ", 0) == 0) {
+      j.job.set_error(text.substr(7));
+      continue;
+    }
+    const auto colon = text.find(": ");
+    if (colon == std::string::npos) continue;
+    const v1::JobState s = state_of(text.substr(0, colon));
+    if (s == v1::JOB_STATE_UNSPECIFIED) continue;
+    if (s != v1::FAILED) j.job.clear_error();
+    if (text.find(": its worker process crashed") != std::string::npos) ++j.crashes;
+    add(s, when, text.substr(colon + 2));
+  }
+  j.job.set_attempts(attempts);
+  const std::string now = utc_now();
+  if (j.job.state() == v1::RUNNING)
+    add(v1::QUEUED, now, "the job store was rebuilt while it ran; queued to run again (from its last checkpoint where it has one)");
+  if (j.job.state() == v1::SUCCEEDED) {
+    const fs::path res = state / "results" / j.job.scenario_hash();
+    if (fs::exists(res / "run.json", ec)) {
+      j.job.set_result_bytes(folder_bytes(res.string()));
+    } else {
+      j.results_removed = true;
+      ++rep.results_missing;
+    }
+  }
+  add(j.job.state(), now, "rebuilt by runout serve --recover from the job's record and log");
+  return j;
 }
 
 RecoveryReport recover_store(const std::string& state_dir, const StateLock& held) {
@@ -194,60 +255,7 @@ RecoveryReport recover_store(const std::string& state_dir, const StateLock& held
           rec.owner().empty())
         continue;  // not a whole record of this job (cut short, or not ours)
       ++rep.records;
-      StoredJob j;
-      j.job = rec.job();
-      j.owner = rec.owner();
-      j.scenario = rec.scenario();
-      const std::string id = j.job.id();
-      // The history from the job's log: "TIME attempt N: started ...", "TIME STATE: reason", "TIME error: ...".
-      auto add = [&](v1::JobState s, const std::string& when, const std::string& reason) {
-        auto* t = j.job.add_transitions();
-        t->set_state(s);
-        t->set_time_utc(when);
-        t->set_reason(reason);
-        j.job.set_state(s);
-        j.job.set_updated_utc(when);
-      };
-      add(v1::QUEUED, j.job.created_utc(), "submitted");
-      std::ifstream in(logs / (id + ".log"));
-      std::string line;
-      int attempts = 0;
-      while (std::getline(in, line)) {
-        const auto sp = line.find(' ');
-        if (sp == std::string::npos) continue;
-        const std::string when = line.substr(0, sp), text = line.substr(sp + 1);
-        if (!is_stamp(when)) continue;  // the worker's own output (libraries' messages), not the job system's
-        if (text.rfind("attempt ", 0) == 0 && text.find(": started") != std::string::npos) {
-          ++attempts;
-          add(v1::RUNNING, when, "started (attempt " + std::to_string(attempts) + ")");
-          continue;
-        }
-        if (text.rfind("error: ", 0) == 0) {
-          j.job.set_error(text.substr(7));
-          continue;
-        }
-        const auto colon = text.find(": ");
-        if (colon == std::string::npos) continue;
-        const v1::JobState s = state_of(text.substr(0, colon));
-        if (s == v1::JOB_STATE_UNSPECIFIED) continue;
-        if (s != v1::FAILED) j.job.clear_error();
-        if (text.find(": its worker process crashed") != std::string::npos) ++j.crashes;
-        add(s, when, text.substr(colon + 2));
-      }
-      j.job.set_attempts(attempts);
-      const std::string now = utc_now();
-      if (j.job.state() == v1::RUNNING)
-        add(v1::QUEUED, now, "the job store was rebuilt while it ran; queued to run again (from its last checkpoint where it has one)");
-      if (j.job.state() == v1::SUCCEEDED) {
-        const fs::path res = state / "results" / j.job.scenario_hash();
-        if (fs::exists(res / "run.json", ec)) {
-          j.job.set_result_bytes(folder_bytes(res.string()));
-        } else {
-          j.results_removed = true;
-          ++rep.results_missing;
-        }
-      }
-      add(j.job.state(), now, "rebuilt by runout serve --recover from the job's record and log");
+      StoredJob j = rebuild_job(rec, state, rep);
       try {
         store.insert_recovered(j);
       } catch (const std::exception&) {
