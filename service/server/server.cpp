@@ -26,6 +26,7 @@
 #include <iostream>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <sstream>
 
 #include "jobs/run.hpp"
@@ -191,35 +192,42 @@ struct Server::Impl final : v1::Runout::Service {
   }
 
 
+  // The digest of a submitted scenario as sent (a retry sends the same bytes).
+  static std::string request_digest(const v1::Scenario& sc) {
+    std::string bytes;
+    google::protobuf::io::StringOutputStream so(&bytes);
+    google::protobuf::io::CodedOutputStream co(&so);
+    co.SetSerializationDeterministic(true);
+    sc.SerializeToCodedStream(&co);
+    co.Trim();
+    return jobs::sha256_hex(bytes);
+  }
+
+  // The answer to a request id used before: its job (the same request), or ALREADY_EXISTS.
+  std::optional<Status> answer_retry(const std::string& owner, const v1::SubmitRequest& req, const std::string& request_hash,
+                                     v1::Job* resp) {
+    if (req.request_id().empty()) return std::nullopt;
+    try {
+      const auto prior = store->find_request(owner, req.request_id());
+      if (!prior || prior->second.empty()) return std::nullopt;
+      if (prior->second != request_hash)
+        return Status(StatusCode::ALREADY_EXISTS, "request_id '" + req.request_id() + "' was used for job " + prior->first.job.id() +
+                                                      " with another scenario; use a new request id for a new scenario");
+      *resp = with_live(prior->first);
+      return Status::OK;
+    } catch (const std::exception& e) {
+      return Status(StatusCode::INTERNAL, std::string("the job store failed: ") + e.what());
+    }
+  }
+
   Status SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRequest* req, v1::Job* resp) override {
     std::string owner;
     if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
     if (!req->has_scenario()) return {StatusCode::INVALID_ARGUMENT, "scenario: missing"};
     if (req->request_id().size() > 200) return {StatusCode::INVALID_ARGUMENT, "request_id: longer than 200 characters"};
     // A retry (the same request id) is answered before anything else, by the digest of the request.
-    std::string request_hash;
-    {
-      std::string bytes;
-      google::protobuf::io::StringOutputStream so(&bytes);
-      google::protobuf::io::CodedOutputStream co(&so);
-      co.SetSerializationDeterministic(true);
-      req->scenario().SerializeToCodedStream(&co);
-      co.Trim();
-      request_hash = jobs::sha256_hex(bytes);
-    }
-    if (!req->request_id().empty()) {
-      try {
-        if (const auto prior = store->find_request(owner, req->request_id()); prior && !prior->second.empty()) {
-          if (prior->second != request_hash)
-            return {StatusCode::ALREADY_EXISTS, "request_id '" + req->request_id() + "' was used for job " + prior->first.job.id() +
-                                                    " with another scenario; use a new request id for a new scenario"};
-          *resp = with_live(prior->first);
-          return Status::OK;
-        }
-      } catch (const std::exception& e) {
-        return {StatusCode::INTERNAL, std::string("the job store failed: ") + e.what()};
-      }
-    }
+    const std::string request_hash = request_digest(req->scenario());
+    if (auto st = answer_retry(owner, *req, request_hash, resp)) return *st;
     v1::Scenario s = req->scenario();
     std::vector<std::string> uploads;  // of this submission: removed when it is refused
     InFlight in_flight{*this, {}};
