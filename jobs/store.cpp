@@ -1,4 +1,5 @@
 #include "jobs/store.hpp"
+#include "jobs/store_sql.hpp"
 
 #include <sqlite3.h>
 
@@ -10,75 +11,8 @@ namespace runout::jobs {
 
 namespace {
 
-// A prepared statement that finalises itself.
-class Stmt {
- public:
-  Stmt(sqlite3* db, const char* sql) : db_(db) {
-    if (sqlite3_prepare_v2(db, sql, -1, &s_, nullptr) != SQLITE_OK)
-      throw StoreError(std::string("job store: ") + sqlite3_errmsg(db) + " in: " + sql);
-  }
-  ~Stmt() { sqlite3_finalize(s_); }
-  Stmt(const Stmt&) = delete;
-  Stmt& operator=(const Stmt&) = delete;
-  Stmt& bind(int k, const std::string& v) {
-    sqlite3_bind_text(s_, k, v.data(), int(v.size()), SQLITE_TRANSIENT);
-    return *this;
-  }
-  Stmt& blob(int k, const std::string& v) {
-    sqlite3_bind_blob(s_, k, v.data(), int(v.size()), SQLITE_TRANSIENT);
-    return *this;
-  }
-  Stmt& bind(int k, std::int64_t v) {
-    sqlite3_bind_int64(s_, k, v);
-    return *this;
-  }
-  Stmt& null(int k) {
-    sqlite3_bind_null(s_, k);
-    return *this;
-  }
-  /// true while rows come.
-  bool step() {
-    const int rc = sqlite3_step(s_);
-    if (rc == SQLITE_ROW) return true;
-    if (rc == SQLITE_DONE) return false;
-    throw StoreError(std::string("job store: ") + sqlite3_errmsg(db_));
-  }
-  std::string text(int c) const {
-    const auto* p = reinterpret_cast<const char*>(sqlite3_column_blob(s_, c));
-    return p ? std::string(p, std::size_t(sqlite3_column_bytes(s_, c))) : std::string();
-  }
-  std::int64_t i64(int c) const { return sqlite3_column_int64(s_, c); }
-  sqlite3_stmt* get() const { return s_; }
-
- private:
-  sqlite3* db_;
-  sqlite3_stmt* s_ = nullptr;
-};
-
-// BEGIN IMMEDIATE ... COMMIT, rolled back when an exception leaves the scope.
-class Transaction {
- public:
-  explicit Transaction(sqlite3* db) : db_(db) { run("BEGIN IMMEDIATE"); }
-  ~Transaction() {
-    if (!done_) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
-  }
-  void commit() {
-    run("COMMIT");
-    done_ = true;
-  }
-
- private:
-  void run(const char* sql) {
-    char* err = nullptr;
-    if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
-      std::string m = err ? err : "?";
-      sqlite3_free(err);
-      throw StoreError("job store: " + m);
-    }
-  }
-  sqlite3* db_;
-  bool done_ = false;
-};
+using sql::Stmt;
+using sql::Transaction;
 
 constexpr const char* kColumns =
     "id, owner, name, hash, request_id, state, created, updated, error, attempts, scenario, progress, result_bytes, "
@@ -554,33 +488,6 @@ void JobStore::insert_recovered(const StoredJob& j) {
   tx.commit();
 }
 
-void JobStore::record_upload(const std::string& owner, const std::string& id, std::int64_t bytes) {
-  std::lock_guard lk(mu_);
-  Stmt(db_, "INSERT OR REPLACE INTO uploads(id, owner, bytes, time) VALUES (?, ?, ?, ?)")
-      .bind(1, id)
-      .bind(2, owner)
-      .bind(3, bytes)
-      .bind(4, std::int64_t(std::time(nullptr)))
-      .step();
-}
-
-std::int64_t JobStore::upload_bytes(const std::string& owner) const {
-  std::lock_guard lk(mu_);
-  Stmt st(db_, "SELECT COALESCE(SUM(bytes), 0) FROM uploads WHERE owner = ?");
-  st.bind(1, owner);
-  st.step();
-  return st.i64(0);
-}
-
-std::vector<std::string> JobStore::uploads_older_than(double cutoff_epoch_s) const {
-  std::lock_guard lk(mu_);
-  Stmt st(db_, "SELECT id FROM uploads GROUP BY id HAVING MAX(time) < ?");
-  st.bind(1, std::int64_t(cutoff_epoch_s));
-  std::vector<std::string> out;
-  while (st.step()) out.push_back(st.text(0));
-  return out;
-}
-
 std::optional<std::pair<StoredJob, std::string>> JobStore::find_request(const std::string& owner,
                                                                        const std::string& request_id) const {
   std::lock_guard lk(mu_);
@@ -590,20 +497,6 @@ std::optional<std::pair<StoredJob, std::string>> JobStore::find_request(const st
   std::pair<StoredJob, std::string> out{read_row(&st), st.text(15)};
   load_transitions(out.first);
   return out;
-}
-
-bool JobStore::forget_upload(const std::string& id, const std::string& owner) {
-  std::lock_guard lk(mu_);
-  Stmt(db_, "DELETE FROM uploads WHERE id = ? AND owner = ?").bind(1, id).bind(2, owner).step();
-  Stmt st(db_, "SELECT COUNT(*) FROM uploads WHERE id = ?");
-  st.bind(1, id);
-  st.step();
-  return st.i64(0) > 0;
-}
-
-void JobStore::forget_upload(const std::string& id) {
-  std::lock_guard lk(mu_);
-  Stmt(db_, "DELETE FROM uploads WHERE id = ?").bind(1, id).step();
 }
 
 }  // namespace runout::jobs
