@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <mutex>
 
+#include "jobs/h5_attr.hpp"
 #include "jobs/scenario.hpp"
 #include "jobs/timeseries.hpp"
 
@@ -12,37 +13,12 @@ namespace runout::jobs {
 
 namespace {
 
+using h5::get_attr_string;
+using h5::put_attr_string;
+
 // 3: with the pressure solver's cross-step state (the operators its preconditioner was built from),
 // without which a continued run is not the uninterrupted run bit for bit.
 constexpr const char* kFormat = "runout VOF checkpoint 3";
-
-void put_attr_string(hid_t loc, const char* name, const std::string& v) {
-  hid_t t = H5Tcopy(H5T_C_S1);
-  H5Tset_size(t, v.size() + 1);
-  hid_t sp = H5Screate(H5S_SCALAR);
-  hid_t a = H5Acreate2(loc, name, t, sp, H5P_DEFAULT, H5P_DEFAULT);
-  const herr_t st = H5Awrite(a, t, v.c_str());
-  H5Aclose(a);
-  H5Sclose(sp);
-  H5Tclose(t);
-  if (st < 0) throw std::runtime_error(std::string("checkpoint: cannot write attribute ") + name);
-}
-
-std::string get_attr_string(hid_t loc, const char* name) {
-  if (H5Aexists(loc, name) <= 0) return {};
-  hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
-  hid_t t = H5Aget_type(a);
-  const std::size_t n = H5Tget_size(t);
-  std::string v(n, '\0');
-  hid_t mt = H5Tcopy(H5T_C_S1);
-  H5Tset_size(mt, n);
-  H5Aread(a, mt, v.data());
-  H5Tclose(mt);
-  H5Tclose(t);
-  H5Aclose(a);
-  v.resize(v.find('\0') == std::string::npos ? v.size() : v.find('\0'));
-  return v;
-}
 
 void put_doubles(hid_t g, const char* name, const std::vector<double>& v, hsize_t cols = 1) {
   const hsize_t dims[2] = {hsize_t(v.size()) / cols, cols};

@@ -8,12 +8,16 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "jobs/h5_attr.hpp"
 #include "jobs/scenario.hpp"
 #include "jobs/timeseries.hpp"
 
 namespace runout::jobs {
 
 namespace {
+
+using h5::get_attr_string;
+using h5::put_attr_string;
 
 // The scalars, by position in the dataset "scalars" (their names are in its attribute "names").
 constexpr const char* kScalarNames =
@@ -27,34 +31,6 @@ struct File {
     if (id >= 0) H5Fclose(id);
   }
 };
-
-void put_attr_string(hid_t loc, const char* name, const std::string& v) {
-  hid_t t = H5Tcopy(H5T_C_S1);
-  H5Tset_size(t, v.size() + 1);
-  hid_t sp = H5Screate(H5S_SCALAR);
-  hid_t a = H5Acreate2(loc, name, t, sp, H5P_DEFAULT, H5P_DEFAULT);
-  const herr_t st = a < 0 ? -1 : H5Awrite(a, t, v.c_str());
-  if (a >= 0) H5Aclose(a);
-  H5Sclose(sp);
-  H5Tclose(t);
-  if (st < 0) throw std::runtime_error(std::string("checkpoint: cannot write attribute ") + name);
-}
-
-std::string get_attr_string(hid_t loc, const char* name) {
-  if (H5Aexists(loc, name) <= 0) return {};
-  hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
-  hid_t t = H5Aget_type(a);
-  const std::size_t n = H5Tget_size(t);
-  std::string v(n, '\0');
-  hid_t mt = H5Tcopy(H5T_C_S1);
-  H5Tset_size(mt, n);
-  H5Aread(a, mt, v.data());
-  H5Tclose(mt);
-  H5Tclose(t);
-  H5Aclose(a);
-  v.resize(v.find('\0') == std::string::npos ? v.size() : v.find('\0'));
-  return v;
-}
 
 // A dataset of `n` values of `file_type` from memory of `mem_type`; 2D (rows x cols) when rows > 0.
 void put(hid_t f, const char* name, hid_t file_type, hid_t mem_type, const void* data, std::size_t n, hsize_t rows = 0) {
