@@ -1,5 +1,6 @@
 #pragma once
 // Subcommands of the `runout` program. Each returns the process exit code.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,8 @@ void prepare(CLI::App& app);
 int parse_args(CLI::App& app, const std::vector<std::string>& args);
 /// Prints "<name>: <message>" on standard error; returns kUsage.
 int usage_error(const std::string& name, const std::string& message);
+/// A positive integer written as the whole of `v` (--threads, --workers, ...); nothing otherwise.
+std::optional<int> positive_int(const std::string& v);
 
 /// The connection options of the client commands (--server, --token, --token-file, --tls-ca,
 /// --tls). `server_env`: --server defaults to $RUNOUT_SERVER; --token always to $RUNOUT_TOKEN.

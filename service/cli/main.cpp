@@ -125,6 +125,16 @@ void prepare(CLI::App& app) {
   app.set_help_flag("-h,--help", "Print this command's options and exit");
 }
 
+std::optional<int> positive_int(const std::string& v) {
+  try {
+    std::size_t used = 0;
+    const int n = std::stoi(v, &used);
+    if (used == v.size() && n >= 1) return n;
+  } catch (...) {
+  }
+  return std::nullopt;
+}
+
 int usage_error(const std::string& name, const std::string& message) {
   std::cerr << name << ": " << message << "\n";
   return kUsage;

@@ -71,15 +71,9 @@ int run(const std::vector<std::string>& args) {
     if (!f->empty()) *f = fs::absolute(*f).string();
   }
   if (app.count("--threads")) {
-    int n = 0;
-    try {
-      std::size_t used = 0;
-      n = std::stoi(threads, &used);
-      if (used != threads.size()) n = 0;
-    } catch (...) {
-    }
-    if (n < 1) return usage_error("runout run", "--threads takes a positive integer, got '" + threads + "'");
-    omp_set_num_threads(n);
+    const auto n = positive_int(threads);
+    if (!n) return usage_error("runout run", "--threads takes a positive integer, got '" + threads + "'");
+    omp_set_num_threads(*n);
   }
   if (scenario.empty() || out.empty()) {
     return usage_error("runout run",

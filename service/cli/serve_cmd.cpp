@@ -43,14 +43,10 @@ int serve(const std::vector<std::string>& args) {
   app.add_option("--log-file", log_file, "The server's log (default: standard error)")->type_name("FILE");
   if (const int rc = parse_args(app, args); rc >= 0) return rc;
   auto number = [&](const char* flag, const std::string& v, int* out) {
-    try {
-      std::size_t used = 0;
-      *out = std::stoi(v, &used);
-      if (used == v.size() && *out >= 1) return true;
-    } catch (...) {
-    }
-    usage_error("runout serve", std::string(flag) + " takes a positive integer, got '" + v + "'");
-    return false;
+    const auto n = positive_int(v);
+    if (!n) usage_error("runout serve", std::string(flag) + " takes a positive integer, got '" + v + "'");
+    *out = n.value_or(0);
+    return n.has_value();
   };
   int n = 0;
   if (app.count("--workers")) {
