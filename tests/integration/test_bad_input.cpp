@@ -18,6 +18,7 @@
 #include "jobs/run.hpp"
 #include "jobs/scenario.hpp"
 #include "terrain/terrain.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace fs = std::filesystem;
 using namespace runout;
@@ -44,26 +45,8 @@ std::vector<std::string> bundled_scenarios() {
   return out;
 }
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct TempDir {
-  fs::path p;
-  TempDir() {
-    static int counter = 0;
-    p = fs::temp_directory_path() / ("runout-bad-input-" + std::to_string(getpid()) + "-" + std::to_string(counter++));
-    fs::create_directories(p);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(p, ec);
-  }
-  std::string operator/(const std::string& n) const { return (p / n).string(); }
-};
+using runout::test_support::read_text;
+using runout::test_support::TempDir;
 
 void write_text(const std::string& path, const std::string& text) {
   std::ofstream out(path);

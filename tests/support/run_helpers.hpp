@@ -18,6 +18,7 @@
 
 #include "jobs/run.hpp"
 #include "jobs/scenario.hpp"
+#include "tests/support/temp_dir.hpp"
 #include "terrain/terrain.hpp"
 
 namespace fs = std::filesystem;
@@ -27,33 +28,14 @@ namespace runout::test_support::run {
 
 namespace fs = std::filesystem;
 using namespace runout;
+using test_support::read_text;
+using test_support::TempDir;
 
-
-// A number of run.json ("key": value, searched from `from` on; NaN if missing) and a file's text.
+// A number of run.json ("key": value, searched from `from` on; NaN if missing).
 inline double json_number(const std::string& j, const std::string& key, std::size_t from = 0) {
   const auto k = j.find("\"" + key + "\": ", from);
   return k == std::string::npos ? NAN : std::atof(j.c_str() + k + key.size() + 4);
 }
-inline std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct TempDir {
-  fs::path p;
-  TempDir() {
-    p = fs::temp_directory_path() / ("runout-test-" + std::to_string(getpid()) + "-" + std::to_string(counter()++));
-    fs::create_directories(p);
-  }
-  ~TempDir() { fs::remove_all(p); }
-  static int& counter() {
-    static int c = 0;
-    return c;
-  }
-  std::string operator/(const std::string& n) const { return (p / n).string(); }
-};
 
 // A DEM in UTM 32N (EPSG:32632): a slope of `deg` falling to the east, flattening into a valley.
 inline void make_dem(const std::string& path, int n, double cell, double deg, const char* epsg = "EPSG:32632", bool with_crs = true,

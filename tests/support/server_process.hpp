@@ -15,30 +15,11 @@
 #include <vector>
 
 #include "service/client/client.hpp"
+#include "tests/support/temp_dir.hpp"
 
 namespace runout::test_support {
 
 namespace fs = std::filesystem;
-
-inline std::string read_text(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct TempDir {
-  fs::path p;
-  TempDir() {
-    static int n = 0;
-    p = fs::temp_directory_path() / ("runout-svc-" + std::to_string(getpid()) + "-" + std::to_string(n++));
-    fs::create_directories(p);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(p, ec);
-  }
-};
 
 struct ServerOptions {
   std::int64_t file_size_limit = 0;  ///< RLIMIT_FSIZE of the server (and its workers); 0: none
