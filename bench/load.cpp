@@ -22,7 +22,7 @@
 #include <thread>
 #include <vector>
 
-#include "jobs/scenario.hpp"
+#include "jobs/scenario/scenario.hpp"
 #include "service/client/client.hpp"
 
 namespace fs = std::filesystem;

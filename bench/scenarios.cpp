@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "jobs/run.hpp"
+#include "jobs/drivers/run.hpp"
 
 namespace fs = std::filesystem;
 

@@ -17,8 +17,8 @@
 #include <utility>
 #include <vector>
 
-#include "jobs/run.hpp"
-#include "jobs/scenario.hpp"
+#include "jobs/drivers/run.hpp"
+#include "jobs/scenario/scenario.hpp"
 
 namespace runout::bench {
 

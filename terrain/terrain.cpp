@@ -8,7 +8,6 @@
 #include <ogr_geometry.h>
 #include <ogr_spatialref.h>
 #include <ogrsf_frmts.h>
-#include <openssl/evp.h>
 
 #include <algorithm>
 #include <cctype>
@@ -680,28 +679,6 @@ void write_ascii_on(const std::string& path, const std::string& template_path, c
   const char* opts[] = {"DECIMAL_PRECISION=4", nullptr};
   GDALDatasetUniquePtr out(asc->CreateCopy(path.c_str(), dst.get(), FALSE, const_cast<char**>(opts), nullptr, nullptr));
   if (!out) throw TerrainError("writing '" + path + "' failed" + gdal_message());
-}
-
-std::string sha256_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw TerrainError("cannot read '" + path + "' to hash it");
-  std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> ctx(EVP_MD_CTX_new(), EVP_MD_CTX_free);
-  EVP_DigestInit_ex(ctx.get(), EVP_sha256(), nullptr);
-  char buf[1 << 16];
-  while (in) {
-    in.read(buf, sizeof buf);
-    EVP_DigestUpdate(ctx.get(), buf, std::size_t(in.gcount()));
-  }
-  unsigned char md[EVP_MAX_MD_SIZE];
-  unsigned int len = 0;
-  EVP_DigestFinal_ex(ctx.get(), md, &len);
-  static const char* hex = "0123456789abcdef";
-  std::string s;
-  for (unsigned k = 0; k < len; ++k) {
-    s += hex[md[k] >> 4];
-    s += hex[md[k] & 15];
-  }
-  return s;
 }
 
 }  // namespace runout::terrain

@@ -101,7 +101,4 @@ OutlineReport write_outline(const std::string& geojson_path, const std::string& 
 /// exports that demand the input DEM's grid (ISeeSnow).
 void write_ascii_on(const std::string& path, const std::string& template_path, const Grid& g, const std::vector<double>& values);
 
-/// SHA-256 of a file, hex.
-std::string sha256_file(const std::string& path);
-
 }  // namespace runout::terrain

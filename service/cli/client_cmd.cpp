@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "jobs/scenario.hpp"
+#include "jobs/scenario/scenario.hpp"
 #include "service/cli/commands.hpp"
 #include "service/cli/output_dir.hpp"
 #include "service/client/client.hpp"

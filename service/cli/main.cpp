@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "jobs/worker.hpp"
+#include "jobs/drivers/worker_task.hpp"
 #include "service/cli/commands.hpp"
 
 namespace {

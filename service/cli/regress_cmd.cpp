@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "jobs/regression.hpp"
-#include "jobs/scenario.hpp"
+#include "jobs/regression/regression.hpp"
+#include "jobs/scenario/scenario.hpp"
 #include "service/cli/commands.hpp"
 #include "service/client/client.hpp"
 #include "service/server/server.hpp"

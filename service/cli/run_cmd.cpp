@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "jobs/run.hpp"
+#include "jobs/drivers/run.hpp"
 #include "service/cli/commands.hpp"
 #include "service/cli/output_dir.hpp"
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "jobs/state_dir.hpp"
+#include "jobs/system/state_dir.hpp"
 #include "service/cli/commands.hpp"
 #include "service/server/server.hpp"
 

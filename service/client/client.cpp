@@ -8,8 +8,8 @@
 #include <sstream>
 
 #include "grpc/health/v1/health.grpc.pb.h"
-#include "jobs/sha256.hpp"
-#include "jobs/store.hpp"
+#include "jobs/digest/sha256.hpp"
+#include "jobs/system/store.hpp"
 #include "runout/v1/service.grpc.pb.h"
 
 namespace fs = std::filesystem;

@@ -8,9 +8,9 @@
 #include <optional>
 #include <sstream>
 
-#include "jobs/scheduler.hpp"
-#include "jobs/store.hpp"
-#include "jobs/worker.hpp"
+#include "jobs/system/scheduler.hpp"
+#include "jobs/system/store.hpp"
+#include "jobs/system/worker.hpp"
 #include "runout/v1/worker.pb.h"
 #include "service/server/server.hpp"
 

@@ -29,14 +29,13 @@
 #include <optional>
 #include <sstream>
 
-#include "jobs/run.hpp"
-#include "jobs/scenario.hpp"
-#include "jobs/scheduler.hpp"
-#include "jobs/sha256.hpp"
-#include "jobs/state_dir.hpp"
-#include "jobs/worker.hpp"
+#include "jobs/scenario/scenario.hpp"
+#include "jobs/system/scheduler.hpp"
+#include "jobs/digest/sha256.hpp"
+#include "jobs/system/state_dir.hpp"
+#include "jobs/system/worker.hpp"
 #include "runout/v1/worker.pb.h"
-#include "jobs/store.hpp"
+#include "jobs/system/store.hpp"
 #include "runout/v1/service.grpc.pb.h"
 #include "service/server/inputs.hpp"
 #include "service/server/tokens.hpp"

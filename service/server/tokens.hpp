@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "jobs/sha256.hpp"
+#include "jobs/digest/sha256.hpp"
 #include "service/server/inputs.hpp"
 #include "service/server/server.hpp"
 

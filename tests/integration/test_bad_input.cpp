@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "jobs/run.hpp"
-#include "jobs/scenario.hpp"
+#include "jobs/drivers/run.hpp"
+#include "jobs/scenario/scenario.hpp"
 #include "terrain/terrain.hpp"
 #include "tests/support/temp_dir.hpp"
 

@@ -16,9 +16,9 @@
 #include <sstream>
 #include <thread>
 
-#include "jobs/scenario.hpp"
-#include "jobs/sha256.hpp"
-#include "jobs/store.hpp"
+#include "jobs/scenario/scenario.hpp"
+#include "jobs/digest/sha256.hpp"
+#include "jobs/system/store.hpp"
 #include <sqlite3.h>
 #include "service/client/client.hpp"
 #include "tests/support/server_process.hpp"

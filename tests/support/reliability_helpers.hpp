@@ -20,9 +20,9 @@
 #include <set>
 #include <thread>
 
-#include "jobs/scenario.hpp"
-#include "jobs/sha256.hpp"
-#include "jobs/store.hpp"
+#include "jobs/scenario/scenario.hpp"
+#include "jobs/digest/sha256.hpp"
+#include "jobs/system/store.hpp"
 #include "terrain/terrain.hpp"
 #include "tests/support/server_process.hpp"
 
@@ -144,7 +144,7 @@ inline std::map<std::string, std::string> fingerprint(const fs::path& dir) {
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
     const std::string n = e.path().filename().string(), ext = e.path().extension().string();
-    if (ext == ".tif" || n == "outline.geojson") fp[n] = terrain::sha256_file(e.path().string());
+    if (ext == ".tif" || n == "outline.geojson") fp[n] = jobs::sha256_file(e.path().string());
     if (ext == ".h5")
       for (const auto& [k, v] : h5_datasets(e.path())) fp[n + ":" + k] = v;
     if (n == "run.json")

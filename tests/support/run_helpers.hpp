@@ -16,8 +16,8 @@
 #include <map>
 #include <sstream>
 
-#include "jobs/run.hpp"
-#include "jobs/scenario.hpp"
+#include "jobs/drivers/run.hpp"
+#include "jobs/scenario/scenario.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "terrain/terrain.hpp"
 

@@ -1,0 +1,309 @@
+#include "jobs/drivers/run.hpp"
+
+#include "jobs/digest/sha256.hpp"
+
+#include "jobs/drivers/lab_run.hpp"
+
+#include <google/protobuf/util/json_util.h>
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "engine/sh2d.hpp"
+#include "jobs/formats/sh_checkpoint.hpp"
+#include "jobs/formats/timeseries.hpp"
+#include "jobs/figures/map.hpp"
+
+#ifndef RUNOUT_VERSION
+#define RUNOUT_VERSION "unknown"
+#endif
+
+namespace runout::jobs {
+namespace fs = std::filesystem;
+
+namespace {
+
+double since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string jstr(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"': o += "\\\""; break;
+      case '\\': o += "\\\\"; break;
+      case '\n': o += "\\n"; break;
+      case '\t': o += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char b[8];
+          std::snprintf(b, sizeof b, "\\u%04x", c);
+          o += b;
+        } else {
+          o += c;
+        }
+    }
+  }
+  return o + "\"";
+}
+
+
+}  // namespace
+
+RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt) {
+  if (s.vof) return run_lab(s, out_dir, opt);
+  RunSummary sum;
+  const auto t0 = std::chrono::steady_clock::now();
+  terrain::DemReport dem_rep;
+  const terrain::Grid grid = terrain::prepare_grid(s.dem, &dem_rep);
+  terrain::ReleaseReport rel_rep;
+  const auto h0 = terrain::rasterize_releases(grid, s.releases, &rel_rep);
+  sum.nx = grid.nx;
+  sum.ny = grid.ny;
+  sum.dx = grid.dx;
+  sum.crs = grid.crs_name;
+  sum.release_area_m2 = rel_rep.area_m2;
+  sum.release_volume_m3 = rel_rep.volume_m3;
+  sum.notes = rel_rep.notes;
+
+  // Engine grid: local origin at the grid's centre.
+  engine::Terrain2D t;
+  t.nx = grid.nx;
+  t.ny = grid.ny;
+  t.dx = t.dy = grid.dx;
+  t.x0 = -0.5 * (grid.nx - 1) * grid.dx;
+  t.y0 = -0.5 * (grid.ny - 1) * grid.dx;
+  t.z = grid.z;
+  t.outside = grid.outside;
+  auto cfg = s.config;
+  cfg.time.progress = opt.progress;
+  cfg.time.progress_every = opt.progress_every;
+  sum.seconds_prepare = since(t0);
+
+  // Checkpoints: the solver's whole state between two steps, with the scenario's hash; the time
+  // series so far lies beside it (CHECKPOINT.timeseries.h5), so that a continued run's outputs are
+  // the whole run's.
+  const bool checkpoints = !opt.checkpoint_path.empty(), continued = !opt.restart_path.empty();
+  const std::string hash = checkpoints || continued ? scenario_hash(s) : std::string();
+  ShCheckpoint restart;
+  if (continued) {
+    restart = read_sh_checkpoint(opt.restart_path);
+    if (restart.scenario_hash != hash)
+      throw ScenarioError("checkpoint " + opt.restart_path + " belongs to another scenario (its scenario hash " +
+                          restart.scenario_hash.substr(0, 12) + "... is not this one's " + hash.substr(0, 12) + "...)");
+    if (restart.state.nx != t.nx || restart.state.ny != t.ny || restart.state.tile != cfg.tile)
+      throw ScenarioError("checkpoint " + opt.restart_path + " is of another grid");
+  }
+
+  std::unique_ptr<TimeSeriesWriter> series;
+  if (s.timeseries_interval > 0) {
+    series = continued ? std::make_unique<TimeSeriesWriter>(out_dir, grid, t, opt.restart_path + ".timeseries.h5", restart.timeseries_frames)
+                       : std::make_unique<TimeSeriesWriter>(out_dir, grid, t);
+    cfg.snapshot_interval = s.timeseries_interval;
+    cfg.snapshot = [&](double time, const engine::Sh2dStateView& v) { series->write(time, v); };
+  }
+  if (checkpoints) {
+    cfg.checkpoint_interval = opt.checkpoint_interval_s;
+    cfg.checkpoint = [&](const engine::Sh2dCheckpoint& c) {
+      // The frames first: a checkpoint never refers to frames that are not beside it.
+      if (series) series->save_copy(opt.checkpoint_path + ".timeseries.h5");
+      write_sh_checkpoint(opt.checkpoint_path, hash, series ? series->frames() : 0, c);
+    };
+  }
+  const auto t1 = std::chrono::steady_clock::now();
+  const std::clock_t cpu0 = std::clock();
+  const double continued_from = continued ? restart.state.t : std::numeric_limits<double>::quiet_NaN();
+  engine::Sh2dResult res;
+  if (continued) {
+    try {
+      res = engine::run_sh2d(t, cfg, restart.state);
+    } catch (const std::invalid_argument& e) {  // the engine's checks of the checkpoint
+      throw ScenarioError("checkpoint " + opt.restart_path + ": " + e.what());
+    }
+  } else {
+    res = engine::run_sh2d(t, cfg, engine::state_from_normal_depth(t, h0));
+  }
+  restart.state = {};  // its fields are no longer needed
+  sum.cpu_seconds = double(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  int frames = 0;
+  if (series) frames = series->finish();
+  sum.seconds_run = since(t1);
+  const auto& d = res.diag;
+  sum.volume_initial = d.volume_initial;
+  sum.volume_final = d.volume_final;
+  sum.volume_outflow = d.volume_outflow;
+  sum.volume_error = d.volume_error();
+  sum.t = d.t;
+  sum.steps = d.steps;
+  sum.stop = std::string(engine::to_string(d.stop));
+  sum.max_speed = d.max_speed;
+
+  // Figures of the hazard map.
+  const auto& hz = res.hazard;
+  double mx = 0, my = 0, m = 0;
+  for (int j = 0; j < grid.ny; ++j)
+    for (int i = 0; i < grid.nx; ++i) {
+      const double v = h0[std::size_t(j) * grid.nx + i];
+      m += v;
+      mx += v * grid.cx(i);
+      my += v * grid.cy(j);
+    }
+  mx /= m;
+  my /= m;
+  long affected = 0;
+  for (int j = 0; j < grid.ny; ++j)
+    for (int i = 0; i < grid.nx; ++i) {
+      const std::size_t k = std::size_t(j) * grid.nx + i;
+      sum.max_depth = std::max(sum.max_depth, hz.max_depth[k]);
+      if (hz.max_depth[k] <= s.outline_threshold) continue;
+      ++affected;
+      sum.runout_m = std::max(sum.runout_m, std::hypot(grid.cx(i) - mx, grid.cy(j) - my));
+    }
+  sum.affected_area_m2 = double(affected) * grid.dx * grid.dx;
+  // The engine stops a run whose state turns non-finite; this guards what the records would say.
+  for (const auto& [name, v] : {std::pair<const char*, double>{"final volume", d.volume_final}, {"outflow volume", d.volume_outflow},
+                                {"maximum speed", d.max_speed}, {"maximum depth", sum.max_depth},
+                                {"kinetic-energy peak", d.kinetic_energy_peak}, {"runout", sum.runout_m}})
+    if (!std::isfinite(v))
+      throw std::runtime_error(std::string("the run's ") + name + " is not finite (" + json_number(v) +
+                               "): the flow state became NaN or infinite; no results written");
+
+  // Outputs.
+  const auto t2 = std::chrono::steady_clock::now();
+  auto out = [&](const std::string& name) { return (fs::path(out_dir) / name).string(); };
+  // Cells outside the domain are nodata in every raster.
+  auto masked = [&](const std::vector<double>& v) {
+    std::vector<double> m = v;
+    for (std::size_t k = 0; k < m.size(); ++k)
+      if (grid.outside[k]) m[k] = std::numeric_limits<double>::quiet_NaN();
+    return m;
+  };
+  for (const auto& name : s.rasters) {
+    const std::vector<double>* v = nullptr;
+    std::string desc;
+    if (name == "max_depth") v = &hz.max_depth, desc = "maximum flow depth normal to the surface [m]";
+    if (name == "max_speed") v = &hz.max_speed, desc = "maximum flow speed [m/s]";
+    if (name == "max_pressure") v = &hz.max_pressure, desc = "maximum pressure rho u^2 [Pa]";
+    if (name == "deposit") v = &hz.final_depth, desc = "deposit depth normal to the surface at the end [m]";
+    if (name == "arrival_time") v = &hz.arrival_time, desc = "arrival time of the flow [s]";
+    terrain::write_cog(out(name + ".tif"), grid, masked(*v), desc);
+    sum.files.push_back(name + ".tif");
+  }
+  const auto outline = terrain::write_outline(out("outline.geojson"), out("outline.gpkg"), grid, hz.max_depth, s.outline_threshold);
+  if (outline.geojson) sum.files.push_back("outline.geojson");
+  else sum.notes.push_back("outline.geojson not written: the grid's CRS is local (no geographic coordinates)");
+  sum.files.push_back("outline.gpkg");
+  figures::MapRequest mreq;
+  mreq.title = s.scenario.name().empty() ? "runout" : s.scenario.name();
+  if (mreq.title.size() > 60) mreq.title = mreq.title.substr(0, 57) + "...";
+  mreq.outline_threshold = s.outline_threshold;
+  mreq.scale = grid.nx * grid.ny > 1000000 ? 1 : 2;
+  figures::write_map_png(out("map.png"), grid, hz.max_depth, h0, mreq);
+  sum.files.push_back("map.png");
+  if (series) {
+    sum.files.push_back("timeseries.h5");
+    sum.files.push_back("timeseries.xmf");
+  }
+  sum.seconds_write = since(t2);
+
+  // ISeeSnow export: peak flow thickness and velocity on the input DEM's grid, and the result row.
+  if (!opt.iseesnow_id.empty()) {
+    const std::string stem = fs::path(s.releases.front().path).stem().string() + "_" + opt.iseesnow_id + "_null_runout";
+    terrain::write_ascii_on(out(stem + "_pft.asc"), s.dem.dem_path, grid, masked(hz.max_depth));
+    terrain::write_ascii_on(out(stem + "_pfv.asc"), s.dem.dem_path, grid, masked(hz.max_speed));
+    // The benchmark's result table (simulationResultTable.csv): one row per simulation; the
+    // leading digits of the id are the row index, the rest the test case.
+    std::size_t digits = 0;
+    while (digits < opt.iseesnow_id.size() && std::isdigit(static_cast<unsigned char>(opt.iseesnow_id[digits]))) ++digits;
+    const std::string index = digits ? std::to_string(std::stoi(opt.iseesnow_id.substr(0, digits))) : "";
+    std::ofstream csv(out("iseesnow_" + opt.iseesnow_id + ".csv"));
+    csv << ",testCase,computation duration (CPU) [s],avalanche flow time [s],volume at t0 [m3],"
+           "volume at tFinal [m3],spatial resolution x [m],spatial resolution y [m],number of particles\n";
+    csv << index << "," << opt.iseesnow_id.substr(digits) << "," << json_number(sum.cpu_seconds) << "," << json_number(d.t) << ","
+        << json_number(d.volume_initial) << "," << json_number(d.volume_final) << "," << json_number(grid.dx) << "," << json_number(grid.dx) << ",\n";
+    if (!csv) throw std::runtime_error("writing the ISeeSnow CSV failed");
+    // The model configuration file the benchmark asks for, named like the peak fields.
+    std::ofstream cfg(out(stem + ".txt"));
+    const auto& m = s.scenario.material();
+    cfg << "runout " << RUNOUT_VERSION << ": depth-averaged Savage-Hutter model (NOC-TVD scheme, "
+        << "curvature in the bed friction " << (s.scenario.numerics().curvature_off() ? "off" : "on") << ")\n"
+        << "scenario = " << s.scenario.name() << "\n"
+        << "rheology = " << (m.rheology().empty() ? "coulomb" : m.rheology()) << "\n";
+    if (m.has_voellmy_mu()) cfg << "mu = " << json_number(m.voellmy_mu()) << "\n";
+    if (m.has_voellmy_xi()) cfg << "xi_m_s2 = " << json_number(m.voellmy_xi()) << "\n";
+    if (m.has_bed_friction_deg()) cfg << "bed_friction_deg = " << json_number(m.bed_friction_deg()) << "\n";
+    if (m.has_internal_friction_deg()) cfg << "internal_friction_deg = " << json_number(m.internal_friction_deg()) << "\n";
+    cfg << "earth_pressure = " << (m.earth_pressure().empty() ? "unity" : m.earth_pressure()) << "\n"
+        << "limiter = " << (s.scenario.numerics().limiter().empty() ? "minmod" : s.scenario.numerics().limiter()) << "\n"
+        << "cfl = " << json_number(s.config.time.cfl) << "\n"
+        << "cell_size_m = " << json_number(grid.dx) << "\n"
+        << "release_volume_m3 = " << json_number(d.volume_initial) << "\n"
+        << "stop = " << engine::to_string(d.stop) << " at t = " << json_number(d.t) << " s\n";
+    if (!cfg) throw std::runtime_error("writing the ISeeSnow configuration file failed");
+    sum.files.push_back(stem + ".txt");
+    for (const char* suffix : {"_pft.asc", "_pfv.asc"}) sum.files.push_back(stem + suffix);
+    sum.files.push_back("iseesnow_" + opt.iseesnow_id + ".csv");
+  }
+
+  // Run record.
+  std::string scenario_json;
+  google::protobuf::util::JsonPrintOptions po;
+  po.always_print_primitive_fields = true;
+  po.preserve_proto_field_names = true;
+  (void)google::protobuf::util::MessageToJsonString(s.scenario, &scenario_json, po);
+  std::ostringstream r;
+  r << "{\n  \"software\": {\"name\": \"runout\", \"version\": " << jstr(RUNOUT_VERSION) << "},\n";
+  r << "  \"created_utc\": " << jstr([] {
+    char b[32];
+    const std::time_t now = std::time(nullptr);
+    std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+    return std::string(b);
+  }()) << ",\n";
+  r << "  \"scenario_file\": " << jstr(s.source) << ",\n  \"scenario\": " << scenario_json << ",\n";
+  r << "  \"inputs\": [";
+  for (std::size_t k = 0; k < s.input_files.size(); ++k)
+    r << (k ? ", " : "") << "{\"path\": " << jstr(s.input_files[k]) << ", \"sha256\": " << jstr(sha256_file(s.input_files[k])) << "}";
+  r << "],\n";
+  r << "  \"dem\": {\"source_crs\": " << jstr(dem_rep.source_crs) << ", \"source_resolution_m\": " << json_number(dem_rep.source_resolution_m)
+    << ", \"z_min_m\": " << json_number(dem_rep.z_min) << ", \"z_max_m\": " << json_number(dem_rep.z_max)
+    << ", \"slope_mean_deg\": " << json_number(dem_rep.slope_mean_deg) << ", \"slope_p90_deg\": " << json_number(dem_rep.slope_p90_deg)
+    << ", \"slope_max_deg\": " << json_number(dem_rep.slope_max_deg) << ", \"cells_without_data\": " << dem_rep.cells_without_data
+    << ", \"cells_outside_area\": " << dem_rep.cells_outside_area << "},\n";
+  r << "  \"grid\": {\"crs\": " << jstr(grid.crs_name) << ", \"nx\": " << grid.nx << ", \"ny\": " << grid.ny
+    << ", \"cell_size_m\": " << json_number(grid.dx) << ", \"x_min\": " << json_number(grid.x_min) << ", \"y_min\": " << json_number(grid.y_min)
+    << ", \"local_origin\": [" << json_number(grid.x_min + 0.5 * grid.nx * grid.dx) << ", " << json_number(grid.y_min + 0.5 * grid.ny * grid.dx)
+    << "]},\n";
+  r << "  \"release\": {\"polygons\": " << rel_rep.polygons << ", \"cells\": " << rel_rep.cells << ", \"area_m2\": "
+    << json_number(rel_rep.area_m2) << ", \"volume_m3\": " << json_number(rel_rep.volume_m3) << ", \"notes\": [";
+  for (std::size_t k = 0; k < rel_rep.notes.size(); ++k) r << (k ? ", " : "") << jstr(rel_rep.notes[k]);
+  r << "]},\n";
+  r << "  \"mass_balance\": {\"volume_initial_m3\": " << json_number(d.volume_initial) << ", \"volume_final_m3\": " << json_number(d.volume_final)
+    << ", \"volume_outflow_m3\": " << json_number(d.volume_outflow) << ", \"relative_error\": " << json_number(d.volume_error()) << "},\n";
+  r << "  \"solver\": {\"steps\": " << d.steps << ", \"simulated_s\": " << json_number(d.t) << ", \"stop\": " << jstr(sum.stop)
+    << ", \"continued_from_t_s\": " << json_number(continued_from) << ", \"max_speed_m_s\": " << json_number(d.max_speed) << ", \"kinetic_energy_peak\": " << json_number(d.kinetic_energy_peak)
+    << ", \"positivity_limited\": " << d.positivity_limited << ", \"cell_updates\": " << json_number(d.cell_updates)
+    << ", \"mean_active_fraction\": " << json_number(d.mean_active_fraction) << ", \"max_active_fraction\": " << json_number(d.max_active_fraction)
+    << "},\n";
+  r << "  \"results\": {\"affected_area_m2\": " << json_number(sum.affected_area_m2) << ", \"outline_polygons\": " << outline.polygons
+    << ", \"outline_area_m2\": " << json_number(outline.area_m2) << ", \"runout_from_release_centroid_m\": " << json_number(sum.runout_m)
+    << ", \"max_depth_m\": " << json_number(sum.max_depth) << ", \"outline_threshold_m\": " << json_number(s.outline_threshold)
+    << ", \"timeseries_frames\": " << frames << "},\n";
+  r << "  \"timings_s\": {\"prepare\": " << json_number(sum.seconds_prepare) << ", \"run\": " << json_number(sum.seconds_run)
+    << ", \"write\": " << json_number(sum.seconds_write) << "},\n";
+  r << "  \"outputs\": [";
+  for (std::size_t k = 0; k < sum.files.size(); ++k) r << (k ? ", " : "") << jstr(sum.files[k]);
+  r << ", \"run.json\"]\n}\n";
+  std::ofstream f(out("run.json"));
+  f << r.str();
+  if (!f) throw std::runtime_error("writing run.json failed");
+  sum.files.push_back("run.json");
+  return sum;
+}
+
+}  // namespace runout::jobs

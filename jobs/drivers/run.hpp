@@ -1,0 +1,55 @@
+#pragma once
+// The run driver: terrain -> engine -> outputs (rasters, outline, map, run record) for one resolved
+// scenario, writing into a directory.
+// The command line's `runout run` and (later) the service's workers call the same code.
+#include <string>
+#include <vector>
+
+#include "engine/run_control.hpp"
+#include "jobs/scenario/scenario.hpp"
+
+namespace runout::jobs {
+
+struct RunOptions {
+  engine::ProgressHook progress;  ///< optional; returning false cancels the run
+  long progress_every = 50;
+  /// ISeeSnow benchmark export (validation.md A8) when not empty: the simulation id (e.g.
+  /// "03CoulombOnly"). Writes <release>_<id>_null_runout_pft.asc / _pfv.asc on the DEM's grid and
+  /// iseesnow_<id>.csv.
+  std::string iseesnow_id;
+  /// Write checkpoints to this file (replaced each time, atomically) every checkpoint interval of
+  /// simulated time and when the run is cancelled; empty: none. Both engines: VOF runs
+  /// (jobs/checkpoint.hpp, the frames so far in FILE.fields.h5) and depth-averaged runs
+  /// (jobs/sh_checkpoint.hpp, the time series so far in FILE.timeseries.h5).
+  std::string checkpoint_path;
+  /// Continue from this checkpoint instead of the initial state. VOF runs: same scenario but the end
+  /// time and the write and checkpoint intervals may differ. Depth-averaged runs: the same scenario
+  /// (jobs::scenario_hash); the continued run's outputs are the uninterrupted run's, bit for bit.
+  std::string restart_path;
+  /// The interval of simulated time between checkpoints [s] for depth-averaged runs, and for VOF
+  /// runs whose scenario sets no lab.checkpoint_interval_s (0: checkpoints only when the run is
+  /// interrupted).
+  double checkpoint_interval_s = 0;
+};
+
+struct RunSummary {
+  int nx = 0, ny = 0;
+  double dx = 0;
+  std::string crs;
+  double release_area_m2 = 0, release_volume_m3 = 0;
+  double affected_area_m2 = 0, runout_m = 0, max_speed = 0, max_depth = 0;
+  double volume_initial = 0, volume_final = 0, volume_outflow = 0, volume_error = 0;
+  double t = 0;
+  long steps = 0;
+  std::string stop;
+  double seconds_prepare = 0, seconds_run = 0, seconds_write = 0;
+  double cpu_seconds = 0;  ///< processor time of the solve (all threads)
+  std::vector<std::string> files;  ///< written, relative to the output directory
+  std::vector<std::string> notes;
+};
+
+/// Run a scenario and write every output into `out_dir` (which must exist). Throws ScenarioError or
+/// terrain::TerrainError for bad input; returns the summary also written to run.json.
+RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt = {});
+
+}  // namespace runout::jobs

@@ -1,0 +1,139 @@
+#include "jobs/drivers/worker_task.hpp"
+
+#include <omp.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+#include "jobs/drivers/run.hpp"
+#include "jobs/scenario/scenario.hpp"
+#include "runout/v1/worker.pb.h"
+#include "terrain/terrain.hpp"
+
+namespace runout::jobs {
+
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_stop(int) { g_stop = 1; }
+
+bool write_all(int fd, const char* p, std::size_t n) {
+  while (n > 0) {
+    const ssize_t w = ::write(fd, p, n);
+    if (w < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    p += w;
+    n -= std::size_t(w);
+  }
+  return true;
+}
+
+// One event: 4 bytes of length (little endian), then the message.
+bool send_event(int fd, const v1::WorkerEvent& ev) {
+  std::string body;
+  ev.SerializeToString(&body);
+  const auto n = std::uint32_t(body.size());
+  const char head[4] = {char(n & 255), char((n >> 8) & 255), char((n >> 16) & 255), char((n >> 24) & 255)};
+  return write_all(fd, head, 4) && write_all(fd, body.data(), body.size());
+}
+
+}  // namespace
+
+int worker_main(int in_fd, int out_fd) {
+  // Stray prints of libraries go to the log (standard error), never into the event stream.
+  const int events = dup(out_fd);
+  if (events < 0) return 3;
+  dup2(2, out_fd);
+  std::signal(SIGTERM, on_stop);
+  std::signal(SIGINT, on_stop);
+  std::signal(SIGPIPE, SIG_IGN);
+  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit makes writes fail (and the run report it), not the process die
+
+  std::string in;
+  {
+    char b[65536];
+    for (;;) {
+      const ssize_t n = ::read(in_fd, b, sizeof b);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      in.append(b, std::size_t(n));
+    }
+  }
+  v1::WorkerTask task;
+  auto failed = [&](const std::string& error, bool bad_input) {
+    v1::WorkerEvent ev;
+    ev.mutable_failed()->set_error(error);
+    ev.mutable_failed()->set_bad_input(bad_input);
+    return send_event(events, ev) ? 0 : 3;
+  };
+  if (!task.ParseFromString(in)) return failed("the worker received an unreadable task", false);
+  if (task.threads() > 0) omp_set_num_threads(task.threads());
+
+  try {
+    const ResolvedScenario r = resolve_scenario(task.scenario(), "/");
+    RunOptions opt;
+    opt.progress_every = 1;  // the stop flag is seen after every step
+    opt.checkpoint_path = task.checkpoint_path();
+    opt.restart_path = task.restart_path();
+    const double t_end = r.vof ? r.scenario.lab().end_time_s() : r.config.time.t_end;
+    opt.checkpoint_interval_s = task.checkpoint_interval_s() < 0 ? t_end / 20 : task.checkpoint_interval_s();
+    const double every = task.progress_interval_s() > 0 ? task.progress_interval_s() : 0.5;
+    const auto wall0 = std::chrono::steady_clock::now();
+    auto last = wall0 - std::chrono::hours(1);
+    bool event_failed = false;
+    opt.progress = [&](const engine::Progress& p) {
+      if (task.validate_only()) return false;  // prepared and one step taken: every input check has run
+      const auto now = std::chrono::steady_clock::now();
+      if (std::chrono::duration<double>(now - last).count() >= every) {
+        last = now;
+        v1::WorkerEvent ev;
+        auto* pr = ev.mutable_progress();
+        pr->set_simulated_s(p.t);
+        pr->set_dt_s(p.dt);
+        pr->set_volume_m3(p.mass);
+        pr->set_max_speed_m_s(p.max_speed);
+        pr->set_active_fraction(p.active_fraction);
+        pr->set_end_time_s(t_end);
+        pr->set_steps(p.step);
+        const double wall = std::chrono::duration<double>(now - wall0).count();
+        pr->set_seconds_left(p.t > 0 ? wall * (t_end - p.t) / p.t : 0.0);
+        event_failed = event_failed || !send_event(events, ev);
+      }
+      return g_stop == 0 && !event_failed;
+    };
+    const RunSummary sum = run_scenario(r, task.out_dir(), opt);
+    v1::WorkerEvent ev;
+    if (sum.stop == "cancelled" && !task.validate_only()) {
+      ev.mutable_interrupted()->set_simulated_s(sum.t);
+      ev.mutable_interrupted()->set_checkpoint_written(!task.checkpoint_path().empty());
+    } else {
+      auto* d = ev.mutable_done();
+      d->set_steps(sum.steps);
+      d->set_simulated_s(sum.t);
+      d->set_stop(task.validate_only() ? "validated" : sum.stop);
+      char b[300];
+      std::snprintf(b, sizeof b, "%ld steps to t = %.3f s (stop: %s), affected area %.0f m2, runout %.0f m, max speed %.1f m/s",
+                    sum.steps, sum.t, sum.stop.c_str(), sum.affected_area_m2, sum.runout_m, sum.max_speed);
+      d->set_summary(b);
+    }
+    return send_event(events, ev) ? 0 : 3;
+  } catch (const ScenarioError& e) {
+    return failed(e.what(), true);
+  } catch (const terrain::TerrainError& e) {
+    return failed(e.what(), true);
+  } catch (const std::invalid_argument& e) {
+    return failed(e.what(), true);
+  } catch (const std::exception& e) {
+    return failed(e.what(), false);
+  }
+}
+
+}  // namespace runout::jobs

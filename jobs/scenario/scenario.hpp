@@ -1,0 +1,69 @@
+#pragma once
+// Scenario files: JSON read through protobuf's JSON mapping into runout.v1.Scenario, then resolved
+// (defaults, paths relative to the file, names to enums) and validated before anything runs. Every
+// error names the field and the problem.
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "engine/sh2d.hpp"
+#include "runout/v1/scenario.pb.h"
+#include "terrain/terrain.hpp"
+
+namespace runout::jobs {
+
+struct ScenarioError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct ResolvedScenario {
+  v1::Scenario scenario;  ///< as given, with the defaults filled in
+  std::string source;     ///< the file it came from (empty when given as a message)
+  terrain::DemRequest dem;
+  std::vector<terrain::ReleaseRequest> releases;
+  engine::Sh2dConfig config;  ///< material, numerics, boundaries (progress hook left empty)
+  std::vector<std::string> rasters;
+  double outline_threshold = 0.1;
+  double timeseries_interval = 0;  ///< [s]; 0: no time series
+  std::vector<std::string> input_files;  ///< for hashing
+  bool vof = false;  ///< engine "vof": the `lab` block holds the set-up; DEM and releases unused
+};
+
+/// The version of what a VOF run's results contain (run.json, the fields) for an unchanged scenario.
+/// Bump it when they change meaning or value, so that a service does not answer from results of the
+/// older kind (2: B6's shock is the bore, no longer the resting deposit's edge; 3: 3D runs add
+/// comparison.png, and a polygon obstacle's shadow window starts behind the polygon; 4: the viscous
+/// stress's transpose part takes the harmonic face viscosity by default; 5: walls and inflows take the
+/// granular viscosity evaluated on the face, lab.wall_viscosity "face"). Adding a
+/// file or a figure counts too: a cached result lacks it. The test
+/// Scenarios.VofResultsMatchTheFingerprintOfTheirVersion holds this version's figures for twelve
+/// short runs and fails when a change to the numerics moves them (options those runs do not take
+/// are not covered); Scenarios.VofHashCarriesTheResultsVersion pins a hash that a bump changes.
+inline constexpr int kVofResultsVersion = 5;
+
+/// The version of what a depth-averaged run's results contain (rasters, outline, run.json, time
+/// series) for an unchanged scenario; the same rule as kVofResultsVersion (1: run.json's and the
+/// summary's maximum speed is the maximum of max_speed.tif, the flowing cells'). The test
+/// Scenarios.HashCarriesEachEnginesResultsVersion pins a hash that a bump changes.
+inline constexpr int kDepthAveragedResultsVersion = 1;
+
+/// A number for messages and run records: 10 significant digits, null when not finite.
+std::string json_number(double v);
+
+/// SHA-256 of a resolved scenario: its message with the input paths and the job limits left out,
+/// the content of every input file, and the version of what its engine's results contain. Two
+/// scenarios with the same hash compute the same result. The versions are parameters for tests.
+std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version = kDepthAveragedResultsVersion,
+                          int vof_version = kVofResultsVersion);
+
+/// The raster names an output list may hold.
+const std::vector<std::string>& raster_names();
+
+/// Parse a scenario from JSON text. Throws ScenarioError.
+v1::Scenario parse_scenario_json(const std::string& json);
+/// Read, parse, resolve and validate a scenario file. Throws ScenarioError.
+ResolvedScenario load_scenario(const std::string& path);
+/// Resolve and validate a message; relative paths are taken from `base_dir`. Throws ScenarioError.
+ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base_dir);
+
+}  // namespace runout::jobs

@@ -1,0 +1,502 @@
+#include "jobs/system/store.hpp"
+#include "jobs/system/store_sql.hpp"
+
+#include <sqlite3.h>
+
+#include <chrono>
+#include <ctime>
+#include <random>
+
+namespace runout::jobs {
+
+namespace {
+
+using sql::Stmt;
+using sql::Transaction;
+
+constexpr const char* kColumns =
+    "id, owner, name, hash, request_id, state, created, updated, error, attempts, scenario, progress, result_bytes, "
+    "results_removed, crashes";
+
+void add_transition(sqlite3* db, const std::string& id, v1::JobState s, const std::string& when, const std::string& reason) {
+  Stmt(db, "INSERT INTO transitions(job, time, state, reason) VALUES (?, ?, ?, ?)")
+      .bind(1, id)
+      .bind(2, when)
+      .bind(3, std::int64_t(s))
+      .bind(4, reason)
+      .step();
+}
+
+}  // namespace
+
+std::string utc_now() {
+  const auto now = std::chrono::system_clock::now();
+  const std::time_t t = std::chrono::system_clock::to_time_t(now);
+  const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char b[64];
+  std::snprintf(b, sizeof b, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday, tm.tm_hour,
+                tm.tm_min, tm.tm_sec, int(ms));
+  return b;
+}
+
+std::string new_job_id() {
+  static thread_local std::mt19937_64 rng{std::random_device{}() ^
+                                          std::uint64_t(std::chrono::steady_clock::now().time_since_epoch().count())};
+  char b[24];
+  std::snprintf(b, sizeof b, "j%016llx", static_cast<unsigned long long>(rng()));
+  return b;
+}
+
+std::string state_name(v1::JobState s) {
+  switch (s) {
+    case v1::QUEUED: return "queued";
+    case v1::RUNNING: return "running";
+    case v1::SUCCEEDED: return "succeeded";
+    case v1::FAILED: return "failed";
+    case v1::CANCELLED: return "cancelled";
+    default: return "unknown";
+  }
+}
+
+bool is_final(v1::JobState s) { return s == v1::SUCCEEDED || s == v1::FAILED || s == v1::CANCELLED; }
+
+JobStore::JobStore(const std::string& path) {
+  if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX, nullptr) !=
+      SQLITE_OK) {
+    const std::string m = db_ ? sqlite3_errmsg(db_) : "out of memory";
+    sqlite3_close(db_);
+    db_ = nullptr;
+    throw StoreError("job store '" + path + "': " + m);
+  }
+  sqlite3_busy_timeout(db_, 10000);
+  exec("PRAGMA journal_mode=WAL");
+  // Every committed state change survives a power loss: the WAL is synced at each commit.
+  exec("PRAGMA synchronous=FULL");
+  exec("PRAGMA foreign_keys=ON");
+  exec(R"(CREATE TABLE IF NOT EXISTS jobs(
+           seq INTEGER PRIMARY KEY AUTOINCREMENT,
+           id TEXT UNIQUE NOT NULL,
+           owner TEXT NOT NULL,
+           name TEXT NOT NULL,
+           hash TEXT NOT NULL,
+           request_id TEXT,
+           state INTEGER NOT NULL,
+           created TEXT NOT NULL,
+           updated TEXT NOT NULL,
+           error TEXT NOT NULL DEFAULT '',
+           attempts INTEGER NOT NULL DEFAULT 0,
+           scenario BLOB NOT NULL,
+           progress BLOB,
+           result_bytes INTEGER NOT NULL DEFAULT 0,
+           results_removed INTEGER NOT NULL DEFAULT 0,
+           cancel_requested INTEGER NOT NULL DEFAULT 0,
+           interrupted INTEGER NOT NULL DEFAULT 0);
+         CREATE UNIQUE INDEX IF NOT EXISTS jobs_request ON jobs(owner, request_id) WHERE request_id IS NOT NULL;
+         CREATE INDEX IF NOT EXISTS jobs_owner_hash ON jobs(owner, hash);
+         CREATE INDEX IF NOT EXISTS jobs_state ON jobs(state, seq);
+         CREATE TABLE IF NOT EXISTS transitions(
+           job TEXT NOT NULL REFERENCES jobs(id),
+           time TEXT NOT NULL,
+           state INTEGER NOT NULL,
+           reason TEXT NOT NULL);
+         CREATE INDEX IF NOT EXISTS transitions_job ON transitions(job);)");
+  // Stores written before the cancel flag existed get the column.
+  sqlite3_stmt* probe = nullptr;
+  if (sqlite3_prepare_v2(db_, "SELECT cancel_requested FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
+    exec("ALTER TABLE jobs ADD COLUMN cancel_requested INTEGER NOT NULL DEFAULT 0");
+  sqlite3_finalize(probe);
+  // ... and the count of attempts the server ended cleanly (interrupted by a stop, queued again).
+  probe = nullptr;
+  if (sqlite3_prepare_v2(db_, "SELECT interrupted FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK) {
+    // The clean interruptions so far, from the transitions they left.
+    exec("ALTER TABLE jobs ADD COLUMN interrupted INTEGER NOT NULL DEFAULT 0;"
+         "UPDATE jobs SET interrupted = (SELECT COUNT(*) FROM transitions t WHERE t.job = jobs.id AND t.state = 1 "
+         "AND t.reason LIKE 'interrupted by the server stopping%')");
+  }
+  sqlite3_finalize(probe);
+  // ... and the count of the job's worker processes that crashed (died of a signal nobody sent).
+  probe = nullptr;
+  if (sqlite3_prepare_v2(db_, "SELECT crashes FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
+    exec("ALTER TABLE jobs ADD COLUMN crashes INTEGER NOT NULL DEFAULT 0");
+  sqlite3_finalize(probe);
+  // ... and the digest of the request that created a job (a retry must send the same).
+  probe = nullptr;
+  if (sqlite3_prepare_v2(db_, "SELECT request_hash FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
+    exec("ALTER TABLE jobs ADD COLUMN request_hash TEXT");
+  sqlite3_finalize(probe);
+  exec(R"(CREATE TABLE IF NOT EXISTS uploads(
+           id TEXT NOT NULL,
+           owner TEXT NOT NULL,
+           bytes INTEGER NOT NULL,
+           time REAL NOT NULL,
+           PRIMARY KEY(id, owner));)");
+}
+
+JobStore::~JobStore() { sqlite3_close(db_); }
+
+void JobStore::exec(const char* sql) const {
+  char* err = nullptr;
+  if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
+    std::string m = err ? err : "?";
+    sqlite3_free(err);
+    throw StoreError("job store: " + m);
+  }
+}
+
+StoredJob JobStore::read_row(void* p) const {
+  auto* st = static_cast<Stmt*>(p);
+  StoredJob j;
+  j.job.set_id(st->text(0));
+  j.owner = st->text(1);
+  j.job.set_name(st->text(2));
+  j.job.set_scenario_hash(st->text(3));
+  j.job.set_request_id(st->text(4));
+  j.job.set_state(v1::JobState(st->i64(5)));
+  j.job.set_created_utc(st->text(6));
+  j.job.set_updated_utc(st->text(7));
+  j.job.set_error(st->text(8));
+  j.job.set_attempts(int(st->i64(9)));
+  if (!j.scenario.ParseFromString(st->text(10))) throw StoreError("job store: job " + j.job.id() + " holds an unreadable scenario");
+  const std::string prog = st->text(11);
+  if (!prog.empty()) (void)j.job.mutable_progress()->ParseFromString(prog);
+  j.job.set_result_bytes(st->i64(12));
+  j.results_removed = st->i64(13) != 0;
+  j.crashes = int(st->i64(14));
+  return j;
+}
+
+void JobStore::load_transitions(StoredJob& j) const {
+  Stmt st(db_, "SELECT time, state, reason FROM transitions WHERE job = ? ORDER BY rowid");
+  st.bind(1, j.job.id());
+  while (st.step()) {
+    auto* t = j.job.add_transitions();
+    t->set_time_utc(st.text(0));
+    t->set_state(v1::JobState(st.i64(1)));
+    t->set_reason(st.text(2));
+  }
+}
+
+SubmitOutcome JobStore::submit(const std::string& owner, const std::string& hash, const std::string& request_id,
+                               const v1::Scenario& scenario, int max_queued, const std::string& request_hash) {
+  std::lock_guard lk(mu_);
+  Transaction tx(db_);
+  SubmitOutcome out;
+  auto existing = [&](Stmt& st) {
+    if (!st.step()) return false;
+    out.job = read_row(&st);
+    load_transitions(out.job);
+    return true;
+  };
+  if (!request_id.empty()) {
+    Stmt st(db_, (std::string("SELECT ") + kColumns + " FROM jobs WHERE owner = ? AND request_id = ?").c_str());
+    st.bind(1, owner).bind(2, request_id);
+    if (existing(st)) {
+      if (out.job.job.scenario_hash() != hash)
+        throw RequestIdConflict("request_id '" + request_id + "' was used for job " + out.job.job.id() +
+                                " with another scenario; use a new request id for a new scenario");
+      tx.commit();
+      return out;
+    }
+  }
+  {
+    Stmt st(db_, (std::string("SELECT ") + kColumns +
+                  " FROM jobs WHERE owner = ? AND hash = ? AND state IN (1, 2, 3) AND results_removed = 0 "
+                  "ORDER BY seq DESC LIMIT 1")
+                     .c_str());
+    st.bind(1, owner).bind(2, hash);
+    if (existing(st)) {
+      tx.commit();
+      return out;
+    }
+  }
+  {
+    Stmt st(db_, "SELECT COUNT(*) FROM jobs WHERE owner = ? AND state IN (1, 2)");
+    st.bind(1, owner);
+    st.step();
+    if (st.i64(0) >= max_queued)
+      throw QueueFull("this client already has " + std::to_string(st.i64(0)) + " queued or running jobs (the server's limit is " +
+                      std::to_string(max_queued) + ")");
+  }
+  const std::string id = new_job_id(), now = utc_now();
+  std::string blob;
+  scenario.SerializeToString(&blob);
+  Stmt ins(db_,
+           "INSERT INTO jobs(id, owner, name, hash, request_id, state, created, updated, scenario, request_hash) "
+           "VALUES (?, ?, ?, ?, ?, 1, ?, ?, ?, ?)");
+  ins.bind(1, id).bind(2, owner).bind(3, scenario.name()).bind(4, hash);
+  if (request_id.empty())
+    ins.null(5);
+  else
+    ins.bind(5, request_id);
+  ins.bind(6, now).bind(7, now).blob(8, blob);
+  if (request_hash.empty())
+    ins.null(9);
+  else
+    ins.bind(9, request_hash);
+  ins.step();
+  add_transition(db_, id, v1::QUEUED, now, "submitted");
+  tx.commit();
+  out.created = true;
+  out.job.owner = owner;
+  out.job.scenario = scenario;
+  auto& j = out.job.job;
+  j.set_id(id);
+  j.set_state(v1::QUEUED);
+  j.set_name(scenario.name());
+  j.set_scenario_hash(hash);
+  j.set_created_utc(now);
+  j.set_updated_utc(now);
+  j.set_request_id(request_id);
+  auto* t = j.add_transitions();
+  t->set_state(v1::QUEUED);
+  t->set_time_utc(now);
+  t->set_reason("submitted");
+  return out;
+}
+
+std::optional<StoredJob> JobStore::get(const std::string& id, const std::string& owner) const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_, (std::string("SELECT ") + kColumns + " FROM jobs WHERE id = ?").c_str());
+  st.bind(1, id);
+  if (!st.step()) return std::nullopt;
+  StoredJob j = read_row(&st);
+  if (!owner.empty() && j.owner != owner) return std::nullopt;
+  load_transitions(j);
+  return j;
+}
+
+std::vector<StoredJob> JobStore::list(const std::string& owner, const std::vector<v1::JobState>& states, int page_size,
+                                      const std::string& page_token, std::string* next_page_token) const {
+  std::lock_guard lk(mu_);
+  std::string sql = std::string("SELECT ") + kColumns + ", seq FROM jobs WHERE owner = ? AND seq < ?";
+  if (!states.empty()) {
+    sql += " AND state IN (";
+    for (std::size_t k = 0; k < states.size(); ++k) sql += (k ? ", " : "") + std::to_string(int(states[k]));
+    sql += ")";
+  }
+  sql += " ORDER BY seq DESC LIMIT ?";
+  std::int64_t before = INT64_MAX;
+  if (!page_token.empty()) {
+    try {
+      before = std::stoll(page_token);
+    } catch (...) {
+      throw std::invalid_argument("page_token: not a token this server gave out");
+    }
+  }
+  Stmt st(db_, sql.c_str());
+  st.bind(1, owner).bind(2, before).bind(3, std::int64_t(page_size) + 1);
+  std::vector<StoredJob> out;
+  std::int64_t last_seq = 0;
+  if (next_page_token) next_page_token->clear();
+  while (st.step()) {
+    if (int(out.size()) == page_size) {
+      if (next_page_token) *next_page_token = std::to_string(last_seq);
+      break;
+    }
+    out.push_back(read_row(&st));
+    last_seq = st.i64(15);
+  }
+  for (auto& j : out) load_transitions(j);
+  return out;
+}
+
+std::optional<StoredJob> JobStore::claim_next() {
+  std::lock_guard lk(mu_);
+  Transaction tx(db_);
+  Stmt st(db_, (std::string("SELECT ") + kColumns + " FROM jobs WHERE state = 1 ORDER BY seq LIMIT 1").c_str());
+  if (!st.step()) {
+    tx.commit();
+    return std::nullopt;
+  }
+  StoredJob j = read_row(&st);
+  const std::string now = utc_now();
+  Stmt up(db_, "UPDATE jobs SET state = 2, attempts = attempts + 1, updated = ? WHERE id = ?");
+  up.bind(1, now).bind(2, j.job.id()).step();
+  j.job.set_attempts(j.job.attempts() + 1);
+  add_transition(db_, j.job.id(), v1::RUNNING, now, "started (attempt " + std::to_string(j.job.attempts()) + ")");
+  tx.commit();
+  j.job.set_state(v1::RUNNING);
+  j.job.set_updated_utc(now);
+  load_transitions(j);
+  return j;
+}
+
+void JobStore::transition(const std::string& id, v1::JobState state, const std::string& reason, const std::string& error,
+                          std::int64_t result_bytes, bool crashed) {
+  std::lock_guard lk(mu_);
+  Transaction tx(db_);
+  const std::string now = utc_now();
+  // Back to the queue from a run: the server ended that attempt cleanly (a stop), so it does not
+  // count towards the attempts a crashing job is allowed (requeue_running).
+  Stmt up(db_,
+          "UPDATE jobs SET state = ?, updated = ?, error = ?, result_bytes = CASE WHEN ? >= 0 THEN ? ELSE result_bytes END, "
+          "interrupted = interrupted + CASE WHEN ? = 1 AND state = 2 THEN 1 ELSE 0 END, crashes = crashes + ? WHERE id = ?");
+  up.bind(1, std::int64_t(state)).bind(2, now).bind(3, error).bind(4, result_bytes).bind(5, result_bytes)
+      .bind(6, std::int64_t(state)).bind(7, std::int64_t(crashed ? 1 : 0)).bind(8, id).step();
+  add_transition(db_, id, state, now, reason);
+  tx.commit();
+}
+
+std::optional<StoredJob> JobStore::cancel(const std::string& id, const std::string& owner) {
+  {
+    std::lock_guard lk(mu_);
+    Transaction tx(db_);
+    Stmt st(db_, "SELECT state FROM jobs WHERE id = ? AND owner = ?");
+    st.bind(1, id).bind(2, owner);
+    if (!st.step()) return std::nullopt;
+    if (v1::JobState(st.i64(0)) == v1::QUEUED) {
+      const std::string now = utc_now();
+      Stmt up(db_, "UPDATE jobs SET state = 5, updated = ? WHERE id = ?");
+      up.bind(1, now).bind(2, id).step();
+      add_transition(db_, id, v1::CANCELLED, now, "cancelled by the client before it started");
+    } else if (v1::JobState(st.i64(0)) == v1::RUNNING) {
+      // Kept in the store, so that neither a worker that has just claimed the job nor a restart
+      // after a crash loses it.
+      Stmt(db_, "UPDATE jobs SET cancel_requested = 1 WHERE id = ?").bind(1, id).step();
+    }
+    tx.commit();
+  }
+  return get(id, owner);
+}
+
+int JobStore::requeue_running(const std::string& reason, std::vector<Change>* changed) {
+  std::lock_guard lk(mu_);
+  Transaction tx(db_);
+  struct Row {
+    std::string id;
+    std::int64_t cancel;
+  };
+  std::vector<Row> rows;
+  {
+    Stmt st(db_, "SELECT id, cancel_requested FROM jobs WHERE state = 2");
+    while (st.step()) rows.push_back({st.text(0), st.i64(1)});
+  }
+  const std::string now = utc_now();
+  int queued = 0;
+  for (const auto& r : rows) {
+    // The server went down, not the job (jobs run in processes of their own, which died with it):
+    // this does not count against the job.
+    if (r.cancel) {
+      const char* why = "cancelled by the client; the server stopped before the run did";
+      Stmt(db_, "UPDATE jobs SET state = 5, updated = ? WHERE id = ?").bind(1, now).bind(2, r.id).step();
+      add_transition(db_, r.id, v1::CANCELLED, now, why);
+      if (changed) changed->push_back({r.id, v1::CANCELLED, why});
+    } else {
+      Stmt(db_, "UPDATE jobs SET state = 1, updated = ? WHERE id = ?").bind(1, now).bind(2, r.id).step();
+      add_transition(db_, r.id, v1::QUEUED, now, reason);
+      if (changed) changed->push_back({r.id, v1::QUEUED, reason});
+      ++queued;
+    }
+  }
+  tx.commit();
+  return queued;
+}
+
+bool JobStore::cancel_requested(const std::string& id) const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_, "SELECT cancel_requested FROM jobs WHERE id = ?");
+  st.bind(1, id);
+  return st.step() && st.i64(0) != 0;
+}
+
+void JobStore::save_progress(const std::string& id, const v1::Progress& p) {
+  std::lock_guard lk(mu_);
+  std::string blob;
+  p.SerializeToString(&blob);
+  Stmt(db_, "UPDATE jobs SET progress = ? WHERE id = ?").blob(1, blob).bind(2, id).step();
+}
+
+std::int64_t JobStore::result_bytes_total(const std::string& owner) const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_,
+          "SELECT COALESCE(SUM(b), 0) FROM (SELECT MAX(result_bytes) AS b FROM jobs WHERE owner = ? AND state = 3 "
+          "AND results_removed = 0 GROUP BY hash)");
+  st.bind(1, owner);
+  st.step();
+  return st.i64(0);
+}
+
+std::vector<JobStore::Finished> JobStore::finished_results() const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_,
+          "SELECT hash, MAX(updated), MAX(result_bytes) FROM jobs WHERE state = 3 AND results_removed = 0 GROUP BY hash "
+          "ORDER BY MAX(updated)");
+  std::vector<Finished> out;
+  while (st.step()) out.push_back({st.text(0), st.text(1), st.i64(2)});
+  return out;
+}
+
+void JobStore::mark_results_removed(const std::string& hash, const std::string& reason) {
+  std::lock_guard lk(mu_);
+  Transaction tx(db_);
+  std::vector<std::string> ids;
+  {
+    Stmt st(db_, "SELECT id FROM jobs WHERE hash = ? AND state = 3 AND results_removed = 0");
+    st.bind(1, hash);
+    while (st.step()) ids.push_back(st.text(0));
+  }
+  const std::string now = utc_now();
+  for (const auto& id : ids) {
+    Stmt(db_, "UPDATE jobs SET results_removed = 1, result_bytes = 0, updated = ? WHERE id = ?").bind(1, now).bind(2, id).step();
+    add_transition(db_, id, v1::SUCCEEDED, now, reason);
+  }
+  tx.commit();
+}
+
+bool JobStore::has_hash(const std::string& hash) const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_, "SELECT 1 FROM jobs WHERE hash = ? LIMIT 1");
+  st.bind(1, hash);
+  return st.step();
+}
+
+std::vector<StoredJob> JobStore::active_jobs() const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_, (std::string("SELECT ") + kColumns + " FROM jobs WHERE state IN (1, 2) ORDER BY seq").c_str());
+  std::vector<StoredJob> out;
+  while (st.step()) out.push_back(read_row(&st));
+  return out;
+}
+
+std::int64_t JobStore::job_count() const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_, "SELECT COUNT(*) FROM jobs");
+  st.step();
+  return st.i64(0);
+}
+
+void JobStore::insert_recovered(const StoredJob& j) {
+  std::lock_guard lk(mu_);
+  Transaction tx(db_);
+  std::string blob;
+  j.scenario.SerializeToString(&blob);
+  Stmt ins(db_,
+           "INSERT INTO jobs(id, owner, name, hash, request_id, state, created, updated, error, attempts, scenario, "
+           "result_bytes, results_removed, crashes) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  ins.bind(1, j.job.id()).bind(2, j.owner).bind(3, j.job.name()).bind(4, j.job.scenario_hash());
+  if (j.job.request_id().empty())
+    ins.null(5);
+  else
+    ins.bind(5, j.job.request_id());
+  ins.bind(6, std::int64_t(j.job.state())).bind(7, j.job.created_utc()).bind(8, j.job.updated_utc()).bind(9, j.job.error())
+      .bind(10, std::int64_t(j.job.attempts())).blob(11, blob).bind(12, j.job.result_bytes())
+      .bind(13, std::int64_t(j.results_removed ? 1 : 0)).bind(14, std::int64_t(j.crashes));
+  ins.step();
+  for (const auto& t : j.job.transitions()) add_transition(db_, j.job.id(), t.state(), t.time_utc(), t.reason());
+  tx.commit();
+}
+
+std::optional<std::pair<StoredJob, std::string>> JobStore::find_request(const std::string& owner,
+                                                                       const std::string& request_id) const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_, (std::string("SELECT ") + kColumns + ", COALESCE(request_hash, '') FROM jobs WHERE owner = ? AND request_id = ?").c_str());
+  st.bind(1, owner).bind(2, request_id);
+  if (!st.step()) return std::nullopt;
+  std::pair<StoredJob, std::string> out{read_row(&st), st.text(15)};
+  load_transitions(out.first);
+  return out;
+}
+
+}  // namespace runout::jobs
