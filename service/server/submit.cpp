@@ -1,0 +1,185 @@
+// Submissions: the checks at the door (limits, inputs, validation in a worker), retries answered by
+// their request, queueing.
+#include "service/server/impl.hpp"
+
+#include <google/protobuf/io/coded_stream.h>
+#include <google/protobuf/io/zero_copy_stream_impl_lite.h>
+#include <google/protobuf/util/json_util.h>
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <gdal.h>
+#include <openssl/crypto.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <array>
+#include <csignal>
+#include <cstring>
+#include <set>
+#include <ctime>
+#include <cmath>
+#include <thread>
+#include <condition_variable>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <sstream>
+
+#include "jobs/scenario/scenario.hpp"
+#include "jobs/system/scheduler.hpp"
+#include "jobs/digest/sha256.hpp"
+#include "jobs/system/state_dir.hpp"
+#include "jobs/system/worker.hpp"
+#include "runout/v1/worker.pb.h"
+#include "jobs/system/store.hpp"
+#include "runout/v1/service.grpc.pb.h"
+#include "service/server/inputs.hpp"
+#include "service/server/tokens.hpp"
+#include "terrain/terrain.hpp"
+
+namespace fs = std::filesystem;
+
+namespace runout::service {
+
+// At most this many checks of submissions at once (each a process that may use a job's memory).
+bool Server::Impl::enter_validation() {
+  std::unique_lock lk(validate_mu);
+  const int limit = std::max(2, cfg.workers());
+  if (!validate_cv.wait_for(lk, std::chrono::seconds(60), [&] { return validating < limit; })) return false;
+  ++validating;
+  return true;
+}
+
+void Server::Impl::leave_validation() {
+  {
+    std::lock_guard lk(validate_mu);
+    --validating;
+  }
+  validate_cv.notify_one();
+}
+
+// The digest of a submitted scenario as sent (a retry sends the same bytes).
+std::string Server::Impl::request_digest(const v1::Scenario& sc) {
+  std::string bytes;
+  google::protobuf::io::StringOutputStream so(&bytes);
+  google::protobuf::io::CodedOutputStream co(&so);
+  co.SetSerializationDeterministic(true);
+  sc.SerializeToCodedStream(&co);
+  co.Trim();
+  return jobs::sha256_hex(bytes);
+}
+
+// The answer to a request id used before: its job (the same request), or ALREADY_EXISTS.
+std::optional<Status> Server::Impl::answer_retry(const std::string& owner, const v1::SubmitRequest& req, const std::string& request_hash,
+    v1::Job* resp) {
+  if (req.request_id().empty()) return std::nullopt;
+  try {
+    const auto prior = store->find_request(owner, req.request_id());
+    if (!prior || prior->second.empty()) return std::nullopt;
+    if (prior->second != request_hash)
+      return Status(StatusCode::ALREADY_EXISTS, "request_id '" + req.request_id() + "' was used for job " + prior->first.job.id() +
+                                                    " with another scenario; use a new request id for a new scenario");
+    *resp = with_live(prior->first);
+    return Status::OK;
+  } catch (const std::exception& e) {
+    return Status(StatusCode::INTERNAL, std::string("the job store failed: ") + e.what());
+  }
+}
+
+Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRequest* req, v1::Job* resp) {
+  std::string owner;
+  if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
+  if (!req->has_scenario()) return {StatusCode::INVALID_ARGUMENT, "scenario: missing"};
+  if (req->request_id().size() > 200) return {StatusCode::INVALID_ARGUMENT, "request_id: longer than 200 characters"};
+  // A retry (the same request id) is answered before anything else, by the digest of the request.
+  const std::string request_hash = request_digest(req->scenario());
+  if (auto st = answer_retry(owner, *req, request_hash, resp)) return *st;
+  v1::Scenario s = req->scenario();
+  std::vector<std::string> uploads;  // of this submission: removed when it is refused
+  InFlight in_flight{*this, {}};
+  auto refuse = [&](Status st) {
+    in_flight.release();
+    if (!uploads.empty()) collect_uploads(uploads, owner);
+    return st;
+  };
+  auto input = [&](const std::string& field, std::string* path) {
+    const bool upload = path->rfind("upload:", 0) == 0;
+    if (upload) in_flight.take(path->substr(7, 64));  // before it is looked at: not collected meanwhile
+    Status st = resolve_input(cfg, field, path);
+    if (st.ok() && upload) uploads.push_back(fs::path(*path).parent_path().filename().string());
+    return st;
+  };
+  if (auto st = input("dem.path", s.mutable_dem()->mutable_path()); !st.ok()) return refuse(st);
+  if (s.has_area_of_interest())
+    if (auto st = input("area_of_interest.path", s.mutable_area_of_interest()->mutable_path()); !st.ok()) return refuse(st);
+  for (int k = 0; k < s.releases_size(); ++k)
+    if (auto st = input("releases[" + std::to_string(k) + "].path", s.mutable_releases(k)->mutable_path()); !st.ok())
+      return refuse(st);
+  // The job's limits: within the server's.
+  {
+    const auto& l = s.limits();
+    if (!(std::isfinite(l.max_wall_s()) && l.max_wall_s() >= 0 && l.max_wall_s() <= cfg.max_job_wall_s()))
+      return refuse({StatusCode::INVALID_ARGUMENT, "limits.max_wall_s: must lie in [0, " + jobs::json_number(cfg.max_job_wall_s()) +
+                                                       "] s (0: the server's limit), got " + jobs::json_number(l.max_wall_s())});
+    if (l.max_memory_bytes() < 0 || (cfg.max_job_memory_bytes() > 0 && l.max_memory_bytes() > cfg.max_job_memory_bytes()))
+      return refuse({StatusCode::INVALID_ARGUMENT, "limits.max_memory_bytes: must lie in [0, " +
+                                                       std::to_string(cfg.max_job_memory_bytes()) + "] (0: the server's limit), got " +
+                                                       std::to_string(l.max_memory_bytes())});
+  }
+  const std::vector<std::string> roots(cfg.data_roots().begin(), cfg.data_roots().end());
+  std::string hash;
+  try {
+    const auto r = jobs::resolve_scenario(s, "/");
+    hash = jobs::scenario_hash(r);
+  } catch (const jobs::ScenarioError& e) {
+    return refuse({StatusCode::INVALID_ARGUMENT, jobs::client_message(e.what(), cfg.state_dir(), roots)});
+  } catch (const terrain::TerrainError& e) {
+    return refuse({StatusCode::INVALID_ARGUMENT, jobs::client_message(e.what(), cfg.state_dir(), roots)});
+  } catch (const std::exception& e) {
+    return refuse({StatusCode::INTERNAL, "validating the scenario failed: " + jobs::client_message(e.what(), cfg.state_dir(), roots)});
+  }
+  // Everything else `runout run` checks (unless these very inputs were accepted or computed before:
+  // the hash covers the scenario and the content of every input).
+  std::error_code ec;
+  bool known = fs::exists(fs::path(sched->results_dir(hash)) / "run.json", ec);
+  try {
+    known = known || store->has_hash(hash);
+  } catch (const std::exception&) {
+  }
+  if (!known) {
+    if (!enter_validation())
+      return refuse({StatusCode::RESOURCE_EXHAUSTED, "the server is checking too many submissions at once; try again"});
+    const Status st = check_in_worker(cfg, s, [this](const std::string& l) { log(l); });
+    leave_validation();
+    if (!st.ok()) return refuse(st);
+  }
+  try {
+    const auto out = store->submit(owner, hash, req->request_id(), s, cfg.max_queued_per_client(), request_hash);
+    *resp = with_live(out.job);
+    if (out.created) {
+      try {
+        sched->write_record(out.job);
+      } catch (const std::exception& e) {
+        log("job " + resp->id() + ": " + e.what() + " (`runout serve --recover` cannot rebuild it)");
+      }
+      log("job " + resp->id() + ": queued (" + owner + ", scenario " + hash.substr(0, 12) + ")");
+      sched->touch(resp->id());
+      sched->notify();
+    }
+  } catch (const jobs::RequestIdConflict& e) {
+    return refuse({StatusCode::ALREADY_EXISTS, e.what()});
+  } catch (const jobs::QueueFull& e) {
+    return refuse({StatusCode::RESOURCE_EXHAUSTED, e.what()});
+  } catch (const std::exception& e) {
+    return {StatusCode::INTERNAL, jobs::client_message(e.what(), cfg.state_dir(), roots)};
+  }
+  return Status::OK;
+}
+
+}  // namespace runout::service

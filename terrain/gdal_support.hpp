@@ -1,0 +1,33 @@
+#pragma once
+// What the terrain room's files share about GDAL and OGR: start-up, error text, CRS handling,
+// number formatting for messages and in-memory rasters on a Grid. Internal to terrain/.
+#include <gdal_priv.h>
+#include <ogr_spatialref.h>
+
+#include <memory>
+#include <string>
+
+#include "terrain/terrain.hpp"
+
+namespace runout::terrain::detail {
+
+/// Registers GDAL's drivers once; GDAL's own error printing is off (errors are read back).
+void init_gdal();
+/// ": <GDAL's last error>" or "".
+std::string gdal_message();
+/// A number for messages, `prec` decimals (4 significant digits for huge values).
+std::string fmt(double v, int prec = 1);
+/// A CRS from user input ("EPSG:2056", WKT, PROJ, or "local" for local Cartesian metres); errors
+/// name `what`.
+OGRSpatialReference srs_from(const std::string& text, const std::string& what);
+OGRSpatialReference wgs84();
+std::string wkt(const OGRSpatialReference& s);
+/// "EPSG:32632", the CRS's name, or "local metres".
+std::string crs_name(const OGRSpatialReference& s);
+/// A coordinate transformation; nullptr for two local CRSs (the identity: they have no datum to relate).
+std::unique_ptr<OGRCoordinateTransformation> transform(const OGRSpatialReference& from, const OGRSpatialReference& to,
+                                                       const std::string& what);
+/// A one-band in-memory raster on the grid (north-up, the grid's CRS).
+GDALDatasetUniquePtr mem_raster(const Grid& g, GDALDataType type);
+
+}  // namespace runout::terrain::detail
