@@ -172,24 +172,16 @@ void write_png(cairo_surface_t* surf, const std::string& path) {
   if (cairo_surface_write_to_png(surf, path.c_str()) != CAIRO_STATUS_SUCCESS) throw std::runtime_error("cannot write " + path);
 }
 
-}  // namespace
+// Where the section lies on the page: its origin (bottom left), top, scale [px/m] and size.
+struct SectionLayout {
+  double ox, oy, top, scale, sec_w, sec_h, gap, ser_h;
+};
 
-void write_section_figure(const std::string& path, const SectionFigure& f) {
-  if (f.nx < 1 || f.ny < 1 || f.alpha.size() != std::size_t(f.nx) * std::size_t(f.ny))
-    throw std::runtime_error("comparison figure: the section does not match its grid");
-  const double Lx = f.nx * f.dx, Ly = f.ny * f.dy;
-  const double left = 70, right = 30, top = 40, gap = 60;
-  const double plot_w = 900;
-  const double scale = std::min(plot_w / Lx, 420 / Ly);  // pixels per metre, equal in x and y
-  const double sec_w = Lx * scale, sec_h = Ly * scale;
-  const bool series = f.t.size() >= 2;
-  const double ser_h = series ? 200 : 0;
-  const int W = int(left + std::max(sec_w, 500.0) + right + 90), H = int(top + sec_h + 90 + (series ? 40 + ser_h + 100 : 0));
-  auto [surf, ctx] = canvas(W, H, f.title, left);
-  cairo_t* cr = ctx.get();
-
-  // Section: x to the right, y up; the material coloured by speed, blended into white by alpha.
-  const double ox = left, oy = top + sec_h;
+// The section: the material coloured by speed, the free surface, ours and the reference's fronts
+// and surface angles, and their captions.
+void draw_section(cairo_t* cr, const SectionFigure& f, const SectionLayout& L) {
+  const double ox = L.ox, oy = L.oy, top = L.top, scale = L.scale, sec_h = L.sec_h;
+  // x to the right, y up; the material coloured by speed, blended into white by alpha.
   auto X = [&](double x) { return ox + (x - f.x0) * scale; };
   auto Y = [&](double y) { return oy - (y - f.y0) * scale; };
   {
@@ -254,11 +246,31 @@ void write_section_figure(const std::string& path, const SectionFigure& f) {
     if (!ref.empty()) text(cr, ox, ly + 17, source_name(f.ref_source) + ":" + ref, 12, kReference);
   }
 
-  if (!series) {
-    write_png(surf.get(), path);
-    return;
-  }
-  // Monitors over time: fluxes [l/s] on the left axis, the moving share [0, 1] on the right.
+}
+
+// The monitors over time below the section: fluxes [l/s] (or the shock's distance) on the left
+// axis, the moving share [0, 1] on the right, with ours and the reference's figures.
+// The captions under the monitors: what each line is, ours and the reference's figures.
+void series_captions(cairo_t* cr, const SectionFigure& f, double ox, double ty, bool shock) {
+  text(cr, ox, ty,
+       shock ? "the shock's distance from the end wall (blue), share of the material moving > 1 cm/s (grey)"
+             : "gate flux (blue), outflow at the end (green), share of the material moving > 1 cm/s (grey)",
+       11);
+  std::string ours;
+  auto add = [](std::string& to, const std::string& s) { to += (to.empty() ? " " : ", ") + s; };
+  if (!std::isnan(f.fluidised)) add(ours, "fluidised " + fmt("%.2f s", f.fluidised) + " (black tick)");
+  if (!std::isnan(f.gate_flux_early)) add(ours, "gate flux " + fmt("%.2f l/s", f.gate_flux_early) + " (median 0.12-0.30 s)");
+  if (!std::isnan(f.strain_early)) add(ours, "gate strain rate " + fmt("%.1f 1/s", f.strain_early) + " (median 0.10-0.20 s)");
+  if (!ours.empty()) text(cr, ox, ty + 17, "ours:" + ours, 11);
+  std::string ref;
+  if (!std::isnan(f.ref_fluidised)) add(ref, "fluidised " + fmt("%.2f s", f.ref_fluidised) + " (dashed)");
+  if (!std::isnan(f.ref_outflow)) add(ref, "outflow " + fmt("%.2f l/s", f.ref_outflow) + " (dashed)");
+  if (!std::isnan(f.ref_strain)) add(ref, "gate strain rate " + fmt("%.0f 1/s", f.ref_strain));
+  if (!ref.empty()) text(cr, ox, ty + 34, source_name(f.ref_source) + ":" + ref, 11, kReference);
+}
+
+void draw_series(cairo_t* cr, const SectionFigure& f, const SectionLayout& L) {
+  const double ox = L.ox, top = L.top, sec_h = L.sec_h, sec_w = L.sec_w, gap = L.gap, ser_h = L.ser_h;
   const double py = top + sec_h + gap + 40, pw = std::max(sec_w, 500.0), ph = ser_h;
   const double t0 = f.t.front(), t1 = f.t.back();
   const bool shock = !f.shock.empty();
@@ -342,22 +354,28 @@ void write_section_figure(const std::string& path, const SectionFigure& f) {
     cairo_stroke(cr);
   }
   cairo_set_line_width(cr, 1);
-  double ty = py + ph + 50;
-  text(cr, ox, ty,
-       shock ? "the shock's distance from the end wall (blue), share of the material moving > 1 cm/s (grey)"
-             : "gate flux (blue), outflow at the end (green), share of the material moving > 1 cm/s (grey)",
-       11);
-  std::string ours;
-  auto add = [](std::string& to, const std::string& s) { to += (to.empty() ? " " : ", ") + s; };
-  if (!std::isnan(f.fluidised)) add(ours, "fluidised " + fmt("%.2f s", f.fluidised) + " (black tick)");
-  if (!std::isnan(f.gate_flux_early)) add(ours, "gate flux " + fmt("%.2f l/s", f.gate_flux_early) + " (median 0.12-0.30 s)");
-  if (!std::isnan(f.strain_early)) add(ours, "gate strain rate " + fmt("%.1f 1/s", f.strain_early) + " (median 0.10-0.20 s)");
-  if (!ours.empty()) text(cr, ox, ty + 17, "ours:" + ours, 11);
-  std::string ref;
-  if (!std::isnan(f.ref_fluidised)) add(ref, "fluidised " + fmt("%.2f s", f.ref_fluidised) + " (dashed)");
-  if (!std::isnan(f.ref_outflow)) add(ref, "outflow " + fmt("%.2f l/s", f.ref_outflow) + " (dashed)");
-  if (!std::isnan(f.ref_strain)) add(ref, "gate strain rate " + fmt("%.0f 1/s", f.ref_strain));
-  if (!ref.empty()) text(cr, ox, ty + 34, source_name(f.ref_source) + ":" + ref, 11, kReference);
+  series_captions(cr, f, ox, py + ph + 50, shock);
+}
+
+}  // namespace
+
+void write_section_figure(const std::string& path, const SectionFigure& f) {
+  if (f.nx < 1 || f.ny < 1 || f.alpha.size() != std::size_t(f.nx) * std::size_t(f.ny))
+    throw std::runtime_error("comparison figure: the section does not match its grid");
+  const double Lx = f.nx * f.dx, Ly = f.ny * f.dy;
+  const double left = 70, right = 30, top = 40, gap = 60;
+  const double plot_w = 900;
+  const double scale = std::min(plot_w / Lx, 420 / Ly);  // pixels per metre, equal in x and y
+  const double sec_w = Lx * scale, sec_h = Ly * scale;
+  const bool series = f.t.size() >= 2;
+  const double ser_h = series ? 200 : 0;
+  const int W = int(left + std::max(sec_w, 500.0) + right + 90), H = int(top + sec_h + 90 + (series ? 40 + ser_h + 100 : 0));
+  auto [surf, ctx] = canvas(W, H, f.title, left);
+  cairo_t* cr = ctx.get();
+
+  const SectionLayout layout{left, top + sec_h, top, scale, sec_w, sec_h, gap, ser_h};
+  draw_section(cr, f, layout);
+  if (series) draw_series(cr, f, layout);
   write_png(surf.get(), path);
 }
 

@@ -104,12 +104,8 @@ constexpr DepthClass kClasses[] = {{0.1, {255, 255, 178}, "0.1 - 0.5"}, {0.5, {2
                                    {1.0, {253, 141, 60}, "1 - 2"},      {2.0, {240, 59, 32}, "2 - 5"},
                                    {5.0, {189, 0, 38}, "> 5"}};
 
-}  // namespace
-
-void write_map_png(const std::string& path, const Grid& g, const std::vector<double>& max_depth,
-                   const std::vector<double>& release, const MapRequest& req) {
-  GDALAllRegister();
-  // Hillshade with GDAL's DEM tools (north-up raster, row 0 north).
+// Hillshade with GDAL's DEM tools (north-up raster, row 0 north), one byte per cell.
+std::vector<std::uint8_t> hillshade(const Grid& g) {
   auto* mem = GetGDALDriverManager()->GetDriverByName("MEM");
   GDALDatasetUniquePtr dem(mem->Create("", g.nx, g.ny, 1, GDT_Float32, nullptr));
   double gt[6] = {g.x_min, g.dx, 0, g.y_min + g.ny * g.dx, 0, -g.dx};
@@ -129,6 +125,16 @@ void write_map_png(const std::string& path, const Grid& g, const std::vector<dou
   std::vector<std::uint8_t> shade(g.cells());
   if (hs->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, g.nx, g.ny, shade.data(), g.nx, g.ny, GDT_Byte, 0, 0) != CE_None)
     throw TerrainError("map: reading the hillshade failed");
+  return shade;
+}
+
+}  // namespace
+
+void write_map_png(const std::string& path, const Grid& g, const std::vector<double>& max_depth,
+                   const std::vector<double>& release, const MapRequest& req) {
+  GDALAllRegister();
+  const std::vector<std::uint8_t> shade = hillshade(g);
+  auto* mem = GetGDALDriverManager()->GetDriverByName("MEM");
 
   const int s = std::max(1, req.scale), mw = g.nx * s, mh = g.ny * s, pad = 10, legend = 210, top = 30;
   Image img(mw + 2 * pad + legend, std::max(mh + top + 50, 330));

@@ -7,6 +7,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -22,6 +23,45 @@
 namespace fs = std::filesystem;
 
 namespace runout::cli {
+
+namespace {
+
+// A job of the service that ended, and the wall time from submission to its results downloaded.
+struct ServiceRun {
+  v1::Job fin;
+  double wall = 0;
+};
+
+// Submits the scenario (its inputs uploaded), follows the job and downloads its results into
+// `results`; nothing (and the reason on standard error) when the job did not succeed.
+std::optional<ServiceRun> run_through_service(const service::ClientOptions& opt, const std::string& scenario,
+                                              const fs::path& results) {
+  std::error_code ec;
+  const auto t0 = std::chrono::steady_clock::now();
+  service::Client client(opt);
+  std::ifstream in(scenario);
+  if (!in) throw jobs::ScenarioError("cannot read scenario '" + scenario + "'");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  auto s = jobs::parse_scenario_json(ss.str());
+  s = service::upload_inputs(client, s, fs::absolute(scenario).parent_path().string());
+  const auto job = client.submit(s, "");
+  std::fprintf(stderr, "runout regress: job %s on %s\n", job.id().c_str(), opt.server.c_str());
+  const auto fin = client.watch(job.id());
+  if (fin.state() != v1::SUCCEEDED) {
+    std::cerr << "runout regress: the job " << service::state_word(fin.state()) << (fin.error().empty() ? "" : ": " + fin.error())
+              << "\n";
+    return std::nullopt;
+  }
+  fs::remove_all(results, ec);
+  fs::create_directories(results);
+  const auto listing = client.results(job.id());
+  for (const auto& f : listing.files()) client.download(job.id(), f.name(), (results / f.name()).string());
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return ServiceRun{fin, wall};
+}
+
+}  // namespace
 
 int regress(const std::vector<std::string>& args) {
   service::ClientOptions opt;
@@ -73,28 +113,11 @@ int regress(const std::vector<std::string>& args) {
       embedded->start();
       opt.server = embedded->address();
     }
-    const auto t0 = std::chrono::steady_clock::now();
-    service::Client client(opt);
-    std::ifstream in(scenario);
-    if (!in) throw jobs::ScenarioError("cannot read scenario '" + scenario + "'");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    auto s = jobs::parse_scenario_json(ss.str());
-    s = service::upload_inputs(client, s, fs::absolute(scenario).parent_path().string());
-    const auto job = client.submit(s, "");
-    std::fprintf(stderr, "runout regress: job %s on %s\n", job.id().c_str(), opt.server.c_str());
-    const auto fin = client.watch(job.id());
-    if (fin.state() != v1::SUCCEEDED) {
-      std::cerr << "runout regress: the job " << service::state_word(fin.state()) << (fin.error().empty() ? "" : ": " + fin.error())
-                << "\n";
-      return kFailed;
-    }
     const fs::path results = fs::path(out) / "run";
-    fs::remove_all(results, ec);
-    fs::create_directories(results);
-    const auto listing = client.results(job.id());
-    for (const auto& f : listing.files()) client.download(job.id(), f.name(), (results / f.name()).string());
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const auto run = run_through_service(opt, scenario, results);
+    if (!run) return kFailed;
+    const auto& fin = run->fin;
+    const double wall = run->wall;
     fs::copy_file(results / "map.png", fs::path(out) / "map.png", fs::copy_options::overwrite_existing);
     if (embedded) {
       embedded->shutdown();
@@ -112,7 +135,7 @@ int regress(const std::vector<std::string>& args) {
     }
     const auto ref = jobs::read_reference(reference);
     const auto o = jobs::compare_run(figures, ref, (results / "max_depth.tif").string(), reference, out);
-    jobs::write_report(out, o, ref, job.id(), fin.scenario_hash(), wall);
+    jobs::write_report(out, o, ref, fin.id(), fin.scenario_hash(), wall);
     for (const auto& r : o.rows)
       std::printf("%-48s %14.6g %14.6g  %s\n", r.name.c_str(), r.reference, r.value, r.ok ? "ok" : "FAIL");
     std::printf("%s: report in %s\n", o.ok ? "PASS" : "REGRESSION", (fs::path(out) / "report.md").string().c_str());

@@ -24,39 +24,104 @@ namespace {
 std::atomic<bool> g_interrupted{false};
 extern "C" void on_interrupt(int) { g_interrupted = true; }
 
-}  // namespace
+// The summary of a finished run on standard output.
+void print_summary(const jobs::RunSummary& sum, bool vof, const fs::path& dest) {
+  if (vof) {
+    std::printf("mesh        %d x %d cells of %.4g m (plane, channel coordinates)\n", sum.nx, sum.ny, sum.dx);
+    std::printf("run         %ld steps to t = %.3f s, %.2f s wall (solve %.2f, write %.2f)\n", sum.steps, sum.t,
+                sum.seconds_prepare + sum.seconds_run + sum.seconds_write, sum.seconds_run, sum.seconds_write);
+    std::printf("granular    %.6g m3 initial, %.6g m3 final (relative error %.1e)\n", sum.volume_initial, sum.volume_final,
+                sum.volume_error);
+    std::printf("flow        peak speed %.3f m/s, front at x = %.4f m, deposit height %.4f m (run.json has the rest)\n",
+                sum.max_speed, sum.runout_m, sum.max_depth);
+    std::printf("results in  %s:", dest.string().c_str());
+    for (const auto& f : sum.files) std::printf(" %s", f.c_str());
+    std::printf("\n");
+    return;
+  }
+  for (const auto& n : sum.notes) std::cerr << "note: " << n << "\n";
+  std::printf("grid        %d x %d cells of %.1f m in %s\n", sum.nx, sum.ny, sum.dx, sum.crs.c_str());
+  std::printf("release     %.0f m2, %.0f m3\n", sum.release_area_m2, sum.release_volume_m3);
+  std::printf("run         %ld steps to t = %.1f s (stop: %s), %.2f s wall (prepare %.2f, solve %.2f, write %.2f)\n",
+              sum.steps, sum.t, sum.stop.c_str(), sum.seconds_prepare + sum.seconds_run + sum.seconds_write,
+              sum.seconds_prepare, sum.seconds_run, sum.seconds_write);
+  std::printf("volume      %.6g m3 initial, %.6g m3 final, %.6g m3 left the grid (error %.1e)\n", sum.volume_initial,
+              sum.volume_final, sum.volume_outflow, sum.volume_error);
+  std::printf("hazard      affected area %.0f m2, runout %.0f m from the release centroid, max speed %.1f m/s, max depth %.2f m\n",
+              sum.affected_area_m2, sum.runout_m, sum.max_speed, sum.max_depth);
+  std::printf("results in  %s:", dest.string().c_str());
+  for (const auto& f : sum.files) std::printf(" %s", f.c_str());
+  std::printf("\n");
+}
 
-int run(const std::vector<std::string>& args) {
+constexpr const char* kRunHelp =
+    "Run a scenario (JSON form of runout.v1.Scenario, see README) and write the hazard rasters (COG\n"
+    "GeoTIFF), the runout outline (GeoJSON in WGS84, GeoPackage) and the run record (run.json) into DIR.\n"
+    "Results appear only when the run succeeded. A progress line goes to standard error unless --quiet.";
+
+// The command's arguments.
+struct RunArgs {
   std::string scenario, out, iseesnow, checkpoint, restart, threads;
   bool force = false, quiet = false;
-  CLI::App app{"Run a scenario (JSON form of runout.v1.Scenario, see README) and write the hazard rasters (COG\n"
-               "GeoTIFF), the runout outline (GeoJSON in WGS84, GeoPackage) and the run record (run.json) into DIR.\n"
-               "Results appear only when the run succeeded. A progress line goes to standard error unless --quiet.",
-               "runout run"};
+};
+
+void add_run_options(CLI::App& app, RunArgs& a) {
   prepare(app);
-  app.add_option("SCENARIO.json", scenario, "The scenario file (required)");
-  app.add_option("--out", out,
+  app.add_option("SCENARIO.json", a.scenario, "The scenario file (required)");
+  app.add_option("--out", a.out,
                  "Result directory (required). It must not exist; an existing DIR is replaced only with --force and "
                  "only when it holds a previous result (runout's run.json), once the new one is complete; another "
                  "folder, a file, a link, or the current directory (or one that holds it) is never replaced")
       ->type_name("DIR");
-  app.add_flag("--force", force, "Replace DIR when it holds a previous result (see --out)");
-  app.add_flag("--quiet", quiet, "No progress line and no summary");
-  app.add_option("--threads", threads, "OpenMP threads (a positive integer; default: all cores)")->type_name("N");
-  app.add_option("--iseesnow", iseesnow,
+  app.add_flag("--force", a.force, "Replace DIR when it holds a previous result (see --out)");
+  app.add_flag("--quiet", a.quiet, "No progress line and no summary");
+  app.add_option("--threads", a.threads, "OpenMP threads (a positive integer; default: all cores)")->type_name("N");
+  app.add_option("--iseesnow", a.iseesnow,
                  "Also write the ISeeSnow benchmark files (peak thickness/velocity ESRI ASCII on the DEM's grid, result "
                  "CSV) for this simulation id (01IdealizedTopo, 02RealTopo, 03CoulombOnly)")
       ->type_name("SIMULATION_ID");
-  app.add_option("--checkpoint", checkpoint,
+  app.add_option("--checkpoint", a.checkpoint,
                  "Write the run's state to FILE when the run is interrupted (Ctrl-C, SIGTERM) and, for VOF runs (engine "
                  "\"vof\"), every lab.checkpoint_interval_s. VOF runs: the monitors travel in FILE, the frames so far in "
                  "FILE.fields.h5. Depth-averaged runs: the solver's whole state and hazard maps travel in FILE, the time "
                  "series so far in FILE.timeseries.h5")
       ->type_name("FILE");
-  app.add_option("--restart", restart,
+  app.add_option("--restart", a.restart,
                  "Continue from a --checkpoint FILE of the same scenario exactly as the run would have gone on (run.json "
                  "and fields.h5 are the whole run's; depth-averaged runs: the uninterrupted run's outputs, bit for bit)")
       ->type_name("FILE");
+}
+
+// Runs the resolved scenario into `tmp`; kOk, or the exit code of the failure (its message on
+// standard error; `newline` ends the progress line first).
+int execute(const jobs::ResolvedScenario& resolved, const fs::path& tmp, const jobs::RunOptions& opt, bool newline,
+            jobs::RunSummary& sum) {
+  auto fail = [&](const std::string& message, int code) {
+    if (newline) std::fprintf(stderr, "\n");
+    std::cerr << "runout run: " << message << "\n";
+    return code;
+  };
+  try {
+    sum = jobs::run_scenario(resolved, tmp.string(), opt);
+  } catch (const jobs::ScenarioError& e) {
+    return fail(e.what(), kBadInput);
+  } catch (const terrain::TerrainError& e) {
+    return fail(e.what(), kBadInput);
+  } catch (const std::invalid_argument& e) {  // the engine's checks of its input
+    return fail(e.what(), kBadInput);
+  } catch (const std::exception& e) {
+    return fail(std::string("failed: ") + e.what(), kInternal);
+  }
+  return kOk;
+}
+
+}  // namespace
+
+int run(const std::vector<std::string>& args) {
+  RunArgs a;
+  auto& [scenario, out, iseesnow, checkpoint, restart, threads, force, quiet] = a;
+  CLI::App app{kRunHelp, "runout run"};
+  add_run_options(app, a);
   if (const int rc = parse_args(app, args); rc >= 0) return rc;
   if (app.count("--iseesnow") &&
       (iseesnow.empty() || iseesnow.find_first_of("_/\\ .") != std::string::npos)) {
@@ -131,23 +196,8 @@ int run(const std::vector<std::string>& args) {
     }
     return !g_interrupted.load();
   };
-  auto fail = [&](const std::string& message, int code) {
-    if (!quiet && tty) std::fprintf(stderr, "\n");
-    std::cerr << "runout run: " << message << "\n";
-    return code;
-  };
   jobs::RunSummary sum;
-  try {
-    sum = jobs::run_scenario(resolved, tmp.string(), opt);
-  } catch (const jobs::ScenarioError& e) {
-    return fail(e.what(), kBadInput);
-  } catch (const terrain::TerrainError& e) {
-    return fail(e.what(), kBadInput);
-  } catch (const std::invalid_argument& e) {  // the engine's checks of its input
-    return fail(e.what(), kBadInput);
-  } catch (const std::exception& e) {
-    return fail(std::string("failed: ") + e.what(), kInternal);
-  }
+  if (const int rc = execute(resolved, tmp, opt, !quiet && tty, sum); rc != kOk) return rc;
   if (!quiet && tty) std::fprintf(stderr, "\n");
   if (sum.stop == "cancelled") {
     std::cerr << "runout run: cancelled at t = " << sum.t << " s; no results written\n";
@@ -160,34 +210,7 @@ int run(const std::vector<std::string>& args) {
     return kOutput;
   }
   if (!staged.note().empty()) std::cerr << "runout run: note: " << staged.note() << "\n";
-  if (!quiet && resolved.vof) {
-    std::printf("mesh        %d x %d cells of %.4g m (plane, channel coordinates)\n", sum.nx, sum.ny, sum.dx);
-    std::printf("run         %ld steps to t = %.3f s, %.2f s wall (solve %.2f, write %.2f)\n", sum.steps, sum.t,
-                sum.seconds_prepare + sum.seconds_run + sum.seconds_write, sum.seconds_run, sum.seconds_write);
-    std::printf("granular    %.6g m3 initial, %.6g m3 final (relative error %.1e)\n", sum.volume_initial, sum.volume_final,
-                sum.volume_error);
-    std::printf("flow        peak speed %.3f m/s, front at x = %.4f m, deposit height %.4f m (run.json has the rest)\n",
-                sum.max_speed, sum.runout_m, sum.max_depth);
-    std::printf("results in  %s:", dest.string().c_str());
-    for (const auto& f : sum.files) std::printf(" %s", f.c_str());
-    std::printf("\n");
-    return kOk;
-  }
-  if (!quiet) {
-    for (const auto& n : sum.notes) std::cerr << "note: " << n << "\n";
-    std::printf("grid        %d x %d cells of %.1f m in %s\n", sum.nx, sum.ny, sum.dx, sum.crs.c_str());
-    std::printf("release     %.0f m2, %.0f m3\n", sum.release_area_m2, sum.release_volume_m3);
-    std::printf("run         %ld steps to t = %.1f s (stop: %s), %.2f s wall (prepare %.2f, solve %.2f, write %.2f)\n",
-                sum.steps, sum.t, sum.stop.c_str(), sum.seconds_prepare + sum.seconds_run + sum.seconds_write,
-                sum.seconds_prepare, sum.seconds_run, sum.seconds_write);
-    std::printf("volume      %.6g m3 initial, %.6g m3 final, %.6g m3 left the grid (error %.1e)\n", sum.volume_initial,
-                sum.volume_final, sum.volume_outflow, sum.volume_error);
-    std::printf("hazard      affected area %.0f m2, runout %.0f m from the release centroid, max speed %.1f m/s, max depth %.2f m\n",
-                sum.affected_area_m2, sum.runout_m, sum.max_speed, sum.max_depth);
-    std::printf("results in  %s:", dest.string().c_str());
-    for (const auto& f : sum.files) std::printf(" %s", f.c_str());
-    std::printf("\n");
-  }
+  if (!quiet) print_summary(sum, resolved.vof, dest);
   return kOk;
 }
 
