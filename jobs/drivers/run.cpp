@@ -2,9 +2,8 @@
 
 #include "jobs/digest/sha256.hpp"
 
-#include "jobs/drivers/lab_run.hpp"
-
-#include <google/protobuf/util/json_util.h>
+#include "jobs/drivers/vof_lab/run.hpp"
+#include "jobs/drivers/record_head.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -19,10 +18,6 @@
 #include "jobs/formats/timeseries.hpp"
 #include "jobs/figures/map.hpp"
 
-#ifndef RUNOUT_VERSION
-#define RUNOUT_VERSION "unknown"
-#endif
-
 namespace runout::jobs {
 namespace fs = std::filesystem;
 
@@ -31,28 +26,6 @@ namespace {
 double since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
-
-std::string jstr(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    switch (c) {
-      case '"': o += "\\\""; break;
-      case '\\': o += "\\\\"; break;
-      case '\n': o += "\\n"; break;
-      case '\t': o += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char b[8];
-          std::snprintf(b, sizeof b, "\\u%04x", c);
-          o += b;
-        } else {
-          o += c;
-        }
-    }
-  }
-  return o + "\"";
-}
-
 
 }  // namespace
 
@@ -231,7 +204,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
     // The model configuration file the benchmark asks for, named like the peak fields.
     std::ofstream cfg(out(stem + ".txt"));
     const auto& m = s.scenario.material();
-    cfg << "runout " << RUNOUT_VERSION << ": depth-averaged Savage-Hutter model (NOC-TVD scheme, "
+    cfg << "runout " << this_software().version() << ": depth-averaged Savage-Hutter model (NOC-TVD scheme, "
         << "curvature in the bed friction " << (s.scenario.numerics().curvature_off() ? "off" : "on") << ")\n"
         << "scenario = " << s.scenario.name() << "\n"
         << "rheology = " << (m.rheology().empty() ? "coulomb" : m.rheology()) << "\n";
@@ -252,56 +225,68 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   }
 
   // Run record.
-  std::string scenario_json;
-  google::protobuf::util::JsonPrintOptions po;
-  po.always_print_primitive_fields = true;
-  po.preserve_proto_field_names = true;
-  (void)google::protobuf::util::MessageToJsonString(s.scenario, &scenario_json, po);
-  std::ostringstream r;
-  r << "{\n  \"software\": {\"name\": \"runout\", \"version\": " << jstr(RUNOUT_VERSION) << "},\n";
-  r << "  \"created_utc\": " << jstr([] {
-    char b[32];
-    const std::time_t now = std::time(nullptr);
-    std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-    return std::string(b);
-  }()) << ",\n";
-  r << "  \"scenario_file\": " << jstr(s.source) << ",\n  \"scenario\": " << scenario_json << ",\n";
-  r << "  \"inputs\": [";
-  for (std::size_t k = 0; k < s.input_files.size(); ++k)
-    r << (k ? ", " : "") << "{\"path\": " << jstr(s.input_files[k]) << ", \"sha256\": " << jstr(sha256_file(s.input_files[k])) << "}";
-  r << "],\n";
-  r << "  \"dem\": {\"source_crs\": " << jstr(dem_rep.source_crs) << ", \"source_resolution_m\": " << json_number(dem_rep.source_resolution_m)
-    << ", \"z_min_m\": " << json_number(dem_rep.z_min) << ", \"z_max_m\": " << json_number(dem_rep.z_max)
-    << ", \"slope_mean_deg\": " << json_number(dem_rep.slope_mean_deg) << ", \"slope_p90_deg\": " << json_number(dem_rep.slope_p90_deg)
-    << ", \"slope_max_deg\": " << json_number(dem_rep.slope_max_deg) << ", \"cells_without_data\": " << dem_rep.cells_without_data
-    << ", \"cells_outside_area\": " << dem_rep.cells_outside_area << "},\n";
-  r << "  \"grid\": {\"crs\": " << jstr(grid.crs_name) << ", \"nx\": " << grid.nx << ", \"ny\": " << grid.ny
-    << ", \"cell_size_m\": " << json_number(grid.dx) << ", \"x_min\": " << json_number(grid.x_min) << ", \"y_min\": " << json_number(grid.y_min)
-    << ", \"local_origin\": [" << json_number(grid.x_min + 0.5 * grid.nx * grid.dx) << ", " << json_number(grid.y_min + 0.5 * grid.ny * grid.dx)
-    << "]},\n";
-  r << "  \"release\": {\"polygons\": " << rel_rep.polygons << ", \"cells\": " << rel_rep.cells << ", \"area_m2\": "
-    << json_number(rel_rep.area_m2) << ", \"volume_m3\": " << json_number(rel_rep.volume_m3) << ", \"notes\": [";
-  for (std::size_t k = 0; k < rel_rep.notes.size(); ++k) r << (k ? ", " : "") << jstr(rel_rep.notes[k]);
-  r << "]},\n";
-  r << "  \"mass_balance\": {\"volume_initial_m3\": " << json_number(d.volume_initial) << ", \"volume_final_m3\": " << json_number(d.volume_final)
-    << ", \"volume_outflow_m3\": " << json_number(d.volume_outflow) << ", \"relative_error\": " << json_number(d.volume_error()) << "},\n";
-  r << "  \"solver\": {\"steps\": " << d.steps << ", \"simulated_s\": " << json_number(d.t) << ", \"stop\": " << jstr(sum.stop)
-    << ", \"continued_from_t_s\": " << json_number(continued_from) << ", \"max_speed_m_s\": " << json_number(d.max_speed) << ", \"kinetic_energy_peak\": " << json_number(d.kinetic_energy_peak)
-    << ", \"positivity_limited\": " << d.positivity_limited << ", \"cell_updates\": " << json_number(d.cell_updates)
-    << ", \"mean_active_fraction\": " << json_number(d.mean_active_fraction) << ", \"max_active_fraction\": " << json_number(d.max_active_fraction)
-    << "},\n";
-  r << "  \"results\": {\"affected_area_m2\": " << json_number(sum.affected_area_m2) << ", \"outline_polygons\": " << outline.polygons
-    << ", \"outline_area_m2\": " << json_number(outline.area_m2) << ", \"runout_from_release_centroid_m\": " << json_number(sum.runout_m)
-    << ", \"max_depth_m\": " << json_number(sum.max_depth) << ", \"outline_threshold_m\": " << json_number(s.outline_threshold)
-    << ", \"timeseries_frames\": " << frames << "},\n";
-  r << "  \"timings_s\": {\"prepare\": " << json_number(sum.seconds_prepare) << ", \"run\": " << json_number(sum.seconds_run)
-    << ", \"write\": " << json_number(sum.seconds_write) << "},\n";
-  r << "  \"outputs\": [";
-  for (std::size_t k = 0; k < sum.files.size(); ++k) r << (k ? ", " : "") << jstr(sum.files[k]);
-  r << ", \"run.json\"]\n}\n";
-  std::ofstream f(out("run.json"));
-  f << r.str();
-  if (!f) throw std::runtime_error("writing run.json failed");
+  v1::RunRecord rec = run_record_head(s, "depth-averaged");
+  for (const auto& path : s.input_files) {
+    auto* in = rec.add_inputs();
+    in->set_path(path);
+    in->set_sha256(sha256_file(path));
+  }
+  auto* dem = rec.mutable_dem();
+  dem->set_source_crs(dem_rep.source_crs);
+  dem->set_source_resolution_m(dem_rep.source_resolution_m);
+  dem->set_z_min_m(dem_rep.z_min);
+  dem->set_z_max_m(dem_rep.z_max);
+  dem->set_slope_mean_deg(dem_rep.slope_mean_deg);
+  dem->set_slope_p90_deg(dem_rep.slope_p90_deg);
+  dem->set_slope_max_deg(dem_rep.slope_max_deg);
+  dem->set_cells_without_data(int(dem_rep.cells_without_data));
+  dem->set_cells_outside_area(int(dem_rep.cells_outside_area));
+  auto* gr = rec.mutable_grid();
+  gr->set_crs(grid.crs_name);
+  gr->set_nx(grid.nx);
+  gr->set_ny(grid.ny);
+  gr->set_cell_size_m(grid.dx);
+  gr->set_x_min(grid.x_min);
+  gr->set_y_min(grid.y_min);
+  gr->add_local_origin(grid.x_min + 0.5 * grid.nx * grid.dx);
+  gr->add_local_origin(grid.y_min + 0.5 * grid.ny * grid.dx);
+  auto* rel = rec.mutable_release();
+  rel->set_polygons(rel_rep.polygons);
+  rel->set_cells(int(rel_rep.cells));
+  rel->set_area_m2(rel_rep.area_m2);
+  rel->set_volume_m3(rel_rep.volume_m3);
+  for (const auto& note : rel_rep.notes) rel->add_notes(note);
+  auto* mb = rec.mutable_mass_balance();
+  mb->set_volume_initial_m3(d.volume_initial);
+  mb->set_volume_final_m3(d.volume_final);
+  mb->set_volume_outflow_m3(d.volume_outflow);
+  mb->set_relative_error(d.volume_error());
+  auto* so = rec.mutable_solver();
+  so->set_steps(int(d.steps));
+  so->set_simulated_s(d.t);
+  so->set_stop(sum.stop);
+  if (continued) so->set_continued_from_t_s(continued_from);
+  so->set_max_speed_m_s(d.max_speed);
+  so->set_kinetic_energy_peak(d.kinetic_energy_peak);
+  so->set_positivity_limited(double(d.positivity_limited));
+  so->set_cell_updates(d.cell_updates);
+  so->set_mean_active_fraction(d.mean_active_fraction);
+  so->set_max_active_fraction(d.max_active_fraction);
+  auto* re = rec.mutable_results();
+  re->set_affected_area_m2(sum.affected_area_m2);
+  re->set_outline_polygons(outline.polygons);
+  re->set_outline_area_m2(outline.area_m2);
+  re->set_runout_from_release_centroid_m(sum.runout_m);
+  re->set_max_depth_m(sum.max_depth);
+  re->set_outline_threshold_m(s.outline_threshold);
+  re->set_timeseries_frames(frames);
+  auto* ti = rec.mutable_timings_s();
+  ti->set_prepare(sum.seconds_prepare);
+  ti->set_run(sum.seconds_run);
+  ti->set_write(sum.seconds_write);
+  for (const auto& f : sum.files) rec.add_outputs(f);
+  rec.add_outputs("run.json");
+  write_run_record(out("run.json"), rec);
   sum.files.push_back("run.json");
   return sum;
 }

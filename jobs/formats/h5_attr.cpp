@@ -1,5 +1,6 @@
 #include "jobs/formats/h5_attr.hpp"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace runout::jobs::h5 {
@@ -29,6 +30,25 @@ std::string get_attr_string(hid_t loc, const char* name) {
   H5Tclose(t);
   H5Aclose(a);
   v.resize(v.find('\0') == std::string::npos ? v.size() : v.find('\0'));
+  return v;
+}
+
+bool put_attr_double(hid_t loc, const char* name, double v) {
+  hid_t sp = H5Screate(H5S_SCALAR);
+  hid_t a = H5Acreate2(loc, name, H5T_IEEE_F64LE, sp, H5P_DEFAULT, H5P_DEFAULT);
+  const herr_t st = a < 0 ? -1 : H5Awrite(a, H5T_NATIVE_DOUBLE, &v);
+  if (a >= 0) H5Aclose(a);
+  H5Sclose(sp);
+  return st >= 0;
+}
+
+double get_attr_double(hid_t loc, const char* name) {
+  double v = NAN;
+  if (H5Aexists(loc, name) <= 0) return v;
+  hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
+  if (a < 0) return v;
+  if (H5Aread(a, H5T_NATIVE_DOUBLE, &v) < 0) v = NAN;
+  H5Aclose(a);
   return v;
 }
 

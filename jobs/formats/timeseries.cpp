@@ -9,6 +9,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "jobs/formats/h5_attr.hpp"
 #include "jobs/scenario/scenario.hpp"
 
 namespace runout::jobs {
@@ -146,11 +147,7 @@ void TimeSeriesWriter::write(double t, const engine::Sh2dStateView& s) {
   if (g < 0) throw std::runtime_error("time series: cannot create group");
   m.dataset(g, "depth", h);
   m.dataset(g, "speed", sp);
-  hid_t space = H5Screate(H5S_SCALAR);
-  hid_t a = H5Acreate2(g, "time", H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT);
-  H5Awrite(a, H5T_NATIVE_DOUBLE, &t);
-  H5Aclose(a);
-  H5Sclose(space);
+  h5::put_attr_double(g, "time", t);
   H5Gclose(g);
   m.times.push_back(t);
 }

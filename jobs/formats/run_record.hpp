@@ -1,0 +1,40 @@
+#pragma once
+// run.json, the run record (runout.v1.RunRecord, service/proto/runout/v1/run_record.proto), written
+// and read through protobuf's JSON mapping with the proto's snake_case field names. The JSON form
+// (what is printed when, numbers, "NaN") is described in the proto.
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "runout/v1/run_record.pb.h"
+
+namespace runout::jobs {
+
+/// A run record that cannot be read or written; the message names the file.
+struct RunRecordError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Write `record` to `path` (replaced): every double rounded to 10 significant digits (the
+/// embedded scenario as it is), fields without presence printed even when zero.
+void write_run_record(const std::string& path, const v1::RunRecord& record);
+
+/// Read a run record. Throws RunRecordError naming `path` when the file is missing or is not a
+/// run record (fields it does not know are ignored).
+v1::RunRecord read_run_record(const std::string& path);
+
+/// Whether `path` is runout's run record (readable, software.name "runout"); never throws.
+bool is_run_record(const std::string& path);
+
+/// One [y, alpha, u] triple of a station's profile.
+struct ProfilePoint {
+  double y = 0, alpha = 0, u = 0;
+};
+std::vector<ProfilePoint> station_profile(const v1::Station& s);
+/// A profile triple as the record holds it.
+google::protobuf::ListValue profile_point(double y, double alpha, double u);
+
+/// The build of this program: version, git commit, compiler and build type.
+v1::Software this_software();
+
+}  // namespace runout::jobs
