@@ -1,4 +1,4 @@
-// Work-precision and throughput benchmark of the depth-averaged solvers (docs/performance.md).
+// Work-precision and throughput benchmark of the depth-averaged solvers (docs/design/performance.md).
 //
 //   runout_bench_sh [--quick] [--repeat N]
 //

@@ -110,7 +110,7 @@ struct FaceState {
 // Local speed of the central flux: an upper bound of the characteristic speeds |u| + c on both
 // sides, max|u| + sqrt(max c^2) (one square root instead of two). Raising it to the dry-bed front
 // speed u + 2c at wet/dry faces was tried: it adds diffusion and makes thin fronts lag more
-// (docs/engine.md).
+// (docs/design/depth-averaged.md).
 inline double face_speed(double uL, double c2L, double uR, double c2R) {
   return std::max(std::abs(uL), std::abs(uR)) + std::sqrt(std::max(c2L, c2R));
 }

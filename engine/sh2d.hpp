@@ -1,7 +1,7 @@
 #pragma once
 // Two-dimensional Savage-Hutter equations on a raster of terrain elevations z = b(x, y).
 //
-// Conventions (docs/engine.md has the derivation):
+// Conventions (docs/design/depth-averaged.md has the derivation):
 // * x, y are horizontal map coordinates [m]; the grid is the DEM's raster.
 // * h is the flow depth measured NORMAL to the local surface (the convention of Savage & Hutter);
 //   inputs and outputs use h. Inside, the solver carries H = h / cos(theta), the volume per unit

@@ -84,7 +84,7 @@ std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseR
           if (rq.thickness_attribute.empty()) throw TerrainError(what + ": no thickness (set thickness_m or thickness_attribute)");
           t = field_value(*f, rq.thickness_attribute, what);
         }
-        // The same bound as the scenario's releases[].thickness_m (README, Valid ranges).
+        // The same bound as the scenario's releases[].thickness_m (docs/user/scenarios.md, Valid ranges).
         if (!(t > 0 && t <= 500)) throw TerrainError(what + ": thickness must be > 0 m and at most 500 m, got " + fmt(t, 3));
         double smin = rq.has_min_slope ? rq.min_slope : 0.0, smax = rq.has_max_slope ? rq.max_slope : 90.0;
         if (!rq.has_min_slope && !rq.min_slope_attribute.empty()) smin = field_value(*f, rq.min_slope_attribute, what);

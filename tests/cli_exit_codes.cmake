@@ -19,7 +19,7 @@ if(EXISTS ${OUT}/x)
   message(FATAL_ERROR "a failed run left ${OUT}/x behind")
 endif()
 
-# Output directories (README "Outputs of `runout run`"): --force replaces only a previous result of
+# Output directories (docs/user/outputs.md "Outputs of `runout run`"): --force replaces only a previous result of
 # runout, and only once the new one is complete; nothing else is ever deleted.
 function(expect_in dir code regex)
   execute_process(COMMAND ${ARGN} WORKING_DIRECTORY ${dir} RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)

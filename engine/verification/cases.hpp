@@ -1,5 +1,5 @@
 #pragma once
-// Verification cases A1-A7 (docs/verification.md): each sets up the depth-averaged solvers against an
+// Verification cases A1-A7 (docs/validation/verification.md): each sets up the depth-averaged solvers against an
 // exact solution or an invariant, runs them at one or more resolutions and returns rows of figures
 // with a pass/fail against explicit tolerances. Pure numerics: no files, no printing; the CLI
 // (`runout verify`) and the tests format and assert the rows.

@@ -18,7 +18,7 @@ std::vector<Row> case_a1(const Options& o) {
   // The front is where the depth falls to a threshold, in the exact solution and in the run alike:
   // 0.1 m (10 % of h0, the depth hazard maps outline) is checked; 1 mm is reported. The exact tail
   // ahead of it is a degenerate rarefaction (h ~ (x_f - x)^2) that central schemes under-resolve,
-  // so the 1 mm position lags (docs/verification.md).
+  // so the 1 mm position lags (docs/validation/verification.md).
   auto x_at = [&](double thr) {
     return t_end * (2 * ex.c0() + 0.5 * ex.m() * t_end - 3 * std::sqrt(ex.g * std::cos(ex.zeta) * thr));
   };
@@ -102,7 +102,7 @@ std::vector<Row> case_a1(const Options& o) {
 
 // ---------------------------------------------------------------- A2 parabolic cap
 // Compared at t = 5 s: later, a smooth wiggle grows at the cap's crest (amplitude ~1e-3 of the depth
-// by t = 10 s, every limiter) and the observed order becomes erratic (docs/verification.md).
+// by t = 10 s, every limiter) and the observed order becomes erratic (docs/validation/verification.md).
 std::vector<Row> case_a2(const Options& o) {
   const exact::ParabolicCap ex{35 * kDeg, 25 * kDeg, 1.0, 80.0, 4.0, 0.0};
   const double t_end = 5.0, xa = -90, xb = 150;

@@ -1,6 +1,6 @@
 #pragma once
 // Exact and semi-exact solutions of the Savage-Hutter equations used for verification
-// (docs/verification.md; cases A1, A2, A3, A5 of the validation plan). Slope coordinates:
+// (docs/validation/verification.md; cases A1, A2, A3, A5 of the validation plan). Slope coordinates:
 // x along the slope (downhill positive), depth h normal to it, zeta inclination, delta bed
 // friction angle, K earth-pressure coefficient, g gravity. Angles in radians.
 namespace runout::engine::exact {

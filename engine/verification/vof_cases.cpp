@@ -128,7 +128,7 @@ constexpr double kUlid = 0.1;
 // that its error falls with dy^2. Two variants: "predictor" solves the momentum matrix (the
 // viscous term fully implicit; checked), "piso" is the default PISO (3 correctors, each one
 // Jacobi-like sweep of the viscous coupling; reported: its error levels off near 7e-4, the viscous
-// coupling a step leaves unconverged, docs/vof.md).
+// coupling a step leaves unconverged, docs/design/vof.md).
 std::vector<Row> couette_rows(const Options& o, bool steady, bool predictor) {
   const double H = kH, U = kUlid, nu = kNu;
   const double t_end = steady ? 4 * H * H / nu : 0.05 * H * H / nu;

@@ -1,5 +1,5 @@
 #pragma once
-// Verification cases V1-V4 of the VOF engine (engine/vof/, docs/verification.md): Newtonian flows
+// Verification cases V1-V4 of the VOF engine (engine/vof/, docs/validation/verification.md): Newtonian flows
 // with exact solutions (plane Couette, plane Poiseuille, Couette's start-up) and a two-layer column
 // at rest (hydrostatic pressure, no spurious currents). Same rows and registry as A1-A7 (cases.cpp).
 #include <vector>

@@ -712,7 +712,7 @@ struct VofSolver::Impl {
     // predicted; the air around them keeps its velocity (the cells' coefficients to it go to the
     // right-hand side), as under PISO. Predicting the air too let the cell-reconstructed buoyancy
     // force drive air currents over a resting heap's stair-stepped surface (0.1 m/s) that dragged
-    // it along at 2 mm/s (docs/vof.md).
+    // it along at 2 mm/s (docs/design/vof.md).
     const bool material_only = s.cfg_.consistent;
     auto solved = [&](int c) {
       return ix[std::size_t(c)] >= 0 && (!material_only || s.alpha_[std::size_t(c)] >= s.cfg_.consistent_alpha);
@@ -772,7 +772,7 @@ struct VofSolver::Impl {
     return its_total;
   }
 
-  // The active region (docs/vof.md, "Skipping air far from the material"): cells with material
+  // The active region (docs/design/vof.md, "Skipping air far from the material"): cells with material
   // (alpha > active_alpha), cells with an inflow face, and `active_layers` layers of cells around
   // them. Only these take part in the pressure equation; the rest is air at rest under the
   // atmosphere's hydrostatic pressure, and faces to it act as openings. The region is rebuilt when

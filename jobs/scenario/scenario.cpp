@@ -54,7 +54,7 @@ std::string num(double v) {
   return o.str();
 }
 
-// The valid ranges of the numeric fields (README "Valid ranges"): a value outside, NaN or an
+// The valid ranges of the numeric fields (docs/user/scenarios.md "Valid ranges"): a value outside, NaN or an
 // infinity is refused with the field, the range and the value. `lo_open` / `hi_open`: the bound itself
 // is excluded.
 void in_range(const std::string& field, double v, double lo, double hi, const char* unit = "", bool lo_open = false,
@@ -64,7 +64,7 @@ void in_range(const std::string& field, double v, double lo, double hi, const ch
     bad(field, std::string("must lie in ") + (lo_open ? "(" : "[") + num(lo) + ", " + num(hi) + (hi_open ? ")" : "]") +
                    (*unit ? " " : "") + unit + note + ", got " + num(v));
 }
-// Bounds (README "Valid ranges").
+// Bounds (docs/user/scenarios.md "Valid ranges").
 constexpr double kMaxCell = 1e4;          // grid.resolution_m [m]
 constexpr double kMaxThickness = 500;     // a release [m]: rock avalanches start some hundred metres thick
 constexpr double kMaxDensity = 1e4;       // [kg/m3]: above any rock or ore

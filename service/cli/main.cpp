@@ -34,7 +34,7 @@ commands:
         monitors travel in FILE, the frames so far in FILE.fields.h5, so run.json and fields.h5 are
         the whole run's. Depth-averaged runs: the solver's whole state and hazard maps travel in
         FILE, the time series so far in FILE.timeseries.h5; the continued run's outputs are the
-        uninterrupted run's, bit for bit (docs/engine.md).
+        uninterrupted run's, bit for bit (docs/design/depth-averaged.md).
   verify [CASE...] [--full] [--resolutions R1,R2,...] [--limiter NAME] [--csv] [--threads N]
         Run the verification cases against exact solutions and invariants and print a table
         (or CSV). Cases: A1 A2 A3 A4 A5 A6 A7 STRESS (default: all). --full adds the finest
@@ -47,7 +47,7 @@ commands:
         Each job runs in a worker process of its own; jobs left running by a killed server are
         queued again at the next start. One server per state directory (a second one exits).
         --recover rebuilds a missing, empty or damaged job store from the job records, logs and
-        results, then starts (docs/operations.md).
+        results, then starts (docs/user/operations.md).
   submit SCENARIO.json [--wait] [--quiet] [--request-id ID] [--server-paths]
         Upload the scenario's input files and queue it; prints the job id and state. --wait follows
         the job to its end (progress on standard error). --server-paths sends the input paths as
@@ -69,7 +69,7 @@ commands:
         map and a difference map; exit 1 on a regression. --accept makes this run the reference.
   worker
         (Started by the server, not by hand.) Run one job handed over on standard input and report
-        on standard output (service/proto/runout/v1/worker.proto; docs/operations.md).
+        on standard output (service/proto/runout/v1/worker.proto; docs/user/operations.md).
   version
         Print the program version and the versions of the libraries it links.
   help [COMMAND]
@@ -167,7 +167,7 @@ namespace {
 // printed on standard output unless --help is asked for by hand.
 int worker(const std::vector<std::string>& args) {
   CLI::App app{"(Started by the server, not by hand.) Run one job handed over on standard input and report on\n"
-               "standard output (service/proto/runout/v1/worker.proto; docs/operations.md). Takes no options.",
+               "standard output (service/proto/runout/v1/worker.proto; docs/user/operations.md). Takes no options.",
                "runout worker"};
   prepare(app);
   if (const int rc = parse_args(app, args); rc >= 0) return rc;

@@ -2,7 +2,7 @@
 // Output directories of the command line (`runout run`, `runout fetch`): results are written to a
 // temporary sibling and moved into place only when complete, so DIR never holds a partial result.
 //
-// What may be written (README "Outputs of `runout run`"): a DIR that does not exist; with --force
+// What may be written (docs/user/outputs.md "Outputs of `runout run`"): a DIR that does not exist; with --force
 // also a previous result, i.e. a directory whose run.json is runout's run record ("software" named
 // "runout"), a directory holding nothing but the job.log of a fetched failed job, or an empty
 // directory. Anything else is refused, even with --force: a regular file, a symbolic link, a

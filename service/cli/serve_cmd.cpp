@@ -28,7 +28,7 @@ int serve(const std::vector<std::string>& args) {
   prepare(app);
   app.add_flag("--recover", recover,
                "Rebuild a missing, empty or damaged job store from the job records, logs and results, then start "
-               "(docs/operations.md)");
+               "(docs/user/operations.md)");
   app.add_option("--config", config, "JSON configuration file (runout.v1.ServerConfig)")->type_name("FILE");
   app.add_option("--listen", listen, "Address to listen on (default 127.0.0.1:50051; port 0: any free port)")->type_name("HOST:PORT");
   app.add_option("--state-dir", state_dir, "The job store, uploads, logs and results (default ./runout-state)")->type_name("DIR");

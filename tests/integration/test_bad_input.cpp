@@ -1,5 +1,5 @@
 // Bad input to `runout run` and the service: every scenario field with a value outside its
-// documented range (README "Valid ranges"), non-finite numbers, lenient JSON, input files that are
+// documented range (docs/user/scenarios.md "Valid ranges"), non-finite numbers, lenient JSON, input files that are
 // not regular files. Each is refused with a ScenarioError naming the field; the bundled scenarios
 // stay valid with the same hash.
 #include <gtest/gtest.h>

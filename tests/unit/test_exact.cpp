@@ -1,4 +1,4 @@
-// The exact solutions themselves, against the reference numbers of docs/verification.md.
+// The exact solutions themselves, against the reference numbers of docs/validation/verification.md.
 #include <gtest/gtest.h>
 
 #include <cmath>

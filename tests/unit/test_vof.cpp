@@ -193,7 +193,7 @@ TEST(VofSolver, B9HeapSteeperThanPhiFails) {
 // g (sin 40 - cos 40 tan 33) = 1.43 m/s2 once the material has yielded. With the consistent
 // coupling and the momentum predictor it does (0.19 m/s at 0.2 s); the PISO default reaches
 // 0.085 m/s there (0.015 m/s in the middle of a 2 m layer): each corrector is one Jacobi sweep of a viscous coupling that dominates the
-// momentum matrix, and the yielded layer is held as if it were stiff (docs/vof.md).
+// momentum matrix, and the yielded layer is held as if it were stiff (docs/design/vof.md).
 double layer_speed_on_a_slope(bool consistent, Bc bed = Bc::wall, double delta_deg = 0) {
   BlockSpec b;
   b.x1 = 1.0, b.y1 = 0.06, b.nx = 200, b.ny = 12, b.thickness = 0.005;
@@ -278,7 +278,7 @@ TEST(VofSolver, CoulombFrictionBedLetsTheLayerSlideAtDelta) {
 // friction at phi: 0.5 - g tan(phi) 0.04 s = 0.245 m/s; the face viscosity's layer keeps 0.35 m/s
 // under PISO with 3 correctors): each corrector is one Jacobi sweep of the viscous coupling at the
 // clip, and the viscosities and the transpose part stay those of the step's start, so the momentum
-// balance lags the bed until both converge (docs/vof.md, "The PISO correctors do not converge the
+// balance lags the bed until both converge (docs/design/vof.md, "The PISO correctors do not converge the
 // stiff viscous coupling").
 struct SlidingLayer {
   double speed = 0;          ///< the material's mean speed at 0.04 s (its momentum over its mass)
@@ -358,7 +358,7 @@ TEST(VofSolver, StickWallCarriesTheCoulombStressWithTheFaceViscosity) {
 
 // The same layer's momentum against its bed's impulse: the correctors' lag (above) closes as they
 // converge the viscous coupling, so that the momentum lost approaches the Coulomb impulse of the bed
-// (measured: 0.61 with 3 correctors, 0.94 with 100, 0.965 with 1,000; docs/vof.md). A bed stress
+// (measured: 0.61 with 3 correctors, 0.94 with 100, 0.965 with 1,000; docs/design/vof.md). A bed stress
 // that were not the Coulomb stress, or momentum made or lost elsewhere, shows as a ratio away from 1.
 TEST(VofSolver, CorrectorsConvergeTheSlidingLayersMomentumToItsBedImpulse) {
   const auto few = sliding_layer(WallViscosity::face, false, 3), many = sliding_layer(WallViscosity::face, false, 100);
@@ -457,7 +457,7 @@ RotatingSand rotating_sand(Transpose transpose) {
 
 // Without the viscous stress's transpose part the sand turns with the box (no avalanche) and its
 // pressure stays within its weight. With the explicit part and the linear face viscosity the same
-// run reaches ten times that pressure and 0.1 m/s (docs/vof.md).
+// run reaches ten times that pressure and 0.1 m/s (docs/design/vof.md).
 TEST(VofSolver, RotatingSandWithoutTransposeKeepsItsWeightPressure) {
   const auto r = rotating_sand(Transpose::off);
   EXPECT_LT(r.pressure_over_weight, 1.0);
