@@ -10,7 +10,7 @@ namespace runout::engine::vof {
 const Patch& Mesh::patch(const std::string& name) const {
   const int k = patch_index(name);
   if (k < 0) throw std::invalid_argument("mesh: no patch '" + name + "'");
-  return patches[std::size_t(k)];
+  return patches[k];
 }
 
 int Mesh::patch_index(const std::string& name) const {
@@ -28,9 +28,9 @@ void Mesh::finish() {
     const std::size_t k = std::size_t(f);
     magSf[k] = norm(Sf[k]);
     const Vec n = (1.0 / magSf[k]) * Sf[k];
-    const Vec cp = centre[std::size_t(owner[k])];
+    const Vec cp = centre[owner[k]];
     if (f < n_internal) {
-      const Vec cn = centre[std::size_t(neighbour[k])];
+      const Vec cn = centre[neighbour[k]];
       delta_coeff[k] = 1.0 / std::abs(dot(cn - cp, n));
       const double dp = std::abs(dot(Cf[k] - cp, n)), dn = std::abs(dot(cn - Cf[k], n));
       weight[k] = dn / (dp + dn);
@@ -41,14 +41,14 @@ void Mesh::finish() {
   // Every cell must be closed: the sum of its outward area vectors vanishes.
   std::vector<Vec> sum(static_cast<std::size_t>(cells()));
   for (int f = 0; f < nf; ++f) {
-    sum[std::size_t(owner[std::size_t(f)])] = sum[std::size_t(owner[std::size_t(f)])] + Sf[std::size_t(f)];
+    sum[owner[f]] = sum[owner[f]] + Sf[f];
     if (f < n_internal)
-      sum[std::size_t(neighbour[std::size_t(f)])] = sum[std::size_t(neighbour[std::size_t(f)])] - Sf[std::size_t(f)];
+      sum[neighbour[f]] = sum[neighbour[f]] - Sf[f];
   }
   for (int c = 0; c < cells(); ++c) {
-    const double scale = std::cbrt(volume[std::size_t(c)]) * std::cbrt(volume[std::size_t(c)]);
+    const double scale = std::cbrt(volume[c]) * std::cbrt(volume[c]);
     // Plane meshes have no front/back faces: only x and y must close.
-    const Vec s = sum[std::size_t(c)];
+    const Vec s = sum[c];
     const double open = thickness > 0 ? std::hypot(s.x, s.y) : norm(s);
     if (open > 1e-9 * std::max(scale, 1e-30)) throw std::logic_error("mesh: cell " + std::to_string(c) + " is not closed");
   }
@@ -81,7 +81,7 @@ std::vector<double> graded_nodes(double a, double b, int n, double grading) {
   v[0] = a;
   double y = a;
   for (int k = 0; k < n; ++k, h *= r) v[std::size_t(k) + 1] = (y += h);
-  v[std::size_t(n)] = b;
+  v[n] = b;
   return v;
 }
 }  // namespace
@@ -104,11 +104,11 @@ Mesh block_mesh(const BlockSpec& s) {
   std::vector<int> id(std::size_t(s.nx) * std::size_t(s.ny), -1);
   for (int j = 0; j < s.ny; ++j)
     for (int i = 0; i < s.nx; ++i) {
-      const double cx = 0.5 * (xs[std::size_t(i)] + xs[std::size_t(i) + 1]), cy = 0.5 * (ys[std::size_t(j)] + ys[std::size_t(j) + 1]);
+      const double cx = 0.5 * (xs[i] + xs[std::size_t(i) + 1]), cy = 0.5 * (ys[j] + ys[std::size_t(j) + 1]);
       if (inside(cx, cy) || (s.blocked_if && s.blocked_if(Vec{cx, cy, 0}))) continue;
       id[std::size_t(j) * std::size_t(s.nx) + std::size_t(i)] = m.cells();
       m.centre.push_back({cx, cy, 0});
-      m.volume.push_back((xs[std::size_t(i) + 1] - xs[std::size_t(i)]) * (ys[std::size_t(j) + 1] - ys[std::size_t(j)]) * s.thickness);
+      m.volume.push_back((xs[std::size_t(i) + 1] - xs[i]) * (ys[std::size_t(j) + 1] - ys[j]) * s.thickness);
     }
   if (m.cells() == 0) throw std::invalid_argument("block mesh: every cell is blocked");
   auto cell = [&](int i, int j) {
@@ -118,8 +118,8 @@ Mesh block_mesh(const BlockSpec& s) {
   // Faces normal to x: between (i-1, j) and (i, j).
   for (int j = 0; j < s.ny; ++j)
     for (int i = 0; i <= s.nx; ++i) {
-      const double dy = ys[std::size_t(j) + 1] - ys[std::size_t(j)];
-      const Vec c{xs[std::size_t(i)], 0.5 * (ys[std::size_t(j)] + ys[std::size_t(j) + 1]), 0};
+      const double dy = ys[std::size_t(j) + 1] - ys[j];
+      const Vec c{xs[i], 0.5 * (ys[j] + ys[std::size_t(j) + 1]), 0};
       const int a = cell(i - 1, j), b = cell(i, j);
       if (a >= 0 && b >= 0) {
         m.owner.push_back(a);
@@ -135,8 +135,8 @@ Mesh block_mesh(const BlockSpec& s) {
   // Faces normal to y: between (i, j-1) and (i, j).
   for (int j = 0; j <= s.ny; ++j)
     for (int i = 0; i < s.nx; ++i) {
-      const double dx = xs[std::size_t(i) + 1] - xs[std::size_t(i)];
-      const Vec c{0.5 * (xs[std::size_t(i)] + xs[std::size_t(i) + 1]), ys[std::size_t(j)], 0};
+      const double dx = xs[std::size_t(i) + 1] - xs[i];
+      const Vec c{0.5 * (xs[i] + xs[std::size_t(i) + 1]), ys[j], 0};
       const int a = cell(i, j - 1), b = cell(i, j);
       if (a >= 0 && b >= 0) {
         m.owner.push_back(a);
@@ -270,9 +270,9 @@ Mesh structured_hex_mesh(const HexGridSpec& s) {
           Vec S = 0.5 * cross(p11 - p00, p01 - p10);
           const Vec C = 0.25 * (p00 + p10 + p11 + p01);
           // Orient from a to b (or out of the one cell on the boundary).
-          const Vec along = a >= 0 && b >= 0 ? m.centre[std::size_t(b)] - m.centre[std::size_t(a)]
-                            : a >= 0         ? C - m.centre[std::size_t(a)]
-                                             : m.centre[std::size_t(b)] - C;
+          const Vec along = a >= 0 && b >= 0 ? m.centre[b] - m.centre[a]
+                            : a >= 0         ? C - m.centre[a]
+                                             : m.centre[b] - C;
           if (dot(S, along) < 0) S = (-1.0) * S;
           if (a >= 0 && b >= 0) {
             m.owner.push_back(a);
@@ -290,11 +290,11 @@ Mesh structured_hex_mesh(const HexGridSpec& s) {
   for (const char* name : {"bottom", "right", "top", "left", "back", "front"}) append_patch(m, name, bnd[name]);
   // Volumes by the divergence theorem: V = sum over the cell's faces of (Cf - c) . Sf / 3.
   for (int f = 0; f < m.faces(); ++f) {
-    const int o = m.owner[std::size_t(f)];
-    m.volume[std::size_t(o)] += dot(m.Cf[std::size_t(f)] - m.centre[std::size_t(o)], m.Sf[std::size_t(f)]) / 3;
+    const int o = m.owner[f];
+    m.volume[o] += dot(m.Cf[f] - m.centre[o], m.Sf[f]) / 3;
     if (f < m.n_internal) {
-      const int nb = m.neighbour[std::size_t(f)];
-      m.volume[std::size_t(nb)] -= dot(m.Cf[std::size_t(f)] - m.centre[std::size_t(nb)], m.Sf[std::size_t(f)]) / 3;
+      const int nb = m.neighbour[f];
+      m.volume[nb] -= dot(m.Cf[f] - m.centre[nb], m.Sf[f]) / 3;
     }
   }
   for (std::size_t c = 0; c < n; ++c)

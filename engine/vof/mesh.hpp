@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "engine/vof/fv/field.hpp"
+
 namespace runout::engine::vof {
 
 struct Vec {
@@ -28,16 +30,16 @@ struct Patch {
 };
 
 struct Mesh {
-  std::vector<Vec> centre;     ///< per cell
-  std::vector<double> volume;  ///< per cell
-  std::vector<int> owner, neighbour;  ///< per face; neighbour only for internal faces
-  std::vector<Vec> Sf, Cf;     ///< per face: area vector (out of the owner), centre
+  CellField<Vec> centre;     ///< per cell
+  CellField<double> volume;  ///< per cell
+  FaceField<int> owner, neighbour;  ///< per face; neighbour only for internal faces
+  FaceField<Vec> Sf, Cf;     ///< per face: area vector (out of the owner), centre
   int n_internal = 0;          ///< faces [0, n_internal) are internal
   std::vector<Patch> patches;  ///< boundary faces in order, each patch contiguous
   double thickness = 0;        ///< plane meshes: the one cell's depth [m]; 0 for 3D meshes
   /// Derived per face: |Sf|, 1/|d . n| (d: owner centre to neighbour centre, or to the face centre on
   /// the boundary), and the owner's interpolation weight.
-  std::vector<double> magSf, delta_coeff, weight;
+  FaceField<double> magSf, delta_coeff, weight;
 
   int cells() const { return int(volume.size()); }
   int faces() const { return int(owner.size()); }

@@ -9,9 +9,9 @@ template <class Pick>
 void split_patch(Mesh& m, const std::string& from, const std::string& to, Pick pick) {
   const int pi = m.patch_index(from);
   if (pi < 0) throw std::invalid_argument("mesh: no patch '" + from + "'");
-  const Patch p = m.patches[std::size_t(pi)];
+  const Patch p = m.patches[pi];
   std::vector<int> keep, moved;
-  for (int f = p.start; f < p.start + p.size; ++f) (pick(m.Cf[std::size_t(f)]) ? moved : keep).push_back(f);
+  for (int f = p.start; f < p.start + p.size; ++f) (pick(m.Cf[f]) ? moved : keep).push_back(f);
   if (moved.empty()) return;
   // New face order: everything before the patch, its kept faces, its moved faces, everything after.
   std::vector<int> order;
@@ -21,13 +21,13 @@ void split_patch(Mesh& m, const std::string& from, const std::string& to, Pick p
   for (int f = p.start + p.size; f < m.faces(); ++f) order.push_back(f);
   auto permute = [&](auto& v) {
     auto old = v;
-    for (std::size_t k = 0; k < order.size(); ++k) v[k] = old[std::size_t(order[k])];
+    for (std::size_t k = 0; k < order.size(); ++k) v[k] = old[order[k]];
   };
   permute(m.owner);
   permute(m.Sf);
   permute(m.Cf);
   // neighbour holds internal faces only, which do not move.
-  m.patches[std::size_t(pi)].size = int(keep.size());
+  m.patches[pi].size = int(keep.size());
   Patch np{to, p.start + int(keep.size()), int(moved.size())};
   m.patches.insert(m.patches.begin() + pi + 1, np);
   if (keep.empty()) m.patches.erase(m.patches.begin() + pi);

@@ -50,6 +50,9 @@ struct PatchBc {
   double friction_creep_speed = 1e-4;  ///< Coulomb friction: below this sliding speed [m/s] the friction force falls linearly
   std::function<Vec(const Vec&)> inflow_velocity;  ///< inflow: velocity at a face centre
   std::function<double(const Vec&)> inflow_alpha;  ///< inflow: phase fraction at a face centre
+  /// The condition by its name in the registry (engine/vof/bc/registry.cpp), for kinds without a
+  /// Bc value; empty: `kind`'s.
+  std::string type = {};
 };
 
 /// How the viscous stress's transpose part is taken (VofConfig::viscous_transpose).
@@ -198,23 +201,25 @@ class VofSolver {
 
   const Mesh& mesh() const { return mesh_; }
   double time() const { return t_; }
-  const std::vector<double>& alpha() const { return alpha_; }
-  const std::vector<Vec>& velocity() const { return U_; }
-  const std::vector<double>& pressure() const { return p_; }        ///< full pressure p [Pa]
-  const std::vector<double>& viscosity() const { return nu1_; }     ///< granular-phase nu [m2/s]
-  const std::vector<double>& face_flux() const { return phi_; }
+  const std::vector<double>& alpha() const;
+  const std::vector<Vec>& velocity() const;
+  const std::vector<double>& pressure() const;   ///< full pressure p [Pa]
+  const std::vector<double>& viscosity() const;  ///< granular-phase nu [m2/s]
+  const std::vector<double>& face_flux() const;
   /// Granular volume flux per face [m3/s] over the last step (alpha times the face flux, limited).
   const std::vector<double>& granular_flux() const;
 
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  struct Impl;  // the fields, the equations and their solvers (engine/vof/solver.cpp)
   Mesh mesh_;
   VofConfig cfg_;
   double t_ = 0, dt_ = 0, t_limit_ = 1e300;
-  std::vector<double> alpha_, p_rgh_, p_, nu1_, phi_;
-  std::vector<Vec> U_;
-  friend struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
+
+/// The boundary conditions' and the granular viscosity models' names (PatchBc::type,
+/// VofConfig::rheology).
+std::vector<std::string> boundary_condition_names();
+std::vector<std::string> granular_viscosity_names();
 
 }  // namespace runout::engine::vof

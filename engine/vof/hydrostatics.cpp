@@ -1,0 +1,38 @@
+#include "engine/vof/hydrostatics.hpp"
+
+#include <algorithm>
+
+namespace runout::engine::vof {
+
+Hydrostatics::Hydrostatics(const Mesh& m, const VofConfig& cfg, const Fields& fields)
+    : m_(m), fields_(fields), gravity_(cfg.gravity), rho2_(cfg.rho2), excess_(cfg.coulomb_pressure == CoulombPressure::excess) {}
+
+void Hydrostatics::resize() {
+  gh_.assign(std::size_t(m_.cells()), 0);
+  ghf_.assign(std::size_t(m_.faces()), 0);
+}
+
+void Hydrostatics::update(double t, const std::function<bool(int)>& opening, bool force) {
+  if (force) gravity_set_ = false;
+  const Vec g = gravity_(t);
+  if (gravity_set_ && g.x == g_last_.x && g.y == g_last_.y && g.z == g_last_.z) return;
+  gravity_set_ = true;
+  g_last_ = g;
+  const int nc = m_.cells(), nf = m_.faces();
+  for (int c = 0; c < nc; ++c) gh_[c] = dot(g, m_.centre[c]);
+  for (int f = 0; f < nf; ++f) ghf_[f] = dot(g, m_.Cf[f]);
+  gh_ref_ = 1e300;
+  for (int f = m_.n_internal; f < nf; ++f)
+    if (opening(f)) gh_ref_ = std::min(gh_ref_, ghf_[f]);
+  if (gh_ref_ == 1e300)  // a closed domain: the level is zero at its highest cell
+    for (int c = 0; c < nc; ++c) gh_ref_ = std::min(gh_ref_, gh_[c]);
+}
+
+void Hydrostatics::zero() {
+  std::fill(gh_.begin(), gh_.end(), 0.0);
+  std::fill(ghf_.begin(), ghf_.end(), 0.0);
+  gh_ref_ = 0;
+  gravity_set_ = false;
+}
+
+}  // namespace runout::engine::vof

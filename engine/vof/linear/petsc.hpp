@@ -1,0 +1,109 @@
+#pragma once
+// The VOF engine's linear solvers through PETSc: the process-wide start of PETSc, the momentum
+// predictor's solver (BiCGStab + ILU over every cell) and the pressure solver over the active
+// region (CG with GAMG or hypre BoomerAMG, its preconditioner kept across steps and refreshed
+// every VofConfig::pressure_pc_refresh steps, saved into and restored from a checkpoint). The
+// equations hand them coefficients; nothing else in the engine calls PETSc.
+#include <petscksp.h>
+
+#include <string>
+#include <vector>
+
+#include "engine/vof/solver.hpp"
+
+namespace runout::engine::vof {
+
+void petsc_check(PetscErrorCode e, const char* what);
+/// PETSc (and with it MPI) is started once per process, on first use.
+void petsc_init();
+
+/// The momentum predictor's system over every cell: both velocity components share the matrix.
+class MomentumSolver {
+ public:
+  MomentumSolver() = default;
+  MomentumSolver(const MomentumSolver&) = delete;
+  MomentumSolver& operator=(const MomentumSolver&) = delete;
+  ~MomentumSolver();
+  /// nnz: the nonzeros per row; rtol: VofConfig::momentum_rtol.
+  void setup(int cells, const std::vector<int>& nnz, double rtol);
+  /// Start a new matrix (every entry zero, the structure kept).
+  void begin();
+  void set(PetscInt row, PetscInt col, double value);
+  /// Assemble the matrix and hand it to the solver.
+  void assemble();
+  /// Solve with the right-hand side b and the initial guess x (every cell's); the solution into x.
+  /// Returns the iterations; throws when the solver does not converge (t: the time, for the message).
+  int solve(const std::vector<double>& b, std::vector<double>& x, double t);
+
+ private:
+  int n_ = 0;
+  Mat M_ = nullptr;
+  ::Vec x_ = nullptr, b_ = nullptr;
+  KSP ksp_ = nullptr;
+};
+
+/// The pressure system over the active region's cells (rows in the region's order).
+class PressureSolver {
+ public:
+  explicit PressureSolver(const VofConfig& cfg) : cfg_(cfg) {}
+  PressureSolver(const PressureSolver&) = delete;
+  PressureSolver& operator=(const PressureSolver&) = delete;
+  ~PressureSolver();
+
+  /// The solver: CG with an algebraic multigrid preconditioner. Made anew with every system (GAMG
+  /// keeps its coarse levels' solvers, whose sizes would not fit another); checks the
+  /// preconditioner's name.
+  void make_ksp();
+  /// (Re)create the system for `rows` rows with nnz nonzeros per row.
+  void make_system(int rows, const std::vector<int>& nnz);
+  /// The relative tolerance of the next solves: the last corrector's or the ones before it.
+  void set_tolerance(bool final);
+
+  /// Start the matrix (reuse: a later corrector of the step keeps the step's matrix).
+  void begin_matrix(bool reuse);
+  /// The off-diagonal pair (i, j), (j, i) of a symmetric matrix.
+  void set_pair(PetscInt i, PetscInt j, double value);
+  /// The diagonal (unless reuse), the right-hand side and the initial guess of every row; then the
+  /// matrix assembled (unless reuse).
+  void set_rows(const std::vector<double>& diag, const std::vector<double>& rhs, const std::vector<double>& x0, bool reuse);
+  /// Solve (initial: the initial hydrostatic solve, three passes; closed: a closed domain, the
+  /// correction fixed to zero in row 0 with diagonal diag0). Returns the iterations.
+  int solve(bool initial, bool reuse, bool closed, double diag0, double t);
+  /// The solution, row by row.
+  void solution(std::vector<double>& x) const;
+  /// Add s to every row of the solution (a closed domain's level).
+  void shift(double s);
+
+  /// The pressure solver's cross-step state for a checkpoint: the refresh counter and the operators
+  /// the preconditioner was built from (compressed rows; both share the active region's structure).
+  void save_pc(VofState& st) const;
+  /// After make_system() for the restored region: the refresh counter, and the preconditioner
+  /// built as the run that wrote the checkpoint built it (closed: placed where a closed domain's
+  /// run had it).
+  void restore_pc(const VofState& st, bool closed);
+
+  bool later_outer = false;  ///< in an outer corrector after the step's first (the preconditioner is kept)
+  double ksp_seconds = 0;    ///< time in KSPSolve since step() last took it
+
+ private:
+  void remember_pc(Mat Ap);
+  void set_operator(Mat M, const VofState& st, const std::vector<double>& values);
+  void timed_solve(Mat Ap);
+
+  const VofConfig& cfg_;
+  int n_ = 0;
+  Mat A_ = nullptr;
+  ::Vec x_ = nullptr, b_ = nullptr, r_ = nullptr, dx_ = nullptr;
+  KSP ksp_ = nullptr;
+  Mat Apin_ = nullptr;  // closed domains: the matrix with row 0 pinned
+  // Copies of the operators the preconditioner was built from, at the current solver's latest
+  // build and at its first (nullptr: none built yet), and the number of builds. A checkpoint
+  // carries them, so that restore_pc() builds the preconditioner the uninterrupted run keeps using
+  // until its next refresh.
+  Mat Apc_ = nullptr, Apc_first_ = nullptr;
+  int pc_builds_ = 0;
+  int steps_since_pc_ = 0;
+  bool system_fresh_ = true;  // the system was just (re)created
+};
+
+}  // namespace runout::engine::vof

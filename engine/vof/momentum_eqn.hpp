@@ -1,0 +1,67 @@
+#pragma once
+// The momentum equation (dissertation eqs. 4.54-4.58), as interFoam's UEqn:
+//   ddt(rho, U) + div(rho_phi, U) - laplacian(mu_f, U) = div(mu_f (grad U)^T) + boundary terms,
+// Euler implicit, upwind convection of the mass flux (optionally limitedLinearV as a deferred
+// correction), the viscous term implicit with the linear face viscosity and its transpose part
+// explicit. It yields 1/A and H/A for the pressure equation (PISO: 1/A; SIMPLEC under
+// VofConfig::consistent: 1/(A - H1) in the material) and, optionally, the momentum predictor.
+// Also the velocity gradient and the viscosities it takes.
+#include "engine/vof/active_region.hpp"
+#include "engine/vof/bc/boundary.hpp"
+#include "engine/vof/fields.hpp"
+#include "engine/vof/fv/fv_matrix.hpp"
+#include "engine/vof/linear/petsc.hpp"
+
+namespace runout::engine::vof {
+
+class MomentumEqn {
+ public:
+  MomentumEqn(const Mesh& m, const VofConfig& cfg, const BcContext& bc_ctx, const Boundaries& bcs, const ActiveRegion& region,
+              const Reconstruction& reconstruct, int dims);
+  /// The momentum predictor's solver over every cell (nnz per row).
+  void setup_predictor(const std::vector<int>& nnz);
+
+  /// The Gauss gradient of the velocity per cell into F.gradU (boundary values from the
+  /// conditions; only faces of the active region contribute, the air beyond rests).
+  void velocity_gradient(Fields& F) const;
+  /// The gradient, then the granular viscosity and the mixture viscosity of the active cells.
+  void update_viscosity(Fields& F) const;
+
+  /// The matrix from the current fields (once per step and outer corrector), and its 1/A.
+  void build(const Fields& F, double dt);
+  /// H/A from the current velocity (every corrector).
+  void update_HbyA(const Fields& F);
+  /// Solve the matrix with the last pressure's and the buoyancy's force; returns the iterations.
+  int predict(Fields& F, double t);
+  /// For the initial hydrostatic solve: unit 1/A and no H/A.
+  void unit_coefficients();
+
+  const FvMatrix<Vec>& matrix() const { return UEqn_; }
+  CellField<double> rAU, rAtU;   ///< 1/A per unit volume [m3 s/kg]; the consistent coupling's 1/(A - H1)
+  FaceField<double> rAUf, rAtUf; ///< the same on the faces
+  CellField<Vec> HbyA;
+
+ private:
+  void transient(const Fields& F, double dt);
+  void transpose_stress(const Fields& F);
+  void convection_diffusion(const Fields& F);
+  void limited_linear_correction(const Fields& F);
+  void boundary_terms(const Fields& F);
+  void coefficients(const Fields& F, double dt);
+  void predictor_forces();
+
+  const Mesh& m_;
+  const VofConfig& cfg_;
+  const BcContext& bc_ctx_;
+  const Boundaries& bcs_;
+  const ActiveRegion& region_;
+  const Reconstruction& reconstruct_;
+  const int dims_;
+  FvMatrix<Vec> UEqn_;
+  CellField<Vec> H_;
+  CellField<double> H1_;
+  CellField<Vec> force_, known_;  // the predictor's force and the known neighbours' share
+  MomentumSolver solver_;
+};
+
+}  // namespace runout::engine::vof

@@ -1,0 +1,220 @@
+#include "engine/vof/pressure_eqn.hpp"
+
+namespace runout::engine::vof {
+
+PressureEqn::PressureEqn(const Mesh& m, const VofConfig& cfg, const BcContext& bc_ctx, const Boundaries& bcs, const ActiveRegion& region,
+                         const Reconstruction& reconstruct, PressureSolver& solver)
+    : m_(m), cfg_(cfg), bc_ctx_(bc_ctx), bcs_(bcs), region_(region), reconstruct_(reconstruct), solver_(solver) {
+  const auto nc = std::size_t(m.cells()), nf = std::size_t(m.faces());
+  pEqn_.resize(m.cells(), m.faces());
+  phiHbyA_.assign(nf, 0);
+  phig_ = phiHbyA_;
+  pout_ = phiHbyA_;
+  open_.assign(nf, 0);
+  rec_.assign(nc, Vec{});
+  rec_old_ = rec_;
+}
+
+void PressureEqn::make_system() { solver_.make_system(region_.n_active, region_.pressure_nonzeros()); }
+
+int PressureEqn::correct(Fields& F, const MomentumEqn& UEqn, bool initial, bool reuse, bool final, double t) {
+  solver_.set_tolerance(final);
+  const bool closed = !bcs_.has_opening() && region_.whole_mesh();  // no opening anywhere: the level is free
+  // The consistent coupling (VofConfig::consistent): the pressure equation and the correction take
+  // 1/(A - H1); the part of the last pressure's force that 1/A would have carried, (1/A -
+  // 1/(A - H1)) F_old, stays in the predicted flux and velocity (SIMPLEC).
+  const bool cons = cfg_.consistent && !initial;
+  const Coupling k{cons, cons ? UEqn.rAtU : UEqn.rAU, cons ? UEqn.rAtUf : UEqn.rAUf};
+  // Within a step 1/A, the density and the active region do not change (reuse), and with them
+  // neither which faces are openings, the Laplacian coefficients, the buoyancy fluxes nor the
+  // outside pressures: those are set by the step's first call. Every call forms the predicted flux
+  // from the correctors' H/A.
+  if (!reuse) laplacian_coefficients(F, k);
+  predicted_flux(UEqn, initial, k);
+  assemble(F, reuse);
+  const int its = solver_.solve(initial, reuse, closed, diag_rows_.empty() ? 0.0 : diag_rows_[0], t);
+  solver_.solution(x_rows_);
+  for (int r = 0; r < region_.n_active; ++r) F.p_rgh[region_.cells[std::size_t(r)]] = x_rows_[std::size_t(r)];
+  correct_flux_and_velocity(F, UEqn, initial, k);
+  for (int c : region_.cells) F.p[c] = F.p_rgh[c] + F.rho[c] * bc_ctx_.hydrostatics.gh(c);
+  if (closed) fix_level(F);
+  return its;
+}
+
+void PressureEqn::laplacian_coefficients(const Fields& F, const Coupling& k) {
+  const Hydrostatics& hs = bc_ctx_.hydrostatics;
+  auto& coef = pEqn_.upper;
+  for (int f : region_.faces) {
+    phig_[f] = coef[f] = pout_[f] = 0;
+    open_[f] = 0;
+    const int o = m_.owner[f];
+    const bool ao = region_.active(o);
+    if (internal(m_, f)) {
+      const int nb = m_.neighbour[f];
+      const bool an = region_.active(nb);
+      if (ao && an) {
+        phig_[f] = -hs.ghf(f) * (F.rho[nb] - F.rho[o]) * m_.delta_coeff[f] * m_.magSf[f] * k.rAf[f];
+        coef[f] = k.rAf[f] * m_.magSf[f] * m_.delta_coeff[f];
+      } else if (ao || an) {
+        const int a = ao ? o : nb;
+        open_[f] = ao ? 1 : -1;
+        coef[f] = k.rA[a] * m_.magSf[f] * m_.delta_coeff[f];
+        pout_[f] = hs.outside_p_rgh(f, a);
+      }
+    } else if (ao && bcs_[f].opening()) {
+      open_[f] = 1;
+      coef[f] = k.rAf[f] * m_.magSf[f] * m_.delta_coeff[f];
+      pout_[f] = hs.outside_p_rgh(f, o);
+    }
+  }
+}
+
+// phiHbyA = flux(H/A) + phig; under the consistent coupling plus (1/A - 1/(A - H1)) F_old |Sf|,
+// with F_old's reconstruction kept in rec_old_.
+void PressureEqn::predicted_flux(const MomentumEqn& UEqn, bool initial, const Coupling& k) {
+  const Hydrostatics& hs = bc_ctx_.hydrostatics;
+  const auto& HbyA = UEqn.HbyA;
+  const auto &rAU = UEqn.rAU, &rAtU = UEqn.rAtU;
+  const auto &rAUf = UEqn.rAUf, &rAtUf = UEqn.rAtUf;
+  auto& rec_old = rec_old_;
+  if (k.consistent)
+    for (int c : region_.cells) rec_old[c] = Vec{};
+  for (int f : region_.faces) {
+    const int o = m_.owner[f];
+    const signed char op = open_[f];
+    double ph = 0;
+    if (internal(m_, f)) {
+      const int nb = m_.neighbour[f];
+      if (op == 0) {  // both cells active (an active face that is no opening)
+        ph = initial ? 0.0 : dot(interpolate(m_, f, HbyA), m_.Sf[f]);
+        if (k.consistent) {
+          const double Fold = hs.face_force(f);
+          ph += (rAUf[f] - rAtUf[f]) * Fold * m_.magSf[f];
+          rec_old[o] = rec_old[o] + Fold * m_.Sf[f];
+          rec_old[nb] = rec_old[nb] + Fold * m_.Sf[f];
+        }
+      } else {
+        const int a = op > 0 ? o : nb;
+        ph = initial ? 0.0 : dot(HbyA[a], m_.Sf[f]);
+        if (k.consistent) {
+          const double sg = op;
+          const double Fout = hs.opening_force(f, a, pout_[f]);  // out of a
+          ph += sg * (rAU[a] - rAtU[a]) * Fout * m_.magSf[f];
+          rec_old[a] = rec_old[a] + (sg * Fout) * m_.Sf[f];
+        }
+      }
+    } else if (region_.active(o)) {
+      ph = bcs_[f].predicted_flux(bc_ctx_, f, HbyA[o], initial);
+      if (bcs_[f].opening() && k.consistent) {
+        const double Fout = hs.opening_force(f, o, pout_[f]);
+        ph += (rAU[o] - rAtU[o]) * Fout * m_.magSf[f];
+        rec_old[o] = rec_old[o] + Fout * m_.Sf[f];
+      }
+    }
+    phiHbyA_[f] = ph + phig_[f];
+  }
+}
+
+// laplacian(rAUf, p_rgh) = div(phiHbyA), an opening's outside pressure on the right-hand side.
+// Within a step the matrix does not change (1/A is built once per step): later correctors keep it
+// and its preconditioner and assemble only the right-hand side; the diagonal is kept from the
+// step's first call (the closed domain's pinning needs it then too).
+void PressureEqn::assemble(const Fields& F, bool reuse) {
+  const auto& ix = region_.index;
+  const auto& coef = pEqn_.upper;
+  auto &diag = pEqn_.diag, &rhs = pEqn_.source;
+  if (!reuse)
+    for (int c : region_.cells) diag[c] = 0.0;
+  for (int c : region_.cells) rhs[c] = 0.0;
+  for (int f : region_.faces) {
+    const double c = coef[f];
+    const int o = m_.owner[f];
+    if (open_[f] != 0) {
+      const int a = open_[f] > 0 ? o : m_.neighbour[f];
+      const double sg = open_[f];
+      rhs[a] -= sg * phiHbyA_[f];
+      if (!reuse) diag[a] += c;
+      rhs[a] += c * pout_[f];
+      continue;
+    }
+    if (!region_.active(o)) continue;
+    rhs[o] -= phiHbyA_[f];
+    if (internal(m_, f)) {
+      const int nb = m_.neighbour[f];
+      rhs[nb] += phiHbyA_[f];
+      if (!reuse) {
+        diag[o] += c;
+        diag[nb] += c;
+      }
+    }
+  }
+  solver_.begin_matrix(reuse);
+  if (!reuse)
+    for (int f : region_.faces)
+      if (open_[f] == 0 && internal(m_, f) && region_.active(m_.owner[f])) solver_.set_pair(ix[m_.owner[f]], ix[m_.neighbour[f]], -coef[f]);
+  const auto n = std::size_t(region_.n_active);
+  diag_rows_.resize(n);
+  rhs_rows_.resize(n);
+  x_rows_.resize(n);
+  for (std::size_t r = 0; r < n; ++r) {
+    const int c = region_.cells[r];
+    diag_rows_[r] = diag[c];
+    rhs_rows_[r] = rhs[c];
+    x_rows_[r] = F.p_rgh[c];
+  }
+  solver_.set_rows(diag_rows_, rhs_rows_, x_rows_, reuse);
+}
+
+// phi = phiHbyA + pEqn.flux(); U = H/A + rA reconstruct((phig + pEqn.flux()) / rAf) (plus the
+// consistent coupling's share of F_old).
+void PressureEqn::correct_flux_and_velocity(Fields& F, const MomentumEqn& UEqn, bool initial, const Coupling& k) {
+  auto& rec = rec_;
+  for (int c : region_.cells) rec[c] = Vec{};
+  for (int f : region_.faces) {
+    const int o = m_.owner[f];
+    const signed char op = open_[f];
+    if (op != 0) {
+      // An opening: the flux out of the active cell a follows its pressure and the outside's.
+      const int a = op > 0 ? o : m_.neighbour[f];
+      const double sg = op;
+      const double pflux_out = pEqn_.flux_out(f, F.p_rgh[a], pout_[f]);
+      F.phi[f] = phiHbyA_[f] + sg * pflux_out;
+      if (k.rA[a] > 0) {
+        const double q = pflux_out / k.rA[a] / m_.magSf[f];
+        rec[a] = rec[a] + (q * sg) * m_.Sf[f];
+      }
+      continue;
+    }
+    const double pflux = internal(m_, f) ? pEqn_.flux(m_, f, F.p_rgh) : 0.0;
+    F.phi[f] = phiHbyA_[f] + pflux;
+    if (internal(m_, f) && k.rAf[f] > 0) {
+      const double q = (phig_[f] + pflux) / k.rAf[f] / m_.magSf[f];
+      rec[o] = rec[o] + q * m_.Sf[f];
+      rec[m_.neighbour[f]] = rec[m_.neighbour[f]] + q * m_.Sf[f];
+    }
+  }
+  if (initial) return;
+  for (int c : region_.cells) {
+    const Vec R = reconstruct_(c, rec[c]);
+    F.U[c] = UEqn.HbyA[c] + k.rA[c] * R;
+    if (k.consistent) F.U[c] = F.U[c] + (UEqn.rAU[c] - UEqn.rAtU[c]) * reconstruct_(c, rec_old_[c]);
+  }
+}
+
+// A closed domain fixes the pressure only up to a constant, but the Coulomb viscosity needs the
+// pressure itself: it is zero in the highest cell (along gravity), the top of the air.
+void PressureEqn::fix_level(Fields& F) {
+  const int nc = m_.cells();
+  const Hydrostatics& hs = bc_ctx_.hydrostatics;
+  int top = 0;
+  for (int c = 1; c < nc; ++c)
+    if (hs.gh(c) < hs.gh(top)) top = c;
+  const double pmin = F.p[top];
+  for (int c = 0; c < nc; ++c) {
+    F.p[c] -= pmin;
+    F.p_rgh[c] -= pmin;
+  }
+  solver_.shift(-pmin);
+}
+
+}  // namespace runout::engine::vof
