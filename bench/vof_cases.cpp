@@ -25,11 +25,12 @@ double median_between(const std::vector<double>& t, const std::vector<double>& v
   return w[w.size() / 2];
 }
 
-// Where the station at x starts in run.json's "stations" (npos if there is none).
+// The index of the station at x in the record's stations (kNoStation if there is none).
 std::size_t station(const std::string& j, double x) {
-  for (auto k = j.find("{\"x_m\": "); k != std::string::npos; k = j.find("{\"x_m\": ", k + 1))
-    if (std::abs(std::atof(j.c_str() + k + 8) - x) < 1e-6) return k;
-  return std::string::npos;
+  const auto r = record(j);
+  for (int k = 0; k < r.stations_size(); ++k)
+    if (std::abs(r.stations(k).x_m() - x) < 1e-6) return std::size_t(k);
+  return kNoStation;
 }
 
 }  // namespace
@@ -167,13 +168,8 @@ int lab_b4(bool check) {
                    ub = field(j, "basal_u_m_s", k), sr = field(j, "strain_rate_1_s", k);
       // The profile's points in the material (alpha above 0.5): [y, alpha, u] triples.
       long points = 0;
-      const auto pk = k == std::string::npos ? k : j.find("\"profile_y_alpha_u\": [", k);
-      if (pk != std::string::npos) {
-        const auto p0 = pk + 22;                                       // after the array's '['
-        const auto pe = j[p0] == ']' ? p0 : j.find("]]", p0);           // empty, or its last triple's end
-        for (auto b = j.find('[', p0); b != std::string::npos && b < pe; b = j.find('[', b + 1))
-          points += std::atof(j.c_str() + j.find(", ", b) + 2) > 0.5;
-      }
+      if (k != kNoStation)
+        for (const auto& p : runout::jobs::station_profile(record(j).stations(int(k)))) points += p.alpha > 0.5;
       std::printf("| %s | x = %.1f m | %.2f | %.2f | %.2f | %.2f | %.0f | %ld |\n", mat, x, 100 * d, um, us, ub, sr, points);
       const std::string s = w + " at x = " + std::to_string(x).substr(0, 3) + " m";
       c(k != std::string::npos && d > 0.3 * h0 && d < 2 * h0, s + ": the flow arrives, 0.3 to 2 times the inflow depth deep");
@@ -243,7 +239,8 @@ int lab_b7(bool full, bool check, int jobs) {
     const auto& sum = ran.sum;
     const std::string& j = ran.json;
     const double cells = field(j, "cells"), ratio = field(j, "max_depth_ratio"), xd = field(j, "max_depth_x_m"), zd = field(j, "max_depth_z_m");
-    shadow[q] = field(j, "sheltered_dry_area_m2");
+    const auto rec = record(j);
+    shadow[q] = rec.chute().obstacles_size() ? rec.chute().obstacles(0).sheltered_dry_area_m2() : NAN;
     std::printf("| %s | %.0f | %ld | %.0f | %.2f | %.1f | %.1f | %.2f | %.3f, %.3f | %.1f |\n", shape, cells, sum.steps, sum.seconds_run,
                 1e6 * sum.seconds_run / sum.steps / cells, 1e3 * field(j, "undisturbed_depth_m"), 1e3 * field(j, "max_depth_m"), ratio, xd, zd,
                 1e4 * shadow[q]);

@@ -1,4 +1,4 @@
-// Shared by the VOF benchmarks (vof.cpp, vof_cases.cpp): reading run.json and running a scenario
+// Shared by the VOF benchmarks (vof.cpp, vof_cases.cpp): reading run.json (the run record) and running a scenario
 // in a temporary directory.
 #pragma once
 
@@ -17,38 +17,39 @@
 #include <utility>
 #include <vector>
 
+#include <google/protobuf/util/json_util.h>
+
 #include "jobs/drivers/run.hpp"
+#include "jobs/formats/run_record.hpp"
 #include "jobs/scenario/scenario.hpp"
 
 namespace runout::bench {
 
-// A number from run.json ("key": value; null or missing as NaN), searched from `from` on; by
-// default from the run's own blocks on (after the echoed scenario, whose compact JSON has no
-// "key": with a space, but a later change of its format must not make a key match there).
-inline double field(const std::string& json, const std::string& key, std::size_t from = std::string::npos) {
-  if (from == std::string::npos) {
-    from = json.find("\n  \"mesh\": ");
-    if (from == std::string::npos) from = 0;
-  }
-  const auto k = json.find("\"" + key + "\": ", from);
-  if (k == std::string::npos || json.compare(k + key.size() + 4, 4, "null") == 0) return NAN;
-  return std::atof(json.c_str() + k + key.size() + 4);
+// run.json's text parsed as the run record (an empty record when the run failed).
+inline runout::v1::RunRecord record(const std::string& json) {
+  runout::v1::RunRecord r;
+  google::protobuf::util::JsonParseOptions o;
+  o.ignore_unknown_fields = true;
+  if (!json.empty() && !google::protobuf::util::JsonStringToMessage(json, &r, o).ok()) return {};
+  return r;
 }
 
-// A number array from run.json ("key": [a, b, null, ...]; null as NaN).
+// Which part of the record field() reads: the whole record, station k (its index), or none.
+constexpr std::size_t kWholeRecord = std::string::npos - 1;
+constexpr std::size_t kNoStation = std::string::npos;
+
+// A number of the record by its field name (jobs::figure_by_name; NaN when missing or not
+// computed), of the whole record or of one station.
+inline double field(const std::string& json, const std::string& key, std::size_t station = kWholeRecord) {
+  const auto r = record(json);
+  if (station == kWholeRecord) return runout::jobs::figure_by_name(r, key);
+  if (station >= std::size_t(r.stations_size())) return NAN;
+  return runout::jobs::figure_by_name(r.stations(int(station)), key);
+}
+
+// A list of numbers of the record by its field name ("NaN" entries as NaN).
 inline std::vector<double> series(const std::string& json, const std::string& key) {
-  std::vector<double> v;
-  auto k = json.find("\"" + key + "\": [");
-  if (k == std::string::npos) return v;
-  k += key.size() + 5;
-  const auto e = json.find(']', k);
-  while (k < e) {
-    while (k < e && (json[k] == ' ' || json[k] == ',')) ++k;
-    if (k >= e) break;
-    v.push_back(json.compare(k, 4, "null") == 0 ? NAN : std::atof(json.c_str() + k));
-    k = json.find_first_of(",]", k);
-  }
-  return v;
+  return runout::jobs::series_by_name(record(json), key);
 }
 
 // The scenario file scenarios/lab/NAME.json of this source tree.

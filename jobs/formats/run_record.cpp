@@ -123,6 +123,47 @@ pb::ListValue profile_point(double y, double alpha, double u) {
   return l;
 }
 
+namespace {
+
+// The first field named `name` (depth first, field order) that is set: a number, or a list of them.
+const pb::Message* owner_of(const pb::Message& m, const std::string& name, const pb::FieldDescriptor** field, bool repeated) {
+  const auto* d = m.GetDescriptor();
+  const auto* r = m.GetReflection();
+  for (int k = 0; k < d->field_count(); ++k) {
+    const auto* f = d->field(k);
+    if (f->message_type() && f->message_type()->full_name() == "runout.v1.Scenario") continue;
+    const bool number = f->cpp_type() == pb::FieldDescriptor::CPPTYPE_DOUBLE || f->cpp_type() == pb::FieldDescriptor::CPPTYPE_INT32;
+    if (f->name() == name && number && f->is_repeated() == repeated && (repeated || !f->has_presence() || r->HasField(m, f))) {
+      *field = f;
+      return &m;
+    }
+    if (f->cpp_type() == pb::FieldDescriptor::CPPTYPE_MESSAGE && !f->is_repeated() && r->HasField(m, f))
+      if (const auto* o = owner_of(r->GetMessage(m, f), name, field, repeated)) return o;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+double figure_by_name(const pb::Message& m, const std::string& name) {
+  const pb::FieldDescriptor* f = nullptr;
+  const pb::Message* o = owner_of(m, name, &f, false);
+  if (!o) return NAN;
+  const auto* r = o->GetReflection();
+  return f->cpp_type() == pb::FieldDescriptor::CPPTYPE_DOUBLE ? r->GetDouble(*o, f) : double(r->GetInt32(*o, f));
+}
+
+std::vector<double> series_by_name(const pb::Message& m, const std::string& name) {
+  const pb::FieldDescriptor* f = nullptr;
+  const pb::Message* o = owner_of(m, name, &f, true);
+  std::vector<double> v;
+  if (!o) return v;
+  const auto* r = o->GetReflection();
+  for (int q = 0; q < r->FieldSize(*o, f); ++q)
+    v.push_back(f->cpp_type() == pb::FieldDescriptor::CPPTYPE_DOUBLE ? r->GetRepeatedDouble(*o, f, q) : double(r->GetRepeatedInt32(*o, f, q)));
+  return v;
+}
+
 v1::Software this_software() {
   v1::Software s;
   s.set_name("runout");

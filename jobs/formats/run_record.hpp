@@ -34,6 +34,13 @@ std::vector<ProfilePoint> station_profile(const v1::Station& s);
 /// A profile triple as the record holds it.
 google::protobuf::ListValue profile_point(double y, double alpha, double u);
 
+/// A number of a record (or of one of its messages, e.g. a Station) by its field name: the first
+/// set field of that name, in field order and depth first (the embedded scenario and lists of
+/// messages not searched); NaN when there is none. For readers that compare many figures alike.
+double figure_by_name(const google::protobuf::Message& m, const std::string& name);
+/// A list of numbers by its field name, found as figure_by_name finds a number (empty if none).
+std::vector<double> series_by_name(const google::protobuf::Message& m, const std::string& name);
+
 /// The build of this program: version, git commit, compiler and build type.
 v1::Software this_software();
 

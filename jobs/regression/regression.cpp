@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "jobs/system/store.hpp"
+#include "jobs/formats/run_record.hpp"
 
 
 namespace fs = std::filesystem;
@@ -42,10 +43,10 @@ google::protobuf::Struct parse_json(const fs::path& p) {
 
 double number(const google::protobuf::Struct& s, const std::string& a, const std::string& b) {
   const auto it = s.fields().find(a);
-  if (it == s.fields().end() || !it->second.has_struct_value()) throw std::runtime_error("run record: no '" + a + "'");
+  if (it == s.fields().end() || !it->second.has_struct_value()) throw std::runtime_error("reference: no '" + a + "'");
   const auto& in = it->second.struct_value().fields();
   const auto jt = in.find(b);
-  if (jt == in.end()) throw std::runtime_error("run record: no '" + a + "." + b + "'");
+  if (jt == in.end()) throw std::runtime_error("reference: no '" + a + "." + b + "'");
   return jt->second.number_value();
 }
 
@@ -90,13 +91,16 @@ std::string fmt(double v, int prec = 6) {
 }  // namespace
 
 RegressionFigures measure_run(const std::string& results_dir) {
-  const auto rec = parse_json(fs::path(results_dir) / "run.json");
+  const std::string path = (fs::path(results_dir) / "run.json").string();
+  const auto rec = read_run_record(path);
+  if (!rec.has_results() || !rec.results().has_runout_from_release_centroid_m() || !rec.solver().has_max_speed_m_s() || !rec.has_mass_balance())
+    throw std::runtime_error("run record " + path + " is not a depth-averaged run's (no results, solver or mass balance)");
   RegressionFigures f;
-  f.runout_m = number(rec, "results", "runout_from_release_centroid_m");
-  f.affected_area_m2 = number(rec, "results", "affected_area_m2");
-  f.max_depth_m = number(rec, "results", "max_depth_m");
-  f.max_speed_m_s = number(rec, "solver", "max_speed_m_s");
-  f.volume_error = number(rec, "mass_balance", "relative_error");
+  f.runout_m = rec.results().runout_from_release_centroid_m();
+  f.affected_area_m2 = rec.results().affected_area_m2();
+  f.max_depth_m = rec.results().max_depth_m();
+  f.max_speed_m_s = rec.solver().max_speed_m_s();
+  f.volume_error = rec.mass_balance().relative_error();
   const Raster r = read_raster((fs::path(results_dir) / "max_depth.tif").string());
   OGRSpatialReference ll, grid;
   ll.importFromEPSG(4326);

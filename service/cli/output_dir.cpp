@@ -1,7 +1,7 @@
 #include "service/cli/output_dir.hpp"
 
-#include <google/protobuf/struct.pb.h>
-#include <google/protobuf/util/json_util.h>
+#include "jobs/formats/run_record.hpp"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -29,25 +29,8 @@ fs::path canonical_or_self(const fs::path& p) {
   return ec ? p : c;
 }
 
-// runout's run record: run.json, a JSON object whose "software" is {"name": "runout", ...}.
-bool has_run_record(const fs::path& dir) {
-  const fs::path f = dir / "run.json";
-  std::error_code ec;
-  if (!fs::is_regular_file(f, ec) || fs::file_size(f, ec) > (std::uintmax_t(256) << 20)) return false;
-  std::ifstream in(f, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  if (!in) return false;
-  google::protobuf::Struct record;
-  google::protobuf::util::JsonParseOptions opt;
-  if (!google::protobuf::util::JsonStringToMessage(ss.str(), &record, opt).ok()) return false;
-  const auto sw = record.fields().find("software");
-  if (sw == record.fields().end() || !sw->second.has_struct_value()) return false;
-  const auto& fields = sw->second.struct_value().fields();
-  const auto name = fields.find("name");
-  return name != fields.end() && name->second.kind_case() == google::protobuf::Value::kStringValue &&
-         name->second.string_value() == "runout";
-}
+// runout's run record: run.json, a runout.v1.RunRecord whose software is named "runout".
+bool has_run_record(const fs::path& dir) { return jobs::is_run_record((dir / "run.json").string()); }
 
 // What `--force` may replace: a previous result (its run record), the job.log alone of a fetched
 // failed job, or an empty directory. `dir` is a directory (not a link).

@@ -30,9 +30,9 @@ TEST(Scenarios, LabCoulombExcessPressureDoesNotDependOnTheAirAbove) {
     TempDir d;
     const auto sum = jobs::run_scenario(r, d.p.string());
     EXPECT_EQ(sum.stop, "end-time");
-    const std::string j = read_text(d / "run.json");
-    const Fig f{json_number(j, "peak_speed_m_s"), json_number(j, "rest_time_s"), json_number(j, "upper_surface_angle_deg"),
-                json_number(j, "front_x_m")};
+    const auto j = run_record(d / "run.json");
+    const Fig f{record_figure(j, "peak_speed_m_s"), record_figure(j, "rest_time_s"), record_figure(j, "upper_surface_angle_deg"),
+                record_figure(j, "front_x_m")};
     std::printf("B2 at 5 mm, %s pressure, domain %.2f m high: peak %.4f m/s, rest %.3f s, surface %.2f deg, front %.4f m\n",
                 pressure, y_max, f.peak, f.rest, f.angle, f.front);
     return f;
@@ -88,7 +88,7 @@ TEST(Scenarios, LabWallViscosityIsValidatedAndReachesTheRun) {
     }
     TempDir d;
     ASSERT_EQ(jobs::run_scenario(r, d.p.string()).stop, "end-time");
-    front[k] = json_number(read_text(d / "run.json"), "front_x_m");
+    front[k] = record_figure(d / "run.json", "front_x_m");
   }
   std::printf("B2 at 5 mm, 0.6 s: front %.4f m (face viscosity on the walls), %.4f m (the cell's)\n", front[0], front[1]);
   EXPECT_GE(front[0], front[1] + 0.005);  // at least a cell further
@@ -120,9 +120,9 @@ TEST(Scenarios, LabOuterCorrectorsAreValidatedAndReachTheRun) {
     r = jobs::resolve_scenario(r.scenario, std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab");
     TempDir d;
     ASSERT_EQ(jobs::run_scenario(r, d.p.string()).stop, "end-time");
-    const std::string j = read_text(d / "run.json");
-    its[k] = json_number(j, "pressure_iterations");
-    steps[k] = json_number(j, "steps");
+    const auto j = run_record(d / "run.json");
+    its[k] = record_figure(j, "pressure_iterations");
+    steps[k] = record_figure(j, "steps");
   }
   std::printf("coarse B2 to 0.2 s, consistent: %.0f pressure iterations in %.0f steps (1 outer corrector), %.0f in %.0f (3)\n", its[0], steps[0],
               its[1], steps[1]);
@@ -148,10 +148,10 @@ TEST(Scenarios, LabPressurePreconditionerIsChosenByName) {
       if (k == 1 && std::string(e.what()).find("no hypre") != std::string::npos) GTEST_SKIP() << e.what();
       throw;
     }
-    const std::string j = read_text(d / "run.json");
-    peak[k] = json_number(j, "peak_speed_m_s");
-    angle[k] = json_number(j, "mean_surface_angle_deg");
-    iterations[k] = json_number(j, "pressure_iterations");
+    const auto j = run_record(d / "run.json");
+    peak[k] = record_figure(j, "peak_speed_m_s");
+    angle[k] = record_figure(j, "mean_surface_angle_deg");
+    iterations[k] = record_figure(j, "pressure_iterations");
   }
   EXPECT_NE(iterations[1], iterations[0]) << "the same CG iterations: was hypre taken at all?";
   // The correctors before the last solve to a relative 0.1 only, so the two preconditioners' runs
@@ -294,8 +294,8 @@ TEST(Scenarios, LabMomentumConvectionIsValidatedAndChangesTheRun) {
   EXPECT_EQ(ll.scenario.lab().momentum_convection(), "limited_linear");
   const TempDir d1, d2;
   const auto a = jobs::run_scenario(plain, d1.p.string()), b = jobs::run_scenario(ll, d2.p.string());
-  const double fa = json_number(read_text((d1.p / "run.json").string()), "front_x_m"),
-               fb = json_number(read_text((d2.p / "run.json").string()), "front_x_m");
+  const double fa = record_figure((d1.p / "run.json").string(), "front_x_m"),
+               fb = record_figure((d2.p / "run.json").string(), "front_x_m");
   std::printf("collapse to 0.15 s on 1 cm cells: front %.3f m (upwind), %.3f m (limited linear); %ld and %ld steps\n", fa, fb, a.steps, b.steps);
   EXPECT_GE(fb, fa);  // less numerical viscosity: the front runs at least as far
   EXPECT_NE(a.steps, b.steps);  // the option reaches the engine

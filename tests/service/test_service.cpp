@@ -16,6 +16,7 @@
 #include <sstream>
 #include <thread>
 
+#include "jobs/formats/run_record.hpp"
 #include "jobs/scenario/scenario.hpp"
 #include "jobs/digest/sha256.hpp"
 #include "jobs/system/store.hpp"
@@ -376,21 +377,13 @@ TEST(Service, StoppedServerContinuesAVofJobFromItsCheckpoint) {
   const auto whole = c2.watch(c2.submit(lab).id());
   ASSERT_EQ(whole.state(), v1::SUCCEEDED);
   c2.download(whole.id(), "run.json", (d.p / "whole.json").string());
-  const std::string a = read_text(d.p / "continued.json"), b = read_text(d.p / "whole.json");
-  auto number = [](const std::string& j, const std::string& key) {
-    const auto k = j.find("\"" + key + "\": ");
-    return k == std::string::npos ? NAN : std::atof(j.c_str() + k + key.size() + 4);
-  };
-  auto samples = [](const std::string& j) {
-    const auto k = j.find("\"t_s\": [");
-    return k == std::string::npos ? -1L : long(std::count(j.begin() + long(k), j.begin() + long(j.find(']', k)), ','));
-  };
-  EXPECT_GT(number(a, "continued_from_t_s"), 0.2);
-  EXPECT_EQ(number(a, "frames"), number(b, "frames"));
-  EXPECT_EQ(samples(a), samples(b));
-  EXPECT_GT(samples(b), 40);
-  EXPECT_NEAR(number(a, "front_x_m"), number(b, "front_x_m"), 1e-9);
-  EXPECT_NEAR(number(a, "volume_final_m3"), number(b, "volume_final_m3"), 1e-6 * number(b, "volume_final_m3"));
+  const auto a = jobs::read_run_record((d.p / "continued.json").string()), b = jobs::read_run_record((d.p / "whole.json").string());
+  EXPECT_GT(a.solver().continued_from_t_s(), 0.2);
+  EXPECT_EQ(a.results().frames(), b.results().frames());
+  EXPECT_EQ(a.monitors().t_s_size(), b.monitors().t_s_size());
+  EXPECT_GT(b.monitors().t_s_size(), 40);
+  EXPECT_NEAR(a.results().front_x_m(), b.results().front_x_m(), 1e-9);
+  EXPECT_NEAR(a.results().volume_final_m3(), b.results().volume_final_m3(), 1e-6 * b.results().volume_final_m3());
 }
 
 // A checkpoint the server cannot continue (here: damaged) does not fail the job: it runs again

@@ -18,6 +18,7 @@
 
 #include "jobs/drivers/run.hpp"
 #include "jobs/scenario/scenario.hpp"
+#include "tests/support/run_record.hpp"
 #include "tests/support/temp_dir.hpp"
 #include "terrain/terrain.hpp"
 
@@ -31,11 +32,10 @@ using namespace runout;
 using test_support::read_text;
 using test_support::TempDir;
 
-// A number of run.json ("key": value, searched from `from` on; NaN if missing).
-inline double json_number(const std::string& j, const std::string& key, std::size_t from = 0) {
-  const auto k = j.find("\"" + key + "\": ", from);
-  return k == std::string::npos ? NAN : std::atof(j.c_str() + k + key.size() + 4);
-}
+using test_support::record_figure;
+using test_support::run_record;
+using test_support::station_at;
+using test_support::as_vector;
 
 // A DEM in UTM 32N (EPSG:32632): a slope of `deg` falling to the east, flattening into a valley.
 inline void make_dem(const std::string& path, int n, double cell, double deg, const char* epsg = "EPSG:32632", bool with_crs = true,
