@@ -8,7 +8,7 @@ bool ActiveRegion::update(bool force) {
   const int nc = m_.cells();
   if (cfg_.active_layers <= 0) {
     if (n_active == nc && !force) return false;
-    set(std::vector<int>(std::size_t(nc), 0));
+    set(std::vector<int>(nc, 0));
     return true;
   }
   if (!force && n_active > 0 && material_inside()) return false;
@@ -29,7 +29,7 @@ bool ActiveRegion::material_inside() {
   front.clear();
   for (int c : halo)
     if (fields_.alpha[c] > cfg_.active_alpha) {
-      mark_[std::size_t(c)] = stamp_;
+      mark_[c] = stamp_;
       front.push_back(c);
     }
   bool inside = true;
@@ -43,8 +43,8 @@ bool ActiveRegion::material_inside() {
       for (int f : cell_faces_[c]) {
         if (f >= m_.n_internal) continue;
         const int other = across(m_, f, c);
-        if (mark_[std::size_t(other)] != stamp_) {
-          mark_[std::size_t(other)] = stamp_;
+        if (mark_[other] != stamp_) {
+          mark_[other] = stamp_;
           next.push_back(other);
         }
       }
@@ -60,17 +60,17 @@ bool ActiveRegion::material_inside() {
 // it stays in the computation (layers + 1).
 std::vector<int> ActiveRegion::layers_from_material() const {
   const int nc = m_.cells(), nf = m_.faces(), layers = cfg_.active_layers;
-  std::vector<int> d(std::size_t(nc), -1), front, next;
+  std::vector<int> d(nc, -1), front, next;
   for (int c = 0; c < nc; ++c)
     if (fields_.alpha[c] > cfg_.active_alpha) {
-      d[std::size_t(c)] = 0;
+      d[c] = 0;
       front.push_back(c);
     }
   for (int f = m_.n_internal; f < nf; ++f)
     if (bcs_[f].seeds_active_region()) {
       const int o = m_.owner[f];
-      if (d[std::size_t(o)] < 0) {
-        d[std::size_t(o)] = 0;
+      if (d[o] < 0) {
+        d[o] = 0;
         front.push_back(o);
       }
     }
@@ -80,20 +80,20 @@ std::vector<int> ActiveRegion::layers_from_material() const {
       for (int f : cell_faces_[c]) {
         if (f >= m_.n_internal) continue;
         const int other = across(m_, f, c);
-        if (d[std::size_t(other)] < 0) {
-          d[std::size_t(other)] = k;
+        if (d[other] < 0) {
+          d[other] = k;
           next.push_back(other);
         }
       }
     front.swap(next);
   }
   std::vector<int> stack;
-  std::vector<char> out(std::size_t(nc), 0);
+  std::vector<char> out(nc, 0);
   for (int f = m_.n_internal; f < nf; ++f)
     if (bcs_[f].opening()) {
       const int o = m_.owner[f];
-      if (d[std::size_t(o)] < 0 && !out[std::size_t(o)]) {
-        out[std::size_t(o)] = 1;
+      if (d[o] < 0 && !out[o]) {
+        out[o] = 1;
         stack.push_back(o);
       }
     }
@@ -103,29 +103,29 @@ std::vector<int> ActiveRegion::layers_from_material() const {
     for (int f : cell_faces_[c]) {
       if (f >= m_.n_internal) continue;
       const int other = across(m_, f, c);
-      if (d[std::size_t(other)] < 0 && !out[std::size_t(other)]) {
-        out[std::size_t(other)] = 1;
+      if (d[other] < 0 && !out[other]) {
+        out[other] = 1;
         stack.push_back(other);
       }
     }
   }
   for (int c = 0; c < nc; ++c)
-    if (d[std::size_t(c)] < 0 && !out[std::size_t(c)]) d[std::size_t(c)] = layers + 1;
+    if (d[c] < 0 && !out[c]) d[c] = layers + 1;
   return d;
 }
 
 void ActiveRegion::set(const std::vector<int>& d) {
   const int nc = m_.cells(), nf = m_.faces();
   Fields& F = fields_;
-  index.assign(std::size_t(nc), -1);
+  index.assign(nc, -1);
   cells.clear();
   for (int c = 0; c < nc; ++c)
-    if (d[std::size_t(c)] >= 0) {
+    if (d[c] >= 0) {
       index[c] = int(cells.size());
       cells.push_back(c);
     }
   n_active = int(cells.size());
-  std::vector<char> in_halo(std::size_t(nc), 0);
+  std::vector<char> in_halo(nc, 0);
   faces.clear();
   for (int f = 0; f < nf; ++f) {
     const int o = m_.owner[f];
@@ -133,17 +133,17 @@ void ActiveRegion::set(const std::vector<int>& d) {
     const bool an = f < m_.n_internal && index[m_.neighbour[f]] >= 0;
     if (ao || an) {
       faces.push_back(f);
-      in_halo[std::size_t(o)] = 1;
-      if (f < m_.n_internal) in_halo[std::size_t(m_.neighbour[f])] = 1;
+      in_halo[o] = 1;
+      if (f < m_.n_internal) in_halo[m_.neighbour[f]] = 1;
     } else {
       F.phi[f] = 0;
       F.alpha_phi[f] = F.rho_phi[f] = 0;
     }
   }
   // Cells joining the halo start from their resting state (their old-time values are stale).
-  if (halo_flag_.size() != std::size_t(nc)) halo_flag_.assign(std::size_t(nc), 0);
+  if (halo_flag_.size() != std::size_t(nc)) halo_flag_.assign(nc, 0);
   for (int c = 0; c < nc; ++c)
-    if (in_halo[std::size_t(c)] && !halo_flag_[std::size_t(c)]) {
+    if (in_halo[c] && !halo_flag_[c]) {
       if (index[c] < 0) F.U[c] = Vec{};
       F.rho_old[c] = F.rho[c];
       F.U_old[c] = F.U[c];
@@ -155,7 +155,7 @@ void ActiveRegion::set(const std::vector<int>& d) {
   frozen_min = 1e300;
   frozen_max = -1e300;
   for (int c = 0; c < nc; ++c) {
-    if (in_halo[std::size_t(c)]) {
+    if (in_halo[c]) {
       halo.push_back(c);
     } else {
       const double a = F.alpha[c];
@@ -169,7 +169,7 @@ void ActiveRegion::set(const std::vector<int>& d) {
       F.p_rgh[c] = F.p[c] - F.rho[c] * hydrostatics_.gh(c);
     }
   }
-  if (mark_.size() != std::size_t(nc)) mark_.assign(std::size_t(nc), 0u);
+  if (mark_.size() != std::size_t(nc)) mark_.assign(nc, 0u);
 }
 
 std::vector<int> ActiveRegion::pressure_nonzeros() const {
@@ -177,8 +177,8 @@ std::vector<int> ActiveRegion::pressure_nonzeros() const {
   for (int f = 0; f < m_.n_internal; ++f) {
     const int io = index[m_.owner[f]], in = index[m_.neighbour[f]];
     if (io >= 0 && in >= 0) {
-      ++nnz[std::size_t(io)];
-      ++nnz[std::size_t(in)];
+      ++nnz[io];
+      ++nnz[in];
     }
   }
   return nnz;

@@ -8,8 +8,8 @@ Hydrostatics::Hydrostatics(const Mesh& m, const VofConfig& cfg, const Fields& fi
     : m_(m), fields_(fields), gravity_(cfg.gravity), rho2_(cfg.rho2), excess_(cfg.coulomb_pressure == CoulombPressure::excess) {}
 
 void Hydrostatics::resize() {
-  gh_.assign(std::size_t(m_.cells()), 0);
-  ghf_.assign(std::size_t(m_.faces()), 0);
+  gh_.assign(m_.cells(), 0);
+  ghf_.assign(m_.faces(), 0);
 }
 
 void Hydrostatics::update(double t, const std::function<bool(int)>& opening, bool force) {

@@ -21,9 +21,9 @@ int Mesh::patch_index(const std::string& name) const {
 
 void Mesh::finish() {
   const int nf = faces();
-  magSf.assign(std::size_t(nf), 0);
-  delta_coeff.assign(std::size_t(nf), 0);
-  weight.assign(std::size_t(nf), 1);
+  magSf.assign(nf, 0);
+  delta_coeff.assign(nf, 0);
+  weight.assign(nf, 1);
   for (int f = 0; f < nf; ++f) {
     const std::size_t k = std::size_t(f);
     magSf[k] = norm(Sf[k]);

@@ -52,7 +52,7 @@ int MomentumEqn::predict(Fields& F, double t) {
   auto solved = [&](int c) { return region_.active(c) && (!material_only || F.alpha[c] >= cfg_.consistent_alpha); };
   const auto& cO = UEqn_.upper;
   const auto& cN = UEqn_.lower;
-  known_.assign(std::size_t(nc), Vec{});
+  known_.assign(nc, Vec{});
   solver_.begin();
   for (int f = 0; f < m_.n_internal; ++f) {
     const int o = m_.owner[f], nb = m_.neighbour[f];
@@ -66,7 +66,7 @@ int MomentumEqn::predict(Fields& F, double t) {
   for (int c = 0; c < nc; ++c) solver_.set(c, c, solved(c) ? UEqn_.diag[c] : 1.0);
   solver_.assemble();
   int its_total = 0;
-  auto b = std::vector<double>(std::size_t(nc)), x = b;
+  auto b = std::vector<double>(nc), x = b;
   for (int i = 0; i < dims_; ++i) {
     for (int c = 0; c < nc; ++c) {
       double src = 0, x0 = 0;
@@ -77,11 +77,11 @@ int MomentumEqn::predict(Fields& F, double t) {
       } else if (region_.active(c)) {
         src = x0 = comp(F.U[c], i);
       }
-      b[std::size_t(c)] = src;
-      x[std::size_t(c)] = x0;
+      b[c] = src;
+      x[c] = x0;
     }
     its_total += solver_.solve(b, x, t);
-    for (int c : region_.cells) comp_ref(F.U[c], i) = x[std::size_t(c)];
+    for (int c : region_.cells) comp_ref(F.U[c], i) = x[c];
   }
   return its_total;
 }

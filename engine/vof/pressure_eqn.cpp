@@ -34,7 +34,7 @@ int PressureEqn::correct(Fields& F, const MomentumEqn& UEqn, bool initial, bool 
   assemble(F, reuse);
   const int its = solver_.solve(initial, reuse, closed, diag_rows_.empty() ? 0.0 : diag_rows_[0], t);
   solver_.solution(x_rows_);
-  for (int r = 0; r < region_.n_active; ++r) F.p_rgh[region_.cells[std::size_t(r)]] = x_rows_[std::size_t(r)];
+  for (int r = 0; r < region_.n_active; ++r) F.p_rgh[region_.cells[r]] = x_rows_[r];
   correct_flux_and_velocity(F, UEqn, initial, k);
   for (int c : region_.cells) F.p[c] = F.p_rgh[c] + F.rho[c] * bc_ctx_.hydrostatics.gh(c);
   if (closed) fix_level(F);

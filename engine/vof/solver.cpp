@@ -35,10 +35,10 @@ double mean_cell_size(const Mesh& m) {
 
 // The nonzeros per row of a matrix over every cell.
 std::vector<int> cell_nonzeros(const Mesh& m) {
-  std::vector<int> nnz(std::size_t(m.cells()), 1);
+  std::vector<int> nnz(m.cells(), 1);
   for (int f = 0; f < m.n_internal; ++f) {
-    ++nnz[std::size_t(m.owner[f])];
-    ++nnz[std::size_t(m.neighbour[f])];
+    ++nnz[m.owner[f]];
+    ++nnz[m.neighbour[f]];
   }
   return nnz;
 }
@@ -67,7 +67,7 @@ struct VofSolver::Impl {
     pressure_solver.make_ksp();  // checks the preconditioner's name early
     F.resize(m.cells(), m.faces(), cfg.nu_max);
     hydrostatics.resize();
-    div.assign(std::size_t(m.cells()), 0);
+    div.assign(m.cells(), 0);
     UEqn.setup_predictor(cell_nonzeros(m));
   }
 
@@ -106,6 +106,7 @@ struct VofSolver::Impl {
     }
   }
   Courant courant(double dt) const;
+  double next_dt(const Courant& co, double dt, double time_left) const;
   void initial_pressure(double t);
   void diagnostics(StepStats& st, double t);
 };
@@ -127,6 +128,16 @@ VofSolver::Impl::Courant VofSolver::Impl::courant(double dt) const {
     if (a > 0.01 && a < 0.99) k.alpha_co = std::max(k.alpha_co, cc);
   }
   return k;
+}
+
+// The next step's length: the Courant numbers' targets, growing by at most 20 % a step, at most
+// dt_max, and not beyond the end of run().
+double VofSolver::Impl::next_dt(const Courant& co, double dt, double time_left) const {
+  const double fac = std::min({cfg.max_co / std::max(co.co, 1e-30), cfg.max_alpha_co / std::max(co.alpha_co, 1e-30),
+                               cfg.max_air_co / std::max(co.air_co, 1e-30)});
+  const double grow = std::min(std::min(fac, 1.0 + 0.1 * fac), 1.2);
+  dt = std::min(grow * dt, cfg.dt_max);
+  return std::min(dt, std::max(1e-12, time_left));
 }
 
 // Hydrostatic pressure: the pressure equation with no velocity and unit 1/A. Inflow faces carry
@@ -187,7 +198,7 @@ void VofSolver::Impl::diagnostics(StepStats& st, double t) {
 VofSolver::VofSolver(Mesh mesh, VofConfig cfg) : mesh_(std::move(mesh)), cfg_(std::move(cfg)) {
   impl_ = std::make_unique<Impl>(mesh_, cfg_);
   dt_ = cfg_.dt_initial;
-  impl_->region.set(std::vector<int>(std::size_t(mesh_.cells()), 0));  // until initialise() finds the material, every cell counts
+  impl_->region.set(std::vector<int>(mesh_.cells(), 0));  // until initialise() finds the material, every cell counts
 }
 
 VofSolver::~VofSolver() = default;
@@ -259,7 +270,7 @@ void VofSolver::restore(const VofState& st) {
   I.region.set(std::vector<int>(nc, 0));
   I.update_rho();
   std::vector<int> d(nc, -1);
-  for (int c : st.active_cells) d[std::size_t(c)] = 0;
+  for (int c : st.active_cells) d[c] = 0;
   I.region.set(d);
   // The resting air's values as the run left them (they seed the solvers when cells join the region).
   F.p_rgh = st.p_rgh;
@@ -270,52 +281,51 @@ void VofSolver::restore(const VofState& st) {
   I.pressure_solver.restore_pc(st, !I.bcs.has_opening() && I.region.whole_mesh());
 }
 
+// One step: the phase fraction with the last fluxes, then the momentum matrix and the pressure
+// correctors (PISO; PIMPLE with outer correctors), then the viscosity of the new velocity.
 StepStats VofSolver::step() {
   using clk = std::chrono::steady_clock;
   const auto t0 = clk::now();
   auto& I = *impl_;
   auto& F = I.F;
   StepStats st;
-  // The time step from the Courant numbers of the last step's fluxes.
-  const auto co = I.courant(dt_);
-  const double fac = std::min({cfg_.max_co / std::max(co.co, 1e-30), cfg_.max_alpha_co / std::max(co.alpha_co, 1e-30),
-                               cfg_.max_air_co / std::max(co.air_co, 1e-30)});
-  const double grow = std::min(std::min(fac, 1.0 + 0.1 * fac), 1.2);
-  dt_ = std::min(grow * dt_, cfg_.dt_max);
-  dt_ = std::min(dt_, std::max(1e-12, t_limit_ - t_));
+  const auto co = I.courant(dt_);  // of the last step's fluxes
+  dt_ = I.next_dt(co, dt_, t_limit_ - t_);
   t_ += dt_;
   I.update_gravity(t_);
   I.keep_old_time();
-  // The phase fraction with the last fluxes, the mixture density, the active region.
-  I.alpha_eqn.solve(F, dt_);
-  I.update_rho();
+
+  I.alpha_eqn.solve(F, dt_);  // alpha, alpha_phi, rho_phi
+  I.update_rho();             // rho(alpha)
   if (I.region.update(false)) I.pEqn.make_system();
-  // The momentum matrix and the PISO correctors (in PIMPLE's outer correctors).
+
   double t_p = 0;
   I.pressure_solver.ksp_seconds = 0;
   const int n_outer = std::max(1, cfg_.n_outer_correctors), n_corr = std::max(1, cfg_.n_correctors);
   for (int outer = 0; outer < n_outer; ++outer) {
     I.pressure_solver.later_outer = outer > 0;
-    if (outer > 0) I.UEqn.update_viscosity(F);  // from the latest velocity and pressure (it takes the gradient)
+    if (outer > 0) I.UEqn.update_viscosity(F);  // grad U, nu1 and mu from the latest velocity and pressure
     else I.UEqn.velocity_gradient(F);
-    I.UEqn.build(F, dt_);
+    I.UEqn.build(F, dt_);  // ddt(rho, U) + div(rho_phi, U) - laplacian(mu_f, U) = div(mu_f (grad U)^T) + boundaries
     if (cfg_.momentum_predictor) st.momentum_iterations += I.UEqn.predict(F, t_);
     for (int k = 0; k < n_corr; ++k) {
       I.UEqn.update_HbyA(F);
       const auto tp = clk::now();
-      st.pressure_iterations += I.pEqn.correct(F, I.UEqn, false, k > 0, outer + 1 == n_outer && k + 1 == n_corr, t_);
+      const bool final = outer + 1 == n_outer && k + 1 == n_corr;
+      st.pressure_iterations += I.pEqn.correct(F, I.UEqn, false, k > 0, final, t_);  // p_rgh, phi, U
       t_p += std::chrono::duration<double>(clk::now() - tp).count();
     }
   }
   I.pressure_solver.later_outer = false;
   I.UEqn.update_viscosity(F);
+
   st.t = t_;
   st.dt = dt_;
-  st.active_cells = I.region.n_active;
-  I.diagnostics(st, t_);
   st.co = co.co;
   st.alpha_co = co.alpha_co;
   st.air_co = co.air_co;
+  st.active_cells = I.region.n_active;
+  I.diagnostics(st, t_);
   st.seconds_pressure = t_p;
   st.seconds_pressure_solve = I.pressure_solver.ksp_seconds;
   st.seconds_total = std::chrono::duration<double>(clk::now() - t0).count();

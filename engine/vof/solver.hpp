@@ -16,14 +16,19 @@
 //     how stiff the material behaves (docs/vof.md). The optional predictor (momentum_predictor)
 //     solves the momentum matrix with the last pressure first; on B2 it lets the pressure in the
 //     granular phase swing to -75 kPa and the material flow like a liquid, so it stays off.
-//   * the granular phase's Coulomb viscosity nu = tan(phi) p / (rho_g |strain rate|) clipped to
-//     [nu_min, nu_max] (listing B.1), air Newtonian, mixture mu = alpha rho1 nu1 + (1 - alpha) rho2 nu2;
-//   * boundary conditions as data: wall (stick), Coulomb slip wall (listing B.2), inflow (velocity and
-//     fill profile), outflow, atmosphere (total pressure 0; air flows in, anything flows out);
+//   * the granular phase's viscosity by name (VofConfig::rheology; models/): the Coulomb viscosity
+//     nu = tan(phi) p / (rho_g |strain rate|) clipped to [nu_min, nu_max] (listing B.1); air
+//     Newtonian, mixture mu = alpha rho1 nu1 + (1 - alpha) rho2 nu2 (mixture.hpp);
+//   * boundary conditions one class each, by name (bc/): wall (stick), Coulomb slip wall (listing
+//     B.2), Coulomb friction, inflow (velocity and fill profile), outflow, symmetry, atmosphere
+//     (total pressure 0; air flows in, anything flows out);
 //   * Courant-number time-step control for velocity and interface (eqs. 4.64-4.65);
 //   * gravity may depend on time (rotating box).
-// Linear systems through PETSc KSP (pressure: CG with GAMG or hypre BoomerAMG, by name); a solver
-// that does not converge is an error.
+// Linear systems through PETSc KSP (linear/; pressure: CG with GAMG or hypre BoomerAMG, by name); a
+// solver that does not converge is an error.
+// The code: solver.cpp (the step), alpha_eqn, momentum_eqn (+ momentum_predictor), pressure_eqn,
+// active_region and hydrostatics, over the finite-volume vocabulary of fv/ (cell and face fields,
+// interpolate, reconstruct, FvMatrix) and the fields of fields.hpp.
 #include <functional>
 #include <map>
 #include <memory>

@@ -41,7 +41,7 @@ Boundaries::Boundaries(const Mesh& m, const std::map<std::string, PatchBc>& bc) 
     if (it == bc.end()) throw VofError("boundary conditions: patch '" + p.name + "' has none");
     conditions_.push_back(make_boundary_condition(p.name, it->second));
     if (conditions_.back()->opening()) has_opening_ = true;
-    for (int f = p.start; f < p.start + p.size; ++f) face_[std::size_t(f - m.n_internal)] = conditions_.back().get();
+    for (int f = p.start; f < p.start + p.size; ++f) face_[f - m.n_internal] = conditions_.back().get();
   }
   for (const auto& [name, _] : bc)
     if (m.patch_index(name) < 0) throw VofError("boundary conditions: the mesh has no patch '" + name + "'");

@@ -60,8 +60,6 @@ class BoundaryCondition {
 /// The condition `patch`'s PatchBc names (PatchBc::type, or its kind); throws VofError for an
 /// unknown name (listing the valid ones) or an incomplete PatchBc.
 std::unique_ptr<BoundaryCondition> make_boundary_condition(const std::string& patch, const PatchBc& bc);
-/// The names make_boundary_condition() knows.
-std::vector<std::string> boundary_condition_names();
 
 // Shared by the wall-like conditions.
 
@@ -84,7 +82,7 @@ class Boundaries {
   /// Throws VofError for a patch without a condition or a condition without a patch.
   Boundaries(const Mesh& m, const std::map<std::string, PatchBc>& bc);
   /// The condition of boundary face f.
-  const BoundaryCondition& operator[](int f) const { return *face_[std::size_t(f - n_internal_)]; }
+  const BoundaryCondition& operator[](int f) const { return *face_[f - n_internal_]; }
   /// Whether any patch opens to the atmosphere (then the pressure level is fixed).
   bool has_opening() const { return has_opening_; }
 

@@ -19,10 +19,10 @@ struct FvMatrix {
   CellField<T> source;
 
   void resize(int cells, int faces) {
-    diag.assign(std::size_t(cells), 0.0);
-    source.assign(std::size_t(cells), T{});
-    upper.assign(std::size_t(faces), 0.0);
-    lower.assign(std::size_t(faces), 0.0);
+    diag.assign(cells, 0.0);
+    source.assign(cells, T{});
+    upper.assign(faces, 0.0);
+    lower.assign(faces, 0.0);
   }
 
   /// The diagonal A (interFoam's UEqn.A(), per cell, not divided by the volume).

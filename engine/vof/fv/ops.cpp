@@ -9,18 +9,18 @@ void CellFaces::build(const Mesh& m) {
     ++start[std::size_t(m.owner[f]) + 1];
     if (f < m.n_internal) ++start[std::size_t(m.neighbour[f]) + 1];
   }
-  for (int c = 0; c < nc; ++c) start[std::size_t(c) + 1] += start[std::size_t(c)];
-  face_list.assign(std::size_t(start[std::size_t(nc)]), 0);
+  for (int c = 0; c < nc; ++c) start[std::size_t(c) + 1] += start[c];
+  face_list.assign(std::size_t(start[nc]), 0);
   std::vector<int> next(start.begin(), start.end() - 1);
   for (int f = 0; f < nf; ++f) {
-    face_list[std::size_t(next[std::size_t(m.owner[f])]++)] = f;
-    if (f < m.n_internal) face_list[std::size_t(next[std::size_t(m.neighbour[f])]++)] = f;
+    face_list[next[m.owner[f]]++] = f;
+    if (f < m.n_internal) face_list[next[m.neighbour[f]]++] = f;
   }
 }
 
 void Reconstruction::build(const Mesh& m, const CellFaces& cell_faces, int dims) {
   const int nc = m.cells();
-  inv_.resize(std::size_t(nc));
+  inv_.resize(nc);
   for (int c = 0; c < nc; ++c) {
     double t[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
     for (int f : cell_faces[c]) {

@@ -56,7 +56,7 @@ struct CellFaces {
   std::vector<int> start, face_list;
   void build(const Mesh& m);
   std::span<const int> operator[](int c) const {
-    return {face_list.data() + start[std::size_t(c)], std::size_t(start[std::size_t(c) + 1] - start[std::size_t(c)])};
+    return {face_list.data() + start[c], std::size_t(start[std::size_t(c) + 1] - start[c])};
   }
 };
 

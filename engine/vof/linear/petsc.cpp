@@ -23,14 +23,14 @@ void petsc_init() {
     PetscInitialized(&started);
     if (!started) {
       std::vector<struct sigaction> before(NSIG);
-      for (int sig = 1; sig < NSIG; ++sig) sigaction(sig, nullptr, &before[std::size_t(sig)]);
+      for (int sig = 1; sig < NSIG; ++sig) sigaction(sig, nullptr, &before[sig]);
       petsc_check(PetscInitializeNoArguments(), "PetscInitialize");
       PetscPopSignalHandler();
       for (int sig = 1; sig < NSIG; ++sig) {
         if (sig == SIGKILL || sig == SIGSTOP || sig == SIGCHLD) continue;
         struct sigaction now{};
         if (sigaction(sig, nullptr, &now) != 0) continue;
-        if (now.sa_handler != before[std::size_t(sig)].sa_handler) sigaction(sig, &before[std::size_t(sig)], nullptr);
+        if (now.sa_handler != before[sig].sa_handler) sigaction(sig, &before[sig], nullptr);
       }
     }
   });
@@ -78,8 +78,8 @@ void MomentumSolver::assemble() {
 
 int MomentumSolver::solve(const std::vector<double>& b, std::vector<double>& x, double t) {
   for (PetscInt c = 0; c < n_; ++c) {
-    VecSetValue(b_, c, b[std::size_t(c)], INSERT_VALUES);
-    VecSetValue(x_, c, x[std::size_t(c)], INSERT_VALUES);
+    VecSetValue(b_, c, b[c], INSERT_VALUES);
+    VecSetValue(x_, c, x[c], INSERT_VALUES);
   }
   VecAssemblyBegin(b_);
   VecAssemblyEnd(b_);

@@ -91,11 +91,11 @@ void PressureSolver::set_rows(const std::vector<double>& diag, const std::vector
   for (int k = 0; k < n_; ++k) {
     if (!reuse) {
       const PetscInt r0 = k;
-      const PetscScalar v = diag[std::size_t(k)];
+      const PetscScalar v = diag[k];
       petsc_check(MatSetValues(A_, 1, &r0, 1, &r0, &v, INSERT_VALUES), "MatSetValues");
     }
-    bv[k] = rhs[std::size_t(k)];
-    xv[k] = x0[std::size_t(k)];
+    bv[k] = rhs[k];
+    xv[k] = x0[k];
   }
   VecRestoreArray(b_, &bv);
   VecRestoreArray(x_, &xv);
@@ -230,12 +230,12 @@ void PressureSolver::save_pc(VofState& st) const {
 // and assemble it.
 void PressureSolver::set_operator(Mat M, const VofState& st, const std::vector<double>& values) {
   for (int i = 0; i < n_; ++i) {
-    const int k0 = st.pc_rows[std::size_t(i)], k1 = st.pc_rows[std::size_t(i) + 1];
+    const int k0 = st.pc_rows[i], k1 = st.pc_rows[std::size_t(i) + 1];
     if (k0 < 0 || k1 < k0 || std::size_t(k1) > st.pc_cols.size()) throw VofError("restore: the checkpoint's pressure operator is damaged");
     for (int k = k0; k < k1; ++k) {
-      const PetscInt r0 = i, c0 = st.pc_cols[std::size_t(k)];
+      const PetscInt r0 = i, c0 = st.pc_cols[k];
       if (c0 < 0 || c0 >= n_) throw VofError("restore: the checkpoint's pressure operator is damaged");
-      const PetscScalar v = values[std::size_t(k)];
+      const PetscScalar v = values[k];
       if (MatSetValues(M, 1, &r0, 1, &c0, &v, INSERT_VALUES))
         throw VofError("restore: the checkpoint's pressure operator does not fit the active region's system");
     }

@@ -19,7 +19,5 @@ class GranularViscosity {
 
 /// The model VofConfig::rheology names; an unknown name is a VofError listing the valid ones.
 std::unique_ptr<GranularViscosity> make_granular_viscosity(const VofConfig& cfg);
-/// The names make_granular_viscosity() knows.
-std::vector<std::string> granular_viscosity_names();
 
 }  // namespace runout::engine::vof
