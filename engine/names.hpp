@@ -29,7 +29,7 @@ template <class E, std::size_t N>
 std::string_view name_of(const NameTable<E, N>& table, E e) {
   for (const auto& [n, v] : table)
     if (v == e) return n;
-  return "?";
+  throw std::logic_error("a value missing from its name table");  // a table that misses one of its enum's values
 }
 
 }  // namespace runout::engine

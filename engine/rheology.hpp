@@ -1,10 +1,9 @@
 #pragma once
 // Basal friction and earth pressure of the depth-averaged model.
 //
-// Coulomb (Savage & Hutter 1989):   tau_b = tan(delta) * N
-// Voellmy (Voellmy 1955; Salm 1993): tau_b = mu * N + rho * g * |u|^2 / xi
-// with N the basal normal stress, which on curved terrain includes the centrifugal part
-// rho * h * kappa * |u|^2 (Savage & Hutter 1991, dissertation eq. 3.48).
+// The friction laws (Coulomb, Voellmy) are entries of engine/friction/registry.hpp; each gives
+// tau_b = mu * N + rho * g * |u|^2 * inv_xi with N the basal normal stress, which on curved terrain
+// includes the centrifugal part rho * h * kappa * |u|^2 (Savage & Hutter 1991, dissertation eq. 3.48).
 //
 // Earth-pressure coefficient (Savage & Hutter 1989, dissertation eq. 3.36), active where the flow
 // extends (du/dx >= 0), passive where it is compressed:
@@ -17,41 +16,35 @@
 #include <stdexcept>
 #include <string>
 
+#include "engine/friction/registry.hpp"
 #include "engine/names.hpp"
 
 namespace runout::engine {
-
-enum class Rheology { coulomb, voellmy };
-inline constexpr NameTable<Rheology, 2> kRheologyNames{
-    {{"coulomb", Rheology::coulomb}, {"voellmy", Rheology::voellmy}}};
 
 enum class EarthPressure { unity, active_passive };
 inline constexpr NameTable<EarthPressure, 2> kEarthPressureNames{
     {{"unity", EarthPressure::unity}, {"active-passive", EarthPressure::active_passive}}};
 
-struct Material {
-  Rheology rheology = Rheology::coulomb;
-  double delta = 0.0;      ///< bed friction angle [rad] (Coulomb)
+/// The flowing material: its friction law (engine/friction/registry.hpp) with that law's parameters
+/// (FrictionParams: delta, mu, xi), the earth pressure and the density.
+struct Material : FrictionParams {
+  const FrictionLaw* rheology = &friction::coulomb;
   double phi = 0.0;        ///< internal friction angle [rad] (earth pressure)
-  double mu = 0.0;         ///< Voellmy dry-friction coefficient [-]
-  double xi = 1.0e300;     ///< Voellmy turbulent-friction coefficient [m/s^2]
   EarthPressure earth_pressure = EarthPressure::unity;
   double density = 300.0;  ///< bulk density [kg/m^3], for pressure outputs only
 
+  /// The law's coefficients, computed once before a run.
+  BasalFriction friction() const { return rheology->coefficients(*this); }
   /// Basal Coulomb coefficient: tan(delta) for Coulomb, mu for Voellmy.
-  double coulomb_coefficient() const { return rheology == Rheology::coulomb ? std::tan(delta) : mu; }
+  double coulomb_coefficient() const { return friction().mu; }
   /// 1/xi, zero for pure Coulomb friction.
-  double inv_xi() const { return rheology == Rheology::voellmy ? 1.0 / xi : 0.0; }
+  double inv_xi() const { return friction().inv_xi; }
 
   /// Throws std::invalid_argument naming the offending parameter.
   void validate() const {
     auto bad = [](const std::string& m) { throw std::invalid_argument("material: " + m); };
-    if (rheology == Rheology::coulomb && !(delta >= 0.0 && delta < M_PI / 2))
-      bad("bed friction angle delta must lie in [0, 90) degrees");
-    if (rheology == Rheology::voellmy) {
-      if (!(mu >= 0.0 && std::isfinite(mu))) bad("Voellmy mu must be >= 0");
-      if (!(xi > 0.0)) bad("Voellmy xi must be > 0 m/s^2");
-    }
+    if (rheology == nullptr) bad("no friction law");
+    if (const std::string why = rheology->check(*this); !why.empty()) bad(why);
     if (earth_pressure == EarthPressure::active_passive) {
       if (!(phi > 0.0 && phi < M_PI / 2)) bad("internal friction angle phi must lie in (0, 90) degrees");
       if (std::atan(coulomb_coefficient()) > phi + 1e-12)

@@ -90,7 +90,8 @@ Sh1dResult run_sh1d(const Channel1D& ch, const Sh1dConfig& cfg, Sh1dState init) 
   const auto wall0 = std::chrono::steady_clock::now();
   const int n = ch.n;
   const double dx = ch.dx, g = cfg.gravity, hdry = cfg.dry_depth;
-  const double mu = cfg.material.coulomb_coefficient(), ixi = cfg.material.inv_xi();
+  const BasalFriction friction = cfg.material.friction();  // the law, resolved once (engine/friction)
+  const double mu = friction.mu, ixi = friction.inv_xi;
   const bool kap = cfg.material.earth_pressure == EarthPressure::active_passive;
   const double kact = kap ? k_x(cfg.material.phi, std::atan(mu), true) : 1.0;
   const double kpas = kap ? k_x(cfg.material.phi, std::atan(mu), false) : 1.0;

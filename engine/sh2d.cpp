@@ -183,8 +183,10 @@ class Solver {
         T_(cfg.tile), ntx_((nx_ + T_ - 1) / T_), nty_((ny_ + T_ - 1) / T_), ntiles_(ntx_ * nty_) {
     g_ = cfg.gravity;
     qcap_ = cfg.curvature_cap * cfg.gravity;
-    mu_ = cfg.material.coulomb_coefficient();
-    ixi_ = cfg.material.inv_xi();
+    // The friction law, resolved once: its two coefficients enter the kernels (engine/friction).
+    const BasalFriction friction = cfg.material.friction();
+    mu_ = friction.mu;
+    ixi_ = friction.inv_xi;
     kap_ = cfg.material.earth_pressure == EarthPressure::active_passive;
     if (kap_) {
       const double d = std::atan(mu_), phi = cfg.material.phi;

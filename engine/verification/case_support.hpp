@@ -79,7 +79,7 @@ inline Terrain2D plane(int nx, int ny, double ds, double dy, double zeta, double
 
 inline Material coulomb(double delta_deg) {
   Material m;
-  m.rheology = Rheology::coulomb;
+  m.rheology = &friction::coulomb;
   m.delta = delta_deg * kDeg;
   m.phi = std::max(delta_deg, 30.0) * kDeg;
   return m;

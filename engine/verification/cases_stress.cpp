@@ -51,7 +51,7 @@ std::vector<Row> case_stress(const Options& o) {
     const double delta = U(5, 40);
     cfg.material = coulomb(delta);
     if (sc % 4 == 1) {
-      cfg.material.rheology = Rheology::voellmy;
+      cfg.material.rheology = &friction::voellmy;
       cfg.material.mu = U(0.05, 0.6);
       cfg.material.xi = U(300, 5000);
     }

@@ -90,11 +90,11 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 v1::Release& rel(v1::Scenario& s) { return *s.mutable_releases(0); }
 
 const std::vector<BadCase> kDepthAveraged = {
-    {"thickness 1e300", [](v1::Scenario& s) { rel(s).set_thickness_m(1e300); }, "releases[0].thickness_m", "at most 500 m, got 1e+300"},
-    {"thickness 1e6", [](v1::Scenario& s) { rel(s).set_thickness_m(1e6); }, "releases[0].thickness_m", "at most 500 m"},
+    {"thickness 1e300", [](v1::Scenario& s) { rel(s).set_thickness_m(1e300); }, "releases[0].thickness_m", "(0, 500] m, got 1e+300"},
+    {"thickness 1e6", [](v1::Scenario& s) { rel(s).set_thickness_m(1e6); }, "releases[0].thickness_m", "(0, 500] m"},
     {"thickness inf", [](v1::Scenario& s) { rel(s).set_thickness_m(kInf); }, "releases[0].thickness_m", "got inf"},
     {"thickness nan", [](v1::Scenario& s) { rel(s).set_thickness_m(kNaN); }, "releases[0].thickness_m", "got nan"},
-    {"thickness 0", [](v1::Scenario& s) { rel(s).set_thickness_m(0); }, "releases[0].thickness_m", "must be > 0 m"},
+    {"thickness 0", [](v1::Scenario& s) { rel(s).set_thickness_m(0); }, "releases[0].thickness_m", "(0, 500] m, got 0"},
     {"min slope 90", [](v1::Scenario& s) { rel(s).set_min_slope_deg(90); }, "releases[0].min_slope_deg", "[0, 90) deg"},
     {"max slope nan", [](v1::Scenario& s) { rel(s).set_max_slope_deg(kNaN); }, "releases[0].max_slope_deg", "(0, 90] deg"},
     {"density inf", [](v1::Scenario& s) { s.mutable_material()->set_density_kg_m3(kInf); }, "material.density_kg_m3", "(0, 10000] kg/m3, got inf"},
@@ -122,7 +122,7 @@ const std::vector<BadCase> kDepthAveraged = {
     {"flow threshold -1", [](v1::Scenario& s) { s.mutable_outputs()->set_flow_threshold_m(-1); }, "outputs.flow_threshold_m", "(0, 100] m"},
     {"time series interval inf", [](v1::Scenario& s) { s.mutable_outputs()->set_timeseries_interval_s(kInf); }, "outputs.timeseries_interval_s", "[0, 100000] s"},
     {"time series interval nan", [](v1::Scenario& s) { s.mutable_outputs()->set_timeseries_interval_s(kNaN); }, "outputs.timeseries_interval_s", "got nan"},
-    {"resolution 1e308", [](v1::Scenario& s) { s.mutable_grid()->set_resolution_m(1e308); }, "grid.resolution_m", "(0, 10000] m (0 or unset: the DEM's), got 1e+308"},
+    {"resolution 1e308", [](v1::Scenario& s) { s.mutable_grid()->set_resolution_m(1e308); }, "grid.resolution_m", "(0, 10000] m (0: the DEM's), got 1e+308"},
     {"resolution inf", [](v1::Scenario& s) { s.mutable_grid()->set_resolution_m(kInf); }, "grid.resolution_m", "got inf"},
     {"resolution -10", [](v1::Scenario& s) { s.mutable_grid()->set_resolution_m(-10); }, "grid.resolution_m", "got -10"},
     {"limits.max_wall_s inf", [](v1::Scenario& s) { s.mutable_limits()->set_max_wall_s(kInf); }, "limits.max_wall_s", "finite"},

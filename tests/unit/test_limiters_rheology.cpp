@@ -48,7 +48,7 @@ TEST(Names, UnknownNameListsTheValidOnes) {
   } catch (const std::invalid_argument& e) {
     EXPECT_STREQ(e.what(), "unknown limiter 'vanLeer' (valid: minmod, vanleer, superbee)");
   }
-  EXPECT_THROW(parse_name(kRheologyNames, "rheology", "bingham"), std::invalid_argument);
+  EXPECT_THROW(friction_law("bingham"), std::invalid_argument);
 }
 
 TEST(EarthPressure, ActiveBelowOnePassiveAbove) {
@@ -102,7 +102,7 @@ TEST(Material, ValidationNamesTheParameter) {
   }
   m.phi = 30 * kDeg;
   EXPECT_NO_THROW(m.validate());
-  m.rheology = Rheology::voellmy;
+  m.rheology = &friction::voellmy;
   m.mu = 0.2;
   m.xi = 0;
   EXPECT_THROW(m.validate(), std::invalid_argument);

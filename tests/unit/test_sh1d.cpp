@@ -102,7 +102,7 @@ TEST(Sh1d, VoellmyLayerReachesItsTerminalSpeed) {
   const int n = 40;
   auto ch = Channel1D::uniform(n, 2.0, 0.0, 35 * kDeg);
   Sh1dConfig cfg;
-  cfg.material.rheology = Rheology::voellmy;
+  cfg.material.rheology = &friction::voellmy;
   cfg.material.mu = 0.25;
   cfg.material.xi = 2000;
   cfg.time.t_end = 200.0;

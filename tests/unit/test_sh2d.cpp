@@ -128,7 +128,7 @@ TEST(Sh2d, VoellmyLayerReachesItsTerminalSpeed) {
   for (int j = 0; j < t.ny; ++j)
     for (int i = 0; i < t.nx; ++i) t.z[std::size_t(j) * t.nx + i] = -std::tan(th) * i * t.dx;
   Sh2dConfig cfg;
-  cfg.material.rheology = Rheology::voellmy;
+  cfg.material.rheology = &friction::voellmy;
   cfg.material.mu = 0.2;
   cfg.material.xi = 1000.0;
   cfg.time.t_end = 120.0;

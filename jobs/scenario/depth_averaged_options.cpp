@@ -1,0 +1,155 @@
+// The option tables of every scenario and of the depth-averaged engine (options.hpp).
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "engine/limiters.hpp"
+#include "engine/rheology.hpp"
+#include "engine/sh2d.hpp"
+#include "jobs/scenario/options.hpp"
+#include "jobs/scenario/scenario.hpp"
+
+namespace runout::jobs {
+
+namespace {
+
+using T = OptionType;
+using U = Unset;
+using S = v1::Scenario;
+using R = ResolvedScenario;
+
+template <class E, std::size_t N>
+std::vector<std::string> names(const engine::NameTable<E, N>& t) {
+  std::vector<std::string> out;
+  for (const auto& [n, e] : t) out.emplace_back(n);
+  return out;
+}
+template <class E, std::size_t N>
+E value(const engine::NameTable<E, N>& t, const std::string& name) {
+  return engine::parse_name(t, "value", name);  // the table has checked the name
+}
+
+std::vector<std::string> friction_law_names() {
+  std::vector<std::string> out;
+  for (const auto* law : engine::kFrictionLaws) out.emplace_back(law->name);
+  return out;
+}
+
+double radians(double deg) { return deg * M_PI / 180.0; }
+
+// Bounds (the README's "Valid ranges").
+constexpr double kMaxCell = 1e4;            // grid.resolution_m [m]
+constexpr double kMaxThickness = 500;       // a release [m]: rock avalanches start some hundred metres thick
+constexpr double kMaxDensity = 1e4;         // [kg/m3]: above any rock or ore
+constexpr double kMaxXi = 1e5;              // Voellmy xi [m/s2]
+constexpr double kMaxEndTime = 1e5;         // numerics.end_time_s, outputs.timeseries_interval_s [s]
+constexpr double kMaxDepthThreshold = 100;  // outline and flow thresholds [m]
+
+}  // namespace
+
+const OptionTable& scenario_options() {
+  static const OptionTable t = {
+      {"name", T::text, U::as_given, "", {}, {}, "", "free text, copied to the run record", "run record"},
+      {"engine", T::choice, U::fill, "depth-averaged", {}, {"depth-averaged", "vof"}, "",
+       "the engine: depth-averaged (Savage-Hutter, on a DEM) or vof (the laboratory set-up of `lab`)", "ResolvedScenario::vof",
+       "", [](const S& s, R& r) { r.vof = s.engine() == "vof"; }},
+      {"limits.max_wall_s", T::number, U::as_given, "", {}, {}, "s",
+       "the service's wall-time limit of one attempt (checked by the server); not part of the hash", "the service's job", "the server's"},
+      {"limits.max_memory_bytes", T::integer, U::as_given, "", {}, {}, "bytes",
+       "the service's memory limit of the job's process; not part of the hash", "the service's job", "the server's"},
+  };
+  return t;
+}
+
+const OptionTable& depth_averaged_options() {
+  static const OptionTable t = {
+      {"dem.path", T::path, U::required, "", {}, {}, "", "the terrain: any raster GDAL reads (GeoTIFF, ESRI ASCII grid, SRTM .hgt, ...)",
+       "DemRequest::dem_path"},
+      {"dem.crs", T::text, U::as_given, "", {}, {}, "", "the DEM's CRS when the file has none (\"EPSG:2056\"; \"local\": local metres)",
+       "DemRequest::dem_crs", "", [](const S& s, R& r) { r.dem.dem_crs = s.dem().crs(); }},
+      {"area_of_interest.path", T::path, U::as_given, "", {}, {}, "", "a polygon file that bounds the computation; default the whole DEM",
+       "DemRequest::aoi_path"},
+      {"grid.resolution_m", T::number, U::as_given, "", Range{0, kMaxCell, true}, {}, "m", "cell size of the computation",
+       "DemRequest::resolution", "the DEM's", [](const S& s, R& r) { r.dem.resolution = s.grid().resolution_m(); }},
+      {"grid.crs", T::choice, U::as_given, "", {}, {"utm", "dem", "EPSG:<code>"}, "",
+       "the computation's CRS; default (unset) utm: the UTM zone of the area's centre", "DemRequest::target_crs", "",
+       [](const S& s, R& r) { r.dem.target_crs = s.grid().crs(); }},
+      {"grid.resampling", T::choice, U::fill, "cubic", {}, {"near", "bilinear", "cubic", "cubicspline", "lanczos", "average"}, "",
+       "GDAL's resampling of the DEM onto the grid", "DemRequest::resampling", "",
+       [](const S& s, R& r) { r.dem.resampling = s.grid().resampling(); }},
+      {"releases[].path", T::path, U::required, "", {}, {}, "", "release polygons in any CRS GDAL/PROJ know; at least one release",
+       "ReleaseRequest::path"},
+      {"releases[].thickness_m", T::number, U::as_given, "", Range{0, kMaxThickness, true}, {}, "m",
+       "release thickness of every polygon (or thickness_attribute)", "ReleaseRequest::thickness"},
+      {"releases[].thickness_attribute", T::text, U::as_given, "", {}, {}, "", "the attribute that holds each polygon's thickness",
+       "ReleaseRequest::thickness_attribute"},
+      {"releases[].thickness_measured", T::choice, U::as_given, "normal", {}, {"normal", "vertical"}, "",
+       "the thickness is measured normal to the slope or vertically", "ReleaseRequest::vertical"},
+      {"releases[].min_slope_deg", T::number, U::as_given, "", Range{0, 90, false, true}, {}, "deg",
+       "slope window: only cells at least this steep release", "ReleaseRequest::min_slope"},
+      {"releases[].max_slope_deg", T::number, U::as_given, "", Range{0, 90, true}, {}, "deg",
+       "slope window: only cells at most this steep release", "ReleaseRequest::max_slope"},
+      {"releases[].min_slope_attribute", T::text, U::as_given, "", {}, {}, "", "the slope window's lower bound per polygon",
+       "ReleaseRequest::min_slope_attribute"},
+      {"releases[].max_slope_attribute", T::text, U::as_given, "", {}, {}, "", "the slope window's upper bound per polygon",
+       "ReleaseRequest::max_slope_attribute"},
+      {"releases[].crs", T::text, U::as_given, "", {}, {}, "", "the polygons' CRS when the file has none", "ReleaseRequest::crs"},
+      {"material.rheology", T::choice, U::fill, "coulomb", {}, friction_law_names(), "",
+       "the basal friction law (engine/friction; the section below)", "Material::rheology", "",
+       [](const S& s, R& r) { r.config.material.rheology = &engine::friction_law(s.material().rheology()); }},
+      {"material.density_kg_m3", T::number, U::fill, "300", Range{0, kMaxDensity, true}, {}, "kg/m3",
+       "bulk density, for the pressure outputs", "Material::density", "",
+       [](const S& s, R& r) { r.config.material.density = s.material().density_kg_m3(); }},
+      {"material.bed_friction_deg", T::number, U::as_given, "", Range{0, 90, false, true}, {}, "deg",
+       "delta, the bed friction angle (coulomb)", "Material::delta (radians)", "", [](const S& s, R& r) {
+         if (s.material().has_bed_friction_deg()) r.config.material.delta = radians(s.material().bed_friction_deg());
+       }},
+      {"material.voellmy_mu", T::number, U::as_given, "", Range{0, 5, false, true}, {}, "", "mu, the dry-friction coefficient (voellmy)",
+       "Material::mu", "", [](const S& s, R& r) {
+         if (s.material().has_voellmy_mu()) r.config.material.mu = s.material().voellmy_mu();
+       }},
+      {"material.voellmy_xi", T::number, U::as_given, "", Range{0, kMaxXi, true}, {}, "m/s^2",
+       "xi, the turbulent-friction coefficient (voellmy)", "Material::xi", "", [](const S& s, R& r) {
+         if (s.material().has_voellmy_xi()) r.config.material.xi = s.material().voellmy_xi();
+       }},
+      {"material.internal_friction_deg", T::number, U::as_given, "", Range{0, 90, false, true}, {}, "deg",
+       "phi, the internal friction angle (earth_pressure active-passive)", "Material::phi (radians)", "", [](const S& s, R& r) {
+         if (s.material().has_internal_friction_deg()) r.config.material.phi = radians(s.material().internal_friction_deg());
+       }},
+      {"material.earth_pressure", T::choice, U::fill, "unity", {}, names(engine::kEarthPressureNames), "",
+       "earth-pressure coefficient: 1 (hydrostatic) or active/passive from phi and delta", "Material::earth_pressure", "",
+       [](const S& s, R& r) { r.config.material.earth_pressure = value(engine::kEarthPressureNames, s.material().earth_pressure()); }},
+      {"numerics.scheme", T::choice, U::fill, "noc-tvd", {}, {"noc-tvd"}, "",
+       "NOC predictor with TVD-limited slopes, central face fluxes (the only one)", "-"},
+      {"numerics.limiter", T::choice, U::fill, "minmod", {}, names(engine::kLimiterNames), "", "the TVD slope limiter",
+       "Sh2dConfig::limiter", "", [](const S& s, R& r) { r.config.limiter = value(engine::kLimiterNames, s.numerics().limiter()); }},
+      {"numerics.cfl", T::number, U::fill, "0.45", Range{0.01, 0.5}, {}, "", "Courant number of the time step",
+       "Sh2dConfig::time.cfl", "", [](const S& s, R& r) { r.config.time.cfl = s.numerics().cfl(); }},
+      {"numerics.end_time_s", T::number, U::fill, "600", Range{0, kMaxEndTime, true}, {}, "s", "the simulated time at most",
+       "Sh2dConfig::time.t_end", "", [](const S& s, R& r) { r.config.time.t_end = s.numerics().end_time_s(); }},
+      {"numerics.stop_fraction", T::number, U::fill, "0.01", Range{0, 1, false, true}, {}, "",
+       "stop when the kinetic energy falls below this fraction of its peak", "Sh2dConfig::time.stop_fraction", "",
+       [](const S& s, R& r) { r.config.time.stop_fraction = s.numerics().stop_fraction(); }},
+      {"numerics.boundary", T::choice, U::fill, "outflow", {}, names(engine::kBoundary2DNames), "",
+       "at the grid's edges: material leaves (outflow) or is held (wall)", "Sh2dConfig::west, east, south, north", "",
+       [](const S& s, R& r) {
+         r.config.west = r.config.east = r.config.south = r.config.north = value(engine::kBoundary2DNames, s.numerics().boundary());
+       }},
+      {"numerics.curvature_off", T::flag, U::as_given, "false", {}, {}, "", "true: no centrifugal term in the friction",
+       "Sh2dConfig::curvature (negated)", "", [](const S& s, R& r) { r.config.curvature = !s.numerics().curvature_off(); }},
+      {"outputs.rasters", T::choice_list, U::fill, "all", {}, raster_names(), "", "the rasters to write",
+       "ResolvedScenario::rasters", "", [](const S& s, R& r) { r.rasters.assign(s.outputs().rasters().begin(), s.outputs().rasters().end()); }},
+      {"outputs.outline_threshold_m", T::number, U::fill, "0.1", Range{0, kMaxDepthThreshold, true}, {}, "m",
+       "the depth that outlines the runout", "ResolvedScenario::outline_threshold", "",
+       [](const S& s, R& r) { r.outline_threshold = s.outputs().outline_threshold_m(); }},
+      {"outputs.flow_threshold_m", T::number, U::fill, "0.01", Range{0, kMaxDepthThreshold, true}, {}, "m",
+       "the depth that counts as flowing (arrival time, speed and pressure maps)", "Sh2dConfig::flow_threshold", "",
+       [](const S& s, R& r) { r.config.flow_threshold = s.outputs().flow_threshold_m(); }},
+      {"outputs.timeseries_interval_s", T::number, U::as_given, "", Range{0, kMaxEndTime}, {}, "s",
+       "HDF5 + XDMF frames of depth and speed this often", "ResolvedScenario::timeseries_interval", "none",
+       [](const S& s, R& r) { r.timeseries_interval = s.outputs().timeseries_interval_s(); }},
+  };
+  return t;
+}
+
+}  // namespace runout::jobs

@@ -1,0 +1,102 @@
+// Engine "vof": the laboratory block, completed and checked by its option table (lab_options.cpp),
+// then the checks between its fields.
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "jobs/scenario/options.hpp"
+#include "jobs/scenario/scenario.hpp"
+#include "jobs/scenario/scenario_impl.hpp"
+
+namespace runout::jobs {
+
+namespace {
+
+void check_obstacles(const v1::Lab& l, bool three_d) {
+  for (int k = 0; k < l.obstacles_size(); ++k) {
+    const auto& o = l.obstacles(k);
+    const std::string f = "lab.obstacles[" + std::to_string(k) + "]";
+    if (o.shape() == "polygon") {
+      if (o.polygon_xy_size() < 6 || o.polygon_xy_size() % 2) bad(f + ".polygon_xy", "needs x, y pairs of at least 3 corners");
+      continue;
+    }
+    if (!three_d) bad(f + ".shape", "'" + o.shape() + "' needs a 3D set-up (lab.nz > 0)");
+    if (o.shape() == "cylinder" && !(o.radius() > 0 && o.height() > 0)) bad(f + ".radius", "a cylinder needs radius > 0 and height > 0");
+    if (o.shape() != "cylinder" && !(o.edge() > 0)) bad(f + ".edge", "a tetrahedron needs edge > 0");
+  }
+}
+
+void check_chute(const v1::Lab& l, bool three_d) {
+  const auto& c = l.chute();
+  if (!three_d) bad("lab.chute", "a curved chute needs a 3D set-up (lab.nz > 0)");
+  if (l.y_min() != 0) bad("lab.y_min", "must be 0 with a chute (y is the height above its bed)");
+  if (!(c.bend_deg() > 0)) bad("lab.chute.bend_deg", "must lie in (0, 90) deg");
+  if (!(c.bend_end_m() > c.bend_start_m() && c.bend_start_m() > l.x_min())) bad("lab.chute.bend_end_m", "needs x_min < bend_start_m < bend_end_m");
+  // The normals of the bend meet at its centre of curvature: the mesh must stay below it.
+  const double radius = (c.bend_end_m() - c.bend_start_m()) / (c.bend_deg() * 3.14159265358979323846 / 180);
+  const double zmax = std::max(std::abs(l.z_min()), std::abs(l.z_max()));
+  const double bed_max = c.channel_radius_m() > 0 ? zmax * zmax / (2 * c.channel_radius_m()) : 0;
+  if (!(l.y_max() + bed_max < 0.9 * radius))
+    bad("lab.y_max", "the mesh (" + std::to_string(l.y_max() + bed_max) + " m above the reference surface) must stay well below the bend's radius of curvature (" +
+                         std::to_string(radius) + " m)");
+  if (!l.obstacles().empty()) bad("lab.obstacles", "obstacles are not supported on a curved chute");
+}
+
+void check_fill(const v1::Lab& l, bool three_d) {
+  for (int k = 0; k < l.fill_size(); ++k) {
+    const auto& f = l.fill(k);
+    const std::string fk = "lab.fill[" + std::to_string(k) + "]";
+    if (f.cap_radius() != 0 || f.cap_height() != 0) {
+      if (!three_d) bad(fk + ".cap_radius", "a spherical cap needs a 3D set-up (lab.nz > 0)");
+      if (!(f.cap_radius() > 0 && f.cap_height() > 0 && f.cap_height() <= f.cap_radius()))
+        bad(fk + ".cap_height", "a cap needs cap_radius > 0 and 0 < cap_height <= cap_radius");
+    } else if (f.polygon_xy_size() > 0) {
+      if (f.polygon_xy_size() < 6 || f.polygon_xy_size() % 2) bad(fk + ".polygon_xy", "needs x, y pairs of at least 3 corners");
+    } else if (!(f.x_max() > f.x_min() && f.y_max() > f.y_min())) {
+      bad(fk, "needs x_max > x_min and y_max > y_min (or polygon_xy)");
+    }
+  }
+}
+
+void check_boundaries(const v1::Lab& l, bool three_d) {
+  for (int k = 0; k < l.boundaries_size(); ++k) {
+    const auto& b = l.boundaries(k);
+    const std::string f = "lab.boundaries[" + std::to_string(k) + "]";
+    if (!three_d && (b.side() == "back" || b.side() == "front")) bad(f + ".side", "'" + b.side() + "' needs a 3D set-up (lab.nz > 0)");
+    if (b.kind() == "inflow" && !(b.inflow_height() > 0)) bad(f + ".inflow_height", "an inflow needs a fill height > 0 m");
+    if (b.kind() == "inflow" && b.side() != "left") bad(f + ".side", "inflow is supported on the left side only");
+    if (b.has_from() && b.has_to() && !(b.to() > b.from())) bad(f + ".to", "must exceed from");
+    if (l.has_chute() && (b.has_from() || b.has_to())) bad(f + ".from", "a curved chute takes whole sides only (no from/to)");
+    if (l.has_chute() && b.kind() == "inflow") bad(f + ".kind", "inflow is not supported on a curved chute");
+  }
+}
+
+}  // namespace
+
+ResolvedScenario resolve_lab(v1::Scenario s) {
+  if (!s.has_lab()) bad("lab", "engine \"vof\" needs the lab block (domain, cells, fill, boundaries)");
+  apply_option_rules(lab_options(), s);
+  const auto& l = s.lab();
+  if (!(l.x_max() > l.x_min())) bad("lab.x_max", "must exceed lab.x_min");
+  if (!(l.y_max() > l.y_min())) bad("lab.y_max", "must exceed lab.y_min");
+  if (l.nz() > 0 && !(l.z_max() > l.z_min())) bad("lab.z_max", "must exceed lab.z_min");
+  if (double(l.nx()) * l.ny() * std::max(1, l.nz()) > 4e6) bad("lab.nx", "more than 4 million cells");
+  const bool three_d = l.nz() > 0;
+  check_obstacles(l, three_d);
+  bool fed = false;
+  for (const auto& b : l.boundaries()) fed |= b.kind() == "inflow";
+  if (l.fill().empty() && !fed) bad("lab.fill", "at least one region of granular material is needed (or an inflow)");
+  if (l.has_chute()) check_chute(l, three_d);
+  check_fill(l, three_d);
+  check_boundaries(l, three_d);
+  const auto& ref = l.reference();
+  if (ref.has_front_x_min() != ref.has_front_x_max() || (ref.has_front_x_min() && ref.front_x_max() < ref.front_x_min()))
+    bad("lab.reference.front_x_max", "the front is a range: give front_x_min and front_x_max >= front_x_min");
+  require_finite(s, "");
+  ResolvedScenario r;
+  r.vof = true;
+  r.scenario = std::move(s);
+  return r;
+}
+
+}  // namespace runout::jobs

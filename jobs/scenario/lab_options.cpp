@@ -1,0 +1,144 @@
+// The option table of the VOF laboratory block `lab` (options.hpp) and its materials. The mapping
+// into the engine's VofConfig lives in the lab driver (jobs/drivers/vof_lab/config.cpp), which
+// `maps_to` names.
+#include <string>
+#include <vector>
+
+#include "jobs/scenario/options.hpp"
+
+namespace runout::jobs {
+
+namespace {
+
+using T = OptionType;
+using U = Unset;
+
+constexpr double kExt = 1e4;   // |coordinate| of the lab block [m]
+constexpr double kTime = 1e4;  // lab times [s]
+const Range kCoord{-kExt, kExt};
+const Range kLength{0, kExt};
+
+std::vector<std::string> material_names() {
+  std::vector<std::string> out;
+  for (const auto& m : lab_materials()) out.push_back(m.name);
+  return out;
+}
+
+Option coord(std::string path, std::string doc) {
+  return {std::move(path), T::number, U::as_given, "", kCoord, {}, "m", std::move(doc), "mesh and geometry"};
+}
+Option length(std::string path, std::string doc, std::string zero = "") {
+  return {std::move(path), T::number, U::as_given, "", kLength, {}, "m", std::move(doc), "geometry", std::move(zero)};
+}
+
+}  // namespace
+
+const std::vector<LabMaterial>& lab_materials() {
+  // validation.md part B; fine-sand: the rotating box, whose side walls raise the effective phi.
+  static const std::vector<LabMaterial> m = {
+      {"pvc", 936.17, 32, 20, "PVC granulate of the laboratory chutes"},
+      {"sand", 1626.67, 37, 18, "quartz sand"},
+      {"fine-sand", 1855, 54.5, 54.5, "the rotating box's fine sand (its side walls raise the effective phi)"},
+  };
+  return m;
+}
+
+const OptionTable& lab_options() {
+  static const OptionTable t = {
+      {"lab.inclination_deg", T::number, U::as_given, "", Range{-90, 90, true, true}, {}, "deg", "zeta, the channel's inclination",
+       "VofConfig::gravity"},
+      coord("lab.x_min", "domain: x down the channel"),
+      coord("lab.x_max", "domain: x down the channel"),
+      coord("lab.y_min", "domain: y normal to the channel's bottom"),
+      coord("lab.y_max", "domain: y normal to the channel's bottom"),
+      coord("lab.z_min", "3D domain: z across the channel"),
+      coord("lab.z_max", "3D domain: z across the channel"),
+      {"lab.nx", T::integer, U::required, "", Range{2, 4e6}, {}, "", "cells along x", "mesh"},
+      {"lab.ny", T::integer, U::required, "", Range{2, 4e6}, {}, "", "cells along y", "mesh"},
+      {"lab.nz", T::integer, U::as_given, "", Range{1, 4e6}, {}, "", "cells along z (3D)", "mesh", "a plane set-up"},
+      coord("lab.fill[].x_min", "a rectangle of granular material"),
+      coord("lab.fill[].x_max", "a rectangle of granular material"),
+      coord("lab.fill[].y_min", "a rectangle of granular material"),
+      coord("lab.fill[].y_max", "a rectangle of granular material"),
+      coord("lab.fill[].polygon_xy[]", "or a polygon: x1, y1, x2, y2, ... (at least 3 corners)"),
+      length("lab.fill[].cap_radius", "3D: a spherical cap on the bed, its sphere's radius"),
+      length("lab.fill[].cap_height", "3D: the cap's height at its centre (0 < cap_height <= cap_radius)"),
+      coord("lab.fill[].cap_x", "3D: the cap's centre"),
+      coord("lab.fill[].cap_z", "3D: the cap's centre"),
+      {"lab.boundaries[].side", T::choice, U::required, "", {}, {"bottom", "top", "left", "right", "back", "front", "obstacle"}, "",
+       "the side (back, front: 3D); a side not listed is a wall", "VofConfig::bc"},
+      {"lab.boundaries[].kind", T::choice, U::required, "", {},
+       {"wall", "coulomb-slip", "coulomb-friction", "atmosphere", "outflow", "inflow", "symmetry"}, "",
+       "the boundary condition (engine/vof/bc)", "VofConfig::bc[side].kind"},
+      coord("lab.boundaries[].from", "the part of the side this applies to (along it); default all"),
+      coord("lab.boundaries[].to", "the part of the side this applies to (along it); default all"),
+      {"lab.boundaries[].inflow_u0", T::number, U::as_given, "", Range{-100, 100}, {}, "m/s", "inflow: velocity along x at the bottom",
+       "VofConfig::bc inflow_velocity"},
+      {"lab.boundaries[].inflow_dudy", T::number, U::as_given, "", Range{-1e4, 1e4}, {}, "1/s",
+       "inflow: the velocity's growth with y up to the fill height", "VofConfig::bc inflow_velocity"},
+      length("lab.boundaries[].inflow_height", "inflow: granular material below this y, air above"),
+      {"lab.material", T::choice, U::fill, "pvc", {}, material_names(), "", "the granular material (the table below)",
+       "VofConfig::rho1, phi_deg; coulomb-slip delta"},
+      {"lab.phi_deg", T::number, U::as_given, "", Range{0, 80, true, true}, {}, "deg", "internal friction angle instead of the material's",
+       "VofConfig::phi_deg"},
+      {"lab.bed_friction_deg", T::number, U::as_given, "", Range{0, 80, false, true}, {}, "deg",
+       "bed friction angle of coulomb-slip sides instead of the material's", "coulomb-slip delta"},
+      {"lab.end_time_s", T::number, U::fill, "1", Range{0, kTime, true}, {}, "s", "the simulated time", "run control"},
+      {"lab.write_interval_s", T::number, U::fill, "0.05", Range{0, kTime}, {}, "s", "fields to HDF5 this often", "run control"},
+      {"lab.max_courant", T::number, U::fill, "0.2", Range{0.01, 1}, {}, "", "the time step's Courant number",
+       "VofConfig::max_co, max_alpha_co"},
+      {"lab.correctors", T::integer, U::fill, "3", Range{1, 50}, {}, "", "PISO correctors per step", "VofConfig::n_correctors"},
+      {"lab.outer_correctors", T::integer, U::keep, "1", Range{1, 20}, {}, "",
+       "outer correctors per step (PIMPLE's nOuterCorrectors); 1: PISO as interFoam", "VofConfig::n_outer_correctors"},
+      {"lab.rotation_period_s", T::number, U::as_given, "", Range{0, 1e6}, {}, "s", "the channel rotates (the rotating box, B1)",
+       "VofConfig::gravity", "fixed"},
+      coord("lab.stations_x[]", "report depth and velocity profiles at these x (run.json)"),
+      {"lab.active_layers", T::integer, U::fill, "4", Range{-1, 1000}, {}, "",
+       "layers of air cells computed around the material; -1: every cell", "VofConfig::active_layers"},
+      {"lab.checkpoint_interval_s", T::number, U::as_given, "", Range{0, kTime}, {}, "s",
+       "with `runout run --checkpoint`: a checkpoint this often (simulated time)", "run control", "only when interrupted"},
+      {"lab.obstacles[].shape", T::choice, U::required, "", {}, {"polygon", "cylinder", "tetrahedron-edge", "tetrahedron-face"}, "",
+       "cells inside are left out (cylinder, tetrahedra: 3D)", "mesh"},
+      coord("lab.obstacles[].polygon_xy[]", "polygon: x1, y1, x2, y2, ... (at least 3 corners)"),
+      coord("lab.obstacles[].x", "3D shapes: the footprint's centre"),
+      coord("lab.obstacles[].z", "3D shapes: the footprint's centre"),
+      length("lab.obstacles[].radius", "cylinder"),
+      length("lab.obstacles[].height", "cylinder"),
+      length("lab.obstacles[].edge", "tetrahedra"),
+      {"lab.reference.source", T::text, U::as_given, "", {}, {}, "", "what the run is compared with, named in comparison.png",
+       "figures"},
+      {"lab.reference.front_x_min", T::number, U::as_given, "", Range{}, {}, "m", "final front: a range (with front_x_max)",
+       "figures"},
+      {"lab.reference.front_x_max", T::number, U::as_given, "", Range{}, {}, "m", "final front: a range (with front_x_min)",
+       "figures"},
+      {"lab.reference.surface_angle_deg", T::number, U::as_given, "", Range{0, 90, false, true}, {}, "deg",
+       "upper deposit surface against the channel bottom", "figures"},
+      {"lab.reference.fluidised_time_s", T::number, U::as_given, "", Range{0}, {}, "s", "whole mass moving", "figures"},
+      {"lab.reference.outflow_l_s", T::number, U::as_given, "", Range{0}, {}, "l/s", "granular flux through the gate", "figures"},
+      {"lab.reference.gate_strain_rate_1_s", T::number, U::as_given, "", Range{0}, {}, "1/s", "strain rate at the gate", "figures"},
+      {"lab.reference.depth_ratio_max", T::number, U::as_given, "", Range{0}, {}, "",
+       "3D: the deepest column at most this many times the undisturbed depth", "figures"},
+      {"lab.viscous_transpose", T::choice, U::fill, "harmonic", {}, {"explicit", "harmonic", "off"}, "",
+       "the viscous stress's transpose part: harmonic face viscosity, linear (interFoam) or none", "VofConfig::viscous_transpose"},
+      {"lab.chute.bend_deg", T::number, U::as_given, "", Range{0, 90, true, true}, {}, "deg",
+       "a curved chute (3D): turns up by this much", "mesh"},
+      coord("lab.chute.bend_start_m", "the bend's start (arc length)"),
+      coord("lab.chute.bend_end_m", "the bend's end (arc length)"),
+      length("lab.chute.channel_radius_m", "R of the cross-channel parabola", "flat across"),
+      {"lab.pressure_coupling", T::choice, U::fill, "piso", {}, {"piso", "consistent"}, "",
+       "the pressure equation with 1/A (interFoam) or SIMPLEC's 1/(A - H1) with the momentum predictor",
+       "VofConfig::consistent, momentum_predictor"},
+      {"lab.momentum_convection", T::choice, U::keep, "upwind", {}, {"upwind", "limited_linear"}, "",
+       "face values of the momentum's convection: first order or TVD (limitedLinearV 1)", "VofConfig::momentum_convection"},
+      {"lab.coulomb_pressure", T::choice, U::keep, "total", {}, {"total", "excess"}, "",
+       "the Coulomb viscosity's confining pressure: p, or p less the still air's hydrostatic pressure",
+       "VofConfig::coulomb_pressure"},
+      {"lab.pressure_preconditioner", T::choice, U::keep, "gamg", {}, {"gamg", "hypre"}, "",
+       "the pressure solve's preconditioner: PETSc's GAMG or hypre's BoomerAMG", "VofConfig::pressure_pc"},
+      {"lab.wall_viscosity", T::choice, U::keep, "face", {}, {"face", "cell"}, "",
+       "viscosity on walls and inflows: evaluated on the face (as OpenFOAM) or the cell's", "VofConfig::wall_viscosity"},
+  };
+  return t;
+}
+
+}  // namespace runout::jobs
