@@ -1,5 +1,7 @@
 #include "jobs/drivers/record_head.hpp"
 
+#include "jobs/digest/sha256.hpp"
+
 #include <omp.h>
 
 #include <cstdlib>
@@ -17,6 +19,11 @@ v1::RunRecord run_record_head(const ResolvedScenario& s, const std::string& engi
   rec.set_created_utc(b);
   rec.set_scenario_file(s.source);
   *rec.mutable_scenario() = s.scenario;
+  for (const auto& path : s.input_files) {
+    auto* in = rec.add_inputs();
+    in->set_path(path);
+    in->set_sha256(sha256_file(path));
+  }
   auto* ex = rec.mutable_execution();
   ex->set_threads(omp_get_max_threads());
   const char* env = std::getenv("PETSC_OPTIONS");

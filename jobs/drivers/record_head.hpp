@@ -1,6 +1,6 @@
 #pragma once
 // The part of the run record every engine writes alike: the software, the engine, when, the scenario
-// and how the run was executed (threads, PETSC_OPTIONS).
+// and its input files' digests, and how the run was executed (threads, PETSC_OPTIONS).
 #include <string>
 
 #include "jobs/formats/run_record.hpp"

@@ -27,7 +27,160 @@ double since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// Cells outside the domain are nodata in every raster.
+std::vector<double> masked_outside(const terrain::Grid& grid, const std::vector<double>& v) {
+  std::vector<double> m = v;
+  for (std::size_t k = 0; k < m.size(); ++k)
+    if (grid.outside[k]) m[k] = std::numeric_limits<double>::quiet_NaN();
+  return m;
+}
+
+// Figures of the hazard map: maximum depth, the affected area and the runout from the release's
+// centroid; a non-finite figure is an error (the engine stops a run whose state turns non-finite).
+void hazard_figures(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::Sh2dResult& res,
+                    RunSummary& sum) {
+  const auto& d = res.diag;
+  const auto& hz = res.hazard;
+  double mx = 0, my = 0, m = 0;
+  for (int j = 0; j < grid.ny; ++j)
+    for (int i = 0; i < grid.nx; ++i) {
+      const double v = h0[std::size_t(j) * grid.nx + i];
+      m += v;
+      mx += v * grid.cx(i);
+      my += v * grid.cy(j);
+    }
+  mx /= m;
+  my /= m;
+  long affected = 0;
+  for (int j = 0; j < grid.ny; ++j)
+    for (int i = 0; i < grid.nx; ++i) {
+      const std::size_t k = std::size_t(j) * grid.nx + i;
+      sum.max_depth = std::max(sum.max_depth, hz.max_depth[k]);
+      if (hz.max_depth[k] <= s.outline_threshold) continue;
+      ++affected;
+      sum.runout_m = std::max(sum.runout_m, std::hypot(grid.cx(i) - mx, grid.cy(j) - my));
+    }
+  sum.affected_area_m2 = double(affected) * grid.dx * grid.dx;
+  // The engine stops a run whose state turns non-finite; this guards what the records would say.
+  for (const auto& [name, v] : {std::pair<const char*, double>{"final volume", d.volume_final}, {"outflow volume", d.volume_outflow},
+                                {"maximum speed", d.max_speed}, {"maximum depth", sum.max_depth},
+                                {"kinetic-energy peak", d.kinetic_energy_peak}, {"runout", sum.runout_m}})
+    if (!std::isfinite(v))
+      throw std::runtime_error(std::string("the run's ") + name + " is not finite (" + json_number(v) +
+                               "): the flow state became NaN or infinite; no results written");
+}
+
+// ISeeSnow export: peak flow thickness and velocity on the input DEM's grid, and the result row.
+void write_iseesnow(const ResolvedScenario& s, const RunOptions& opt, const std::string& out_dir, const terrain::Grid& grid,
+                    const engine::Sh2dResult& res, RunSummary& sum) {
+  const auto& d = res.diag;
+  const auto& hz = res.hazard;
+  auto out = [&](const std::string& name) { return (fs::path(out_dir) / name).string(); };
+  auto masked = [&](const std::vector<double>& v) { return masked_outside(grid, v); };
+  const std::string stem = fs::path(s.releases.front().path).stem().string() + "_" + opt.iseesnow_id + "_null_runout";
+  terrain::write_ascii_on(out(stem + "_pft.asc"), s.dem.dem_path, grid, masked(hz.max_depth));
+  terrain::write_ascii_on(out(stem + "_pfv.asc"), s.dem.dem_path, grid, masked(hz.max_speed));
+  // The benchmark's result table (simulationResultTable.csv): one row per simulation; the
+  // leading digits of the id are the row index, the rest the test case.
+  std::size_t digits = 0;
+  while (digits < opt.iseesnow_id.size() && std::isdigit(static_cast<unsigned char>(opt.iseesnow_id[digits]))) ++digits;
+  const std::string index = digits ? std::to_string(std::stoi(opt.iseesnow_id.substr(0, digits))) : "";
+  std::ofstream csv(out("iseesnow_" + opt.iseesnow_id + ".csv"));
+  csv << ",testCase,computation duration (CPU) [s],avalanche flow time [s],volume at t0 [m3],"
+         "volume at tFinal [m3],spatial resolution x [m],spatial resolution y [m],number of particles\n";
+  csv << index << "," << opt.iseesnow_id.substr(digits) << "," << json_number(sum.cpu_seconds) << "," << json_number(d.t) << ","
+      << json_number(d.volume_initial) << "," << json_number(d.volume_final) << "," << json_number(grid.dx) << "," << json_number(grid.dx) << ",\n";
+  if (!csv) throw std::runtime_error("writing the ISeeSnow CSV failed");
+  // The model configuration file the benchmark asks for, named like the peak fields.
+  std::ofstream cfg(out(stem + ".txt"));
+  const auto& m = s.scenario.material();
+  cfg << "runout " << this_software().version() << ": depth-averaged Savage-Hutter model (NOC-TVD scheme, "
+      << "curvature in the bed friction " << (s.scenario.numerics().curvature_off() ? "off" : "on") << ")\n"
+      << "scenario = " << s.scenario.name() << "\n"
+      << "rheology = " << (m.rheology().empty() ? "coulomb" : m.rheology()) << "\n";
+  if (m.has_voellmy_mu()) cfg << "mu = " << json_number(m.voellmy_mu()) << "\n";
+  if (m.has_voellmy_xi()) cfg << "xi_m_s2 = " << json_number(m.voellmy_xi()) << "\n";
+  if (m.has_bed_friction_deg()) cfg << "bed_friction_deg = " << json_number(m.bed_friction_deg()) << "\n";
+  if (m.has_internal_friction_deg()) cfg << "internal_friction_deg = " << json_number(m.internal_friction_deg()) << "\n";
+  cfg << "earth_pressure = " << (m.earth_pressure().empty() ? "unity" : m.earth_pressure()) << "\n"
+      << "limiter = " << (s.scenario.numerics().limiter().empty() ? "minmod" : s.scenario.numerics().limiter()) << "\n"
+      << "cfl = " << json_number(s.config.time.cfl) << "\n"
+      << "cell_size_m = " << json_number(grid.dx) << "\n"
+      << "release_volume_m3 = " << json_number(d.volume_initial) << "\n"
+      << "stop = " << engine::to_string(d.stop) << " at t = " << json_number(d.t) << " s\n";
+  if (!cfg) throw std::runtime_error("writing the ISeeSnow configuration file failed");
+  sum.files.push_back(stem + ".txt");
+  for (const char* suffix : {"_pft.asc", "_pfv.asc"}) sum.files.push_back(stem + suffix);
+  sum.files.push_back("iseesnow_" + opt.iseesnow_id + ".csv");
+}
+
+// run.json of a depth-averaged run; continued_from: NaN for a run not continued from a checkpoint.
+void write_record(const std::string& path, const ResolvedScenario& s, const terrain::DemReport& dem_rep, const terrain::Grid& grid,
+                  const terrain::ReleaseReport& rel_rep, const engine::Sh2dResult& res, const RunSummary& sum, double continued_from,
+                  const terrain::OutlineReport& outline, int frames) {
+  const auto& d = res.diag;
+  const bool continued = !std::isnan(continued_from);
+  v1::RunRecord rec = run_record_head(s, "depth-averaged");
+  auto* dem = rec.mutable_dem();
+  dem->set_source_crs(dem_rep.source_crs);
+  dem->set_source_resolution_m(dem_rep.source_resolution_m);
+  dem->set_z_min_m(dem_rep.z_min);
+  dem->set_z_max_m(dem_rep.z_max);
+  dem->set_slope_mean_deg(dem_rep.slope_mean_deg);
+  dem->set_slope_p90_deg(dem_rep.slope_p90_deg);
+  dem->set_slope_max_deg(dem_rep.slope_max_deg);
+  dem->set_cells_without_data(int(dem_rep.cells_without_data));
+  dem->set_cells_outside_area(int(dem_rep.cells_outside_area));
+  auto* gr = rec.mutable_grid();
+  gr->set_crs(grid.crs_name);
+  gr->set_nx(grid.nx);
+  gr->set_ny(grid.ny);
+  gr->set_cell_size_m(grid.dx);
+  gr->set_x_min(grid.x_min);
+  gr->set_y_min(grid.y_min);
+  gr->add_local_origin(grid.x_min + 0.5 * grid.nx * grid.dx);
+  gr->add_local_origin(grid.y_min + 0.5 * grid.ny * grid.dx);
+  auto* rel = rec.mutable_release();
+  rel->set_polygons(rel_rep.polygons);
+  rel->set_cells(int(rel_rep.cells));
+  rel->set_area_m2(rel_rep.area_m2);
+  rel->set_volume_m3(rel_rep.volume_m3);
+  for (const auto& note : rel_rep.notes) rel->add_notes(note);
+  auto* mb = rec.mutable_mass_balance();
+  mb->set_volume_initial_m3(d.volume_initial);
+  mb->set_volume_final_m3(d.volume_final);
+  mb->set_volume_outflow_m3(d.volume_outflow);
+  mb->set_relative_error(d.volume_error());
+  auto* so = rec.mutable_solver();
+  so->set_steps(int(d.steps));
+  so->set_simulated_s(d.t);
+  so->set_stop(sum.stop);
+  if (continued) so->set_continued_from_t_s(continued_from);
+  so->set_max_speed_m_s(d.max_speed);
+  so->set_kinetic_energy_peak(d.kinetic_energy_peak);
+  so->set_positivity_limited(double(d.positivity_limited));
+  so->set_cell_updates(d.cell_updates);
+  so->set_mean_active_fraction(d.mean_active_fraction);
+  so->set_max_active_fraction(d.max_active_fraction);
+  auto* re = rec.mutable_results();
+  re->set_affected_area_m2(sum.affected_area_m2);
+  re->set_outline_polygons(outline.polygons);
+  re->set_outline_area_m2(outline.area_m2);
+  re->set_runout_from_release_centroid_m(sum.runout_m);
+  re->set_max_depth_m(sum.max_depth);
+  re->set_outline_threshold_m(s.outline_threshold);
+  re->set_timeseries_frames(frames);
+  auto* ti = rec.mutable_timings_s();
+  ti->set_prepare(sum.seconds_prepare);
+  ti->set_run(sum.seconds_run);
+  ti->set_write(sum.seconds_write);
+  for (const auto& f : sum.files) rec.add_outputs(f);
+  rec.add_outputs("run.json");
+  write_run_record(path, rec);
+}
+
 }  // namespace
+
 
 RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt) {
   if (s.vof) return run_lab(s, out_dir, opt);
@@ -117,46 +270,12 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   sum.stop = std::string(engine::to_string(d.stop));
   sum.max_speed = d.max_speed;
 
-  // Figures of the hazard map.
-  const auto& hz = res.hazard;
-  double mx = 0, my = 0, m = 0;
-  for (int j = 0; j < grid.ny; ++j)
-    for (int i = 0; i < grid.nx; ++i) {
-      const double v = h0[std::size_t(j) * grid.nx + i];
-      m += v;
-      mx += v * grid.cx(i);
-      my += v * grid.cy(j);
-    }
-  mx /= m;
-  my /= m;
-  long affected = 0;
-  for (int j = 0; j < grid.ny; ++j)
-    for (int i = 0; i < grid.nx; ++i) {
-      const std::size_t k = std::size_t(j) * grid.nx + i;
-      sum.max_depth = std::max(sum.max_depth, hz.max_depth[k]);
-      if (hz.max_depth[k] <= s.outline_threshold) continue;
-      ++affected;
-      sum.runout_m = std::max(sum.runout_m, std::hypot(grid.cx(i) - mx, grid.cy(j) - my));
-    }
-  sum.affected_area_m2 = double(affected) * grid.dx * grid.dx;
-  // The engine stops a run whose state turns non-finite; this guards what the records would say.
-  for (const auto& [name, v] : {std::pair<const char*, double>{"final volume", d.volume_final}, {"outflow volume", d.volume_outflow},
-                                {"maximum speed", d.max_speed}, {"maximum depth", sum.max_depth},
-                                {"kinetic-energy peak", d.kinetic_energy_peak}, {"runout", sum.runout_m}})
-    if (!std::isfinite(v))
-      throw std::runtime_error(std::string("the run's ") + name + " is not finite (" + json_number(v) +
-                               "): the flow state became NaN or infinite; no results written");
+  hazard_figures(s, grid, h0, res, sum);
 
   // Outputs.
   const auto t2 = std::chrono::steady_clock::now();
   auto out = [&](const std::string& name) { return (fs::path(out_dir) / name).string(); };
-  // Cells outside the domain are nodata in every raster.
-  auto masked = [&](const std::vector<double>& v) {
-    std::vector<double> m = v;
-    for (std::size_t k = 0; k < m.size(); ++k)
-      if (grid.outside[k]) m[k] = std::numeric_limits<double>::quiet_NaN();
-    return m;
-  };
+  const auto& hz = res.hazard;
   for (const auto& name : s.rasters) {
     const std::vector<double>* v = nullptr;
     std::string desc;
@@ -165,7 +284,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
     if (name == "max_pressure") v = &hz.max_pressure, desc = "maximum pressure rho u^2 [Pa]";
     if (name == "deposit") v = &hz.final_depth, desc = "deposit depth normal to the surface at the end [m]";
     if (name == "arrival_time") v = &hz.arrival_time, desc = "arrival time of the flow [s]";
-    terrain::write_cog(out(name + ".tif"), grid, masked(*v), desc);
+    terrain::write_cog(out(name + ".tif"), grid, masked_outside(grid, *v), desc);
     sum.files.push_back(name + ".tif");
   }
   const auto outline = terrain::write_outline(out("outline.geojson"), out("outline.gpkg"), grid, hz.max_depth, s.outline_threshold);
@@ -185,108 +304,8 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   }
   sum.seconds_write = since(t2);
 
-  // ISeeSnow export: peak flow thickness and velocity on the input DEM's grid, and the result row.
-  if (!opt.iseesnow_id.empty()) {
-    const std::string stem = fs::path(s.releases.front().path).stem().string() + "_" + opt.iseesnow_id + "_null_runout";
-    terrain::write_ascii_on(out(stem + "_pft.asc"), s.dem.dem_path, grid, masked(hz.max_depth));
-    terrain::write_ascii_on(out(stem + "_pfv.asc"), s.dem.dem_path, grid, masked(hz.max_speed));
-    // The benchmark's result table (simulationResultTable.csv): one row per simulation; the
-    // leading digits of the id are the row index, the rest the test case.
-    std::size_t digits = 0;
-    while (digits < opt.iseesnow_id.size() && std::isdigit(static_cast<unsigned char>(opt.iseesnow_id[digits]))) ++digits;
-    const std::string index = digits ? std::to_string(std::stoi(opt.iseesnow_id.substr(0, digits))) : "";
-    std::ofstream csv(out("iseesnow_" + opt.iseesnow_id + ".csv"));
-    csv << ",testCase,computation duration (CPU) [s],avalanche flow time [s],volume at t0 [m3],"
-           "volume at tFinal [m3],spatial resolution x [m],spatial resolution y [m],number of particles\n";
-    csv << index << "," << opt.iseesnow_id.substr(digits) << "," << json_number(sum.cpu_seconds) << "," << json_number(d.t) << ","
-        << json_number(d.volume_initial) << "," << json_number(d.volume_final) << "," << json_number(grid.dx) << "," << json_number(grid.dx) << ",\n";
-    if (!csv) throw std::runtime_error("writing the ISeeSnow CSV failed");
-    // The model configuration file the benchmark asks for, named like the peak fields.
-    std::ofstream cfg(out(stem + ".txt"));
-    const auto& m = s.scenario.material();
-    cfg << "runout " << this_software().version() << ": depth-averaged Savage-Hutter model (NOC-TVD scheme, "
-        << "curvature in the bed friction " << (s.scenario.numerics().curvature_off() ? "off" : "on") << ")\n"
-        << "scenario = " << s.scenario.name() << "\n"
-        << "rheology = " << (m.rheology().empty() ? "coulomb" : m.rheology()) << "\n";
-    if (m.has_voellmy_mu()) cfg << "mu = " << json_number(m.voellmy_mu()) << "\n";
-    if (m.has_voellmy_xi()) cfg << "xi_m_s2 = " << json_number(m.voellmy_xi()) << "\n";
-    if (m.has_bed_friction_deg()) cfg << "bed_friction_deg = " << json_number(m.bed_friction_deg()) << "\n";
-    if (m.has_internal_friction_deg()) cfg << "internal_friction_deg = " << json_number(m.internal_friction_deg()) << "\n";
-    cfg << "earth_pressure = " << (m.earth_pressure().empty() ? "unity" : m.earth_pressure()) << "\n"
-        << "limiter = " << (s.scenario.numerics().limiter().empty() ? "minmod" : s.scenario.numerics().limiter()) << "\n"
-        << "cfl = " << json_number(s.config.time.cfl) << "\n"
-        << "cell_size_m = " << json_number(grid.dx) << "\n"
-        << "release_volume_m3 = " << json_number(d.volume_initial) << "\n"
-        << "stop = " << engine::to_string(d.stop) << " at t = " << json_number(d.t) << " s\n";
-    if (!cfg) throw std::runtime_error("writing the ISeeSnow configuration file failed");
-    sum.files.push_back(stem + ".txt");
-    for (const char* suffix : {"_pft.asc", "_pfv.asc"}) sum.files.push_back(stem + suffix);
-    sum.files.push_back("iseesnow_" + opt.iseesnow_id + ".csv");
-  }
-
-  // Run record.
-  v1::RunRecord rec = run_record_head(s, "depth-averaged");
-  for (const auto& path : s.input_files) {
-    auto* in = rec.add_inputs();
-    in->set_path(path);
-    in->set_sha256(sha256_file(path));
-  }
-  auto* dem = rec.mutable_dem();
-  dem->set_source_crs(dem_rep.source_crs);
-  dem->set_source_resolution_m(dem_rep.source_resolution_m);
-  dem->set_z_min_m(dem_rep.z_min);
-  dem->set_z_max_m(dem_rep.z_max);
-  dem->set_slope_mean_deg(dem_rep.slope_mean_deg);
-  dem->set_slope_p90_deg(dem_rep.slope_p90_deg);
-  dem->set_slope_max_deg(dem_rep.slope_max_deg);
-  dem->set_cells_without_data(int(dem_rep.cells_without_data));
-  dem->set_cells_outside_area(int(dem_rep.cells_outside_area));
-  auto* gr = rec.mutable_grid();
-  gr->set_crs(grid.crs_name);
-  gr->set_nx(grid.nx);
-  gr->set_ny(grid.ny);
-  gr->set_cell_size_m(grid.dx);
-  gr->set_x_min(grid.x_min);
-  gr->set_y_min(grid.y_min);
-  gr->add_local_origin(grid.x_min + 0.5 * grid.nx * grid.dx);
-  gr->add_local_origin(grid.y_min + 0.5 * grid.ny * grid.dx);
-  auto* rel = rec.mutable_release();
-  rel->set_polygons(rel_rep.polygons);
-  rel->set_cells(int(rel_rep.cells));
-  rel->set_area_m2(rel_rep.area_m2);
-  rel->set_volume_m3(rel_rep.volume_m3);
-  for (const auto& note : rel_rep.notes) rel->add_notes(note);
-  auto* mb = rec.mutable_mass_balance();
-  mb->set_volume_initial_m3(d.volume_initial);
-  mb->set_volume_final_m3(d.volume_final);
-  mb->set_volume_outflow_m3(d.volume_outflow);
-  mb->set_relative_error(d.volume_error());
-  auto* so = rec.mutable_solver();
-  so->set_steps(int(d.steps));
-  so->set_simulated_s(d.t);
-  so->set_stop(sum.stop);
-  if (continued) so->set_continued_from_t_s(continued_from);
-  so->set_max_speed_m_s(d.max_speed);
-  so->set_kinetic_energy_peak(d.kinetic_energy_peak);
-  so->set_positivity_limited(double(d.positivity_limited));
-  so->set_cell_updates(d.cell_updates);
-  so->set_mean_active_fraction(d.mean_active_fraction);
-  so->set_max_active_fraction(d.max_active_fraction);
-  auto* re = rec.mutable_results();
-  re->set_affected_area_m2(sum.affected_area_m2);
-  re->set_outline_polygons(outline.polygons);
-  re->set_outline_area_m2(outline.area_m2);
-  re->set_runout_from_release_centroid_m(sum.runout_m);
-  re->set_max_depth_m(sum.max_depth);
-  re->set_outline_threshold_m(s.outline_threshold);
-  re->set_timeseries_frames(frames);
-  auto* ti = rec.mutable_timings_s();
-  ti->set_prepare(sum.seconds_prepare);
-  ti->set_run(sum.seconds_run);
-  ti->set_write(sum.seconds_write);
-  for (const auto& f : sum.files) rec.add_outputs(f);
-  rec.add_outputs("run.json");
-  write_run_record(out("run.json"), rec);
+  if (!opt.iseesnow_id.empty()) write_iseesnow(s, opt, out_dir, grid, res, sum);
+  write_record(out("run.json"), s, dem_rep, grid, rel_rep, res, sum, continued_from, outline, frames);
   sum.files.push_back("run.json");
   return sum;
 }

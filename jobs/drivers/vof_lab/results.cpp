@@ -10,6 +10,18 @@ namespace runout::jobs::vof_lab {
 namespace vof = engine::vof;
 constexpr double kPi = 3.14159265358979323846;
 
+void write_mesh(const LabSetup& su, v1::RunRecord& rec) {
+  const auto& g = su.g;
+  auto* me = rec.mutable_mesh();
+  me->set_cells(su.m.cells());
+  me->set_nx(g.nx);
+  me->set_ny(g.ny);
+  me->set_nz(g.three_d ? g.nz : 0);
+  me->set_dx_m(g.dx);
+  me->set_dy_m(g.dy);
+  if (g.three_d) me->set_dz_m(g.dz);
+}
+
 Deposit deposit(const LabSetup& su, const vof::VofSolver& s) {
   const auto& g = su.g;
   const double dx = g.dx, dy = g.dy;

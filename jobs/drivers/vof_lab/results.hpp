@@ -12,6 +12,9 @@
 
 namespace runout::jobs::vof_lab {
 
+/// mesh: the cells and the grid's size and spacing.
+void write_mesh(const LabSetup& su, v1::RunRecord& rec);
+
 /// The deposit from the column heights (in 3D averaged across the width).
 struct Deposit {
   std::vector<double> h;  ///< column height per i [m]

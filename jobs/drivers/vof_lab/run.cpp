@@ -117,6 +117,15 @@ struct Stepper {
   }
 };
 
+void write_timings(const RunSummary& sum, const RunningFigures& fig, int cells, v1::RunRecord& rec) {
+  auto* ti = rec.mutable_timings_s();
+  ti->set_prepare(sum.seconds_prepare);
+  ti->set_run(sum.seconds_run);
+  ti->set_write(sum.seconds_write);
+  ti->set_microseconds_per_cell_step(fig.steps ? 1e6 * sum.seconds_run / fig.steps / cells : NAN);
+  ti->set_microseconds_per_active_cell_step(fig.active_sum > 0 ? 1e6 * sum.seconds_run / fig.active_sum : NAN);
+}
+
 }  // namespace
 
 RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt) {
@@ -192,19 +201,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   const std::string title = figure_title(r, g, s.time());
 
   v1::RunRecord rec = run_record_head(r, "vof");
-  for (const auto& path : r.input_files) {
-    auto* in = rec.add_inputs();
-    in->set_path(path);
-    in->set_sha256(sha256_file(path));
-  }
-  auto* me = rec.mutable_mesh();
-  me->set_cells(su.m.cells());
-  me->set_nx(g.nx);
-  me->set_ny(g.ny);
-  me->set_nz(g.three_d ? g.nz : 0);
-  me->set_dx_m(g.dx);
-  me->set_dy_m(g.dy);
-  if (g.three_d) me->set_dz_m(g.dz);
+  write_mesh(su, rec);
   fig.write(rec);
   rec.mutable_solver()->set_simulated_s(s.time());
   rec.mutable_solver()->set_stop(sum.stop);
@@ -218,12 +215,7 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
   sum.files = {"fields.h5", "fields.xmf", "figure.png", "run.json", "comparison.png"};
   sum.seconds_write = since(t2);
 
-  auto* ti = rec.mutable_timings_s();
-  ti->set_prepare(sum.seconds_prepare);
-  ti->set_run(sum.seconds_run);
-  ti->set_write(sum.seconds_write);
-  ti->set_microseconds_per_cell_step(fig.steps ? 1e6 * sum.seconds_run / fig.steps / su.m.cells() : NAN);
-  ti->set_microseconds_per_active_cell_step(fig.active_sum > 0 ? 1e6 * sum.seconds_run / fig.active_sum : NAN);
+  write_timings(sum, fig, su.m.cells(), rec);
   for (const auto& f : sum.files) rec.add_outputs(f);
   rec.mutable_execution()->set_petsc_options(petsc_options());
   write_run_record(out_dir + "/run.json", rec);
