@@ -51,7 +51,7 @@ struct VofSolver::Impl {
         cfg(config),
         dims(mesh.thickness > 0 ? 2 : 3),
         bcs(mesh, config.bc),
-        viscosity((make_granular_viscosity(config))),
+        viscosity(make_granular_viscosity(config)),
         mixture(config),
         hydrostatics(mesh, config, F),
         bc_ctx{mesh, F, hydrostatics, *viscosity, mixture, config.wall_viscosity},
