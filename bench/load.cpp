@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "jobs/scenario/scenario.hpp"
+#include "jobs/system/state_dir.hpp"
 #include "service/client/client.hpp"
 
 namespace fs = std::filesystem;
@@ -45,28 +46,8 @@ double quantile(std::vector<double> v, double q) {
   return v[std::min(v.size() - 1, std::size_t(q * double(v.size() - 1) + 0.5))];
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  int clients = 8, jobs_total = 200, workers = 2;
-  for (int k = 1; k + 1 < argc; k += 2) {
-    const std::string a = argv[k];
-    const int v = std::atoi(argv[k + 1]);
-    if (a == "--clients") clients = std::max(1, v);
-    else if (a == "--jobs") jobs_total = std::max(1, v);
-    else if (a == "--workers") workers = std::max(1, v);
-    else {
-      std::fprintf(stderr, "usage: runout_bench_load [--clients N] [--jobs N] [--workers N]\n");
-      return 2;
-    }
-  }
-  const fs::path dir = fs::temp_directory_path() / ("runout-bench-load-" + std::to_string(getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  {
-    std::ofstream t(dir / "tokens");
-    for (int c = 0; c < clients; ++c) t << "client-token-" << c << "\n";
-  }
+// Starts `runout serve` on a free loopback port; its pid and address (from STATE/server.json).
+pid_t start_server(const fs::path& dir, int workers, std::string& address) {
   const std::string scenarios = std::string(RUNOUT_SOURCE_DIR) + "/scenarios";
   const pid_t pid = fork();
   if (pid == 0) {
@@ -77,37 +58,40 @@ int main(int argc, char** argv) {
     _exit(127);
   }
   for (int k = 0; k < 300 && !fs::exists(dir / "state/server.json"); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  std::string address;
-  {
-    std::ifstream in(dir / "state/server.json");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    const std::string s = ss.str();
-    const auto a = s.find("\"listen\": \"") + 11;
-    address = s.substr(a, s.find('"', a) - a);
-  }
-  const long rss_idle = peak_rss_kib(pid);
+  if (const auto info = jobs::read_server_info((dir / "state").string())) address = info->listen();
+  return pid;
+}
 
-  // The small scenario: In den Arelen on a 90 m grid; each job its own release thickness.
+// The small scenario: In den Arelen on a 90 m grid.
+v1::Scenario base_scenario() {
   v1::Scenario base;
-  {
-    std::ifstream in(std::string(RUNOUT_SOURCE_DIR) + "/tests/data/arelen-30m.json");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    base = jobs::parse_scenario_json(ss.str());
-    base.mutable_dem()->set_path("data/arelen/davos_srtm3.tif");
-    base.mutable_area_of_interest()->set_path("data/arelen/aoi.geojson");
-    base.mutable_releases(0)->set_path("data/arelen/release.geojson");
-    base.mutable_releases(0)->clear_thickness_attribute();
-    base.mutable_grid()->set_resolution_m(90);
-    base.mutable_numerics()->set_end_time_s(120);
-  }
+  std::ifstream in(std::string(RUNOUT_SOURCE_DIR) + "/tests/data/arelen-30m.json");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  base = jobs::parse_scenario_json(ss.str());
+  base.mutable_dem()->set_path("data/arelen/davos_srtm3.tif");
+  base.mutable_area_of_interest()->set_path("data/arelen/aoi.geojson");
+  base.mutable_releases(0)->set_path("data/arelen/release.geojson");
+  base.mutable_releases(0)->clear_thickness_attribute();
+  base.mutable_grid()->set_resolution_m(90);
+  base.mutable_numerics()->set_end_time_s(120);
+  return base;
+}
 
+// What the clients saw while submitting.
+struct Submitted {
+  std::vector<double> latencies;                 // of the first sends [ms]
+  std::vector<std::vector<std::string>> ids;     // per client
+  int failures = 0, retried_same = 0;
+};
+
+// `clients` threads, one token each, submit `jobs_total` scenarios in all (each its own release
+// thickness), each twice with the same request id.
+Submitted submit_all(const std::string& address, const v1::Scenario& base, int clients, int jobs_total) {
   std::mutex mu;
   std::vector<double> latencies;
   std::vector<std::vector<std::string>> ids(clients);
   std::atomic<int> failures{0}, retried_same{0};
-  const auto t0 = clk::now();
   std::vector<std::thread> threads;
   for (int c = 0; c < clients; ++c)
     threads.emplace_back([&, c] {
@@ -138,9 +122,15 @@ int main(int argc, char** argv) {
       }
     });
   for (auto& t : threads) t.join();
-  const double submit_s = std::chrono::duration<double>(clk::now() - t0).count();
+  return {latencies, ids, failures.load(), retried_same.load()};
+}
 
-  // Follow every job to its end.
+// Follows every job to its end and lists each client's jobs: (succeeded, other, distinct ids, listed).
+struct Followed {
+  int succeeded = 0, other = 0;
+  std::size_t distinct = 0, listed = 0;
+};
+Followed follow_all(const std::string& address, const std::vector<std::vector<std::string>>& ids, int clients) {
   int succeeded = 0, other = 0;
   std::set<std::string> distinct;
   std::size_t listed = 0;
@@ -161,6 +151,44 @@ int main(int argc, char** argv) {
       token = page.next_page_token();
     } while (!token.empty());
   }
+  return {succeeded, other, distinct.size(), listed};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int clients = 8, jobs_total = 200, workers = 2;
+  for (int k = 1; k + 1 < argc; k += 2) {
+    const std::string a = argv[k];
+    const int v = std::atoi(argv[k + 1]);
+    if (a == "--clients") clients = std::max(1, v);
+    else if (a == "--jobs") jobs_total = std::max(1, v);
+    else if (a == "--workers") workers = std::max(1, v);
+    else {
+      std::fprintf(stderr, "usage: runout_bench_load [--clients N] [--jobs N] [--workers N]\n");
+      return 2;
+    }
+  }
+  const fs::path dir = fs::temp_directory_path() / ("runout-bench-load-" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  {
+    std::ofstream t(dir / "tokens");
+    for (int c = 0; c < clients; ++c) t << "client-token-" << c << "\n";
+  }
+  std::string address;
+  const pid_t pid = start_server(dir, workers, address);
+  const long rss_idle = peak_rss_kib(pid);
+
+  const v1::Scenario base = base_scenario();
+  const auto t0 = clk::now();
+  const Submitted sub = submit_all(address, base, clients, jobs_total);
+  const auto& latencies = sub.latencies;
+  const double submit_s = std::chrono::duration<double>(clk::now() - t0).count();
+
+  const Followed fol = follow_all(address, sub.ids, clients);
+  const int succeeded = fol.succeeded, other = fol.other;
+  const std::size_t listed = fol.listed;
   const double total_s = std::chrono::duration<double>(clk::now() - t0).count();
   const long rss_peak = peak_rss_kib(pid);
   kill(pid, SIGTERM);
@@ -178,10 +206,10 @@ int main(int argc, char** argv) {
   std::printf("| wall time, first submission to last job done | %.2f s |\n", total_s);
   std::printf("| server peak memory (idle / end) | %.0f / %.0f MiB |\n", rss_idle / 1024.0, rss_peak / 1024.0);
   std::printf("| jobs: submitted / distinct ids / listed / succeeded / other | %d / %zu / %zu / %d / %d |\n", jobs_total,
-              distinct.size(), listed, succeeded, other);
-  std::printf("| retries answered with the first job | %d of %d |\n", retried_same.load(), jobs_total);
-  const bool ok = failures == 0 && int(distinct.size()) == jobs_total && int(listed) == jobs_total && succeeded == jobs_total &&
-                  retried_same == jobs_total;
+              fol.distinct, listed, succeeded, other);
+  std::printf("| retries answered with the first job | %d of %d |\n", sub.retried_same, jobs_total);
+  const bool ok = sub.failures == 0 && int(fol.distinct) == jobs_total && int(listed) == jobs_total && succeeded == jobs_total &&
+                  sub.retried_same == jobs_total;
   std::printf("%s\n", ok ? "none lost, none duplicated" : "LOST OR DUPLICATED JOBS");
   return ok ? 0 : 1;
 }

@@ -1,5 +1,7 @@
 #include "jobs/system/state_dir.hpp"
 
+#include <google/protobuf/util/json_util.h>
+
 #include <fcntl.h>
 #include <sqlite3.h>
 #include <sys/file.h>
@@ -285,6 +287,30 @@ RecoveryReport recover_store(const std::string& state_dir, const StateLock& held
   fs::rename(building, db, ec);
   if (ec) throw StateError("cannot move the rebuilt store into place: " + ec.message());
   return rep;
+}
+
+void write_server_info(const std::string& state_dir, const v1::ServerInfo& info) {
+  std::string json;
+  google::protobuf::util::JsonPrintOptions o;
+  o.preserve_proto_field_names = true;
+  if (!google::protobuf::util::MessageToJsonString(info, &json, o).ok()) throw StateError("server.json: cannot write it as JSON");
+  const fs::path dir(state_dir), tmp = dir / "server.json.tmp";
+  {
+    std::ofstream out(tmp);
+    out << json << "\n";
+    if (!out) throw StateError("cannot write '" + tmp.string() + "'");
+  }
+  fs::rename(tmp, dir / "server.json");
+}
+
+std::optional<v1::ServerInfo> read_server_info(const std::string& state_dir) {
+  std::ifstream in(fs::path(state_dir) / "server.json");
+  if (!in) return std::nullopt;
+  std::stringstream ss;
+  ss << in.rdbuf();
+  v1::ServerInfo info;
+  if (!google::protobuf::util::JsonStringToMessage(ss.str(), &info).ok() || info.listen().empty()) return std::nullopt;
+  return info;
 }
 
 }  // namespace runout::jobs

@@ -3,7 +3,10 @@
 // time, a store that never silently forgets, and the rebuilding of a lost store.
 #include <cstdint>
 #include <stdexcept>
+#include <optional>
 #include <string>
+
+#include "runout/v1/service.pb.h"
 
 namespace runout::jobs {
 
@@ -54,5 +57,10 @@ struct RecoveryReport {
 /// an interrupted recovery leaves no half store). A healthy store is left as it is (healthy = true).
 /// The caller holds the state directory's lock (`held`), so no server starts meanwhile.
 RecoveryReport recover_store(const std::string& state_dir, const StateLock& held);
+
+/// STATE/server.json, written by a server once it listens (atomically: a temporary file renamed).
+void write_server_info(const std::string& state_dir, const v1::ServerInfo& info);
+/// STATE/server.json of a running server; nothing when there is none or it cannot be read.
+std::optional<v1::ServerInfo> read_server_info(const std::string& state_dir);
 
 }  // namespace runout::jobs

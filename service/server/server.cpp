@@ -189,10 +189,11 @@ void Server::start() {
   m.lock->set_listen(address());
   m.start_housekeeping();
   m.server->GetHealthCheckService()->SetServingStatus(true);
-  std::ofstream sj(fs::path(m.cfg.state_dir()) / "server.json.tmp");
-  sj << "{\"listen\": \"" << address() << "\", \"pid\": " << getpid() << ", \"started_utc\": \"" << jobs::utc_now() << "\"}\n";
-  sj.close();
-  fs::rename(fs::path(m.cfg.state_dir()) / "server.json.tmp", fs::path(m.cfg.state_dir()) / "server.json");
+  v1::ServerInfo info;
+  info.set_listen(address());
+  info.set_pid(getpid());
+  info.set_started_utc(jobs::utc_now());
+  jobs::write_server_info(m.cfg.state_dir(), info);
   m.log("runout server listening on " + address() + " (state " + m.cfg.state_dir() + ", " + std::to_string(m.cfg.workers()) +
         " worker(s), " + (m.tokens->enabled() ? "tokens" : "no authentication") + (m.cfg.tls_cert().empty() ? "" : ", TLS") + ")");
 }

@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "jobs/system/state_dir.hpp"
 #include "service/client/client.hpp"
 #include "tests/support/temp_dir.hpp"
 
@@ -69,9 +70,7 @@ class ServerProcess {
       }
       std::this_thread::sleep_for(50ms);
     }
-    const std::string s = read_text(state_ / "server.json");
-    const auto a = s.find("\"listen\": \"") + 11;
-    address_ = s.substr(a, s.find('"', a) - a);
+    if (const auto info = jobs::read_server_info(state_.string())) address_ = info->listen();
   }
   /// Signal the server and wait for it; returns its wait status.
   int stop(int sig) {
