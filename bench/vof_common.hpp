@@ -104,6 +104,57 @@ inline Ran run_in_temp(const runout::jobs::ResolvedScenario& r) {
   return ran;
 }
 
+// In a child of run_all: one run, its record (.json) and its summary (.meta) for the parent.
+inline int write_child_result(const runout::jobs::ResolvedScenario& r, const std::filesystem::path& json_path,
+                              const std::filesystem::path& meta_path) {
+  int rc = 0;
+  try {
+    const Ran ran = run_in_temp(r);
+    std::string error = ran.error;
+    std::replace(error.begin(), error.end(), '\n', ' ');
+    std::ofstream(json_path) << ran.json;
+    std::ofstream meta(meta_path);
+    meta.precision(17);
+    const auto& u = ran.sum;
+    meta << u.stop << "\n";
+    for (double x : {double(u.steps), u.seconds_run, u.t, double(u.nx), double(u.ny), u.runout_m, u.max_speed, u.max_depth,
+                     u.volume_initial, u.volume_final, u.volume_error})
+      meta << x << "\n";
+    meta << error << "\n";
+  } catch (...) {
+    rc = 1;
+  }
+  return rc;
+}
+
+// In run_all: the result of a child that ended with `status`, from the files it wrote.
+inline Ran read_child_result(int status, const std::filesystem::path& json_path, const std::filesystem::path& meta_path) {
+  Ran ran;
+  std::ifstream meta(meta_path);
+  std::string stop;
+  std::vector<std::string> v(11);
+  bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 && std::getline(meta, stop);
+  for (auto& x : v) ok = ok && std::getline(meta, x);
+  if (ok) {
+    auto num = [&](int q) { return std::strtod(v[std::size_t(q)].c_str(), nullptr); };
+    auto& u = ran.sum;
+    u.stop = stop;
+    u.steps = long(num(0)), u.seconds_run = num(1), u.t = num(2), u.nx = int(num(3)), u.ny = int(num(4));
+    u.runout_m = num(5), u.max_speed = num(6), u.max_depth = num(7), u.volume_initial = num(8), u.volume_final = num(9),
+    u.volume_error = num(10);
+    std::getline(meta, ran.error);
+    std::ifstream in(json_path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    ran.json = ss.str();
+  } else {
+    ran.error = WIFSIGNALED(status) ? "the run's process ended with signal " + std::to_string(WTERMSIG(status))
+                                    : "the run's process ended with status " + std::to_string(WEXITSTATUS(status));
+    std::fprintf(stderr, "runout_bench_vof: %s\n", ran.error.c_str());
+  }
+  return ran;
+}
+
 // Run scenarios as run_in_temp does, at most `jobs` at a time, each in a child process of its own,
 // and hand each result to `done(k, ran)` in the given order as soon as it and all before it have
 // finished (so tables fill in as the runs end). jobs 0: as many as the machine has cores; 1: one
@@ -137,29 +188,7 @@ void run_all(const std::vector<runout::jobs::ResolvedScenario>& rs, int jobs, Do
   auto collect = [&](std::size_t q, int status) {
     const std::size_t k = running[q].second;
     running.erase(running.begin() + long(q));
-    Ran& ran = out[k];
-    std::ifstream meta(file(k, ".meta"));
-    std::string stop;
-    std::vector<std::string> v(11);
-    bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0 && std::getline(meta, stop);
-    for (auto& x : v) ok = ok && std::getline(meta, x);
-    if (ok) {
-      auto num = [&](int q) { return std::strtod(v[std::size_t(q)].c_str(), nullptr); };
-      auto& u = ran.sum;
-      u.stop = stop;
-      u.steps = long(num(0)), u.seconds_run = num(1), u.t = num(2), u.nx = int(num(3)), u.ny = int(num(4));
-      u.runout_m = num(5), u.max_speed = num(6), u.max_depth = num(7), u.volume_initial = num(8), u.volume_final = num(9),
-      u.volume_error = num(10);
-      std::getline(meta, ran.error);
-      std::ifstream in(file(k, ".json"));
-      std::stringstream ss;
-      ss << in.rdbuf();
-      ran.json = ss.str();
-    } else {
-      ran.error = WIFSIGNALED(status) ? "the run's process ended with signal " + std::to_string(WTERMSIG(status))
-                                      : "the run's process ended with status " + std::to_string(WEXITSTATUS(status));
-      std::fprintf(stderr, "runout_bench_vof: %s\n", ran.error.c_str());
-    }
+    out[k] = read_child_result(status, file(k, ".json"), file(k, ".meta"));
     ready[k] = true;
   };
   // Wait for one of the running children; false when none can be waited for.
@@ -187,23 +216,7 @@ void run_all(const std::vector<runout::jobs::ResolvedScenario>& rs, int jobs, Do
     while (int(running.size()) >= jobs && wait_one()) deliver();
     const pid_t pid = fork();
     if (pid == 0) {
-      int rc = 0;
-      try {
-        const Ran ran = run_in_temp(rs[k]);
-        std::string error = ran.error;
-        std::replace(error.begin(), error.end(), '\n', ' ');
-        std::ofstream(file(k, ".json")) << ran.json;
-        std::ofstream meta(file(k, ".meta"));
-        meta.precision(17);
-        const auto& u = ran.sum;
-        meta << u.stop << "\n";
-        for (double x : {double(u.steps), u.seconds_run, u.t, double(u.nx), double(u.ny), u.runout_m, u.max_speed, u.max_depth,
-                         u.volume_initial, u.volume_final, u.volume_error})
-          meta << x << "\n";
-        meta << error << "\n";
-      } catch (...) {
-        rc = 1;
-      }
+      const int rc = write_child_result(rs[k], file(k, ".json"), file(k, ".meta"));
       std::fflush(stdout);
       std::fflush(stderr);
       _exit(rc);

@@ -83,113 +83,223 @@ void validate(const Channel1D& ch, const Sh1dConfig& cfg, const Sh1dState& s) {
     bad("an inflow boundary needs a hydrograph");
 }
 
-}  // namespace
-
-Sh1dResult run_sh1d(const Channel1D& ch, const Sh1dConfig& cfg, Sh1dState init) {
-  validate(ch, cfg, init);
-  const auto wall0 = std::chrono::steady_clock::now();
-  const int n = ch.n;
-  const double dx = ch.dx, g = cfg.gravity, hdry = cfg.dry_depth;
-  const BasalFriction friction = cfg.material.friction();  // the law, resolved once (engine/friction)
-  const double mu = friction.mu, ixi = friction.inv_xi;
-  const bool kap = cfg.material.earth_pressure == EarthPressure::active_passive;
-  const double kact = kap ? k_x(cfg.material.phi, std::atan(mu), true) : 1.0;
-  const double kpas = kap ? k_x(cfg.material.phi, std::atan(mu), false) : 1.0;
-  const Limiter lim = cfg.limiter;
-  const bool open = cfg.left != Boundary1D::wall || cfg.right != Boundary1D::wall;
-
-  Work w(n);
-  for (int i = 0; i < n; ++i) {
-    w.h[i + G] = init.h[i];
-    w.m[i + G] = init.m[i];
-    w.zeta[i + G] = ch.zeta[i];
-    w.kappa[i + G] = ch.kappa[i];
+// The scheme's state and steps on one channel: ghosts, earth pressure, predictor, positivity
+// limiter, corrector on the staggered cells and the average back onto the cells.
+class Sh1dSolver {
+ public:
+  Sh1dSolver(const Channel1D& ch, const Sh1dConfig& cfg, const Sh1dState& init)
+      : cfg_(cfg), n(ch.n), dx(ch.dx), g(cfg.gravity), hdry(cfg.dry_depth), lim(cfg.limiter),
+        open(cfg.left != Boundary1D::wall || cfg.right != Boundary1D::wall), curv(cfg.curvature ? 1.0 : 0.0), w(ch.n) {
+    const BasalFriction friction = cfg.material.friction();  // the law, resolved once (engine/friction)
+    mu = friction.mu;
+    ixi = friction.inv_xi;
+    kap = cfg.material.earth_pressure == EarthPressure::active_passive;
+    kact = kap ? k_x(cfg.material.phi, std::atan(mu), true) : 1.0;
+    kpas = kap ? k_x(cfg.material.phi, std::atan(mu), false) : 1.0;
+    for (int i = 0; i < n; ++i) {
+      w.h[i + G] = init.h[i];
+      w.m[i + G] = init.m[i];
+      w.zeta[i + G] = ch.zeta[i];
+      w.kappa[i + G] = ch.kappa[i];
+    }
+    // Ghost geometry: a wall is a mirror, so its ghosts carry the mirrored channel (inclination of the
+    // opposite sign, same curvature) and the solution stays symmetric about the wall: no mass crosses
+    // it. Open boundaries extend the edge geometry.
+    for (int k = 0; k < G; ++k) {
+      const bool lw = cfg.left == Boundary1D::wall, rw = cfg.right == Boundary1D::wall;
+      w.zeta[G - 1 - k] = lw ? -ch.zeta[k] : ch.zeta[0];
+      w.kappa[G - 1 - k] = lw ? ch.kappa[k] : ch.kappa[0];
+      w.zeta[n + G + k] = rw ? -ch.zeta[n - 1 - k] : ch.zeta[n - 1];
+      w.kappa[n + G + k] = rw ? ch.kappa[n - 1 - k] : ch.kappa[n - 1];
+    }
   }
-  // Ghost geometry: a wall is a mirror, so its ghosts carry the mirrored channel (inclination of the
-  // opposite sign, same curvature) and the solution stays symmetric about the wall: no mass crosses
-  // it. Open boundaries extend the edge geometry.
-  for (int k = 0; k < G; ++k) {
-    const bool lw = cfg.left == Boundary1D::wall, rw = cfg.right == Boundary1D::wall;
-    w.zeta[G - 1 - k] = lw ? -ch.zeta[k] : ch.zeta[0];
-    w.kappa[G - 1 - k] = lw ? ch.kappa[k] : ch.kappa[0];
-    w.zeta[n + G + k] = rw ? -ch.zeta[n - 1 - k] : ch.zeta[n - 1];
-    w.kappa[n + G + k] = rw ? ch.kappa[n - 1 - k] : ch.kappa[n - 1];
-  }
-  auto vel = [hdry](double h, double m) { return h > hdry ? m / h : 0.0; };
-  auto mass = [&] {
+
+  Sh1dResult run();
+
+ private:
+  double vel(double h, double m) const { return h > hdry ? m / h : 0.0; }
+  double mass() const {
     double s = 0;
     for (int i = G; i < n + G; ++i) s += w.h[i];
     return s * dx;
-  };
+  }
+  void fill_ghosts(double t);
+  void fill_side(Boundary1D b, bool left, double t);
+  void set_beta();
+  double next_dt(double t) const;
+  void predictor(double dt, double lam);
+  void positivity(double lam);
+  void corrector(double dt, double lam, Sh1dResult& r);
+  void average_back();
+  // Slope of the discharge m = h u from the limited slopes of h and of the velocity (product rule):
+  // limiting m itself would clip it where it peaks, ahead of the depth's crest, although the velocity
+  // is smooth and monotone there. Dry neighbours leave the velocity slope at zero.
+  double momentum_slope(const std::vector<double>& H, const std::vector<double>& M, double sh, int k) const {
+    if (!(H[k - 1] > hdry && H[k] > hdry && H[k + 1] > hdry)) return limited_slope(lim, M[k] - M[k - 1], M[k + 1] - M[k]);
+    const double u = M[k] / H[k];
+    return u * sh + H[k] * limited_slope(lim, u - M[k - 1] / H[k - 1], M[k + 1] / H[k + 1] - u);
+  }
+  // Coulomb resistance per unit width; Voellmy's drag is applied implicitly (turbulent_factor).
+  double resistance(double h, double u, double zeta, double kappa) const {
+    return h * mu * std::max(0.0, g * std::cos(zeta) + curv * kappa * u * u);
+  }
+  void drag(double& m, double h, double span) const {
+    if (ixi > 0 && h > hdry) m *= turbulent_factor(std::abs(m) / h, h, span * g * ixi);
+  }
+  double flux_m(int k) const {
+    const double h = w.hp[k], u = vel(h, w.mp[k]);
+    return w.mp[k] * u + 0.5 * w.beta[k] * h * h;
+  }
+  double src(double h, int k) const { return h * g * std::sin(w.zeta[k]); }
+  double scale(int k) const {  // limiter factor for the flux through x_k
+    if (w.mp[k] > 0) return w.r[k - 1];
+    if (w.mp[k] < 0) return w.r[k];
+    return 1.0;
+  }
 
+  const Sh1dConfig& cfg_;
+  const int n;
+  const double dx, g, hdry;
+  const Limiter lim;
+  const bool open;
+  const double curv;
+  double mu = 0, ixi = 0, kact = 1, kpas = 1;
+  bool kap = false;
+  Work w;
+};
+
+void Sh1dSolver::fill_side(Boundary1D b, bool left, double t) {
+  for (int k = 0; k < G; ++k) {
+    const int gi = left ? G - 1 - k : n + G + k;  // ghost index, k-th away from the edge
+    const int mi = left ? G + k : n + G - 1 - k;   // mirror index inside
+    const int ei = left ? G : n + G - 1;           // edge cell
+    switch (b) {
+      case Boundary1D::wall:
+        w.h[gi] = w.h[mi];
+        w.m[gi] = -w.m[mi];
+        break;
+      case Boundary1D::outflow:
+        w.h[gi] = w.h[ei];
+        w.m[gi] = w.m[ei];
+        break;
+      case Boundary1D::inflow: {
+        // The hydrograph state holds at the boundary face: the ghosts are the inside reflected
+        // through it (w_g = 2 w_in - w_mirror), so that the piecewise-linear solution passes
+        // through the prescribed depth and discharge there (second order at the boundary).
+        double hi, ui;
+        cfg_.inflow.at(t, hi, ui);
+        const double qi = hi * (left ? ui : -ui);
+        w.h[gi] = std::max(0.0, 2 * hi - w.h[mi]);
+        w.m[gi] = w.h[gi] > 0 ? 2 * qi - w.m[mi] : 0.0;
+        break;
+      }
+    }
+  }
+}
+
+void Sh1dSolver::fill_ghosts(double t) {
+  fill_side(cfg_.left, true, t);
+  fill_side(cfg_.right, false, t);
+}
+
+// Per-cell earth pressure: active where the flow extends (du/dxi >= 0).
+void Sh1dSolver::set_beta() {
+  for (int k = 1; k < n + 2 * G - 1; ++k) {
+    double K = 1.0;
+    if (kap) K = (vel(w.h[k + 1], w.m[k + 1]) - vel(w.h[k - 1], w.m[k - 1]) >= 0) ? kact : kpas;
+    w.beta[k] = K * g * std::cos(w.zeta[k]);
+  }
+  w.beta[0] = w.beta[1];
+  w.beta[n + 2 * G - 1] = w.beta[n + 2 * G - 2];
+}
+
+double Sh1dSolver::next_dt(double t) const {
+  const auto& tc = cfg_.time;
+  double amax = 0;
+  for (int k = 0; k < n + 2 * G; ++k)
+    amax = std::max(amax, std::abs(vel(w.h[k], w.m[k])) + std::sqrt(w.beta[k] * std::max(w.h[k], 0.0)));
+  double dt = amax > 0 ? tc.cfl * dx / amax : tc.dt_max;
+  dt = std::min({dt, tc.dt_max, tc.t_end - t});
+  if (!(dt > 0) || !std::isfinite(dt)) dt = tc.t_end - t;
+  return dt;
+}
+
+// Predictor (4.78): limited slopes and a half step with the flux Jacobian (4.79, 4.86).
+void Sh1dSolver::predictor(double dt, double lam) {
+  for (int k = 1; k < n + 2 * G - 1; ++k) {
+    w.sh[k] = limited_slope(lim, w.h[k] - w.h[k - 1], w.h[k + 1] - w.h[k]);
+    w.sm[k] = momentum_slope(w.h, w.m, w.sh[k], k);
+    const double h = w.h[k], u = vel(h, w.m[k]), b = w.beta[k];
+    w.hp[k] = std::max(0.0, h - 0.5 * lam * w.sm[k]);
+    double mp = w.m[k] - 0.5 * lam * ((b * h - u * u) * w.sh[k] + 2.0 * u * w.sm[k]) +
+                0.5 * dt * h * g * std::sin(w.zeta[k]);
+    double dummy = 0;
+    apply_friction(mp, dummy, std::abs(mp), 0.5 * dt * resistance(h, u, w.zeta[k], w.kappa[k]));
+    drag(mp, h, 0.5 * dt);
+    w.mp[k] = mp;
+  }
+}
+
+// The predicted values at the cell centres x_k are the fluxes through the faces of the staggered
+// cells [x_k, x_k+1]. Draining-time limiter: no staggered cell sends out more mass than it holds;
+// the factor of the sending cell scales the whole flux, which keeps mass conservative.
+void Sh1dSolver::positivity(double lam) {
+  for (int k = 1; k < n + 2 * G - 2; ++k) {
+    const double content = 0.5 * (w.h[k] + w.h[k + 1]) + (w.sh[k] - w.sh[k + 1]) / 8.0;
+    const double out = lam * (std::max(w.mp[k + 1], 0.0) + std::max(-w.mp[k], 0.0));
+    w.r[k] = out > content ? std::max(content, 0.0) / out : 1.0;
+  }
+  w.r[0] = w.r[n + 2 * G - 2] = 1.0;
+}
+
+// Corrector (4.73, 4.74, 4.77, 4.80) on the staggered cell between k and k+1.
+void Sh1dSolver::corrector(double dt, double lam, Sh1dResult& r) {
+  for (int k = 1; k < n + 2 * G - 2; ++k) {
+    const double s0 = scale(k), s1 = scale(k + 1);
+    double Sh = 0.5 * (w.h[k] + w.h[k + 1]) + (w.sh[k] - w.sh[k + 1]) / 8.0 - lam * (s1 * w.mp[k + 1] - s0 * w.mp[k]);
+    double Sm = 0.5 * (w.m[k] + w.m[k + 1]) + (w.sm[k] - w.sm[k + 1]) / 8.0 - lam * (s1 * flux_m(k + 1) - s0 * flux_m(k));
+    const double hq1 = std::max(0.0, w.hp[k] + 0.25 * w.sh[k]);
+    const double hq3 = std::max(0.0, w.hp[k + 1] - 0.25 * w.sh[k + 1]);
+    Sm += 0.5 * dt * (src(hq1, k) + src(hq3, k + 1));
+    if (Sh < 0) {  // round-off only, after the limiter above
+      ++r.positivity_clips;
+      r.positivity_mass -= Sh * dx;
+      Sh = 0;
+    }
+    // Friction at the half step (midpoint rule, second order), bounded so it never reverses u.
+    const double uq1 = vel(w.hp[k], w.mp[k]), uq3 = vel(w.hp[k + 1], w.mp[k + 1]);
+    const double R = 0.5 * (resistance(hq1, uq1, w.zeta[k], w.kappa[k]) +
+                            resistance(hq3, uq3, w.zeta[k + 1], w.kappa[k + 1]));
+    double dummy = 0;
+    apply_friction(Sm, dummy, std::abs(Sm), dt * R);
+    drag(Sm, Sh, dt);
+    w.Sh[k] = Sh;
+    w.Sm[k] = Sm;
+  }
+}
+
+// Average back onto the cells: cell k lies between staggered cells k-1 and k.
+void Sh1dSolver::average_back() {
+  for (int k = 2; k < n + 2 * G - 3; ++k) {
+    w.sSh[k] = limited_slope(lim, w.Sh[k] - w.Sh[k - 1], w.Sh[k + 1] - w.Sh[k]);
+    w.sSm[k] = momentum_slope(w.Sh, w.Sm, w.sSh[k], k);
+  }
+  for (int k = G; k < n + G; ++k) {
+    const double h = 0.5 * (w.Sh[k - 1] + w.Sh[k]) - (w.sSh[k] - w.sSh[k - 1]) / 8.0;
+    const double m = 0.5 * (w.Sm[k - 1] + w.Sm[k]) - (w.sSm[k] - w.sSm[k - 1]) / 8.0;
+    w.h[k] = h;
+    w.m[k] = h > hdry ? m : 0.0;
+  }
+}
+
+Sh1dResult Sh1dSolver::run() {
+  const auto wall0 = std::chrono::steady_clock::now();
   Sh1dResult r;
   r.max_depth.assign(n, 0.0);
   r.max_speed.assign(n, 0.0);
   r.mass_initial = mass();
-
-  auto fill_ghosts = [&](double t) {
-    auto side = [&](Boundary1D b, bool left) {
-      for (int k = 0; k < G; ++k) {
-        const int gi = left ? G - 1 - k : n + G + k;    // ghost index, k-th away from the edge
-        const int mi = left ? G + k : n + G - 1 - k;     // mirror index inside
-        const int ei = left ? G : n + G - 1;             // edge cell
-        switch (b) {
-          case Boundary1D::wall:
-            w.h[gi] = w.h[mi];
-            w.m[gi] = -w.m[mi];
-            break;
-          case Boundary1D::outflow:
-            w.h[gi] = w.h[ei];
-            w.m[gi] = w.m[ei];
-            break;
-          case Boundary1D::inflow: {
-            // The hydrograph state holds at the boundary face: the ghosts are the inside reflected
-            // through it (w_g = 2 w_in - w_mirror), so that the piecewise-linear solution passes
-            // through the prescribed depth and discharge there (second order at the boundary).
-            double hi, ui;
-            cfg.inflow.at(t, hi, ui);
-            const double qi = hi * (left ? ui : -ui);
-            w.h[gi] = std::max(0.0, 2 * hi - w.h[mi]);
-            w.m[gi] = w.h[gi] > 0 ? 2 * qi - w.m[mi] : 0.0;
-            break;
-          }
-        }
-      }
-    };
-    side(cfg.left, true);
-    side(cfg.right, false);
-  };
-
-  // Per-cell earth pressure: active where the flow extends (du/dxi >= 0).
-  auto set_beta = [&] {
-    for (int k = 1; k < n + 2 * G - 1; ++k) {
-      double K = 1.0;
-      if (kap) K = (vel(w.h[k + 1], w.m[k + 1]) - vel(w.h[k - 1], w.m[k - 1]) >= 0) ? kact : kpas;
-      w.beta[k] = K * g * std::cos(w.zeta[k]);
-    }
-    w.beta[0] = w.beta[1];
-    w.beta[n + 2 * G - 1] = w.beta[n + 2 * G - 2];
-  };
-
-  const double curv = cfg.curvature ? 1.0 : 0.0;
-  // Slope of the discharge m = h u from the limited slopes of h and of the velocity (product rule):
-  // limiting m itself would clip it where it peaks, ahead of the depth's crest, although the velocity
-  // is smooth and monotone there. Dry neighbours leave the velocity slope at zero.
-  auto momentum_slope = [&](const std::vector<double>& H, const std::vector<double>& M, double sh, int k) {
-    if (!(H[k - 1] > hdry && H[k] > hdry && H[k + 1] > hdry)) return limited_slope(lim, M[k] - M[k - 1], M[k + 1] - M[k]);
-    const double u = M[k] / H[k];
-    return u * sh + H[k] * limited_slope(lim, u - M[k - 1] / H[k - 1], M[k + 1] / H[k + 1] - u);
-  };
-  // Coulomb resistance per unit width; Voellmy's drag is applied implicitly (turbulent_factor).
-  auto resistance = [&](double h, double u, double zeta, double kappa) {
-    return h * mu * std::max(0.0, g * std::cos(zeta) + curv * kappa * u * u);
-  };
-  auto drag = [&](double& m, double h, double span) {
-    if (ixi > 0 && h > hdry) m *= turbulent_factor(std::abs(m) / h, h, span * g * ixi);
-  };
-
   double t = 0, ke_peak = 0;
-  const auto& tc = cfg.time;
+  const auto& tc = cfg_.time;
   while (t < tc.t_end) {
     if (r.steps >= tc.max_steps) {
       r.stop = StopReason::max_steps;
@@ -197,81 +307,13 @@ Sh1dResult run_sh1d(const Channel1D& ch, const Sh1dConfig& cfg, Sh1dState init) 
     }
     fill_ghosts(t);
     set_beta();
-    double amax = 0;
-    for (int k = 0; k < n + 2 * G; ++k)
-      amax = std::max(amax, std::abs(vel(w.h[k], w.m[k])) + std::sqrt(w.beta[k] * std::max(w.h[k], 0.0)));
-    double dt = amax > 0 ? tc.cfl * dx / amax : tc.dt_max;
-    dt = std::min({dt, tc.dt_max, tc.t_end - t});
-    if (!(dt > 0) || !std::isfinite(dt)) dt = tc.t_end - t;
+    const double dt = next_dt(t);
     const double lam = dt / dx;
     const double mass_before = open ? mass() : 0.0;
-
-    // Predictor (4.78): limited slopes and a half step with the flux Jacobian (4.79, 4.86).
-    for (int k = 1; k < n + 2 * G - 1; ++k) {
-      w.sh[k] = limited_slope(lim, w.h[k] - w.h[k - 1], w.h[k + 1] - w.h[k]);
-      w.sm[k] = momentum_slope(w.h, w.m, w.sh[k], k);
-      const double h = w.h[k], u = vel(h, w.m[k]), b = w.beta[k];
-      w.hp[k] = std::max(0.0, h - 0.5 * lam * w.sm[k]);
-      double mp = w.m[k] - 0.5 * lam * ((b * h - u * u) * w.sh[k] + 2.0 * u * w.sm[k]) +
-                  0.5 * dt * h * g * std::sin(w.zeta[k]);
-      double dummy = 0;
-      apply_friction(mp, dummy, std::abs(mp), 0.5 * dt * resistance(h, u, w.zeta[k], w.kappa[k]));
-      drag(mp, h, 0.5 * dt);
-      w.mp[k] = mp;
-    }
-    auto flux_m = [&](int k) {
-      const double h = w.hp[k], u = vel(h, w.mp[k]);
-      return w.mp[k] * u + 0.5 * w.beta[k] * h * h;
-    };
-    auto src = [&](double h, int k) { return h * g * std::sin(w.zeta[k]); };
-    // The predicted values at the cell centres x_k are the fluxes through the faces of the staggered
-    // cells [x_k, x_k+1]. Draining-time limiter: no staggered cell sends out more mass than it holds;
-    // the factor of the sending cell scales the whole flux, which keeps mass conservative.
-    for (int k = 1; k < n + 2 * G - 2; ++k) {
-      const double content = 0.5 * (w.h[k] + w.h[k + 1]) + (w.sh[k] - w.sh[k + 1]) / 8.0;
-      const double out = lam * (std::max(w.mp[k + 1], 0.0) + std::max(-w.mp[k], 0.0));
-      w.r[k] = out > content ? std::max(content, 0.0) / out : 1.0;
-    }
-    w.r[0] = w.r[n + 2 * G - 2] = 1.0;
-    auto scale = [&](int k) {  // factor for the flux through x_k
-      if (w.mp[k] > 0) return w.r[k - 1];
-      if (w.mp[k] < 0) return w.r[k];
-      return 1.0;
-    };
-    // Corrector (4.73, 4.74, 4.77, 4.80) on the staggered cell between k and k+1.
-    for (int k = 1; k < n + 2 * G - 2; ++k) {
-      const double s0 = scale(k), s1 = scale(k + 1);
-      double Sh = 0.5 * (w.h[k] + w.h[k + 1]) + (w.sh[k] - w.sh[k + 1]) / 8.0 - lam * (s1 * w.mp[k + 1] - s0 * w.mp[k]);
-      double Sm = 0.5 * (w.m[k] + w.m[k + 1]) + (w.sm[k] - w.sm[k + 1]) / 8.0 - lam * (s1 * flux_m(k + 1) - s0 * flux_m(k));
-      const double hq1 = std::max(0.0, w.hp[k] + 0.25 * w.sh[k]);
-      const double hq3 = std::max(0.0, w.hp[k + 1] - 0.25 * w.sh[k + 1]);
-      Sm += 0.5 * dt * (src(hq1, k) + src(hq3, k + 1));
-      if (Sh < 0) {  // round-off only, after the limiter above
-        ++r.positivity_clips;
-        r.positivity_mass -= Sh * dx;
-        Sh = 0;
-      }
-      // Friction at the half step (midpoint rule, second order), bounded so it never reverses u.
-      const double uq1 = vel(w.hp[k], w.mp[k]), uq3 = vel(w.hp[k + 1], w.mp[k + 1]);
-      const double R = 0.5 * (resistance(hq1, uq1, w.zeta[k], w.kappa[k]) +
-                              resistance(hq3, uq3, w.zeta[k + 1], w.kappa[k + 1]));
-      double dummy = 0;
-      apply_friction(Sm, dummy, std::abs(Sm), dt * R);
-      drag(Sm, Sh, dt);
-      w.Sh[k] = Sh;
-      w.Sm[k] = Sm;
-    }
-    // Average back onto the cells: cell k lies between staggered cells k-1 and k.
-    for (int k = 2; k < n + 2 * G - 3; ++k) {
-      w.sSh[k] = limited_slope(lim, w.Sh[k] - w.Sh[k - 1], w.Sh[k + 1] - w.Sh[k]);
-      w.sSm[k] = momentum_slope(w.Sh, w.Sm, w.sSh[k], k);
-    }
-    for (int k = G; k < n + G; ++k) {
-      const double h = 0.5 * (w.Sh[k - 1] + w.Sh[k]) - (w.sSh[k] - w.sSh[k - 1]) / 8.0;
-      const double m = 0.5 * (w.Sm[k - 1] + w.Sm[k]) - (w.sSm[k] - w.sSm[k - 1]) / 8.0;
-      w.h[k] = h;
-      w.m[k] = h > hdry ? m : 0.0;
-    }
+    predictor(dt, lam);
+    positivity(lam);
+    corrector(dt, lam, r);
+    average_back();
     t += dt;
     ++r.steps;
     if (open) r.boundary_exchange += mass() - mass_before;
@@ -303,6 +345,14 @@ Sh1dResult run_sh1d(const Channel1D& ch, const Sh1dConfig& cfg, Sh1dState init) 
   r.mass_final = mass();
   r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return r;
+}
+
+}  // namespace
+
+Sh1dResult run_sh1d(const Channel1D& ch, const Sh1dConfig& cfg, Sh1dState init) {
+  validate(ch, cfg, init);
+  Sh1dSolver s(ch, cfg, init);
+  return s.run();
 }
 
 }  // namespace runout::engine

@@ -1,5 +1,5 @@
 #pragma once
-// The active region (docs/vof.md, "Skipping air far from the material"): cells with material
+// The active region (docs/design/vof.md, "Skipping air far from the material"): cells with material
 // (alpha > active_alpha), cells next to an inflow, and `active_layers` layers of cells around them.
 // Only these take part in the pressure equation; the rest is air at rest under the atmosphere's
 // hydrostatic pressure, and faces to it act as openings. The region is rebuilt when material comes

@@ -44,7 +44,7 @@ void MomentumEqn::predictor_forces() {
 // (alpha >= consistent_alpha) are predicted; the air around them keeps its velocity (the cells'
 // coefficients to it go to the right-hand side), as under PISO. Predicting the air too let the
 // cell-reconstructed buoyancy force drive air currents over a resting heap's stair-stepped surface
-// (0.1 m/s) that dragged it along at 2 mm/s (docs/vof.md).
+// (0.1 m/s) that dragged it along at 2 mm/s (docs/design/vof.md).
 int MomentumEqn::predict(Fields& F, double t) {
   predictor_forces();
   const int nc = m_.cells();

@@ -13,7 +13,7 @@
 //     each PISO corrector rebuilds H/A from the latest velocity and solves the pressure equation, as
 //     the dissertation ran it (no momentum predictor, 9 correctors). Each corrector is one
 //     Jacobi-like sweep of the viscous coupling, so the number of correctors and the step size set
-//     how stiff the material behaves (docs/vof.md). The optional predictor (momentum_predictor)
+//     how stiff the material behaves (docs/design/vof.md). The optional predictor (momentum_predictor)
 //     solves the momentum matrix with the last pressure first; on B2 it lets the pressure in the
 //     granular phase swing to -75 kPa and the material flow like a liquid, so it stays off.
 //   * the granular phase's viscosity by name (VofConfig::rheology; models/): the Coulomb viscosity
@@ -46,7 +46,7 @@ namespace runout::engine::vof {
 /// coulomb_friction: the bed's Coulomb friction as a force, tan(delta) p per area against the sliding
 /// velocity (regularised below friction_creep_speed, so that material held by less than it sticks);
 /// unlike coulomb_slip, whose slip fraction divides by the cell's own Coulomb viscosity, it gives the
-/// bed friction delta also where delta < phi (docs/vof.md).
+/// bed friction delta also where delta < phi (docs/design/vof.md).
 enum class Bc { wall, coulomb_slip, atmosphere, inflow, outflow, symmetry, coulomb_friction };
 
 struct PatchBc {
@@ -64,7 +64,7 @@ struct PatchBc {
 enum class Transpose { linear, harmonic, off };
 /// The pressure the Coulomb viscosity (and the Coulomb bed conditions) take as the confining
 /// stress: the full pressure p, or its excess over the still air's hydrostatic pressure at the same
-/// height (what the grains carry beyond the ambient air; docs/vof.md).
+/// height (what the grains carry beyond the ambient air; docs/design/vof.md).
 enum class CoulombPressure { total, excess };
 /// How the momentum's convection term takes its face values (VofConfig::momentum_convection).
 enum class Convection { upwind, limited_linear };
@@ -90,15 +90,15 @@ struct VofConfig {
   /// Outer correctors per step (PIMPLE's nOuterCorrectors): the viscosity, the momentum matrix, the
   /// momentum predictor and the correctors are repeated with the latest velocity and pressure, the
   /// phase fraction kept. 1 (default) is PISO as interFoam runs it. The correctors alone do not
-  /// converge the viscous coupling where the Coulomb viscosity is at its clip (docs/vof.md, "The
+  /// converge the viscous coupling where the Coulomb viscosity is at its clip (docs/design/vof.md, "The
   /// PISO correctors do not converge the stiff viscous coupling"); with the momentum predictor the
   /// outer correctors do.
   int n_outer_correctors = 1;
-  bool momentum_predictor = false;  ///< solve the momentum matrix before the correctors (see docs/vof.md)
+  bool momentum_predictor = false;  ///< solve the momentum matrix before the correctors (see docs/design/vof.md)
   /// The pressure equation's coefficient: false: 1/A (PISO, interFoam); true: the consistent
   /// 1/(A - H1) of SIMPLEC (H1 the sum of the neighbour coefficients), so that in cells where the
   /// viscous coupling dominates A the pressure correction moves the velocity as the transient term
-  /// alone would (a projection), instead of being amplified by the viscosity (docs/vof.md).
+  /// alone would (a projection), instead of being amplified by the viscosity (docs/design/vof.md).
   bool consistent = false;
   /// Under the consistent coupling: cells with at least this much material take SIMPLEC's
   /// coefficient and the momentum predictor; the rest (the air) keep PISO's 1/A and their velocity.
@@ -113,7 +113,7 @@ struct VofConfig {
   /// Coulomb viscosity jumps between its clip (1e2 m2/s) and flowing cells, the linear face value
   /// lets this explicit term outweigh gravity a hundredfold and drive spurious pressures, and the
   /// deposits it converges to lie 2-3 deg below phi (B2, B9); the harmonic one's lie at phi
-  /// (validation.md B2, B9; docs/vof.md).
+  /// (validation.md B2, B9; docs/design/vof.md).
   Transpose viscous_transpose = Transpose::harmonic;
   /// Face values of the momentum's convection term: upwind (first order), or limited_linear:
   /// interFoam's limitedLinearV 1, upwind blended towards linear by a TVD limiter, applied as a
@@ -124,7 +124,7 @@ struct VofConfig {
   /// atmosphere, so the air above the material adds rho_air g per metre of air the domain holds
   /// above it);
   /// excess: p less rho_air g.(x - x_ref), the air at rest's pressure at the same point, which does
-  /// not depend on how much air lies above the material (docs/vof.md).
+  /// not depend on how much air lies above the material (docs/design/vof.md).
   CoulombPressure coulomb_pressure = CoulombPressure::total;
   /// The viscosity in the viscous term on walls and inflows:
   /// face (default): the granular phase's viscosity evaluated on the face, as OpenFOAM evaluates a

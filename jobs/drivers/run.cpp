@@ -179,8 +179,56 @@ void write_record(const std::string& path, const ResolvedScenario& s, const terr
   write_run_record(path, rec);
 }
 
-}  // namespace
+// The engine's grid: the prepared grid with its local origin at the grid's centre.
+engine::Terrain2D engine_terrain(const terrain::Grid& grid) {
+  engine::Terrain2D t;
+  t.nx = grid.nx;
+  t.ny = grid.ny;
+  t.dx = t.dy = grid.dx;
+  t.x0 = -0.5 * (grid.nx - 1) * grid.dx;
+  t.y0 = -0.5 * (grid.ny - 1) * grid.dx;
+  t.z = grid.z;
+  t.outside = grid.outside;
+  return t;
+}
 
+// The checkpoint a run continues from, checked against the scenario (its hash) and the grid.
+ShCheckpoint load_restart(const RunOptions& opt, const std::string& hash, const engine::Terrain2D& t, int tile) {
+  ShCheckpoint restart = read_sh_checkpoint(opt.restart_path);
+  if (restart.scenario_hash != hash)
+    throw ScenarioError("checkpoint " + opt.restart_path + " belongs to another scenario (its scenario hash " +
+                        restart.scenario_hash.substr(0, 12) + "... is not this one's " + hash.substr(0, 12) + "...)");
+  if (restart.state.nx != t.nx || restart.state.ny != t.ny || restart.state.tile != tile)
+    throw ScenarioError("checkpoint " + opt.restart_path + " is of another grid");
+  return restart;
+}
+
+// The hazard rasters the scenario asks for (hazard_rasters()), the outline and the map; their names
+// go to sum.files.
+terrain::OutlineReport write_hazard_outputs(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0,
+                                            const engine::HazardMaps& hz, const std::string& out_dir, RunSummary& sum) {
+  auto out = [&](const std::string& name) { return (fs::path(out_dir) / name).string(); };
+  for (const auto& name : s.rasters)
+    for (const auto& r : hazard_rasters())
+      if (r.name == name) {
+        terrain::write_cog(out(name + ".tif"), grid, masked_outside(grid, hz.*r.map), r.description);
+        sum.files.push_back(name + ".tif");
+      }
+  const auto outline = terrain::write_outline(out("outline.geojson"), out("outline.gpkg"), grid, hz.max_depth, s.outline_threshold);
+  if (outline.geojson) sum.files.push_back("outline.geojson");
+  else sum.notes.push_back("outline.geojson not written: the grid's CRS is local (no geographic coordinates)");
+  sum.files.push_back("outline.gpkg");
+  figures::MapRequest mreq;
+  mreq.title = s.scenario.name().empty() ? "runout" : s.scenario.name();
+  if (mreq.title.size() > 60) mreq.title = mreq.title.substr(0, 57) + "...";
+  mreq.outline_threshold = s.outline_threshold;
+  mreq.scale = grid.nx * grid.ny > 1000000 ? 1 : 2;
+  figures::write_map_png(out("map.png"), grid, hz.max_depth, h0, mreq);
+  sum.files.push_back("map.png");
+  return outline;
+}
+
+}  // namespace
 
 RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt) {
   if (s.vof) return run_lab(s, out_dir, opt);
@@ -197,16 +245,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   sum.release_area_m2 = rel_rep.area_m2;
   sum.release_volume_m3 = rel_rep.volume_m3;
   sum.notes = rel_rep.notes;
-
-  // Engine grid: local origin at the grid's centre.
-  engine::Terrain2D t;
-  t.nx = grid.nx;
-  t.ny = grid.ny;
-  t.dx = t.dy = grid.dx;
-  t.x0 = -0.5 * (grid.nx - 1) * grid.dx;
-  t.y0 = -0.5 * (grid.ny - 1) * grid.dx;
-  t.z = grid.z;
-  t.outside = grid.outside;
+  const engine::Terrain2D t = engine_terrain(grid);
   auto cfg = s.config;
   cfg.time.progress = opt.progress;
   cfg.time.progress_every = opt.progress_every;
@@ -218,14 +257,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   const bool checkpoints = !opt.checkpoint_path.empty(), continued = !opt.restart_path.empty();
   const std::string hash = checkpoints || continued ? scenario_hash(s) : std::string();
   ShCheckpoint restart;
-  if (continued) {
-    restart = read_sh_checkpoint(opt.restart_path);
-    if (restart.scenario_hash != hash)
-      throw ScenarioError("checkpoint " + opt.restart_path + " belongs to another scenario (its scenario hash " +
-                          restart.scenario_hash.substr(0, 12) + "... is not this one's " + hash.substr(0, 12) + "...)");
-    if (restart.state.nx != t.nx || restart.state.ny != t.ny || restart.state.tile != cfg.tile)
-      throw ScenarioError("checkpoint " + opt.restart_path + " is of another grid");
-  }
+  if (continued) restart = load_restart(opt, hash, t, cfg.tile);
 
   std::unique_ptr<TimeSeriesWriter> series;
   if (s.timeseries_interval > 0) {
@@ -274,38 +306,16 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
 
   // Outputs.
   const auto t2 = std::chrono::steady_clock::now();
-  auto out = [&](const std::string& name) { return (fs::path(out_dir) / name).string(); };
-  const auto& hz = res.hazard;
-  for (const auto& name : s.rasters) {
-    const std::vector<double>* v = nullptr;
-    std::string desc;
-    if (name == "max_depth") v = &hz.max_depth, desc = "maximum flow depth normal to the surface [m]";
-    if (name == "max_speed") v = &hz.max_speed, desc = "maximum flow speed [m/s]";
-    if (name == "max_pressure") v = &hz.max_pressure, desc = "maximum pressure rho u^2 [Pa]";
-    if (name == "deposit") v = &hz.final_depth, desc = "deposit depth normal to the surface at the end [m]";
-    if (name == "arrival_time") v = &hz.arrival_time, desc = "arrival time of the flow [s]";
-    terrain::write_cog(out(name + ".tif"), grid, masked_outside(grid, *v), desc);
-    sum.files.push_back(name + ".tif");
-  }
-  const auto outline = terrain::write_outline(out("outline.geojson"), out("outline.gpkg"), grid, hz.max_depth, s.outline_threshold);
-  if (outline.geojson) sum.files.push_back("outline.geojson");
-  else sum.notes.push_back("outline.geojson not written: the grid's CRS is local (no geographic coordinates)");
-  sum.files.push_back("outline.gpkg");
-  figures::MapRequest mreq;
-  mreq.title = s.scenario.name().empty() ? "runout" : s.scenario.name();
-  if (mreq.title.size() > 60) mreq.title = mreq.title.substr(0, 57) + "...";
-  mreq.outline_threshold = s.outline_threshold;
-  mreq.scale = grid.nx * grid.ny > 1000000 ? 1 : 2;
-  figures::write_map_png(out("map.png"), grid, hz.max_depth, h0, mreq);
-  sum.files.push_back("map.png");
+  const auto outline = write_hazard_outputs(s, grid, h0, res.hazard, out_dir, sum);
   if (series) {
     sum.files.push_back("timeseries.h5");
     sum.files.push_back("timeseries.xmf");
   }
   sum.seconds_write = since(t2);
 
+  const std::string record = (fs::path(out_dir) / "run.json").string();
   if (!opt.iseesnow_id.empty()) write_iseesnow(s, opt, out_dir, grid, res, sum);
-  write_record(out("run.json"), s, dem_rep, grid, rel_rep, res, sum, continued_from, outline, frames);
+  write_record(record, s, dem_rep, grid, rel_rep, res, sum, continued_from, outline, frames);
   sum.files.push_back("run.json");
   return sum;
 }

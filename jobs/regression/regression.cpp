@@ -159,6 +159,67 @@ RegressionReference read_reference(const std::string& reference_dir) {
   return r;
 }
 
+namespace {
+
+// diff.tif: the run minus the reference maximum depth, -9999 where either has no data.
+void write_diff_tif(const Raster& a, std::vector<float>& d, const std::string& out_dir) {
+  GDALAllRegister();
+  auto* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
+  const char* opts[] = {"COMPRESS=DEFLATE", nullptr};
+  GDALDatasetUniquePtr tif(gtiff->Create((fs::path(out_dir) / "diff.tif").c_str(), a.nx, a.ny, 1, GDT_Float32,
+                                         const_cast<char**>(opts)));
+  if (!tif) throw std::runtime_error("cannot write diff.tif");
+  tif->SetGeoTransform(const_cast<double*>(a.gt));
+  tif->SetProjection(a.wkt.c_str());
+  tif->GetRasterBand(1)->SetNoDataValue(-9999);
+  tif->GetRasterBand(1)->SetDescription("run minus reference maximum depth [m]");
+  if (tif->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, a.nx, a.ny, d.data(), a.nx, a.ny, GDT_Float32, 0, 0) != CE_None)
+    throw std::runtime_error("writing diff.tif failed");
+}
+
+void write_diff_png(const Raster& a, const Raster& b, const std::vector<float>& d, double scale, const std::string& out_dir) {
+  // diff.png: blue where the run is shallower, red where deeper, white where equal, grey outside;
+  // full colour at max(0.1 m, the largest difference); the reference outline in black.
+  const int s = 2;
+  auto* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  GDALDatasetUniquePtr img(mem->Create("", a.nx * s, a.ny * s, 3, GDT_Byte, nullptr));
+  std::vector<unsigned char> rgb[3];
+  for (auto& c : rgb) c.assign(std::size_t(a.nx) * s * a.ny * s, 0);
+  for (int q = 0; q < a.ny * s; ++q)
+    for (int p = 0; p < a.nx * s; ++p) {
+      const std::size_t k = std::size_t(q / s) * a.nx + p / s, px = std::size_t(q) * a.nx * s + p;
+      unsigned char r = 200, g = 200, bl = 200;
+      if (d[k] != -9999.0f) {
+        const double x = std::clamp(double(d[k]) / scale, -1.0, 1.0);
+        r = static_cast<unsigned char>(255 * (x < 0 ? 1 + x : 1));
+        g = static_cast<unsigned char>(255 * (1 - std::abs(x)));
+        bl = static_cast<unsigned char>(255 * (x > 0 ? 1 - x : 1));
+        // reference outline: a reference cell above 0.1 m next to one below
+        const int i = p / s, j = q / s;
+        const bool in = b.v[k] > 0.1f;
+        bool edge = false;
+        for (auto [di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+          const int ii = i + di, jj = j + dj;
+          if (ii < 0 || jj < 0 || ii >= a.nx || jj >= a.ny) continue;
+          edge |= (b.v[std::size_t(jj) * a.nx + ii] > 0.1f) != in;
+        }
+        if (edge && in) r = g = bl = 0;
+      }
+      rgb[0][px] = r;
+      rgb[1][px] = g;
+      rgb[2][px] = bl;
+    }
+  for (int c = 0; c < 3; ++c)
+    if (img->GetRasterBand(c + 1)->RasterIO(GF_Write, 0, 0, a.nx * s, a.ny * s, rgb[c].data(), a.nx * s, a.ny * s, GDT_Byte, 0,
+                                            0) != CE_None)
+      throw std::runtime_error("drawing diff.png failed");
+  auto* png = GetGDALDriverManager()->GetDriverByName("PNG");
+  GDALDatasetUniquePtr outp(png->CreateCopy((fs::path(out_dir) / "diff.png").c_str(), img.get(), FALSE, nullptr, nullptr, nullptr));
+  if (!outp) throw std::runtime_error("cannot write diff.png");
+}
+
+}  // namespace
+
 RegressionOutcome compare_run(const RegressionFigures& run, const RegressionReference& ref, const std::string& run_max_depth,
                               const std::string& reference_dir, const std::string& out_dir) {
   RegressionOutcome o;
@@ -203,57 +264,9 @@ RegressionOutcome compare_run(const RegressionFigures& run, const RegressionRefe
     map.value = worst;
     map.difference = worst;
     map.ok = worst <= t.depth_map_abs;
-    GDALAllRegister();
-    auto* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
-    const char* opts[] = {"COMPRESS=DEFLATE", nullptr};
-    GDALDatasetUniquePtr tif(gtiff->Create((fs::path(out_dir) / "diff.tif").c_str(), a.nx, a.ny, 1, GDT_Float32,
-                                           const_cast<char**>(opts)));
-    if (!tif) throw std::runtime_error("cannot write diff.tif");
-    tif->SetGeoTransform(const_cast<double*>(a.gt));
-    tif->SetProjection(a.wkt.c_str());
-    tif->GetRasterBand(1)->SetNoDataValue(-9999);
-    tif->GetRasterBand(1)->SetDescription("run minus reference maximum depth [m]");
-    if (tif->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, a.nx, a.ny, d.data(), a.nx, a.ny, GDT_Float32, 0, 0) != CE_None)
-      throw std::runtime_error("writing diff.tif failed");
-    // diff.png: blue where the run is shallower, red where deeper, white where equal, grey outside;
-    // full colour at max(0.1 m, the largest difference); the reference outline in black.
+    write_diff_tif(a, d, out_dir);
     const double scale = std::max(0.1, worst);
-    const int s = 2;
-    auto* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-    GDALDatasetUniquePtr img(mem->Create("", a.nx * s, a.ny * s, 3, GDT_Byte, nullptr));
-    std::vector<unsigned char> rgb[3];
-    for (auto& c : rgb) c.assign(std::size_t(a.nx) * s * a.ny * s, 0);
-    for (int q = 0; q < a.ny * s; ++q)
-      for (int p = 0; p < a.nx * s; ++p) {
-        const std::size_t k = std::size_t(q / s) * a.nx + p / s, px = std::size_t(q) * a.nx * s + p;
-        unsigned char r = 200, g = 200, bl = 200;
-        if (d[k] != -9999.0f) {
-          const double x = std::clamp(double(d[k]) / scale, -1.0, 1.0);
-          r = static_cast<unsigned char>(255 * (x < 0 ? 1 + x : 1));
-          g = static_cast<unsigned char>(255 * (1 - std::abs(x)));
-          bl = static_cast<unsigned char>(255 * (x > 0 ? 1 - x : 1));
-          // reference outline: a reference cell above 0.1 m next to one below
-          const int i = p / s, j = q / s;
-          const bool in = b.v[k] > 0.1f;
-          bool edge = false;
-          for (auto [di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
-            const int ii = i + di, jj = j + dj;
-            if (ii < 0 || jj < 0 || ii >= a.nx || jj >= a.ny) continue;
-            edge |= (b.v[std::size_t(jj) * a.nx + ii] > 0.1f) != in;
-          }
-          if (edge && in) r = g = bl = 0;
-        }
-        rgb[0][px] = r;
-        rgb[1][px] = g;
-        rgb[2][px] = bl;
-      }
-    for (int c = 0; c < 3; ++c)
-      if (img->GetRasterBand(c + 1)->RasterIO(GF_Write, 0, 0, a.nx * s, a.ny * s, rgb[c].data(), a.nx * s, a.ny * s, GDT_Byte, 0,
-                                              0) != CE_None)
-        throw std::runtime_error("drawing diff.png failed");
-    auto* png = GetGDALDriverManager()->GetDriverByName("PNG");
-    GDALDatasetUniquePtr outp(png->CreateCopy((fs::path(out_dir) / "diff.png").c_str(), img.get(), FALSE, nullptr, nullptr, nullptr));
-    if (!outp) throw std::runtime_error("cannot write diff.png");
+    write_diff_png(a, b, d, scale, out_dir);
     o.note = "diff.png: red where this run is deeper, blue where shallower, full colour at " + fmt(scale, 3) +
              " m; black: the reference outline (0.1 m)";
   }

@@ -92,8 +92,24 @@ void require_finite(const google::protobuf::Message& m, const std::string& prefi
   }
 }
 
+const std::vector<HazardRaster>& hazard_rasters() {
+  using M = engine::HazardMaps;
+  static const std::vector<HazardRaster> r = {
+      {"max_depth", "maximum flow depth normal to the surface [m]", &M::max_depth},
+      {"max_speed", "maximum flow speed [m/s]", &M::max_speed},
+      {"max_pressure", "maximum pressure rho u^2 [Pa]", &M::max_pressure},
+      {"deposit", "deposit depth normal to the surface at the end [m]", &M::final_depth},
+      {"arrival_time", "arrival time of the flow [s]", &M::arrival_time},
+  };
+  return r;
+}
+
 const std::vector<std::string>& raster_names() {
-  static const std::vector<std::string> n = {"max_depth", "max_speed", "max_pressure", "deposit", "arrival_time"};
+  static const std::vector<std::string> n = [] {
+    std::vector<std::string> v;
+    for (const auto& r : hazard_rasters()) v.push_back(r.name);
+    return v;
+  }();
   return n;
 }
 

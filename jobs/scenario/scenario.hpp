@@ -57,6 +57,16 @@ std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version 
                           int vof_version = kVofResultsVersion);
 
 /// The raster names an output list may hold.
+/// A hazard raster of the depth-averaged engine: its name in `outputs.rasters`, the description in its
+/// band metadata and the engine's map it holds. A new raster is one line in hazard_rasters().
+struct HazardRaster {
+  std::string name;
+  std::string description;
+  std::vector<double> engine::HazardMaps::*map;
+};
+/// Every hazard raster, in the order of the outputs' default.
+const std::vector<HazardRaster>& hazard_rasters();
+/// The names of hazard_rasters().
 const std::vector<std::string>& raster_names();
 
 /// Parse a scenario from JSON text. Throws ScenarioError.

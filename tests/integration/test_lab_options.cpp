@@ -9,7 +9,7 @@ using namespace runout::test_support::run;
 // 5 mm with the whole top open, once 15 cm and once 30 cm high: with "excess" the collapse is the
 // same (within half a cell, 2 % of the rest time, 0.05 deg). With the full pressure (the default)
 // the taller domain's extra 1.5 Pa of air change it: run to 1 s, the rest time moves from 0.88 to
-// 0.52 s and the front by four cells (docs/vof.md), which the checks below would catch. (The peak
+// 0.52 s and the front by four cells (docs/design/vof.md), which the checks below would catch. (The peak
 // speed, in the thin surface layer, differs by less than 1 % either way.)
 TEST(Scenarios, LabCoulombExcessPressureDoesNotDependOnTheAirAbove) {
   struct Fig {
@@ -69,7 +69,7 @@ TEST(Scenarios, LabCoulombPressureIsValidated) {
 }
 
 // lab.wall_viscosity: "face" by default (left unset; results version 5 tells its results from the
-// cell's), "cell" accepted and reaching the run (B2's front, docs/validation.md B2: the walls with
+// cell's), "cell" accepted and reaching the run (B2's front, docs/validation/validation.md B2: the walls with
 // the cell's viscosity hold the sliding toe back), anything else named in the error.
 TEST(Scenarios, LabWallViscosityIsValidatedAndReachesTheRun) {
   expect_unset_default_option("wall_viscosity", "face", "cell", "wall", [](const v1::Lab& l) { return l.wall_viscosity(); });

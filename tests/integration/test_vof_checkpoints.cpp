@@ -1,5 +1,5 @@
 // VOF checkpoints: runs continued from any checkpoint are the uninterrupted run, bit for bit
-// (docs/vof.md, "Checkpoints").
+// (docs/design/vof.md, "Checkpoints").
 #include "tests/support/run_helpers.hpp"
 
 using namespace runout::test_support::run;

@@ -1,0 +1,437 @@
+// The depth-averaged 2D solver: set-up, the time loop over the active tiles, checkpoints and the
+// entry points run_sh2d.
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "engine/sh2d/solver.hpp"
+
+namespace runout::engine {
+namespace sh2d_detail {
+namespace {
+
+void validate(const Terrain2D& t, const Sh2dConfig& cfg, const Sh2dState& s) {
+  auto bad = [](const std::string& m) { throw std::invalid_argument("2D solver: " + m); };
+  if (t.nx < 1 || t.ny < 1) bad("terrain grid is empty");
+  if (!(t.dx > 0 && t.dy > 0)) bad("cell sizes dx, dy must be > 0");
+  if (t.z.size() != t.cells()) bad("terrain elevation size differs from nx * ny");
+  for (double v : t.z)
+    if (!std::isfinite(v)) bad("terrain elevations must be finite (fill nodata before the engine)");
+  if (s.H.size() != t.cells() || s.HU.size() != t.cells() || s.HV.size() != t.cells())
+    bad("initial state size differs from the terrain grid");
+  if (!t.outside.empty()) {
+    if (t.outside.size() != t.cells()) bad("outside mask size differs from the terrain grid");
+    for (std::size_t k = 0; k < t.cells(); ++k)
+      if (t.outside[k] && s.H[k] != 0) bad("initial depth must be 0 in cells outside the domain (cell " + std::to_string(k) + ")");
+  }
+  for (std::size_t k = 0; k < s.H.size(); ++k)
+    if (!(s.H[k] >= 0) || !std::isfinite(s.H[k]) || !std::isfinite(s.HU[k]) || !std::isfinite(s.HV[k]))
+      bad("initial depth must be finite and >= 0 (cell " + std::to_string(k) + ")");
+  if (!(cfg.time.cfl > 0 && cfg.time.cfl <= 0.5)) bad("CFL number must lie in (0, 0.5]");
+  if (!(cfg.time.t_end >= 0)) bad("end time must be >= 0");
+  if (cfg.tile < 4) bad("tile size must be >= 4 cells");
+  if (!(cfg.curvature_cap >= 0)) bad("curvature cap must be >= 0");
+  cfg.material.validate();
+}
+
+}  // namespace
+
+Solver::Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
+    : t_(t), cfg_(cfg), geo_(SurfaceGeometry::from(t)), nx_(t.nx), ny_(t.ny), n_(t.cells()),
+      T_(cfg.tile), ntx_((nx_ + T_ - 1) / T_), nty_((ny_ + T_ - 1) / T_), ntiles_(ntx_ * nty_) {
+  g_ = cfg.gravity;
+  qcap_ = cfg.curvature_cap * cfg.gravity;
+  // The friction law, resolved once: its two coefficients enter the kernels (engine/friction).
+  const BasalFriction friction = cfg.material.friction();
+  mu_ = friction.mu;
+  ixi_ = friction.inv_xi;
+  kap_ = cfg.material.earth_pressure == EarthPressure::active_passive;
+  if (kap_) {
+    const double d = std::atan(mu_), phi = cfg.material.phi;
+    kx_[0] = k_x(phi, d, true);
+    kx_[1] = k_x(phi, d, false);
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b) ky_[a][b] = k_y(kx_[a], d, b == 0);
+  }
+  for (int b = 0; b < 2; ++b) {
+    H_[b] = s.H;
+    HU_[b] = s.HU;
+    HV_[b] = s.HV;
+    U_[b].resize(n_);
+    V_[b].resize(n_);
+    for (std::size_t k = 0; k < n_; ++k) {
+      U_[b][k] = vel(H_[b][k], HU_[b][k]);
+      V_[b][k] = vel(H_[b][k], HV_[b][k]);
+    }
+  }
+  if (std::any_of(t.outside.begin(), t.outside.end(), [](std::uint8_t o) { return o != 0; })) {
+    out_ = t.outside;
+    near_out_.assign(n_, 0);
+    for (int j = 0; j < ny_; ++j)
+      for (int i = 0; i < nx_; ++i)
+        near_out_[idx(i, j)] = outside(i, j) || (i > 0 && outside(i - 1, j)) || (i < nx_ - 1 && outside(i + 1, j)) ||
+                               (j > 0 && outside(i, j - 1)) || (j < ny_ - 1 && outside(i, j + 1));
+  }
+  box_out_.assign(ntiles_, 0);
+  if (!out_.empty())
+    for (int tt = 0; tt < ntiles_; ++tt) {
+      int i0, i1, j0, j1;
+      tile_range(tt, i0, i1, j0, j1);
+      for (int j = std::max(j0 - 2, 0); j < std::min(j1 + 2, ny_); ++j)
+        for (int i = std::max(i0 - 2, 0); i < std::min(i1 + 2, nx_); ++i) box_out_[tt] |= out_[idx(i, j)];
+    }
+  Pxx_.resize(n_);
+  Pxy_.resize(n_);
+  Pyy_.resize(n_);
+  Ps_.resize(n_);
+  for (std::size_t k = 0; k < n_; ++k) {
+    pressure(k, 1.0, 1.0, 1.0, 0.0, Pxx_[k], Pxy_[k], Pyy_[k]);
+    Ps_[k] = wave_factor(Pxx_[k], Pyy_[k]);
+  }
+  tile_mass_.assign(ntiles_, 0);
+  tile_ke_.assign(ntiles_, 0);
+  tile_speed_.assign(ntiles_, 0);
+  tile_rate_.assign(ntiles_, 0);
+  tile_out_.assign(ntiles_, 0);
+  tile_travel_.assign(ntiles_, 0);
+  tile_limited_.assign(ntiles_, 0);
+  tile_wet_.assign(ntiles_, 0);
+  active_flag_.assign(ntiles_, 0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  hz_.max_depth.assign(n_, 0);
+  hz_.max_speed.assign(n_, 0);
+  hz_.max_pressure.assign(n_, 0);
+  hz_.arrival_time.assign(n_, nan);
+  for (int tt = 0; tt < ntiles_; ++tt) tile_scan(tt);
+  for (std::size_t k = 0; k < n_; ++k) record_hazard(k, 0.0);
+  rebuild_active();
+}
+
+void Solver::tile_scan(int tt) {
+  int i0, i1, j0, j1;
+  tile_range(tt, i0, i1, j0, j1);
+  const auto &H = H_[cur_], &HU = HU_[cur_], &HV = HV_[cur_];
+  double mass = 0, ke = 0, vmax = 0, rate = 0;
+  bool wet = false;
+  for (int j = j0; j < j1; ++j)
+    for (int i = i0; i < i1; ++i) {
+      const std::size_t k = idx(i, j);
+      const double h = H[k], U = vel(h, HU[k]), V = vel(h, HV[k]);
+      const double w = geo_.bx[k] * U + geo_.by[k] * V, sp2 = U * U + V * V + w * w;
+      mass += h;
+      ke += 0.5 * h * sp2;
+      // The speed of flowing cells only, the same number as the maximum-speed map takes.
+      if (h * geo_.c[k] > cfg_.flow_threshold) vmax = std::max(vmax, h > cfg_.dry_depth ? m3(k, HU[k], HV[k]) / h : 0.0);
+      rate = std::max(rate, std::abs(U) / t_.dx + std::abs(V) / t_.dy + Ps_[k] * std::sqrt(std::max(h, 0.0)));
+      wet = wet || h > cfg_.activation_depth;
+    }
+  tile_mass_[tt] = mass;
+  tile_ke_[tt] = ke;
+  tile_speed_[tt] = vmax;
+  tile_rate_[tt] = rate;
+  tile_wet_[tt] = wet;
+}
+
+void Solver::record_hazard(std::size_t k, double t) {
+  const double H = H_[cur_][k], h = H * geo_.c[k];
+  const double sp = H > cfg_.dry_depth ? m3(k, HU_[cur_][k], HV_[cur_][k]) / H : 0.0;
+  hz_.max_depth[k] = std::max(hz_.max_depth[k], h);
+  if (h > cfg_.flow_threshold) {
+    hz_.max_speed[k] = std::max(hz_.max_speed[k], sp);
+    hz_.max_pressure[k] = std::max(hz_.max_pressure[k], cfg_.material.density * sp * sp);
+    if (std::isnan(hz_.arrival_time[k])) hz_.arrival_time[k] = t;
+  }
+}
+
+void Solver::rebuild_active() {
+  std::vector<std::uint8_t> next(ntiles_, 0);
+  for (int tj = 0; tj < nty_; ++tj)
+    for (int ti = 0; ti < ntx_; ++ti) {
+      bool a = !cfg_.skip_inactive;
+      for (int dj = -1; dj <= 1 && !a; ++dj)
+        for (int di = -1; di <= 1 && !a; ++di) {
+          const int u = ti + di, v = tj + dj;
+          if (u >= 0 && v >= 0 && u < ntx_ && v < nty_ && tile_wet_[v * ntx_ + u]) a = true;
+        }
+      next[tj * ntx_ + ti] = a;
+    }
+  active_.clear();
+  for (int tt = 0; tt < ntiles_; ++tt) {
+    if (active_flag_[tt] && !next[tt]) {
+      // A tile leaves the computation: its thin remains (below the activation depth) stay where they
+      // are, at rest, so that the volume is kept exactly. Both time levels hold the frozen state.
+      int i0, i1, j0, j1;
+      tile_range(tt, i0, i1, j0, j1);
+      for (int j = j0; j < j1; ++j)
+        for (int i = i0; i < i1; ++i) {
+          const std::size_t k = idx(i, j);
+          for (int b = 0; b < 2; ++b) {
+            H_[b][k] = H_[cur_][k];
+            HU_[b][k] = HV_[b][k] = U_[b][k] = V_[b][k] = 0.0;
+          }
+        }
+      tile_ke_[tt] = 0;
+      tile_speed_[tt] = 0;
+    }
+    active_flag_[tt] = next[tt];
+    if (next[tt]) active_.push_back(tt);
+  }
+}
+
+Sh2dCheckpoint Solver::checkpoint() const {
+  Sh2dCheckpoint cp;
+  cp.nx = nx_;
+  cp.ny = ny_;
+  cp.tile = T_;
+  cp.t = t_now_;
+  cp.steps = steps_;
+  cp.H = H_[cur_];
+  cp.HU = HU_[cur_];
+  cp.HV = HV_[cur_];
+  cp.U = U_[cur_];
+  cp.V = V_[cur_];
+  cp.hazard.max_depth = hz_.max_depth;
+  cp.hazard.max_speed = hz_.max_speed;
+  cp.hazard.max_pressure = hz_.max_pressure;
+  cp.hazard.arrival_time = hz_.arrival_time;
+  cp.tile_mass = tile_mass_;
+  cp.tile_ke = tile_ke_;
+  cp.tile_speed = tile_speed_;
+  cp.tile_rate = tile_rate_;
+  cp.tile_out = tile_out_;
+  cp.tile_travel = tile_travel_;
+  cp.tile_limited = tile_limited_;
+  cp.tile_wet = tile_wet_;
+  cp.tile_active = active_flag_;
+  cp.volume_initial = volume_initial_;
+  cp.kinetic_energy_peak = ke_peak_;
+  cp.cell_updates = cell_updates_;
+  cp.active_fraction_sum = active_sum_;
+  cp.max_active_fraction = max_active_fraction_;
+  cp.next_snapshot = next_snapshot_;
+  cp.last_snapshot = last_snapshot_;
+  return cp;
+}
+
+void Solver::restore(const Sh2dCheckpoint& cp) {
+  auto bad = [](const std::string& m) { throw std::invalid_argument("2D solver: checkpoint " + m); };
+  if (cp.nx != nx_ || cp.ny != ny_) bad("is of another grid");
+  if (cp.tile != T_) bad("was taken with another tile size");
+  auto cells = [&](const std::vector<double>& v) { return v.size() == n_; };
+  if (!cells(cp.U) || !cells(cp.V) || !cells(cp.hazard.max_depth) || !cells(cp.hazard.max_speed) ||
+      !cells(cp.hazard.max_pressure) || !cells(cp.hazard.arrival_time))
+    bad("is damaged (a field has the wrong size)");
+  const std::size_t nt = std::size_t(ntiles_);
+  if (cp.tile_mass.size() != nt || cp.tile_ke.size() != nt || cp.tile_speed.size() != nt || cp.tile_rate.size() != nt ||
+      cp.tile_out.size() != nt || cp.tile_travel.size() != nt || cp.tile_limited.size() != nt || cp.tile_wet.size() != nt ||
+      cp.tile_active.size() != nt)
+    bad("is damaged (a tile field has the wrong size)");
+  if (!(std::isfinite(cp.t) && cp.t >= 0) || cp.steps < 0) bad("is damaged (time or step count)");
+  // Both time levels hold the state: the level a step writes is never read before it is written,
+  // and inactive tiles hold the same in both (see rebuild_active).
+  cur_ = 0;
+  for (int b = 0; b < 2; ++b) {
+    U_[b] = cp.U;
+    V_[b] = cp.V;
+  }
+  hz_.max_depth = cp.hazard.max_depth;
+  hz_.max_speed = cp.hazard.max_speed;
+  hz_.max_pressure = cp.hazard.max_pressure;
+  hz_.arrival_time = cp.hazard.arrival_time;
+  tile_mass_ = cp.tile_mass;
+  tile_ke_ = cp.tile_ke;
+  tile_speed_ = cp.tile_speed;
+  tile_rate_ = cp.tile_rate;
+  tile_out_ = cp.tile_out;
+  tile_travel_ = cp.tile_travel;
+  tile_limited_ = cp.tile_limited;
+  tile_wet_ = cp.tile_wet;
+  active_flag_ = cp.tile_active;
+  active_.clear();
+  for (int tt = 0; tt < ntiles_; ++tt)
+    if (active_flag_[tt]) active_.push_back(tt);
+  t_now_ = cp.t;
+  steps_ = cp.steps;
+  volume_initial_ = cp.volume_initial;
+  ke_peak_ = cp.kinetic_energy_peak;
+  cell_updates_ = cp.cell_updates;
+  active_sum_ = cp.active_fraction_sum;
+  max_active_fraction_ = cp.max_active_fraction;
+  next_snapshot_ = cp.next_snapshot;
+  last_snapshot_ = cp.last_snapshot;
+  restored_ = true;
+}
+
+double Solver::sum_tiles(const std::vector<double>& v) const {
+  double s = 0;
+  for (int tt = 0; tt < ntiles_; ++tt) s += v[tt];
+  return s;
+}
+
+void Solver::not_finite(const char* what) const {
+  throw std::runtime_error("2D solver: the flow state became non-finite (NaN or infinite " + std::string(what) + ") at step " +
+                           std::to_string(steps_) + ", t = " + std::to_string(t_now_) +
+                           " s: the release is far too thick or the numerics left their range");
+}
+
+// The step length from the fastest active tile's CFL rate, capped by dt_max and the end time.
+double Solver::next_dt() const {
+  const auto& tc = cfg_.time;
+  const double t = t_now_;
+  double rate = 0;
+  for (int tt : active_) rate = std::max(rate, tile_rate_[tt]);
+  if (!std::isfinite(rate)) not_finite("depth or momentum");
+  double dt = rate > 0 ? tc.cfl / rate : tc.dt_max;
+  dt = std::min({dt, tc.dt_max, tc.t_end - t});
+  if (!(dt > 0) || !std::isfinite(dt)) dt = tc.t_end - t;
+  return dt;
+}
+
+// One step of every active tile (in parallel, each thread with its own work space), then the swap of
+// the time levels, the step's bookkeeping and the new set of active tiles. Returns the fraction of
+// the cells computed.
+double Solver::step_all(double dt, std::vector<TileWork>& work) {
+  const double t = t_now_;
+  const int na = int(active_.size());
+  std::size_t ncells = 0;
+  for (int tt : active_) {
+    int i0, i1, j0, j1;
+    tile_range(tt, i0, i1, j0, j1);
+    ncells += std::size_t(i1 - i0) * (j1 - j0);
+  }
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int a = 0; a < na; ++a) step_tile(active_[a], t, dt, work[omp_get_thread_num()]);
+  cur_ = 1 - cur_;
+  t_now_ += dt;
+  ++steps_;
+  cell_updates_ += double(ncells);
+  const double frac = double(ncells) / double(n_);
+  active_sum_ += frac;
+  max_active_fraction_ = std::max(max_active_fraction_, frac);
+  rebuild_active();
+  return frac;
+}
+
+Sh2dResult Solver::run() {
+  const auto wall0 = std::chrono::steady_clock::now();
+  const auto& tc = cfg_.time;
+  Sh2dDiagnostics d;
+  const double cell_area = t_.dx * t_.dy;
+  if (!restored_) volume_initial_ = sum_tiles(tile_mass_) * cell_area;
+  double& t = t_now_;
+  const auto loop0 = std::chrono::steady_clock::now();
+  std::vector<TileWork> work(omp_get_max_threads());
+  for (auto& w : work) w.reserve(T_);
+  const bool snapshots = cfg_.snapshot && cfg_.snapshot_interval > 0;
+  auto snapshot = [&] {
+    cfg_.snapshot(t, Sh2dStateView{H_[cur_], HU_[cur_], HV_[cur_]});
+    last_snapshot_ = t;
+    while (next_snapshot_ <= t) next_snapshot_ += cfg_.snapshot_interval;
+  };
+  // Checkpoints are taken at step boundaries only: the first one at or after each multiple of the
+  // interval (steps are not shortened for them, so they change nothing).
+  const bool checkpoints = bool(cfg_.checkpoint);
+  const double cp_every = cfg_.checkpoint_interval > 0 ? cfg_.checkpoint_interval : 0.0;
+  double next_cp = cp_every > 0 ? cp_every * (std::floor(t / cp_every) + 1) : std::numeric_limits<double>::infinity();
+  const auto stop_rule = [&](double ke) {
+    return tc.stop_fraction > 0 && ke_peak_ > 0 && ke * cell_area < tc.stop_fraction * ke_peak_;
+  };
+  bool ran = true;
+  if (!restored_) {
+    if (snapshots) snapshot();
+  } else if (stop_rule(sum_tiles(tile_ke_))) {
+    // A checkpoint of a cancelled run is taken before the stopping rule looked at its last step.
+    d.stop = StopReason::kinetic_energy;
+    ran = false;
+  }
+  while (ran && t < tc.t_end) {
+    if (steps_ >= tc.max_steps) {
+      d.stop = StopReason::max_steps;
+      break;
+    }
+    const double dt = next_dt();
+    const double frac = step_all(dt, work);
+    // Cheap guard on the whole state: a NaN or infinite depth shows in the volume, a NaN or
+    // infinite momentum in the kinetic energy.
+    const double ke = sum_tiles(tile_ke_);
+    const double mass = sum_tiles(tile_mass_);
+    if (!std::isfinite(mass)) not_finite("depth");
+    if (!std::isfinite(ke)) not_finite("momentum");
+    if (snapshots && t >= next_snapshot_) snapshot();
+    ke_peak_ = std::max(ke_peak_, ke * cell_area);
+    if (tc.progress && steps_ % tc.progress_every == 0) {
+      double vmax = 0;
+      for (int tt = 0; tt < ntiles_; ++tt) vmax = std::max(vmax, tile_speed_[tt]);
+      Progress p{t, dt, mass * cell_area, vmax, ke * cell_area, frac, steps_};
+      if (!tc.progress(p)) {
+        d.stop = StopReason::cancelled;
+        if (checkpoints) cfg_.checkpoint(checkpoint());  // the run can continue from here
+        break;
+      }
+    }
+    if (stop_rule(ke)) {
+      d.stop = StopReason::kinetic_energy;
+      break;
+    }
+    if (checkpoints && t >= next_cp && t < tc.t_end) {
+      cfg_.checkpoint(checkpoint());
+      while (next_cp <= t) next_cp += cp_every;
+    }
+  }
+  if (snapshots && last_snapshot_ != t) snapshot();  // the final state, unless just written
+  d.loop_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loop0).count();
+  Sh2dResult res = finish(d);
+  res.diag.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return res;
+}
+
+// The diagnostics of the run and its results (maps, final state), moved out of the solver.
+Sh2dResult Solver::finish(const Sh2dDiagnostics& loop) {
+  Sh2dResult res;
+  res.diag = loop;
+  auto& d = res.diag;
+  const double cell_area = t_.dx * t_.dy;
+  d.t = t_now_;
+  d.steps = steps_;
+  d.volume_initial = volume_initial_;
+  d.kinetic_energy_peak = ke_peak_;
+  d.cell_updates = cell_updates_;
+  d.max_active_fraction = max_active_fraction_;
+  d.volume_final = sum_tiles(tile_mass_) * cell_area;
+  d.volume_outflow = sum_tiles(tile_out_);
+  d.mean_travel = d.volume_initial > 0 ? sum_tiles(tile_travel_) * cell_area / d.volume_initial : 0.0;
+  for (int tt = 0; tt < ntiles_; ++tt) d.positivity_limited += tile_limited_[tt];
+  d.mean_active_fraction = steps_ > 0 ? active_sum_ / double(steps_) : 0.0;
+  // The reported maximum speed is the map's: flowing cells only.
+  for (std::size_t k = 0; k < n_; ++k) d.max_speed = std::max(d.max_speed, hz_.max_speed[k]);
+  hz_.final_depth.resize(n_);
+  for (std::size_t k = 0; k < n_; ++k) hz_.final_depth[k] = H_[cur_][k] * geo_.c[k];
+  res.hazard = std::move(hz_);
+  res.state.H = std::move(H_[cur_]);
+  res.state.HU = std::move(HU_[cur_]);
+  res.state.HV = std::move(HV_[cur_]);
+  return res;
+}
+
+}  // namespace sh2d_detail
+
+Sh2dResult run_sh2d(const Terrain2D& terrain, const Sh2dConfig& config, Sh2dState initial) {
+  sh2d_detail::validate(terrain, config, initial);
+  sh2d_detail::Solver s(terrain, config, std::move(initial));
+  return s.run();
+}
+
+Sh2dResult run_sh2d(const Terrain2D& terrain, const Sh2dConfig& config, const Sh2dCheckpoint& from) {
+  Sh2dState st{from.H, from.HU, from.HV};
+  sh2d_detail::validate(terrain, config, st);
+  sh2d_detail::Solver s(terrain, config, std::move(st));
+  s.restore(from);
+  return s.run();
+}
+
+}  // namespace runout::engine

@@ -1,0 +1,163 @@
+#pragma once
+// The depth-averaged 2D solver's internals (engine/sh2d.hpp is the interface): the tile work space,
+// the face types and the Solver. solver.cpp holds the set-up, the time loop and checkpoints;
+// step.cpp the scheme of one tile's step (predictor, face fluxes, positivity, update), the hot
+// kernels in one translation unit so that they inline into each other.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "engine/sh2d.hpp"
+
+namespace runout::engine::sh2d_detail {
+
+struct Face {
+  double f0, f1, f2;
+};
+
+// A reconstructed state on one side of a face, in face coordinates: depth, normal and tangential
+// velocity, and the pressure coefficients Pi_nn, Pi_nt of that side's cell.
+struct FaceState {
+  double H, un, ut, Pnn, Pnt;
+};
+
+// Work space of one tile's step, private to the thread computing it. A tile's step runs the whole
+// scheme on its cells and a halo: predictor on the tile grown by two cells, face fluxes and the
+// positivity factors on the tile grown by one, the update on the tile. The halo work is repeated by
+// the neighbouring tile, bit for bit the same, so the scheme stays conservative; in exchange the
+// intermediate fields never leave the cache.
+struct TileWork {
+  int bi0 = 0, bj0 = 0, bw = 0, bh = 0;  // box = tile grown by 2, clipped to the grid
+  bool all_active = true;                // every tile the box touches is active
+  bool has_outside = false;              // the box holds cells outside the domain
+  std::vector<double> sHx, sux, svx, sHy, suy, svy, Hp, Up, Vp, Pxx, Pxy, Pyy, Ps, r;
+  std::vector<double> held;  // 1 where friction holds the cell at rest, else 0
+  // Face fluxes (mass, x-momentum, y-momentum); Fx*[(j - bj0) * (bw + 1) + (i - bi0)]: face left of
+  // cell (i, j), Fy*[(j - bj0) * bw + (i - bi0)]: face below it.
+  std::vector<double> Fx0, Fx1, Fx2, Fy0, Fy1, Fy2;
+  Face fxf(std::size_t k) const { return Face{Fx0[k], Fx1[k], Fx2[k]}; }
+  Face fyf(std::size_t k) const { return Face{Fy0[k], Fy1[k], Fy2[k]}; }
+  void reserve(int T) {
+    const std::size_t n = std::size_t(T + 4) * (T + 4);
+    for (auto* v : {&sHx, &sux, &svx, &sHy, &suy, &svy, &Hp, &Up, &Vp, &Pxx, &Pxy, &Pyy, &Ps, &r}) v->assign(n, 0.0);
+    held.assign(n, 0.0);
+    for (auto* v : {&Fx0, &Fx1, &Fx2}) v->assign(std::size_t(T + 5) * (T + 4), 0.0);
+    for (auto* v : {&Fy0, &Fy1, &Fy2}) v->assign(std::size_t(T + 4) * (T + 5), 0.0);
+  }
+  std::size_t at(int i, int j) const { return std::size_t(j - bj0) * bw + (i - bi0); }
+  std::size_t fx(int i, int j) const { return std::size_t(j - bj0) * (bw + 1) + (i - bi0); }
+  std::size_t fy(int i, int j) const { return std::size_t(j - bj0) * bw + (i - bi0); }
+};
+
+class Solver {
+ public:
+  Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s);
+
+  Sh2dResult run();
+  /// Take up a checkpoint's state (after construction from its depths and momenta).
+  void restore(const Sh2dCheckpoint& cp);
+
+ private:
+  Sh2dCheckpoint checkpoint() const;
+  std::size_t idx(int i, int j) const { return std::size_t(j) * nx_ + i; }
+  void tile_range(int tt, int& i0, int& i1, int& j0, int& j1) const {
+    const int ti = tt % ntx_, tj = tt / ntx_;
+    i0 = ti * T_;
+    i1 = std::min(i0 + T_, nx_);
+    j0 = tj * T_;
+    j1 = std::min(j0 + T_, ny_);
+  }
+  bool cell_active(int i, int j) const { return active_flag_[(j / T_) * ntx_ + i / T_]; }
+  bool outside(int i, int j) const { return !out_.empty() && out_[idx(i, j)]; }
+  // The cell or one of its four neighbours lies outside the domain (such cells take the general loop).
+  bool near_outside(std::size_t k) const { return !near_out_.empty() && near_out_[k]; }
+  double vel(double H, double M) const { return H > cfg_.dry_depth ? M / H : 0.0; }
+
+  // Pi = g [c^4 Kx d d^T + c^2 Ky s s^T], d the downslope unit vector (or (dx, dy) on flat ground).
+  void pressure(std::size_t k, double Kx, double Ky, double ddx, double ddy, double& pxx, double& pxy,
+                double& pyy) const {
+    const double bx = geo_.bx[k], by = geo_.by[k], c = geo_.c[k], gb = std::hypot(bx, by);
+    if (gb > 1e-12) {
+      ddx = bx / gb;
+      ddy = by / gb;
+    }
+    const double a = g_ * c * c * c * c * Kx, b = g_ * c * c * Ky;
+    pxx = a * ddx * ddx + b * ddy * ddy;
+    pxy = (a - b) * ddx * ddy;
+    pyy = a * ddy * ddy + b * ddx * ddx;
+  }
+
+  // The normal reaction keeps the flow on the surface and always includes Q: it turns the velocity
+  // in curved terrain without loss of energy. The option `curvature` only decides whether the
+  // centrifugal part raises the basal friction (as in eq. 3.48), as in the 1D solver.
+  double normal_g(std::size_t k, double U, double V) const {
+    const double Q = std::min(qcap_, U * U * geo_.hxx[k] + 2 * U * V * geo_.hxy[k] + V * V * geo_.hyy[k]);
+    return std::max(0.0, g_ + Q);
+  }
+  // Coulomb resistance per horizontal area (magnitude of the basal friction force, 3D):
+  // mu N / cos(theta) with N / rho = h c (g + Q)_+ = H c^2 (g + Q)_+; gn = (g + Q)_+.
+  double resistance(std::size_t k, double H, double gn) const {
+    const double load = cfg_.curvature ? gn : g_;
+    return H * mu_ * geo_.c[k] * load;
+  }
+  // sqrt(Pxx)/dx + sqrt(Pyy)/dy: the gravity-wave part of the CFL rate, per sqrt(H).
+  double wave_factor(double pxx, double pyy) const { return std::sqrt(pxx) / t_.dx + std::sqrt(pyy) / t_.dy; }
+  double m3(std::size_t k, double MU, double MV) const {
+    const double w = geo_.bx[k] * MU + geo_.by[k] * MV;
+    return std::sqrt(MU * MU + MV * MV + w * w);
+  }
+
+  // The time loop's parts (solver.cpp): the next step's length, one step of every active tile, the
+  // diagnostics and results at the end.
+  double next_dt() const;
+  double step_all(double dt, std::vector<TileWork>& work);
+  [[noreturn]] void not_finite(const char* what) const;
+  double sum_tiles(const std::vector<double>& v) const;
+  Sh2dResult finish(const Sh2dDiagnostics& loop);
+  void tile_scan(int tt);
+  void record_hazard(std::size_t k, double t);
+  void rebuild_active();
+  void step_tile(int tt, double t, double dt, TileWork& w);
+  template <Limiter L>
+  void predictor(TileWork& w, double dt) const;
+  void earth_pressure(std::size_t k, int i, int j, double U, double V, double& Pxx, double& Pxy, double& Pyy,
+                      double& Ps) const;
+  template <Limiter L>
+  void predictor_row(TileWork& w, int j, int ia, int ib, double dt) const;
+  void faces(TileWork& w) const;
+  template <bool X>
+  Face face(const TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi, Boundary2D blo, Boundary2D bhi) const;
+  long positivity(TileWork& w, int i0, int i1, int j0, int j1, double dt) const;
+  void update(int tt, const TileWork& w, double t, double dt);
+
+  const Terrain2D& t_;
+  const Sh2dConfig& cfg_;
+  SurfaceGeometry geo_;
+  int nx_, ny_;
+  std::size_t n_;
+  int T_, ntx_, nty_, ntiles_;
+  double g_ = 9.81, mu_ = 0, ixi_ = 0, qcap_ = 9.81;
+  bool kap_ = false;
+  double kx_[2] = {1, 1}, ky_[2][2] = {{1, 1}, {1, 1}};
+  // State at t (index cur_) and t + dt (1 - cur_); U, V the velocity (zero where dry).
+  std::vector<double> H_[2], HU_[2], HV_[2], U_[2], V_[2];
+  int cur_ = 0;
+  std::vector<std::uint8_t> out_, near_out_;  // empty when every cell is inside
+  std::vector<std::uint8_t> box_out_;         // per tile: its box (tile grown by 2) holds outside cells
+  std::vector<double> Pxx_, Pxy_, Pyy_;  // pressure coefficients for K = 1 (also the start values)
+  std::vector<double> Ps_;                // wave_factor of those
+  std::vector<double> tile_mass_, tile_ke_, tile_speed_, tile_rate_, tile_out_, tile_travel_;
+  std::vector<long> tile_limited_;
+  std::vector<std::uint8_t> tile_wet_, active_flag_;
+  std::vector<int> active_;
+  HazardMaps hz_;
+  // The time loop's running figures (members so that a checkpoint can carry them).
+  double t_now_ = 0, active_sum_ = 0, next_snapshot_ = 0, last_snapshot_ = -1;
+  long steps_ = 0;
+  double cell_updates_ = 0, max_active_fraction_ = 0, ke_peak_ = 0, volume_initial_ = 0;
+  bool restored_ = false;
+};
+
+}  // namespace runout::engine::sh2d_detail
