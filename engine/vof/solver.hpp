@@ -36,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/names.hpp"
 #include "engine/vof/mesh.hpp"
 
 namespace runout::engine::vof {
@@ -70,6 +71,19 @@ enum class CoulombPressure { total, excess };
 enum class Convection { upwind, limited_linear };
 /// Which viscosity the viscous term takes on a boundary face (VofConfig::wall_viscosity).
 enum class WallViscosity { face, cell };
+
+/// The choices above by the names scenarios give them: the lab block's option table takes its
+/// choices from these tables and the lab driver parses with them (one list each).
+inline constexpr NameTable<Transpose, 3> kTransposeNames{
+    {{"explicit", Transpose::linear}, {"harmonic", Transpose::harmonic}, {"off", Transpose::off}}};
+inline constexpr NameTable<CoulombPressure, 2> kCoulombPressureNames{
+    {{"total", CoulombPressure::total}, {"excess", CoulombPressure::excess}}};
+inline constexpr NameTable<Convection, 2> kConvectionNames{
+    {{"upwind", Convection::upwind}, {"limited_linear", Convection::limited_linear}}};
+inline constexpr NameTable<WallViscosity, 2> kWallViscosityNames{{{"face", WallViscosity::face}, {"cell", WallViscosity::cell}}};
+/// The pressure-velocity coupling: PISO with 1/A (false) or the consistent 1/(A - H1) with the
+/// momentum predictor (true; VofConfig::consistent and momentum_predictor).
+inline constexpr NameTable<bool, 2> kPressureCouplingNames{{{"piso", false}, {"consistent", true}}};
 
 struct VofConfig {
   double rho1 = 936.17;        ///< granular bulk density [kg/m3]
@@ -134,7 +148,7 @@ struct VofConfig {
   /// wall, the inflow's on an inflow). A stick wall then carries at most the Coulomb stress
   /// tan(phi) p of the bed wherever the material at it yields (the dissertation's "stick
   /// condition, i.e. bed friction equal to phi"); the Coulomb slip wall keeps the cell's;
-  /// cell: the cell's own viscosity (results versions up to 4). In a layer that slides over the
+  /// cell: the cell's own viscosity. In a layer that slides over the
   /// bed with little shear inside, the cell's strain rate is about half the wall's, and the wall's
   /// shear about twice the Coulomb stress: B2's toe stopped 6 cells short (validation.md).
   WallViscosity wall_viscosity = WallViscosity::face;

@@ -29,6 +29,17 @@ struct TimeSeriesWriter::Impl {
   hid_t file = -1;
   std::vector<double> times;
 
+  // Where the frames go and on which grid (its origin, cells and surface geometry).
+  void place(const std::string& directory, const terrain::Grid& grid, const engine::Terrain2D& t) {
+    dir = directory;
+    nx = grid.nx;
+    ny = grid.ny;
+    dx = grid.dx;
+    x0 = grid.x_min;
+    y0 = grid.y_min;
+    geo = engine::SurfaceGeometry::from(t);
+  }
+
   void dataset(hid_t loc, const char* name, const std::vector<float>& v) {
     const hsize_t dims[2] = {hsize_t(ny), hsize_t(nx)};
     hid_t space = H5Screate_simple(2, dims, nullptr);
@@ -49,13 +60,7 @@ struct TimeSeriesWriter::Impl {
 TimeSeriesWriter::TimeSeriesWriter(const std::string& dir, const terrain::Grid& grid, const engine::Terrain2D& t)
     : impl_(std::make_unique<Impl>()) {
   auto& m = *impl_;
-  m.dir = dir;
-  m.nx = grid.nx;
-  m.ny = grid.ny;
-  m.dx = grid.dx;
-  m.x0 = grid.x_min;
-  m.y0 = grid.y_min;
-  m.geo = engine::SurfaceGeometry::from(t);
+  m.place(dir, grid, t);
   std::lock_guard lk(hdf5_mutex());
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported by us
   m.file = H5Fcreate((dir + "/timeseries.h5").c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
@@ -71,13 +76,7 @@ TimeSeriesWriter::TimeSeriesWriter(const std::string& dir, const terrain::Grid& 
                                    const std::string& continue_from, int frames)
     : impl_(std::make_unique<Impl>()) {
   auto& m = *impl_;
-  m.dir = dir;
-  m.nx = grid.nx;
-  m.ny = grid.ny;
-  m.dx = grid.dx;
-  m.x0 = grid.x_min;
-  m.y0 = grid.y_min;
-  m.geo = engine::SurfaceGeometry::from(t);
+  m.place(dir, grid, t);
   const std::string path = dir + "/timeseries.h5";
   std::lock_guard lk(hdf5_mutex());
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);

@@ -1,9 +1,12 @@
 // The option table of the VOF laboratory block `lab` (options.hpp) and its materials. The mapping
 // into the engine's VofConfig lives in the lab driver (jobs/drivers/vof_lab/config.cpp), which
-// `maps_to` names.
+// `maps_to` names; the choices of the engine's options come from its name tables
+// (engine/vof/solver.hpp), the boundary kinds are checked against its registry by a test
+// (LabOptions.BoundaryKindsAreTheEngineRegistrys).
 #include <string>
 #include <vector>
 
+#include "engine/vof/solver.hpp"
 #include "jobs/scenario/options.hpp"
 
 namespace runout::jobs {
@@ -118,24 +121,24 @@ const OptionTable& lab_options() {
       {"lab.reference.gate_strain_rate_1_s", T::number, U::as_given, "", Range{0}, {}, "1/s", "strain rate at the gate", "figures"},
       {"lab.reference.depth_ratio_max", T::number, U::as_given, "", Range{0}, {}, "",
        "3D: the deepest column at most this many times the undisturbed depth", "figures"},
-      {"lab.viscous_transpose", T::choice, U::fill, "harmonic", {}, {"explicit", "harmonic", "off"}, "",
+      {"lab.viscous_transpose", T::choice, U::fill, "harmonic", {}, names_of(engine::vof::kTransposeNames), "",
        "the viscous stress's transpose part: harmonic face viscosity, linear (interFoam) or none", "VofConfig::viscous_transpose"},
       {"lab.chute.bend_deg", T::number, U::as_given, "", Range{0, 90, true, true}, {}, "deg",
        "a curved chute (3D): turns up by this much", "mesh"},
       coord("lab.chute.bend_start_m", "the bend's start (arc length)"),
       coord("lab.chute.bend_end_m", "the bend's end (arc length)"),
       length("lab.chute.channel_radius_m", "R of the cross-channel parabola", "flat across"),
-      {"lab.pressure_coupling", T::choice, U::fill, "piso", {}, {"piso", "consistent"}, "",
+      {"lab.pressure_coupling", T::choice, U::fill, "piso", {}, names_of(engine::vof::kPressureCouplingNames), "",
        "the pressure equation with 1/A (interFoam) or SIMPLEC's 1/(A - H1) with the momentum predictor",
        "VofConfig::consistent, momentum_predictor"},
-      {"lab.momentum_convection", T::choice, U::keep, "upwind", {}, {"upwind", "limited_linear"}, "",
+      {"lab.momentum_convection", T::choice, U::keep, "upwind", {}, names_of(engine::vof::kConvectionNames), "",
        "face values of the momentum's convection: first order or TVD (limitedLinearV 1)", "VofConfig::momentum_convection"},
-      {"lab.coulomb_pressure", T::choice, U::keep, "total", {}, {"total", "excess"}, "",
+      {"lab.coulomb_pressure", T::choice, U::keep, "total", {}, names_of(engine::vof::kCoulombPressureNames), "",
        "the Coulomb viscosity's confining pressure: p, or p less the still air's hydrostatic pressure",
        "VofConfig::coulomb_pressure"},
       {"lab.pressure_preconditioner", T::choice, U::keep, "gamg", {}, {"gamg", "hypre"}, "",
        "the pressure solve's preconditioner: PETSc's GAMG or hypre's BoomerAMG", "VofConfig::pressure_pc"},
-      {"lab.wall_viscosity", T::choice, U::keep, "face", {}, {"face", "cell"}, "",
+      {"lab.wall_viscosity", T::choice, U::keep, "face", {}, names_of(engine::vof::kWallViscosityNames), "",
        "viscosity on walls and inflows: evaluated on the face (as OpenFOAM) or the cell's", "VofConfig::wall_viscosity"},
   };
   return t;

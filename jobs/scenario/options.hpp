@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/names.hpp"
 #include "runout/v1/scenario.pb.h"
 
 namespace runout::jobs {
@@ -99,5 +100,12 @@ std::string scenario_reference_markdown();
 
 /// "a, b, c"
 std::string join_names(const std::vector<std::string>& names);
+/// The names of an engine's name table, as an option's choices.
+template <class E, std::size_t N>
+std::vector<std::string> names_of(const engine::NameTable<E, N>& table) {
+  std::vector<std::string> v;
+  for (const auto& [name, value] : table) v.emplace_back(name);
+  return v;
+}
 
 }  // namespace runout::jobs

@@ -1,5 +1,10 @@
 // The VOF laboratory set-ups' options through the run driver: each is validated by name and reaches
 // the run; scenario errors name the field; the comparison figure.
+#include <algorithm>
+
+#include "engine/vof/solver.hpp"
+#include "jobs/drivers/vof_lab/config.hpp"
+#include "jobs/scenario/options.hpp"
 #include "tests/support/run_helpers.hpp"
 
 using namespace runout::test_support::run;
@@ -317,4 +322,23 @@ TEST(Scenarios, LabViscousTransposeIsValidated) {
   EXPECT_EQ(lin.scenario.lab().viscous_transpose(), "explicit");
   auto bad = jobs::parse_scenario_json(head + R"(, "viscous_transpose": "implicit"}})");
   expect_resolve_error(bad, {"lab.viscous_transpose", "implicit"});
+}
+
+// The lab block's boundary kinds are the engine's boundary-condition registry (scenarios spell '_'
+// as '-'), and each choice of the engine's options reaches a VofConfig: no list of names besides
+// the engine's.
+TEST(LabOptions, BoundaryKindsAreTheEngineRegistrys) {
+  std::vector<std::string> scenario_kinds = jobs::option(jobs::lab_options(), "lab.boundaries[].kind").choices;
+  for (auto& k : scenario_kinds) std::replace(k.begin(), k.end(), '-', '_');
+  std::vector<std::string> engine_kinds = runout::engine::vof::boundary_condition_names();
+  std::sort(scenario_kinds.begin(), scenario_kinds.end());
+  std::sort(engine_kinds.begin(), engine_kinds.end());
+  EXPECT_EQ(scenario_kinds, engine_kinds);
+  for (const auto& name : jobs::option(jobs::lab_options(), "lab.viscous_transpose").choices) {
+    runout::v1::Lab lab;
+    lab.set_viscous_transpose(name);
+    EXPECT_EQ(runout::engine::name_of(runout::engine::vof::kTransposeNames,
+                                      jobs::vof_lab::lab_config(lab, jobs::vof_lab::lab_material(lab)).viscous_transpose),
+              name);
+  }
 }

@@ -1,10 +1,12 @@
 #include "jobs/drivers/vof_lab/config.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "jobs/scenario/options.hpp"
 #include "jobs/scenario/scenario.hpp"
 
 namespace runout::jobs::vof_lab {
@@ -14,25 +16,23 @@ namespace {
 namespace vof = engine::vof;
 constexpr double kPi = 3.14159265358979323846;
 
-// The value of option `field` from its table; "" is `fallback` (the option's default).
-template <class T>
-T choose(const std::string& value, const char* field, const std::vector<std::pair<const char*, T>>& table, T fallback) {
+// The value of option `field` from the engine's name table; "" is `fallback` (the option's default).
+// The option table has checked the name already; a name it let through would be an error here.
+template <class E, std::size_t N>
+E choose(const std::string& value, const char* field, const engine::NameTable<E, N>& table, E fallback) {
   if (value.empty()) return fallback;
-  std::string valid;
-  for (const auto& [name, v] : table) {
-    if (value == name) return v;
-    valid += (valid.empty() ? "" : ", ") + std::string(name);
+  try {
+    return engine::parse_name(table, field, value);
+  } catch (const std::invalid_argument& e) {
+    throw ScenarioError(std::string(field) + ": " + e.what());
   }
-  throw ScenarioError(std::string(field) + ": unknown '" + value + "' (valid: " + valid + ")");
 }
 
 }  // namespace
 
 Material lab_material(const v1::Lab& L) {
-  // validation.md part B; fine-sand: the rotating box, whose side walls raise the effective phi.
-  Material mat = choose<Material>(L.material(), "lab.material",
-                                  {{"pvc", {936.17, 32, 20}}, {"sand", {1626.67, 37, 18}}, {"fine-sand", {1855, 54.5, 54.5}}},
-                                  {936.17, 32, 20});
+  const LabMaterial& m = jobs::lab_material(L.material());  // the option table's materials (validation.md part B)
+  Material mat{m.rho, m.phi_deg, m.delta_deg};
   if (L.has_phi_deg()) mat.phi_deg = L.phi_deg();
   if (L.has_bed_friction_deg()) mat.delta_deg = L.bed_friction_deg();
   return mat;
@@ -45,21 +45,13 @@ vof::VofConfig lab_config(const v1::Lab& L, const Material& mat) {
   c.max_co = c.max_alpha_co = L.max_courant();
   c.n_correctors = L.correctors();
   c.n_outer_correctors = L.has_outer_correctors() ? L.outer_correctors() : 1;
-  c.viscous_transpose = choose<vof::Transpose>(
-      L.viscous_transpose(), "lab.viscous_transpose",
-      {{"off", vof::Transpose::off}, {"explicit", vof::Transpose::linear}, {"harmonic", vof::Transpose::harmonic}}, vof::Transpose::harmonic);
-  c.momentum_convection = choose<vof::Convection>(L.momentum_convection(), "lab.momentum_convection",
-                                                  {{"upwind", vof::Convection::upwind}, {"limited_linear", vof::Convection::limited_linear}},
-                                                  vof::Convection::upwind);
-  c.coulomb_pressure = choose<vof::CoulombPressure>(L.coulomb_pressure(), "lab.coulomb_pressure",
-                                                    {{"total", vof::CoulombPressure::total}, {"excess", vof::CoulombPressure::excess}},
-                                                    vof::CoulombPressure::total);
-  c.wall_viscosity = choose<vof::WallViscosity>(L.wall_viscosity(), "lab.wall_viscosity",
-                                                {{"face", vof::WallViscosity::face}, {"cell", vof::WallViscosity::cell}}, vof::WallViscosity::face);
+  c.viscous_transpose = choose(L.viscous_transpose(), "lab.viscous_transpose", vof::kTransposeNames, vof::Transpose::harmonic);
+  c.momentum_convection = choose(L.momentum_convection(), "lab.momentum_convection", vof::kConvectionNames, vof::Convection::upwind);
+  c.coulomb_pressure = choose(L.coulomb_pressure(), "lab.coulomb_pressure", vof::kCoulombPressureNames, vof::CoulombPressure::total);
+  c.wall_viscosity = choose(L.wall_viscosity(), "lab.wall_viscosity", vof::kWallViscosityNames, vof::WallViscosity::face);
   if (!L.pressure_preconditioner().empty()) c.pressure_pc = L.pressure_preconditioner();
   c.active_layers = L.active_layers() < 0 ? 0 : L.active_layers();
-  c.consistent = c.momentum_predictor =
-      choose<bool>(L.pressure_coupling(), "lab.pressure_coupling", {{"piso", false}, {"consistent", true}}, false);
+  c.consistent = c.momentum_predictor = choose(L.pressure_coupling(), "lab.pressure_coupling", vof::kPressureCouplingNames, false);
   const double zeta = L.inclination_deg() * kPi / 180;
   const double omega = L.rotation_period_s() > 0 ? 2 * kPi / L.rotation_period_s() : 0.0;
   c.gravity = [zeta, omega](double t) {
@@ -87,16 +79,11 @@ void apply_boundaries(const v1::Lab& L, const Material& mat, vof::Mesh& m, vof::
     });
     if (m.patch_index(name) < 0) throw ScenarioError(field + ": no face of side " + lb.side() + " lies in [from, to]");
     vof::PatchBc pb;
-    pb.kind = choose<vof::Bc>(lb.kind(), (field + ".kind").c_str(),
-                              {{"wall", vof::Bc::wall},
-                               {"atmosphere", vof::Bc::atmosphere},
-                               {"outflow", vof::Bc::outflow},
-                               {"coulomb-slip", vof::Bc::coulomb_slip},
-                               {"coulomb-friction", vof::Bc::coulomb_friction},
-                               {"inflow", vof::Bc::inflow},
-                               {"symmetry", vof::Bc::symmetry}},
-                              vof::Bc::wall);
-    if (pb.kind == vof::Bc::inflow) {
+    // The engine's registry finds the condition by name (engine/vof/bc/registry.cpp); scenarios
+    // spell its names with '-' for '_'.
+    pb.type = lb.kind().empty() ? "wall" : lb.kind();
+    std::replace(pb.type.begin(), pb.type.end(), '-', '_');
+    if (pb.type == "inflow") {
       const double u0 = lb.inflow_u0(), dudy = lb.inflow_dudy(), hin = lb.inflow_height(), ybase = L.y_min();
       // Material below the fill height with the profile; air above enters at rest (appendix A.4:
       // "else (0, 0)").
