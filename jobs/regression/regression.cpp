@@ -1,7 +1,6 @@
 #include "jobs/regression/regression.hpp"
 
 #include <gdal_priv.h>
-#include <google/protobuf/struct.pb.h>
 #include <google/protobuf/util/json_util.h>
 #include <ogr_spatialref.h>
 
@@ -16,6 +15,7 @@
 
 #include "jobs/system/store.hpp"
 #include "jobs/formats/run_record.hpp"
+#include "runout/v1/regression.pb.h"
 
 
 namespace fs = std::filesystem;
@@ -34,20 +34,10 @@ std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
-google::protobuf::Struct parse_json(const fs::path& p) {
-  google::protobuf::Struct s;
-  const auto st = google::protobuf::util::JsonStringToMessage(slurp(p), &s);
-  if (!st.ok()) throw std::runtime_error("'" + p.string() + "': " + std::string(st.message()));
-  return s;
-}
-
-double number(const google::protobuf::Struct& s, const std::string& a, const std::string& b) {
-  const auto it = s.fields().find(a);
-  if (it == s.fields().end() || !it->second.has_struct_value()) throw std::runtime_error("reference: no '" + a + "'");
-  const auto& in = it->second.struct_value().fields();
-  const auto jt = in.find(b);
-  if (jt == in.end()) throw std::runtime_error("reference: no '" + a + "." + b + "'");
-  return jt->second.number_value();
+// A figure or tolerance the reference must hold: `what` names it in the error.
+double required(bool has, double v, const std::string& what) {
+  if (!has) throw std::runtime_error("reference: no '" + what + "'");
+  return v;
 }
 
 struct Raster {
@@ -132,30 +122,30 @@ RegressionReference read_reference(const std::string& reference_dir) {
   const fs::path p = fs::path(reference_dir) / "reference.json";
   if (!fs::exists(p))
     throw std::runtime_error("no reference in '" + reference_dir + "' (accept a run first: runout regress --accept --reason TEXT)");
-  const auto s = parse_json(p);
+  v1::RegressionReference m;
+  const auto st = google::protobuf::util::JsonStringToMessage(slurp(p), &m);
+  if (!st.ok()) throw std::runtime_error("'" + p.string() + "': " + std::string(st.message()));
+  const auto& f = m.figures();
+  const auto& t = m.tolerances();
   RegressionReference r;
-  r.figures.runout_m = number(s, "figures", "runout_m");
-  r.figures.affected_area_m2 = number(s, "figures", "affected_area_m2");
-  r.figures.max_depth_m = number(s, "figures", "max_depth_m");
-  r.figures.max_speed_m_s = number(s, "figures", "max_speed_m_s");
-  r.figures.volume_error = number(s, "figures", "volume_error");
-  r.figures.farmhouse_depth_m = number(s, "figures", "farmhouse_depth_m");
-  r.figures.farmhouse_distance_m = number(s, "figures", "farmhouse_distance_m");
-  r.tolerances.runout_rel = number(s, "tolerances", "runout_rel");
-  r.tolerances.area_rel = number(s, "tolerances", "area_rel");
-  r.tolerances.max_depth_rel = number(s, "tolerances", "max_depth_rel");
-  r.tolerances.max_speed_rel = number(s, "tolerances", "max_speed_rel");
-  r.tolerances.volume_error_abs = number(s, "tolerances", "volume_error_abs");
-  r.tolerances.farmhouse_distance_abs = number(s, "tolerances", "farmhouse_distance_abs");
-  r.tolerances.depth_map_abs = number(s, "tolerances", "depth_map_abs");
-  auto text = [&](const char* k) {
-    const auto it = s.fields().find(k);
-    return it == s.fields().end() ? std::string() : it->second.string_value();
-  };
-  r.accepted_utc = text("accepted_utc");
-  r.reason = text("reason");
-  r.software_version = text("software_version");
-  r.scenario_hash = text("scenario_hash");
+  r.figures.runout_m = required(f.has_runout_m(), f.runout_m(), "figures.runout_m");
+  r.figures.affected_area_m2 = required(f.has_affected_area_m2(), f.affected_area_m2(), "figures.affected_area_m2");
+  r.figures.max_depth_m = required(f.has_max_depth_m(), f.max_depth_m(), "figures.max_depth_m");
+  r.figures.max_speed_m_s = required(f.has_max_speed_m_s(), f.max_speed_m_s(), "figures.max_speed_m_s");
+  r.figures.volume_error = required(f.has_volume_error(), f.volume_error(), "figures.volume_error");
+  r.figures.farmhouse_depth_m = required(f.has_farmhouse_depth_m(), f.farmhouse_depth_m(), "figures.farmhouse_depth_m");
+  r.figures.farmhouse_distance_m = required(f.has_farmhouse_distance_m(), f.farmhouse_distance_m(), "figures.farmhouse_distance_m");
+  r.tolerances.runout_rel = required(t.has_runout_rel(), t.runout_rel(), "tolerances.runout_rel");
+  r.tolerances.area_rel = required(t.has_area_rel(), t.area_rel(), "tolerances.area_rel");
+  r.tolerances.max_depth_rel = required(t.has_max_depth_rel(), t.max_depth_rel(), "tolerances.max_depth_rel");
+  r.tolerances.max_speed_rel = required(t.has_max_speed_rel(), t.max_speed_rel(), "tolerances.max_speed_rel");
+  r.tolerances.volume_error_abs = required(t.has_volume_error_abs(), t.volume_error_abs(), "tolerances.volume_error_abs");
+  r.tolerances.farmhouse_distance_abs = required(t.has_farmhouse_distance_abs(), t.farmhouse_distance_abs(), "tolerances.farmhouse_distance_abs");
+  r.tolerances.depth_map_abs = required(t.has_depth_map_abs(), t.depth_map_abs(), "tolerances.depth_map_abs");
+  r.accepted_utc = m.accepted_utc();
+  r.reason = m.reason();
+  r.software_version = m.software_version();
+  r.scenario_hash = m.scenario_hash();
   return r;
 }
 
@@ -307,21 +297,34 @@ void accept_reference(const std::string& reference_dir, const RegressionFigures&
   }
   fs::create_directories(reference_dir);
   const std::string now = utc_now();
+  v1::RegressionReference m;
+  m.set_accepted_utc(now);
+  m.set_reason(reason);
+  m.set_software_version(version);
+  m.set_scenario_hash(scenario_hash);
+  auto* fig = m.mutable_figures();
+  fig->set_runout_m(f.runout_m);
+  fig->set_affected_area_m2(f.affected_area_m2);
+  fig->set_max_depth_m(f.max_depth_m);
+  fig->set_max_speed_m_s(f.max_speed_m_s);
+  fig->set_volume_error(f.volume_error);
+  fig->set_farmhouse_depth_m(f.farmhouse_depth_m);
+  fig->set_farmhouse_distance_m(f.farmhouse_distance_m);
+  auto* tol = m.mutable_tolerances();
+  tol->set_runout_rel(t.runout_rel);
+  tol->set_area_rel(t.area_rel);
+  tol->set_max_depth_rel(t.max_depth_rel);
+  tol->set_max_speed_rel(t.max_speed_rel);
+  tol->set_volume_error_abs(t.volume_error_abs);
+  tol->set_farmhouse_distance_abs(t.farmhouse_distance_abs);
+  tol->set_depth_map_abs(t.depth_map_abs);
+  std::string json;
+  google::protobuf::util::JsonPrintOptions o;
+  o.preserve_proto_field_names = true;
+  o.add_whitespace = true;
+  if (!google::protobuf::util::MessageToJsonString(m, &json, o).ok()) throw std::runtime_error("cannot write the reference as JSON");
   std::ofstream j(fs::path(reference_dir) / "reference.json");
-  j.precision(12);
-  j << "{\n  \"accepted_utc\": \"" << now << "\",\n  \"reason\": \"";
-  for (char c : reason) {
-    if (c == '"' || c == '\\') j << '\\' << c;
-    else if (static_cast<unsigned char>(c) < 0x20) j << ' ';  // no control characters in the JSON string
-    else j << c;
-  }
-  j << "\",\n  \"software_version\": \"" << version << "\",\n  \"scenario_hash\": \"" << scenario_hash << "\",\n";
-  j << "  \"figures\": {\"runout_m\": " << f.runout_m << ", \"affected_area_m2\": " << f.affected_area_m2
-    << ", \"max_depth_m\": " << f.max_depth_m << ", \"max_speed_m_s\": " << f.max_speed_m_s << ", \"volume_error\": " << f.volume_error
-    << ", \"farmhouse_depth_m\": " << f.farmhouse_depth_m << ", \"farmhouse_distance_m\": " << f.farmhouse_distance_m << "},\n";
-  j << "  \"tolerances\": {\"runout_rel\": " << t.runout_rel << ", \"area_rel\": " << t.area_rel << ", \"max_depth_rel\": "
-    << t.max_depth_rel << ", \"max_speed_rel\": " << t.max_speed_rel << ", \"volume_error_abs\": " << t.volume_error_abs
-    << ", \"farmhouse_distance_abs\": " << t.farmhouse_distance_abs << ", \"depth_map_abs\": " << t.depth_map_abs << "}\n}\n";
+  j << json;
   if (!j) throw std::runtime_error("cannot write the reference");
   fs::copy_file(run_max_depth, fs::path(reference_dir) / "max_depth.tif", fs::copy_options::overwrite_existing);
   std::ofstream h(fs::path(reference_dir) / "HISTORY.md", std::ios::app);
