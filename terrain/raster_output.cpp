@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <cstdlib>
 #include <memory>
 #include <string>
@@ -95,6 +96,13 @@ OutlineReport write_outline(const std::string& geojson_path, const std::string& 
   }
   rep.geojson = true;
   return rep;
+}
+
+std::vector<double> masked_outside(const Grid& g, const std::vector<double>& values) {
+  std::vector<double> m = values;
+  for (std::size_t k = 0; k < m.size(); ++k)
+    if (g.outside[k]) m[k] = std::numeric_limits<double>::quiet_NaN();
+  return m;
 }
 
 void write_ascii_on(const std::string& path, const std::string& template_path, const Grid& g,

@@ -101,4 +101,7 @@ OutlineReport write_outline(const std::string& geojson_path, const std::string& 
 /// exports that demand the input DEM's grid (ISeeSnow).
 void write_ascii_on(const std::string& path, const std::string& template_path, const Grid& g, const std::vector<double>& values);
 
+/// `values` with the cells outside the domain (Grid::outside) as NaN: nodata in every raster written.
+std::vector<double> masked_outside(const Grid& g, const std::vector<double>& values);
+
 }  // namespace runout::terrain

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "engine/sh2d.hpp"
+#include "jobs/formats/iseesnow.hpp"
 #include "jobs/formats/sh_checkpoint.hpp"
 #include "jobs/formats/timeseries.hpp"
 #include "jobs/figures/map.hpp"
@@ -25,14 +26,6 @@ namespace {
 
 double since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-// Cells outside the domain are nodata in every raster.
-std::vector<double> masked_outside(const terrain::Grid& grid, const std::vector<double>& v) {
-  std::vector<double> m = v;
-  for (std::size_t k = 0; k < m.size(); ++k)
-    if (grid.outside[k]) m[k] = std::numeric_limits<double>::quiet_NaN();
-  return m;
 }
 
 // Figures of the hazard map: maximum depth, the affected area and the runout from the release's
@@ -68,50 +61,6 @@ void hazard_figures(const ResolvedScenario& s, const terrain::Grid& grid, const 
     if (!std::isfinite(v))
       throw std::runtime_error(std::string("the run's ") + name + " is not finite (" + json_number(v) +
                                "): the flow state became NaN or infinite; no results written");
-}
-
-// ISeeSnow export: peak flow thickness and velocity on the input DEM's grid, and the result row.
-void write_iseesnow(const ResolvedScenario& s, const RunOptions& opt, const std::string& out_dir, const terrain::Grid& grid,
-                    const engine::Sh2dResult& res, RunSummary& sum) {
-  const auto& d = res.diag;
-  const auto& hz = res.hazard;
-  auto out = [&](const std::string& name) { return (fs::path(out_dir) / name).string(); };
-  auto masked = [&](const std::vector<double>& v) { return masked_outside(grid, v); };
-  const std::string stem = fs::path(s.releases.front().path).stem().string() + "_" + opt.iseesnow_id + "_null_runout";
-  terrain::write_ascii_on(out(stem + "_pft.asc"), s.dem.dem_path, grid, masked(hz.max_depth));
-  terrain::write_ascii_on(out(stem + "_pfv.asc"), s.dem.dem_path, grid, masked(hz.max_speed));
-  // The benchmark's result table (simulationResultTable.csv): one row per simulation; the
-  // leading digits of the id are the row index, the rest the test case.
-  std::size_t digits = 0;
-  while (digits < opt.iseesnow_id.size() && std::isdigit(static_cast<unsigned char>(opt.iseesnow_id[digits]))) ++digits;
-  const std::string index = digits ? std::to_string(std::stoi(opt.iseesnow_id.substr(0, digits))) : "";
-  std::ofstream csv(out("iseesnow_" + opt.iseesnow_id + ".csv"));
-  csv << ",testCase,computation duration (CPU) [s],avalanche flow time [s],volume at t0 [m3],"
-         "volume at tFinal [m3],spatial resolution x [m],spatial resolution y [m],number of particles\n";
-  csv << index << "," << opt.iseesnow_id.substr(digits) << "," << json_number(sum.cpu_seconds) << "," << json_number(d.t) << ","
-      << json_number(d.volume_initial) << "," << json_number(d.volume_final) << "," << json_number(grid.dx) << "," << json_number(grid.dx) << ",\n";
-  if (!csv) throw std::runtime_error("writing the ISeeSnow CSV failed");
-  // The model configuration file the benchmark asks for, named like the peak fields.
-  std::ofstream cfg(out(stem + ".txt"));
-  const auto& m = s.scenario.material();
-  cfg << "runout " << this_software().version() << ": depth-averaged Savage-Hutter model (NOC-TVD scheme, "
-      << "curvature in the bed friction " << (s.scenario.numerics().curvature_off() ? "off" : "on") << ")\n"
-      << "scenario = " << s.scenario.name() << "\n"
-      << "rheology = " << (m.rheology().empty() ? "coulomb" : m.rheology()) << "\n";
-  if (m.has_voellmy_mu()) cfg << "mu = " << json_number(m.voellmy_mu()) << "\n";
-  if (m.has_voellmy_xi()) cfg << "xi_m_s2 = " << json_number(m.voellmy_xi()) << "\n";
-  if (m.has_bed_friction_deg()) cfg << "bed_friction_deg = " << json_number(m.bed_friction_deg()) << "\n";
-  if (m.has_internal_friction_deg()) cfg << "internal_friction_deg = " << json_number(m.internal_friction_deg()) << "\n";
-  cfg << "earth_pressure = " << (m.earth_pressure().empty() ? "unity" : m.earth_pressure()) << "\n"
-      << "limiter = " << (s.scenario.numerics().limiter().empty() ? "minmod" : s.scenario.numerics().limiter()) << "\n"
-      << "cfl = " << json_number(s.config.time.cfl) << "\n"
-      << "cell_size_m = " << json_number(grid.dx) << "\n"
-      << "release_volume_m3 = " << json_number(d.volume_initial) << "\n"
-      << "stop = " << engine::to_string(d.stop) << " at t = " << json_number(d.t) << " s\n";
-  if (!cfg) throw std::runtime_error("writing the ISeeSnow configuration file failed");
-  sum.files.push_back(stem + ".txt");
-  for (const char* suffix : {"_pft.asc", "_pfv.asc"}) sum.files.push_back(stem + suffix);
-  sum.files.push_back("iseesnow_" + opt.iseesnow_id + ".csv");
 }
 
 // run.json of a depth-averaged run; continued_from: NaN for a run not continued from a checkpoint.
@@ -211,7 +160,7 @@ terrain::OutlineReport write_hazard_outputs(const ResolvedScenario& s, const ter
   for (const auto& name : s.rasters)
     for (const auto& r : hazard_rasters())
       if (r.name == name) {
-        terrain::write_cog(out(name + ".tif"), grid, masked_outside(grid, hz.*r.map), r.description);
+        terrain::write_cog(out(name + ".tif"), grid, terrain::masked_outside(grid, hz.*r.map), r.description);
         sum.files.push_back(name + ".tif");
       }
   const auto outline = terrain::write_outline(out("outline.geojson"), out("outline.gpkg"), grid, hz.max_depth, s.outline_threshold);
@@ -314,7 +263,8 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   sum.seconds_write = since(t2);
 
   const std::string record = (fs::path(out_dir) / "run.json").string();
-  if (!opt.iseesnow_id.empty()) write_iseesnow(s, opt, out_dir, grid, res, sum);
+  if (!opt.iseesnow_id.empty())
+    for (auto& f : write_iseesnow(s, opt.iseesnow_id, out_dir, grid, res, sum.cpu_seconds)) sum.files.push_back(std::move(f));
   write_record(record, s, dem_rep, grid, rel_rep, res, sum, continued_from, outline, frames);
   sum.files.push_back("run.json");
   return sum;
