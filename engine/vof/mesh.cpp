@@ -232,27 +232,32 @@ Mesh structured_hex_mesh(const HexGridSpec& s) {
       for (std::size_t i = 0; i <= NI; ++i) X[nid(i, j, k)] = s.node(int(i), int(j), int(k));
   Mesh m;
   m.thickness = 0;
-  const std::size_t n = NI * NJ * NK;
-  m.centre.resize(n);
-  m.volume.assign(n, 0.0);
-  auto cid = [&](long i, long j, long k) {
-    if (i < 0 || j < 0 || k < 0 || i >= s.ni || j >= s.nj || k >= s.nk) return -1;
-    return int((std::size_t(k) * NJ + std::size_t(j)) * NI + std::size_t(i));
-  };
+  // Kept cells numbered i fastest, then j, then k (with nothing blocked: cell (i, j, k) is (k nj + j) ni + i).
+  std::vector<int> id(NI * NJ * NK, -1);
+  int kept = 0;
   for (std::size_t k = 0; k < NK; ++k)
     for (std::size_t j = 0; j < NJ; ++j)
       for (std::size_t i = 0; i < NI; ++i) {
+        if (s.blocked && s.blocked(int(i), int(j), int(k))) continue;
         Vec c;
         for (int q = 0; q < 8; ++q) c = c + X[nid(i + (q & 1), j + ((q >> 1) & 1), k + ((q >> 2) & 1))];
-        m.centre[std::size_t(cid(long(i), long(j), long(k)))] = 0.125 * c;
+        id[(k * NJ + j) * NI + i] = kept++;
+        m.centre.push_back(0.125 * c);
       }
+  if (kept == 0) throw std::invalid_argument("hex mesh: every cell is blocked");
+  m.volume.assign(std::size_t(kept), 0.0);
+  auto cid = [&](long i, long j, long k) {
+    if (i < 0 || j < 0 || k < 0 || i >= s.ni || j >= s.nj || k >= s.nk) return -1;
+    return id[(std::size_t(k) * NJ + std::size_t(j)) * NI + std::size_t(i)];
+  };
   auto cross = [](Vec a, Vec b) { return Vec{a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; };
+  const auto& names = s.patch_names;  // left, right, bottom, top, back, front, blocked
   std::map<std::string, std::vector<BFace>> bnd;
   // Faces normal to grid direction d, between cell (.., n-1, ..) and (.., n, ..) along d.
   for (int d = 0; d < 3; ++d) {
-    const long ni = s.ni + (d == 0), nj = s.nj + (d == 1), nk = s.nk + (d == 2);
-    const char* lo = d == 0 ? "left" : d == 1 ? "bottom" : "back";
-    const char* hi = d == 0 ? "right" : d == 1 ? "top" : "front";
+    const long ni = s.ni + (d == 0), nj = s.nj + (d == 1), nk = s.nk + (d == 2), n_d = d == 0 ? s.ni : d == 1 ? s.nj : s.nk;
+    const std::string& lo = names[std::size_t(2 * d)];
+    const std::string& hi = names[std::size_t(2 * d + 1)];
     for (long k = 0; k < nk; ++k)
       for (long j = 0; j < nj; ++j)
         for (long i = 0; i < ni; ++i) {
@@ -274,20 +279,25 @@ Mesh structured_hex_mesh(const HexGridSpec& s) {
                             : a >= 0         ? C - m.centre[a]
                                              : m.centre[b] - C;
           if (dot(S, along) < 0) S = (-1.0) * S;
+          const long n_here = d == 0 ? i : d == 1 ? j : k;
           if (a >= 0 && b >= 0) {
             m.owner.push_back(a);
             m.neighbour.push_back(b);
             m.Sf.push_back(S);
             m.Cf.push_back(C);
           } else if (a >= 0) {
-            bnd[hi].push_back({a, S, C});
+            bnd[n_here == n_d ? hi : names[6]].push_back({a, S, C});
           } else {
-            bnd[lo].push_back({b, (-1.0) * S, C});
+            bnd[n_here == 0 ? lo : names[6]].push_back({b, (-1.0) * S, C});
           }
         }
   }
   m.n_internal = int(m.owner.size());
-  for (const char* name : {"bottom", "right", "top", "left", "back", "front"}) append_patch(m, name, bnd[name]);
+  // Patches in the order bottom, right, top, left, back, front, blocked; equal names make one patch.
+  std::vector<std::string> order;
+  for (std::size_t q : {2, 1, 3, 0, 4, 5, 6})
+    if (std::find(order.begin(), order.end(), names[q]) == order.end()) order.push_back(names[q]);
+  for (const auto& name : order) append_patch(m, name, bnd[name]);
   // Volumes by the divergence theorem: V = sum over the cell's faces of (Cf - c) . Sf / 3.
   for (int f = 0; f < m.faces(); ++f) {
     const int o = m.owner[f];
@@ -297,7 +307,7 @@ Mesh structured_hex_mesh(const HexGridSpec& s) {
       m.volume[nb] -= dot(m.Cf[f] - m.centre[nb], m.Sf[f]) / 3;
     }
   }
-  for (std::size_t c = 0; c < n; ++c)
+  for (int c = 0; c < m.cells(); ++c)
     if (!(m.volume[c] > 0)) throw std::invalid_argument("hex mesh: cell " + std::to_string(c) + " is inverted or flat (volume " + std::to_string(m.volume[c]) + ")");
   m.finish();
   return m;

@@ -83,10 +83,16 @@ Mesh block_mesh_3d(const Block3Spec& s);
 /// then k, so cell (i, j, k) is (k nj + j) ni + i. Faces may be non-planar (area vector from the
 /// diagonals, exact for the quad's outline); volumes by the divergence theorem; cell centre the
 /// mean of its nodes. Patches as block_mesh_3d: "bottom" (j = 0), "top", "left" (i = 0), "right",
-/// "back" (k = 0), "front". For terrain-following meshes (the curved chute of validation.md B8).
+/// "back" (k = 0), "front". For terrain-following meshes (the curved chute of validation.md B8, the
+/// column meshes over a DEM). Cells for which `blocked` holds are left out (the others keep their
+/// order) and the faces they share with kept cells form the patch `patch_names[6]`. `patch_names`
+/// renames the patches (the low and high ends of i, j, k, then the blocked cells' faces); equal
+/// names make one patch.
 struct HexGridSpec {
   int ni = 1, nj = 1, nk = 1;
   std::function<Vec(int i, int j, int k)> node;
+  std::function<bool(int i, int j, int k)> blocked;
+  std::array<std::string, 7> patch_names = {"left", "right", "bottom", "top", "back", "front", "obstacle"};
 };
 Mesh structured_hex_mesh(const HexGridSpec& s);
 

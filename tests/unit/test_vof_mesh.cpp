@@ -96,3 +96,31 @@ TEST(VofMesh, Block3dAddressingAndACylinderObstacle) {
   for (double v : m.volume) vol += v;
   EXPECT_NEAR(vol, 0.1 * 0.05 * 0.1 - 3 * 12 * 1e-6, 1e-9);  // 12 columns of 3 cells (1 cm) blocked
 }
+
+// A structured hex mesh with cells left out: the others keep their order, the faces towards the
+// left-out cells form one patch, and patches of equal names merge.
+TEST(VofMesh, StructuredHexMeshLeavesOutBlockedCellsAndMergesPatches) {
+  HexGridSpec s;
+  s.ni = 4;
+  s.nj = 2;
+  s.nk = 3;
+  s.node = [](int i, int j, int k) { return Vec{0.1 * i, 0.05 * j + 0.01 * i, 0.1 * k}; };
+  s.blocked = [](int i, int, int k) { return i == 3 && k == 2; };  // one column of two cells
+  s.patch_names = {"sides", "sides", "ground", "top", "sides", "sides", "cut"};
+  const Mesh m = structured_hex_mesh(s);
+  EXPECT_EQ(m.cells(), 4 * 2 * 3 - 2);
+  EXPECT_EQ(m.patches.size(), 4u);
+  EXPECT_EQ(m.patch("ground").size, 4 * 3 - 1);
+  EXPECT_EQ(m.patch("top").size, 4 * 3 - 1);
+  // Around the domain 2 (4 + 3) columns of faces, less the 2 the left-out column had, twice (2 layers).
+  EXPECT_EQ(m.patch("sides").size, (2 * (4 + 3) - 2) * 2);
+  EXPECT_EQ(m.patch("cut").size, 2 * 2);  // its two neighbours, both layers
+  double v = 0;
+  for (double c : m.volume) v += c;
+  EXPECT_NEAR(v, 0.4 * 0.1 * 0.3 - 0.1 * 0.1 * 0.1, 1e-15);
+  // Nothing blocked: the numbering of an unblocked mesh.
+  s.blocked = nullptr;
+  const Mesh full = structured_hex_mesh(s);
+  EXPECT_EQ(full.cells(), 24);
+  EXPECT_NEAR(full.centre[(2 * 2 + 1) * 4 + 3].x, 0.35, 1e-15);  // cell (3, 1, 2)
+}

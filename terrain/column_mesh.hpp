@@ -1,0 +1,52 @@
+#pragma once
+// The terrain-following column mesh of the 3D engine on real terrain: above each cell of the
+// computation grid that lies inside the domain (Grid::outside == 0: inside the area of interest,
+// with DEM data), a column of hexahedra from the ground up to a band height, its layers graded
+// towards the ground. Columns are vertical; each layer interface follows the ground at a constant
+// height above it, so that the cells' bottoms and tops are the ground surface lifted.
+//
+// The ground at the mesh's nodes (the grid cells' corners) is the bilinear interpolant of the cell
+// centres' elevations, extrapolated linearly at the grid's edges: a plane DEM gives a plane ground.
+// The area of interest is followed cell by cell (columns kept by their centre, as the depth-averaged
+// engine keeps cells); the faces towards a left-out column are the mesh's sides.
+//
+// terrain/ computes the nodes and the kept columns; the terrain run driver builds the VOF engine's
+// mesh from them (engine/vof structured_hex_mesh), so terrain/ stays free of the engine.
+#include <cstdint>
+#include <vector>
+
+#include "terrain/terrain.hpp"
+
+namespace runout::terrain {
+
+struct ColumnMeshSpec {
+  double first_layer_m = 0;  ///< the layer on the ground, vertical thickness [m]; > 0
+  double growth = 1.2;       ///< each layer this many times the one below it; 1-3
+  double band_height_m = 0;  ///< from the ground to the mesh's top [m]; > first_layer_m
+};
+
+/// The heights above the ground of the layer interfaces, 0 first and band_height_m last: layers of
+/// first_layer_m growing by `growth`, as many as reach the band height, then all scaled by the same
+/// factor (at most 1) so that they end exactly there. Throws TerrainError naming the option.
+std::vector<double> layer_levels(const ColumnMeshSpec& s);
+
+struct ColumnMesh {
+  int ni = 0, nk = 0;        ///< columns along x (east) and y (north): the grid's cells
+  double x_min = 0, y_min = 0, dx = 0;  ///< the grid's
+  std::vector<double> levels;           ///< layer interfaces above the ground (layer_levels)
+  std::vector<double> ground;           ///< (ni + 1) (nk + 1) node elevations, node (i, k) at k (ni + 1) + i
+  std::vector<std::uint8_t> kept;       ///< per column (grid cell, row k = grid row j): 1 inside the domain
+  int layers() const { return int(levels.size()) - 1; }
+  double ground_at(int i, int k) const { return ground[std::size_t(k) * std::size_t(ni + 1) + std::size_t(i)]; }
+  /// Node (i, k) of interface j in the grid's CRS: x east, y north, z up.
+  double node_x(int i) const { return x_min + i * dx; }
+  double node_y(int k) const { return y_min + k * dx; }
+  double node_z(int i, int k, int j) const { return ground_at(i, k) + levels[std::size_t(j)]; }
+  int kept_columns() const;
+};
+
+/// The column mesh over `g` (at least 2 x 2 cells). Throws TerrainError when the spec is out of
+/// range or no column is kept.
+ColumnMesh column_mesh(const Grid& g, const ColumnMeshSpec& s);
+
+}  // namespace runout::terrain

@@ -1,0 +1,133 @@
+// The terrain-following column mesh of the 3D engine on terrain: layer levels, the ground at the
+// nodes (exact on a plane DEM, whatever its orientation to the grid), the engine's mesh of the kept
+// columns (volume, patches, closed cells) and its quality on a slope.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "engine/vof/mesh_quality.hpp"
+#include "jobs/drivers/vof_terrain/mesh.hpp"
+#include "terrain/column_mesh.hpp"
+
+namespace {
+
+using runout::terrain::ColumnMeshSpec;
+using runout::terrain::Grid;
+namespace vt = runout::jobs::vof_terrain;
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A plane falling at `slope_deg` towards the azimuth `turn_deg` (0: east, counter-clockwise), on a
+// grid of nx x ny cells of dx; the cells for which `out` holds lie outside the domain.
+template <class Out>
+Grid plane(int nx, int ny, double dx, double slope_deg, double turn_deg, Out out) {
+  Grid g;
+  g.nx = nx;
+  g.ny = ny;
+  g.dx = dx;
+  g.x_min = 600000;
+  g.y_min = 5100000;
+  g.z.resize(g.cells());
+  g.outside.resize(g.cells());
+  const double t = std::tan(slope_deg * kPi / 180), a = turn_deg * kPi / 180;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const double x = (i + 0.5) * dx, y = (j + 0.5) * dx;
+      g.z[std::size_t(j) * nx + i] = 2000 - t * (x * std::cos(a) + y * std::sin(a));
+      g.outside[std::size_t(j) * nx + i] = out(i, j) ? 1 : 0;
+    }
+  return g;
+}
+
+}  // namespace
+
+TEST(ColumnMesh, LayersGrowTowardsTheBandHeight) {
+  const auto l = runout::terrain::layer_levels({0.5, 1.2, 10});
+  ASSERT_GE(l.size(), 3u);
+  EXPECT_EQ(l.front(), 0.0);
+  EXPECT_EQ(l.back(), 10.0);
+  EXPECT_LE(l[1], 0.5);
+  EXPECT_GT(l[1], 0.5 / 1.2);
+  for (std::size_t k = 2; k < l.size(); ++k) EXPECT_NEAR((l[k] - l[k - 1]) / (l[k - 1] - l[k - 2]), 1.2, 1e-12);
+  EXPECT_EQ(runout::terrain::layer_levels({1, 1, 4}).size(), 5u);  // uniform layers
+}
+
+TEST(ColumnMesh, BadOptionsAreNamed) {
+  auto message = [](ColumnMeshSpec s) {
+    try {
+      runout::terrain::layer_levels(s);
+    } catch (const runout::terrain::TerrainError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(message({0, 1.2, 10}).find("mesh.first_layer_m"), std::string::npos);
+  EXPECT_NE(message({0.5, 0.9, 10}).find("mesh.growth"), std::string::npos);
+  EXPECT_NE(message({0.5, 1.2, 0.2}).find("mesh.band_height_m"), std::string::npos);
+}
+
+TEST(ColumnMesh, GroundNodesLieOnAPlaneDemAtAnyOrientation) {
+  for (double turn : {0.0, 30.0, 45.0, 200.0}) {
+    const Grid g = plane(12, 9, 10, 35, turn, [](int, int) { return false; });
+    const auto c = runout::terrain::column_mesh(g, {0.5, 1.2, 8});
+    const double t = std::tan(35 * kPi / 180), a = turn * kPi / 180;
+    for (int k = 0; k <= c.nk; ++k)
+      for (int i = 0; i <= c.ni; ++i) {
+        const double x = i * g.dx, y = k * g.dx;
+        EXPECT_NEAR(c.ground_at(i, k), 2000 - t * (x * std::cos(a) + y * std::sin(a)), 1e-9) << "turn " << turn;
+      }
+    EXPECT_EQ(c.kept_columns(), 12 * 9);
+  }
+}
+
+TEST(ColumnMesh, EngineMeshOfTheKeptColumnsOnASlope) {
+  // A 30 deg slope turned by 30 deg against the grid; a corner of 3 x 2 columns outside the domain.
+  const double slope = 30;
+  const Grid g = plane(10, 8, 5, slope, 30, [](int i, int j) { return i >= 7 && j >= 6; });
+  const auto c = runout::terrain::column_mesh(g, {0.4, 1.25, 6});
+  const auto frame = vt::frame_of(c);
+  const auto m = vt::terrain_mesh(c, frame);
+  const int kept = 10 * 8 - 3 * 2;
+  EXPECT_EQ(c.kept_columns(), kept);
+  EXPECT_EQ(m.cells(), kept * c.layers());
+  // Vertical columns between two parallel surfaces: each holds dx^2 times the band height.
+  double volume = 0;
+  for (double v : m.volume) volume += v;
+  EXPECT_NEAR(volume, kept * 25.0 * 6, 1e-9 * kept * 25.0 * 6);
+  // The ground's area is the columns' plan area over cos(slope); it faces down.
+  const auto& ground = m.patch("ground");
+  double area = 0, up = 0;
+  for (int f = ground.start; f < ground.start + ground.size; ++f) {
+    area += m.magSf[f];
+    up += m.Sf[f].y;
+  }
+  EXPECT_EQ(ground.size, kept);
+  EXPECT_NEAR(area, kept * 25.0 / std::cos(slope * kPi / 180), 1e-9 * area);
+  EXPECT_NEAR(up, -kept * 25.0, 1e-9 * kept * 25.0);
+  EXPECT_EQ(m.patch("atmosphere").size, kept);
+  // Sides: the grid's edges and the cut-out corner's two inner edges, every layer.
+  EXPECT_EQ(m.patch("sides").size, (2 * 10 + 2 * 8) * c.layers());
+  // The frame: y up from the lowest ground node, x east and z south from the grid's centre; the
+  // lowest cell centre lies in the first layer (0.4 m at most) above the lowest kept column's ground
+  // (the mean of its four ground nodes).
+  double ymin = 1e300, ground_min = 1e300;
+  for (int k = 0; k < m.cells(); ++k) ymin = std::min(ymin, m.centre[k].y);
+  for (int k = 0; k < c.nk; ++k)
+    for (int i = 0; i < c.ni; ++i)
+      if (c.kept[std::size_t(k) * c.ni + i])
+        ground_min = std::min(ground_min, 0.25 * (c.ground_at(i, k) + c.ground_at(i + 1, k) + c.ground_at(i, k + 1) +
+                                                  c.ground_at(i + 1, k + 1)) - frame.z);
+  EXPECT_GE(ground_min, 0.0);
+  EXPECT_GT(ymin, ground_min);
+  EXPECT_LT(ymin, ground_min + 0.4);
+  EXPECT_NEAR(frame.x, g.x_min + 25, 1e-9);
+  EXPECT_NEAR(frame.y, g.y_min + 20, 1e-9);
+  // Non-orthogonality: the layers follow the 30 deg slope over vertical columns.
+  const auto q = runout::engine::vof::mesh_quality(m);
+  EXPECT_NEAR(q.non_orthogonality_max_deg, slope, 1e-6);
+  EXPECT_GT(q.non_orthogonality_mean_deg, 5.0);
+  EXPECT_LT(q.skewness_max, 0.5);
+  EXPECT_GT(q.aspect_ratio_max, 5 / 0.4 * 0.5);  // the thin first layer
+}
