@@ -6,9 +6,12 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
+#include "engine/sh2d.hpp"
 #include "engine/vof/mesh_quality.hpp"
 #include "jobs/drivers/vof_terrain/mesh.hpp"
+#include "jobs/drivers/vof_terrain/release.hpp"
 #include "terrain/column_mesh.hpp"
 
 namespace {
@@ -130,4 +133,62 @@ TEST(ColumnMesh, EngineMeshOfTheKeptColumnsOnASlope) {
   EXPECT_GT(q.non_orthogonality_mean_deg, 5.0);
   EXPECT_LT(q.skewness_max, 0.5);
   EXPECT_GT(q.aspect_ratio_max, 5 / 0.4 * 0.5);  // the thin first layer
+}
+
+// The release on the terrain mesh holds the depth-averaged engine's volume (its H, the vertical
+// thickness, per column), alpha within [0, 1], and spans several layers with the default mesh.
+TEST(TerrainRelease, VolumeIsTheDepthAveragedEnginesAndAlphaIsBounded) {
+  const Grid g = plane(10, 8, 5, 30, 30, [](int i, int j) { return i >= 7 && j >= 6; });
+  runout::engine::Terrain2D t;
+  t.nx = g.nx;
+  t.ny = g.ny;
+  t.dx = t.dy = g.dx;
+  t.z = g.z;
+  t.outside = g.outside;
+  std::vector<double> h(g.cells(), 0.0);  // 1.5 m normal to the slope in a block of 4 x 3 columns
+  for (int j = 2; j < 5; ++j)
+    for (int i = 2; i < 6; ++i) h[std::size_t(j) * g.nx + i] = 1.5;
+  const auto H = runout::engine::state_from_normal_depth(t, h).H;
+  double volume_2d = 0, h_max = 0;
+  for (double v : H) {
+    volume_2d += v * g.dx * g.dx;
+    h_max = std::max(h_max, v);
+  }
+  const auto spec = vt::default_column_mesh(h_max);
+  const auto c = runout::terrain::column_mesh(g, spec);
+  const auto m = vt::terrain_mesh(c, vt::frame_of(c));
+  const auto alpha = vt::release_alpha(c, H);
+  ASSERT_EQ(alpha.size(), std::size_t(m.cells()));
+  double volume_3d = 0;
+  for (int k = 0; k < m.cells(); ++k) {
+    EXPECT_GE(alpha[k], 0.0);
+    EXPECT_LE(alpha[k], 1.0);
+    volume_3d += alpha[k] * m.volume[k];
+  }
+  EXPECT_NEAR(volume_3d, volume_2d, 1e-12 * volume_2d);
+  // Column (3, 3): kept columns are numbered i fastest, then the layer, then k.
+  int filled = 0;
+  for (int j = 0; j < c.layers(); ++j) {
+    int q = 0;  // kept columns before row k = 3 in layers below, then in this layer
+    q += 3 * c.layers() * 10;  // rows 0-2 are whole (the cut-out corner lies in rows 6-7)
+    q += j * 10 + 3;
+    filled += alpha[std::size_t(q)] > 0;
+  }
+  EXPECT_GE(filled, 4);
+  EXPECT_EQ(alpha[std::size_t(3 * c.layers() * 10 + 3)], 1.0);                        // full on the ground
+  EXPECT_EQ(alpha[std::size_t(3 * c.layers() * 10 + (c.layers() - 1) * 10 + 3)], 0.0);  // air at the top
+  // Material outside the domain, and a band that cannot hold the release, are named.
+  auto message = [&](const runout::terrain::ColumnMesh& mesh, const std::vector<double>& v) {
+    try {
+      vt::release_alpha(mesh, v);
+    } catch (const runout::terrain::TerrainError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  auto outside = H;
+  outside[std::size_t(7) * g.nx + 9] = 1.0;
+  EXPECT_NE(message(c, outside).find("outside the domain"), std::string::npos);
+  const auto low = runout::terrain::column_mesh(g, {0.2, 1.2, 1.0});
+  EXPECT_NE(message(low, H).find("mesh.band_height_m"), std::string::npos);
 }

@@ -1,0 +1,43 @@
+#include "jobs/drivers/vof_terrain/release.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace runout::jobs::vof_terrain {
+
+terrain::ColumnMeshSpec default_column_mesh(double max_vertical_m) {
+  if (!(max_vertical_m > 0) || !std::isfinite(max_vertical_m))
+    throw terrain::TerrainError("mesh: the release holds no material, so the mesh's layers cannot be chosen from it");
+  return {max_vertical_m / 5, 1.2, 8 * max_vertical_m};
+}
+
+std::vector<double> release_alpha(const terrain::ColumnMesh& c, const std::vector<double>& vertical_m) {
+  if (vertical_m.size() != std::size_t(c.ni) * std::size_t(c.nk))
+    throw terrain::TerrainError("release: the thickness raster is not of the mesh's grid");
+  const double band = c.levels.back();
+  std::vector<double> alpha;
+  alpha.reserve(std::size_t(c.kept_columns()) * std::size_t(c.layers()));
+  for (int k = 0; k < c.nk; ++k) {
+    for (int j = 0; j < c.layers(); ++j) {
+      const double lo = c.levels[std::size_t(j)], hi = c.levels[std::size_t(j) + 1];
+      for (int i = 0; i < c.ni; ++i) {
+        const std::size_t col = std::size_t(k) * std::size_t(c.ni) + std::size_t(i);
+        const double h = vertical_m[col];
+        if (!c.kept[col]) {
+          if (j == 0 && h > 0)
+            throw terrain::TerrainError("release: material in the column (" + std::to_string(i) + ", " + std::to_string(k) +
+                                        ") outside the domain");
+          continue;
+        }
+        if (j == 0 && h > band)
+          throw terrain::TerrainError("mesh.band_height_m: " + std::to_string(band) + " m does not hold the release's " +
+                                      std::to_string(h) + " m in column (" + std::to_string(i) + ", " + std::to_string(k) + ")");
+        alpha.push_back(std::clamp((h - lo) / (hi - lo), 0.0, 1.0));
+      }
+    }
+  }
+  return alpha;
+}
+
+}  // namespace runout::jobs::vof_terrain
