@@ -24,6 +24,7 @@ void Mesh::finish() {
   magSf.assign(nf, 0);
   delta_coeff.assign(nf, 0);
   weight.assign(nf, 1);
+  non_orth.assign(nf, Vec{});
   for (int f = 0; f < nf; ++f) {
     const std::size_t k = std::size_t(f);
     magSf[k] = norm(Sf[k]);
@@ -32,10 +33,12 @@ void Mesh::finish() {
     if (f < n_internal) {
       const Vec cn = centre[neighbour[k]];
       delta_coeff[k] = 1.0 / std::abs(dot(cn - cp, n));
+      non_orth[k] = Sf[k] - (magSf[k] * delta_coeff[k]) * (cn - cp);
       const double dp = std::abs(dot(Cf[k] - cp, n)), dn = std::abs(dot(cn - Cf[k], n));
       weight[k] = dn / (dp + dn);
     } else {
       delta_coeff[k] = 1.0 / std::abs(dot(Cf[k] - cp, n));
+      non_orth[k] = Sf[k] - (magSf[k] * delta_coeff[k]) * (Cf[k] - cp);
     }
   }
   // Every cell must be closed: the sum of its outward area vectors vanishes.

@@ -40,6 +40,9 @@ struct Mesh {
   /// Derived per face: |Sf|, 1/|d . n| (d: owner centre to neighbour centre, or to the face centre on
   /// the boundary), and the owner's interpolation weight.
   FaceField<double> magSf, delta_coeff, weight;
+  /// Derived per face: the non-orthogonal part of Sf, Sf - |Sf| delta_coeff d (zero where d is
+  /// along Sf): what the over-relaxed correction of a face gradient takes explicitly.
+  FaceField<Vec> non_orth;
 
   int cells() const { return int(volume.size()); }
   int faces() const { return int(owner.size()); }

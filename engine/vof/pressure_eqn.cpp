@@ -1,5 +1,7 @@
 #include "engine/vof/pressure_eqn.hpp"
 
+#include <algorithm>
+
 namespace runout::engine::vof {
 
 PressureEqn::PressureEqn(const Mesh& m, const VofConfig& cfg, const BcContext& bc_ctx, const Boundaries& bcs, const ActiveRegion& region,
@@ -10,6 +12,8 @@ PressureEqn::PressureEqn(const Mesh& m, const VofConfig& cfg, const BcContext& b
   phiHbyA_.assign(nf, 0);
   phig_ = phiHbyA_;
   pout_ = phiHbyA_;
+  pcorr_ = phiHbyA_;
+  grad_.assign(nc, Vec{});
   open_.assign(nf, 0);
   rec_.assign(nc, Vec{});
   rec_old_ = rec_;
@@ -29,12 +33,22 @@ int PressureEqn::correct(Fields& F, const MomentumEqn& UEqn, bool initial, bool 
   // neither which faces are openings, the Laplacian coefficients, the buoyancy fluxes nor the
   // outside pressures: those are set by the step's first call. Every call forms the predicted flux
   // from the correctors' H/A.
-  if (!reuse) laplacian_coefficients(F, k);
-  predicted_flux(UEqn, initial, k);
-  assemble(F, reuse);
-  const int its = solver_.solve(initial, reuse, closed, diag_rows_.empty() ? 0.0 : diag_rows_[0], t);
-  solver_.solution(x_rows_);
-  for (int r = 0; r < region_.n_active; ++r) F.p_rgh[region_.cells[r]] = x_rows_[r];
+  const int n_non_orth = std::max(0, cfg_.n_non_orthogonal_correctors);
+  if (!reuse) {
+    laplacian_coefficients(F, k);
+    if (n_non_orth > 0) buoyancy_correction(F, k);
+  }
+  // The non-orthogonal correctors solve again with the correction from the latest pressure, the
+  // matrix kept; the flux takes the last correction (interFoam's nNonOrthogonalCorrectors loop).
+  int its = 0;
+  for (int pass = 0; pass <= n_non_orth; ++pass) {
+    if (n_non_orth > 0) pressure_correction(F, k);
+    predicted_flux(UEqn, initial, k);
+    assemble(F, reuse || pass > 0);
+    its += solver_.solve(initial, reuse || pass > 0, closed, diag_rows_.empty() ? 0.0 : diag_rows_[0], t);
+    solver_.solution(x_rows_);
+    for (int r = 0; r < region_.n_active; ++r) F.p_rgh[region_.cells[r]] = x_rows_[r];
+  }
   correct_flux_and_velocity(F, UEqn, initial, k);
   for (int c : region_.cells) F.p[c] = F.p_rgh[c] + F.rho[c] * bc_ctx_.hydrostatics.gh(c);
   if (closed) fix_level(F);
@@ -112,6 +126,7 @@ void PressureEqn::predicted_flux(const MomentumEqn& UEqn, bool initial, const Co
       }
     }
     phiHbyA_[f] = ph + phig_[f];
+    if (cfg_.n_non_orthogonal_correctors > 0) phiHbyA_[f] += pcorr_[f];
   }
 }
 
@@ -188,7 +203,8 @@ void PressureEqn::correct_flux_and_velocity(Fields& F, const MomentumEqn& UEqn, 
     const double pflux = internal(m_, f) ? pEqn_.flux(m_, f, F.p_rgh) : 0.0;
     F.phi[f] = phiHbyA_[f] + pflux;
     if (internal(m_, f) && k.rAf[f] > 0) {
-      const double q = (phig_[f] + pflux) / k.rAf[f] / m_.magSf[f];
+      const double corr = cfg_.n_non_orthogonal_correctors > 0 ? pcorr_[f] : 0.0;
+      const double q = (phig_[f] + pflux + corr) / k.rAf[f] / m_.magSf[f];
       rec[o] = rec[o] + q * m_.Sf[f];
       rec[m_.neighbour[f]] = rec[m_.neighbour[f]] + q * m_.Sf[f];
     }
@@ -198,6 +214,50 @@ void PressureEqn::correct_flux_and_velocity(Fields& F, const MomentumEqn& UEqn, 
     const Vec R = reconstruct_(c, rec[c]);
     F.U[c] = UEqn.HbyA[c] + k.rA[c] * R;
     if (k.consistent) F.U[c] = F.U[c] + (UEqn.rAU[c] - UEqn.rAtU[c]) * reconstruct_(c, rec_old_[c]);
+  }
+}
+
+// The Gauss gradient of x over the active region: face values interpolated between active cells,
+// the cell's own on walls, and at openings the outside's p_rgh (at_openings_outside) or the cell's.
+void PressureEqn::gauss_gradient(const CellField<double>& x, bool at_openings_outside, CellField<Vec>& out) const {
+  for (int c : region_.cells) out[c] = Vec{};
+  for (int f : region_.faces) {
+    const int o = m_.owner[f];
+    if (open_[f] != 0) {
+      const int a = open_[f] > 0 ? o : m_.neighbour[f];
+      const double xf = at_openings_outside ? pout_[f] : x[a];
+      out[a] = out[a] + (double(open_[f]) * xf) * m_.Sf[f];
+    } else if (internal(m_, f)) {
+      if (!region_.active(o)) continue;
+      const int nb = m_.neighbour[f];
+      const double xf = interpolate(m_, f, x);
+      out[o] = out[o] + xf * m_.Sf[f];
+      out[nb] = out[nb] - xf * m_.Sf[f];
+    } else if (region_.active(o)) {
+      out[o] = out[o] + x[o] * m_.Sf[f];
+    }
+  }
+  for (int c : region_.cells) out[c] = (1.0 / m_.volume[c]) * out[c];
+}
+
+// phig's snGrad(rho) with the non-orthogonal part: -ghf rAf non_orth . grad(rho)_f on the faces
+// between active cells.
+void PressureEqn::buoyancy_correction(const Fields& F, const Coupling& k) {
+  gauss_gradient(F.rho, false, grad_);
+  const Hydrostatics& hs = bc_ctx_.hydrostatics;
+  for (int f : region_.faces)
+    if (open_[f] == 0 && internal(m_, f) && region_.active(m_.owner[f]))
+      phig_[f] -= hs.ghf(f) * k.rAf[f] * dot(m_.non_orth[f], interpolate(m_, f, grad_));
+}
+
+// The pressure flux's non-orthogonal part from the latest p_rgh, -rAf non_orth . grad(p_rgh)_f, on
+// the faces between active cells (explicit: it goes with the predicted flux).
+void PressureEqn::pressure_correction(const Fields& F, const Coupling& k) {
+  gauss_gradient(F.p_rgh, true, grad_);
+  for (int f : region_.faces) {
+    pcorr_[f] = 0;
+    if (open_[f] == 0 && internal(m_, f) && region_.active(m_.owner[f]))
+      pcorr_[f] = -k.rAf[f] * dot(m_.non_orth[f], interpolate(m_, f, grad_));
   }
 }
 

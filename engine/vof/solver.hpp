@@ -108,6 +108,13 @@ struct VofConfig {
   /// PISO correctors do not converge the stiff viscous coupling"); with the momentum predictor the
   /// outer correctors do.
   int n_outer_correctors = 1;
+  /// Non-orthogonal correctors per pressure corrector (interFoam's nNonOrthogonalCorrectors): the
+  /// pressure equation's Laplacian and the buoyancy's snGrad(rho) take the non-orthogonal part of
+  /// each face's gradient explicitly, from the cells' Gauss gradients (over-relaxed, Mesh::non_orth),
+  /// and the pressure is solved this many more times with the correction from the latest pressure.
+  /// 0 (default): orthogonal parts only, exact on the laboratory's orthogonal meshes; terrain meshes
+  /// (faces between layers follow the slope over vertical columns) need at least 1.
+  int n_non_orthogonal_correctors = 0;
   bool momentum_predictor = false;  ///< solve the momentum matrix before the correctors (see docs/design/vof.md)
   /// The pressure equation's coefficient: false: 1/A (PISO, interFoam); true: the consistent
   /// 1/(A - H1) of SIMPLEC (H1 the sum of the neighbour coefficients), so that in cells where the
