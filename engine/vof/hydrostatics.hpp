@@ -56,11 +56,18 @@ class Hydrostatics {
   double confining_pressure(int c) const { return fields_.p[c] - coulomb_level(gh_[c]); }
   // The last pressure's and the buoyancy's force per area on an internal face, along Sf:
   // -ghf snGrad(rho) - snGrad(p_rgh) (the momentum predictor's and the consistent coupling's F_old).
+  // With VofConfig::n_non_orthogonal_correctors > 0 the face gradients' non-orthogonal parts are
+  // added (update_non_orthogonal_force, from the fields of its last call).
   double face_force(int f) const {
     const int o = m_.owner[f], nb = m_.neighbour[f];
     const double dl = m_.delta_coeff[f];
-    return -ghf_[f] * (fields_.rho[nb] - fields_.rho[o]) * dl - (fields_.p_rgh[nb] - fields_.p_rgh[o]) * dl;
+    const double orth = -ghf_[f] * (fields_.rho[nb] - fields_.rho[o]) * dl - (fields_.p_rgh[nb] - fields_.p_rgh[o]) * dl;
+    return non_orth_ ? orth + non_orth_force_[f] : orth;
   }
+  /// face_force's non-orthogonal parts, -(ghf Mesh::non_orth . grad(rho)_f + Mesh::non_orth .
+  /// grad(p_rgh)_f) / |Sf|, from the cells' Gauss gradients of the current rho and p_rgh (the cell's
+  /// own value on boundary faces). Nothing without non-orthogonal correctors.
+  void update_non_orthogonal_force();
   // The same on an opening (atmosphere, edge of the active region), out of the active cell a, with
   // the outside's p_rgh pout.
   double opening_force(int f, int a, double pout) const { return -(pout - fields_.p_rgh[a]) * m_.delta_coeff[f]; }
@@ -74,6 +81,9 @@ class Hydrostatics {
   CellField<double> gh_;
   FaceField<double> ghf_;
   double gh_ref_ = 0;
+  bool non_orth_ = false;
+  FaceField<double> non_orth_force_;
+  CellField<Vec> grad_rho_, grad_p_;
   Vec g_last_;
   bool gravity_set_ = false;
 };

@@ -307,9 +307,11 @@ StepStats VofSolver::step() {
     if (outer > 0) I.UEqn.update_viscosity(F);  // grad U, nu1 and mu from the latest velocity and pressure
     else I.UEqn.velocity_gradient(F);
     I.UEqn.build(F, dt_);  // ddt(rho, U) + div(rho_phi, U) - laplacian(mu_f, U) = div(mu_f (grad U)^T) + boundaries
+    I.hydrostatics.update_non_orthogonal_force();  // the last pressure's force (non-orthogonal meshes)
     if (cfg_.momentum_predictor) st.momentum_iterations += I.UEqn.predict(F, t_);
     for (int k = 0; k < n_corr; ++k) {
       I.UEqn.update_HbyA(F);
+      if (cfg_.consistent && k > 0) I.hydrostatics.update_non_orthogonal_force();
       const auto tp = clk::now();
       const bool final = outer + 1 == n_outer && k + 1 == n_corr;
       st.pressure_iterations += I.pEqn.correct(F, I.UEqn, false, k > 0, final, t_);  // p_rgh, phi, U
