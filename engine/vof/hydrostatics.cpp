@@ -1,5 +1,7 @@
 #include "engine/vof/hydrostatics.hpp"
 
+#include "engine/vof/fv/ops.hpp"
+
 #include <algorithm>
 
 namespace runout::engine::vof {
@@ -15,42 +17,16 @@ Hydrostatics::Hydrostatics(const Mesh& m, const VofConfig& cfg, const Fields& fi
 void Hydrostatics::resize() {
   gh_.assign(m_.cells(), 0);
   ghf_.assign(m_.faces(), 0);
-  if (non_orth_) {
-    non_orth_force_.assign(m_.faces(), 0);
-    grad_rho_.assign(m_.cells(), Vec{});
-    grad_p_.assign(m_.cells(), Vec{});
-  }
+  if (non_orth_) non_orth_force_.assign(m_.faces(), 0);
 }
 
 void Hydrostatics::update_non_orthogonal_force() {
   if (!non_orth_) return;
-  const int nc = m_.cells(), nf = m_.faces();
-  for (int c = 0; c < nc; ++c) grad_rho_[c] = grad_p_[c] = Vec{};
-  for (int f = 0; f < nf; ++f) {
-    const int o = m_.owner[f];
-    if (f < m_.n_internal) {
-      const int nb = m_.neighbour[f];
-      const double w = m_.weight[f];
-      const double rf = w * fields_.rho[o] + (1 - w) * fields_.rho[nb], pf = w * fields_.p_rgh[o] + (1 - w) * fields_.p_rgh[nb];
-      grad_rho_[o] = grad_rho_[o] + rf * m_.Sf[f];
-      grad_rho_[nb] = grad_rho_[nb] - rf * m_.Sf[f];
-      grad_p_[o] = grad_p_[o] + pf * m_.Sf[f];
-      grad_p_[nb] = grad_p_[nb] - pf * m_.Sf[f];
-    } else {
-      grad_rho_[o] = grad_rho_[o] + fields_.rho[o] * m_.Sf[f];
-      grad_p_[o] = grad_p_[o] + fields_.p_rgh[o] * m_.Sf[f];
-    }
-  }
-  for (int c = 0; c < nc; ++c) {
-    grad_rho_[c] = (1.0 / m_.volume[c]) * grad_rho_[c];
-    grad_p_[c] = (1.0 / m_.volume[c]) * grad_p_[c];
-  }
+  gauss_gradient(m_, fields_.rho, grad_rho_);
+  gauss_gradient(m_, fields_.p_rgh, grad_p_);
   for (int f = 0; f < m_.n_internal; ++f) {
-    const int o = m_.owner[f], nb = m_.neighbour[f];
-    const double w = m_.weight[f];
     const Vec& k = m_.non_orth[f];
-    const double kr = w * dot(k, grad_rho_[o]) + (1 - w) * dot(k, grad_rho_[nb]);
-    const double kp = w * dot(k, grad_p_[o]) + (1 - w) * dot(k, grad_p_[nb]);
+    const double kr = dot(k, interpolate(m_, f, grad_rho_)), kp = dot(k, interpolate(m_, f, grad_p_));
     non_orth_force_[f] = -(ghf_[f] * kr + kp) / m_.magSf[f];
   }
 }

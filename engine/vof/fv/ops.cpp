@@ -2,6 +2,21 @@
 
 namespace runout::engine::vof {
 
+void gauss_gradient(const Mesh& m, const CellField<double>& x, CellField<Vec>& out) {
+  out.assign(std::size_t(m.cells()), Vec{});
+  for (int f = 0; f < m.faces(); ++f) {
+    const int o = m.owner[f];
+    if (internal(m, f)) {
+      const double xf = interpolate(m, f, x);
+      out[o] = out[o] + xf * m.Sf[f];
+      out[m.neighbour[f]] = out[m.neighbour[f]] - xf * m.Sf[f];
+    } else {
+      out[o] = out[o] + x[o] * m.Sf[f];
+    }
+  }
+  for (int c = 0; c < m.cells(); ++c) out[c] = (1.0 / m.volume[c]) * out[c];
+}
+
 void CellFaces::build(const Mesh& m) {
   const int nc = m.cells(), nf = m.faces();
   start.assign(std::size_t(nc) + 1, 0);

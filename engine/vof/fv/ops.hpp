@@ -51,6 +51,10 @@ inline double strain_rate(const Tensor& gr) {
   return std::sqrt(2 * dd);
 }
 
+/// fvc::grad(x), Gauss linear over the whole mesh: face values interpolated linearly, the cell's own
+/// on boundary faces (zero gradient), into `out`.
+void gauss_gradient(const Mesh& m, const CellField<double>& x, CellField<Vec>& out);
+
 /// The faces of each cell in ascending order, stored flat.
 struct CellFaces {
   std::vector<int> start, face_list;
