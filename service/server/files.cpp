@@ -91,9 +91,11 @@ void Server::Impl::collect_uploads(const std::vector<std::string>& only, const s
   }
   for (const auto& id : drop) {
     if (used.count(id)) continue;
+    // The record first, then the folder: whoever sees the folder gone sees its bytes off the quota
+    // (a crash in between leaves a folder without a record, collected by its age above).
+    store->forget_upload(id);
     std::error_code ec;
     fs::remove_all(fs::path(cfg.state_dir()) / "uploads" / id, ec);
-    store->forget_upload(id);
     log("upload " + id.substr(0, 12) + " removed (" +
         (owner.empty() ? "unused for longer than the upload time-to-live" : "its submission was refused") + ")");
   }
