@@ -12,7 +12,8 @@ Hydrostatics::Hydrostatics(const Mesh& m, const VofConfig& cfg, const Fields& fi
       gravity_(cfg.gravity),
       rho2_(cfg.rho2),
       excess_(cfg.coulomb_pressure == CoulombPressure::excess),
-      non_orth_(cfg.n_non_orthogonal_correctors > 0) {}
+      non_orth_(cfg.n_non_orthogonal_correctors > 0),
+      limiter_(cfg.non_orthogonal_limiter) {}
 
 void Hydrostatics::resize() {
   gh_.assign(m_.cells(), 0);
@@ -22,12 +23,12 @@ void Hydrostatics::resize() {
 
 void Hydrostatics::update_non_orthogonal_force() {
   if (!non_orth_) return;
-  gauss_gradient(m_, fields_.rho, grad_rho_);
-  gauss_gradient(m_, fields_.p_rgh, grad_p_);
+  gauss_gradient_hydrostatic(m_, fields_.p, fields_.rho, gh_, ghf_, grad_p_);
   for (int f = 0; f < m_.n_internal; ++f) {
     const Vec& k = m_.non_orth[f];
-    const double kr = dot(k, interpolate(m_, f, grad_rho_)), kp = dot(k, interpolate(m_, f, grad_p_));
-    non_orth_force_[f] = -(ghf_[f] * kr + kp) / m_.magSf[f];
+    const double rho_f = interpolate(m_, f, fields_.rho);
+    const double corr = -(dot(k, interpolate(m_, f, grad_p_)) - rho_f * dot(k, g_last_)) / m_.magSf[f];
+    non_orth_force_[f] = limited_correction(corr, orthogonal_force(f), limiter_);
   }
 }
 

@@ -3,6 +3,7 @@
 // level x_ref (the highest point open to the atmosphere), the still air's pressure outside the
 // domain's openings and the active region, the pressure on a wall face, the confining pressure of
 // the Coulomb viscosity, and the last pressure's and the buoyancy's force per area on a face.
+#include <cmath>
 #include <functional>
 #include <vector>
 
@@ -10,6 +11,14 @@
 #include "engine/vof/solver.hpp"
 
 namespace runout::engine::vof {
+
+/// A face gradient's non-orthogonal correction limited as OpenFOAM's "limited corrected psi": at
+/// most psi / (1 - psi) times the orthogonal part (psi >= 1: unlimited; 0: no correction).
+inline double limited_correction(double corr, double orth, double psi) {
+  if (psi >= 1) return corr;
+  const double lim = psi / (1 - psi) * std::abs(orth);
+  return std::abs(corr) > lim ? corr * (lim / std::abs(corr)) : corr;
+}
 
 class Hydrostatics {
  public:
@@ -58,15 +67,24 @@ class Hydrostatics {
   // -ghf snGrad(rho) - snGrad(p_rgh) (the momentum predictor's and the consistent coupling's F_old).
   // With VofConfig::n_non_orthogonal_correctors > 0 the face gradients' non-orthogonal parts are
   // added (update_non_orthogonal_force, from the fields of its last call).
+  /// Gravity at the time of the last update().
+  const Vec& gravity() const { return g_last_; }
   double face_force(int f) const {
-    const int o = m_.owner[f], nb = m_.neighbour[f];
-    const double dl = m_.delta_coeff[f];
-    const double orth = -ghf_[f] * (fields_.rho[nb] - fields_.rho[o]) * dl - (fields_.p_rgh[nb] - fields_.p_rgh[o]) * dl;
+    const double orth = orthogonal_force(f);
     return non_orth_ ? orth + non_orth_force_[f] : orth;
   }
-  /// face_force's non-orthogonal parts, -(ghf Mesh::non_orth . grad(rho)_f + Mesh::non_orth .
-  /// grad(p_rgh)_f) / |Sf|, from the cells' Gauss gradients of the current rho and p_rgh (the cell's
-  /// own value on boundary faces). Nothing without non-orthogonal correctors.
+  // face_force's orthogonal part: from the two cells' values along the line joining them.
+  double orthogonal_force(int f) const {
+    const int o = m_.owner[f], nb = m_.neighbour[f];
+    const double dl = m_.delta_coeff[f];
+    return -ghf_[f] * (fields_.rho[nb] - fields_.rho[o]) * dl - (fields_.p_rgh[nb] - fields_.p_rgh[o]) * dl;
+  }
+  /// face_force's non-orthogonal part, -(Mesh::non_orth . grad(p)_f - rho_f Mesh::non_orth . g) /
+  /// |Sf|, from the cells' Gauss gradient of the current pressure p (the cell's own value on boundary
+  /// faces), limited by VofConfig::non_orthogonal_limiter against the orthogonal part. The same as
+  /// the non-orthogonal parts of -ghf snGrad(rho) - snGrad(p_rgh), but from p, which is continuous
+  /// across the interface where p_rgh jumps by (rho1 - rho2) g.(x - x_ref) (docs/design/vof.md).
+  /// Nothing without non-orthogonal correctors.
   void update_non_orthogonal_force();
   // The same on an opening (atmosphere, edge of the active region), out of the active cell a, with
   // the outside's p_rgh pout.
@@ -82,8 +100,9 @@ class Hydrostatics {
   FaceField<double> ghf_;
   double gh_ref_ = 0;
   bool non_orth_ = false;
+  double limiter_ = 1;  // VofConfig::non_orthogonal_limiter
   FaceField<double> non_orth_force_;
-  CellField<Vec> grad_rho_, grad_p_;
+  CellField<Vec> grad_p_;
   Vec g_last_;
   bool gravity_set_ = false;
 };

@@ -14,6 +14,7 @@ PressureEqn::PressureEqn(const Mesh& m, const VofConfig& cfg, const BcContext& b
   pout_ = phiHbyA_;
   pcorr_ = phiHbyA_;
   grad_.assign(nc, Vec{});
+  p_now_.assign(nc, 0.0);
   open_.assign(nf, 0);
   rec_.assign(nc, Vec{});
   rec_old_ = rec_;
@@ -36,7 +37,6 @@ int PressureEqn::correct(Fields& F, const MomentumEqn& UEqn, bool initial, bool 
   const int n_non_orth = std::max(0, cfg_.n_non_orthogonal_correctors);
   if (!reuse) {
     laplacian_coefficients(F, k);
-    if (n_non_orth > 0) buoyancy_correction(F, k);
   }
   // The non-orthogonal correctors solve again with the correction from the latest pressure, the
   // matrix kept; the flux takes the last correction (interFoam's nNonOrthogonalCorrectors loop).
@@ -217,47 +217,51 @@ void PressureEqn::correct_flux_and_velocity(Fields& F, const MomentumEqn& UEqn, 
   }
 }
 
-// The Gauss gradient of x over the active region: face values interpolated between active cells,
-// the cell's own on walls, and at openings the outside's p_rgh (at_openings_outside) or the cell's.
-void PressureEqn::gauss_gradient(const CellField<double>& x, bool at_openings_outside, CellField<Vec>& out) const {
+// The Gauss gradient of the pressure p over the active region: face values interpolated between
+// active cells; on walls and openings the cell's p carried hydrostatically to the face,
+// p + rho (ghf - gh) (the zero gradient of p_rgh that the walls' flux assumes: p itself has the
+// weight's gradient there).
+void PressureEqn::pressure_gradient(const Fields& F, const CellField<double>& p, CellField<Vec>& out) const {
+  const Hydrostatics& hs = bc_ctx_.hydrostatics;
   for (int c : region_.cells) out[c] = Vec{};
   for (int f : region_.faces) {
     const int o = m_.owner[f];
     if (open_[f] != 0) {
       const int a = open_[f] > 0 ? o : m_.neighbour[f];
-      const double xf = at_openings_outside ? pout_[f] : x[a];
-      out[a] = out[a] + (double(open_[f]) * xf) * m_.Sf[f];
+      const double pf = p[a] + F.rho[a] * (hs.ghf(f) - hs.gh(a));
+      out[a] = out[a] + (double(open_[f]) * pf) * m_.Sf[f];
     } else if (internal(m_, f)) {
       if (!region_.active(o)) continue;
       const int nb = m_.neighbour[f];
-      const double xf = interpolate(m_, f, x);
-      out[o] = out[o] + xf * m_.Sf[f];
-      out[nb] = out[nb] - xf * m_.Sf[f];
+      const double pf = interpolate(m_, f, p);
+      out[o] = out[o] + pf * m_.Sf[f];
+      out[nb] = out[nb] - pf * m_.Sf[f];
     } else if (region_.active(o)) {
-      out[o] = out[o] + x[o] * m_.Sf[f];
+      out[o] = out[o] + (p[o] + F.rho[o] * (hs.ghf(f) - hs.gh(o))) * m_.Sf[f];
     }
   }
   for (int c : region_.cells) out[c] = (1.0 / m_.volume[c]) * out[c];
 }
 
-// phig's snGrad(rho) with the non-orthogonal part: -ghf rAf non_orth . grad(rho)_f on the faces
-// between active cells.
-void PressureEqn::buoyancy_correction(const Fields& F, const Coupling& k) {
-  gauss_gradient(F.rho, false, grad_);
-  const Hydrostatics& hs = bc_ctx_.hydrostatics;
-  for (int f : region_.faces)
-    if (open_[f] == 0 && internal(m_, f) && region_.active(m_.owner[f]))
-      phig_[f] -= hs.ghf(f) * k.rAf[f] * dot(m_.non_orth[f], interpolate(m_, f, grad_));
-}
-
-// The pressure flux's non-orthogonal part from the latest p_rgh, -rAf non_orth . grad(p_rgh)_f, on
-// the faces between active cells (explicit: it goes with the predicted flux).
+// The face force's non-orthogonal part from the latest pressure, -rAf (non_orth . grad(p)_f -
+// rho_f non_orth . g), limited against the orthogonal part (VofConfig::non_orthogonal_limiter), on
+// the faces between active cells (explicit: it goes with the predicted flux). It is the
+// non-orthogonal part of -ghf snGrad(rho) - snGrad(p_rgh), taken from p, which is continuous across
+// the interface, where p_rgh jumps by (rho1 - rho2) g.(x - x_ref) and its cell gradients would carry
+// the jump into the neighbouring cells (docs/design/vof.md).
 void PressureEqn::pressure_correction(const Fields& F, const Coupling& k) {
-  gauss_gradient(F.p_rgh, true, grad_);
+  const Hydrostatics& hs = bc_ctx_.hydrostatics;
+  for (int c : region_.cells) p_now_[c] = F.p_rgh[c] + F.rho[c] * hs.gh(c);
+  pressure_gradient(F, p_now_, grad_);
+  const Vec& g = hs.gravity();
   for (int f : region_.faces) {
     pcorr_[f] = 0;
-    if (open_[f] == 0 && internal(m_, f) && region_.active(m_.owner[f]))
-      pcorr_[f] = -k.rAf[f] * dot(m_.non_orth[f], interpolate(m_, f, grad_));
+    if (open_[f] != 0 || !internal(m_, f) || !region_.active(m_.owner[f])) continue;
+    const Vec& kv = m_.non_orth[f];
+    const int o = m_.owner[f], nb = m_.neighbour[f];
+    const double corr = -(dot(kv, interpolate(m_, f, grad_)) - interpolate(m_, f, F.rho) * dot(kv, g));
+    const double orth = -(hs.ghf(f) * (F.rho[nb] - F.rho[o]) + (F.p_rgh[nb] - F.p_rgh[o])) * m_.delta_coeff[f] * m_.magSf[f];
+    pcorr_[f] = k.rAf[f] * limited_correction(corr, orth, cfg_.non_orthogonal_limiter);
   }
 }
 

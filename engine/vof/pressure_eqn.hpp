@@ -38,11 +38,10 @@ class PressureEqn {
   void assemble(const Fields& F, bool reuse);
   void correct_flux_and_velocity(Fields& F, const MomentumEqn& UEqn, bool initial, const Coupling& k);
   void fix_level(Fields& F);
-  // The non-orthogonal correction (VofConfig::n_non_orthogonal_correctors): Gauss gradients of rho
-  // (for phig) and of p_rgh over the active region, and per face -rAf non_orth . grad(p_rgh)_f.
-  void buoyancy_correction(const Fields& F, const Coupling& k);
+  // The non-orthogonal correction (VofConfig::n_non_orthogonal_correctors): the Gauss gradient of p
+  // over the active region, and per face its part of the face force with gravity's, limited.
   void pressure_correction(const Fields& F, const Coupling& k);
-  void gauss_gradient(const CellField<double>& x, bool at_openings_outside, CellField<Vec>& out) const;
+  void pressure_gradient(const Fields& F, const CellField<double>& p, CellField<Vec>& out) const;
 
   const Mesh& m_;
   const VofConfig& cfg_;
@@ -59,7 +58,8 @@ class PressureEqn {
   // neighbour) and the pressure outside.
   FaceField<double> phiHbyA_, phig_, pout_;
   FaceField<double> pcorr_;  // the non-orthogonal part of the pressure flux (0 without correctors)
-  CellField<Vec> grad_;      // a Gauss gradient (the non-orthogonal correction's)
+  CellField<Vec> grad_;      // the Gauss gradient of p (the non-orthogonal correction's)
+  CellField<double> p_now_;  // p from the latest p_rgh
   FaceField<signed char> open_;
   CellField<Vec> rec_, rec_old_;  // sums of face forces times Sf for the reconstruction
   std::vector<double> diag_rows_, rhs_rows_, x_rows_;

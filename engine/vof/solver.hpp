@@ -59,6 +59,10 @@ struct PatchBc {
   /// The condition by its name in the registry (engine/vof/bc/registry.cpp), for kinds without a
   /// Bc value; empty: `kind`'s.
   std::string type = {};
+  /// Coulomb friction: cells on the bed with at least this much material take the friction (the rest a
+  /// wall's shear). 0.5 suits resolved fronts; on coarse terrain grids a front's ground cells are
+  /// partly filled and need the friction too (the terrain driver takes 0.01).
+  double friction_min_alpha = 0.5;
 };
 
 /// How the viscous stress's transpose part is taken (VofConfig::viscous_transpose).
@@ -115,6 +119,14 @@ struct VofConfig {
   /// 0 (default): orthogonal parts only, exact on the laboratory's orthogonal meshes; terrain meshes
   /// (faces between layers follow the slope over vertical columns) need at least 1.
   int n_non_orthogonal_correctors = 0;
+  /// The non-orthogonal correction's limiter psi, as OpenFOAM's "limited corrected psi" snGrad: on
+  /// each face the correction of the face force (pressure and buoyancy together) is at most
+  /// psi / (1 - psi) times its orthogonal part. 1 (default): unlimited. Across the interface of a
+  /// layer on a slope the cells' Gauss gradients mix the material's pressure gradient into the air's
+  /// cells, and unlimited corrections there drive the air at 100 m/s (docs/design/vof.md); 0.5 keeps
+  /// the correction where the orthogonal part carries a force (the material) and removes it where the
+  /// air rests hydrostatically.
+  double non_orthogonal_limiter = 1.0;
   bool momentum_predictor = false;  ///< solve the momentum matrix before the correctors (see docs/design/vof.md)
   /// The pressure equation's coefficient: false: 1/A (PISO, interFoam); true: the consistent
   /// 1/(A - H1) of SIMPLEC (H1 the sum of the neighbour coefficients), so that in cells where the

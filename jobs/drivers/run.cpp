@@ -3,7 +3,9 @@
 #include "jobs/digest/sha256.hpp"
 
 #include "jobs/drivers/vof_lab/run.hpp"
+#include "jobs/drivers/hazard_outputs.hpp"
 #include "jobs/drivers/record_head.hpp"
+#include "jobs/drivers/vof_terrain/run.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -26,41 +28,6 @@ namespace {
 
 double since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-// Figures of the hazard map: maximum depth, the affected area and the runout from the release's
-// centroid; a non-finite figure is an error (the engine stops a run whose state turns non-finite).
-void hazard_figures(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::Sh2dResult& res,
-                    RunSummary& sum) {
-  const auto& d = res.diag;
-  const auto& hz = res.hazard;
-  double mx = 0, my = 0, m = 0;
-  for (int j = 0; j < grid.ny; ++j)
-    for (int i = 0; i < grid.nx; ++i) {
-      const double v = h0[std::size_t(j) * grid.nx + i];
-      m += v;
-      mx += v * grid.cx(i);
-      my += v * grid.cy(j);
-    }
-  mx /= m;
-  my /= m;
-  long affected = 0;
-  for (int j = 0; j < grid.ny; ++j)
-    for (int i = 0; i < grid.nx; ++i) {
-      const std::size_t k = std::size_t(j) * grid.nx + i;
-      sum.max_depth = std::max(sum.max_depth, hz.max_depth[k]);
-      if (hz.max_depth[k] <= s.outline_threshold) continue;
-      ++affected;
-      sum.runout_m = std::max(sum.runout_m, std::hypot(grid.cx(i) - mx, grid.cy(j) - my));
-    }
-  sum.affected_area_m2 = double(affected) * grid.dx * grid.dx;
-  // The engine stops a run whose state turns non-finite; this guards what the records would say.
-  for (const auto& [name, v] : {std::pair<const char*, double>{"final volume", d.volume_final}, {"outflow volume", d.volume_outflow},
-                                {"maximum speed", d.max_speed}, {"maximum depth", sum.max_depth},
-                                {"kinetic-energy peak", d.kinetic_energy_peak}, {"runout", sum.runout_m}})
-    if (!std::isfinite(v))
-      throw std::runtime_error(std::string("the run's ") + name + " is not finite (" + json_number(v) +
-                               "): the flow state became NaN or infinite; no results written");
 }
 
 // run.json of a depth-averaged run; continued_from: NaN for a run not continued from a checkpoint.
@@ -128,19 +95,6 @@ void write_record(const std::string& path, const ResolvedScenario& s, const terr
   write_run_record(path, rec);
 }
 
-// The engine's grid: the prepared grid with its local origin at the grid's centre.
-engine::Terrain2D engine_terrain(const terrain::Grid& grid) {
-  engine::Terrain2D t;
-  t.nx = grid.nx;
-  t.ny = grid.ny;
-  t.dx = t.dy = grid.dx;
-  t.x0 = -0.5 * (grid.nx - 1) * grid.dx;
-  t.y0 = -0.5 * (grid.ny - 1) * grid.dx;
-  t.z = grid.z;
-  t.outside = grid.outside;
-  return t;
-}
-
 // The checkpoint a run continues from, checked against the scenario (its hash) and the grid.
 ShCheckpoint load_restart(const RunOptions& opt, const std::string& hash, const engine::Terrain2D& t, int tile) {
   ShCheckpoint restart = read_sh_checkpoint(opt.restart_path);
@@ -152,34 +106,10 @@ ShCheckpoint load_restart(const RunOptions& opt, const std::string& hash, const 
   return restart;
 }
 
-// The hazard rasters the scenario asks for (hazard_rasters()), the outline and the map; their names
-// go to sum.files.
-terrain::OutlineReport write_hazard_outputs(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0,
-                                            const engine::HazardMaps& hz, const std::string& out_dir, RunSummary& sum) {
-  auto out = [&](const std::string& name) { return (fs::path(out_dir) / name).string(); };
-  for (const auto& name : s.rasters)
-    for (const auto& r : hazard_rasters())
-      if (r.name == name) {
-        terrain::write_cog(out(name + ".tif"), grid, terrain::masked_outside(grid, hz.*r.map), r.description);
-        sum.files.push_back(name + ".tif");
-      }
-  const auto outline = terrain::write_outline(out("outline.geojson"), out("outline.gpkg"), grid, hz.max_depth, s.outline_threshold);
-  if (outline.geojson) sum.files.push_back("outline.geojson");
-  else sum.notes.push_back("outline.geojson not written: the grid's CRS is local (no geographic coordinates)");
-  sum.files.push_back("outline.gpkg");
-  figures::MapRequest mreq;
-  mreq.title = s.scenario.name().empty() ? "runout" : s.scenario.name();
-  if (mreq.title.size() > 60) mreq.title = mreq.title.substr(0, 57) + "...";
-  mreq.outline_threshold = s.outline_threshold;
-  mreq.scale = grid.nx * grid.ny > 1000000 ? 1 : 2;
-  figures::write_map_png(out("map.png"), grid, hz.max_depth, h0, mreq);
-  sum.files.push_back("map.png");
-  return outline;
-}
-
 }  // namespace
 
 RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt) {
+  if (s.terrain) return run_terrain_vof(s, out_dir, opt);
   if (s.vof) return run_lab(s, out_dir, opt);
   RunSummary sum;
   const auto t0 = std::chrono::steady_clock::now();
@@ -251,7 +181,9 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   sum.stop = std::string(engine::to_string(d.stop));
   sum.max_speed = d.max_speed;
 
-  hazard_figures(s, grid, h0, res, sum);
+  hazard_figures(s, grid, h0, res.hazard, sum);
+  require_finite_figures({{"final volume", d.volume_final}, {"outflow volume", d.volume_outflow}, {"maximum speed", d.max_speed},
+                          {"maximum depth", sum.max_depth}, {"kinetic-energy peak", d.kinetic_energy_peak}, {"runout", sum.runout_m}});
 
   // Outputs.
   const auto t2 = std::chrono::steady_clock::now();

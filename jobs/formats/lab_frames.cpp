@@ -69,16 +69,19 @@ void LabFrameWriter::continue_frames(const std::string& continue_from, double t_
 
 void LabFrameWriter::write_centres(const std::vector<vof::Vec>& centres) {
   const auto& g = g_;
-  std::vector<float> xyz(3 * g.cell.size(), NAN);
+  std::vector<double> xyz(3 * g.cell.size(), NAN);
   for (std::size_t q = 0; q < g.cell.size(); ++q)
     if (const int c = g.cell[q]; c >= 0) {
       const auto& v = centres[std::size_t(c)];
-      xyz[3 * q] = float(v.x), xyz[3 * q + 1] = float(v.y), xyz[3 * q + 2] = float(v.z);
+      if (g.georeferenced) xyz[3 * q] = g.origin_east + v.x, xyz[3 * q + 1] = g.origin_north - v.z, xyz[3 * q + 2] = g.origin_elevation + v.y;
+      else xyz[3 * q] = v.x, xyz[3 * q + 1] = v.y, xyz[3 * q + 2] = v.z;
     }
   const hsize_t dims[4] = {hsize_t(g.nz), hsize_t(g.ny), hsize_t(g.nx), 3};
   hid_t sp = H5Screate_simple(4, dims, nullptr);
-  hid_t ds = H5Dcreate2(file_, "centres", H5T_IEEE_F32LE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-  const herr_t st = H5Dwrite(ds, H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, xyz.data());
+  // Georeferenced centres in Float64: projected coordinates of millions of metres keep their
+  // centimetres; a chute's in Float32 as its fields.
+  hid_t ds = H5Dcreate2(file_, "centres", g.georeferenced ? H5T_IEEE_F64LE : H5T_IEEE_F32LE, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+  const herr_t st = H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, xyz.data());
   H5Dclose(ds);
   H5Sclose(sp);
   if (st < 0) {
@@ -101,9 +104,10 @@ void LabFrameWriter::write(double t, const vof::VofSolver& s) {
     if (c < 0) continue;
     const auto k = std::size_t(c);
     a[q] = float(s.alpha()[k]);
-    ux[q] = float(s.velocity()[k].x);
-    uy[q] = float(s.velocity()[k].y);
-    uz[q] = float(s.velocity()[k].z);
+    const auto& u = s.velocity()[k];
+    ux[q] = float(u.x);
+    uy[q] = float(g_.georeferenced ? -u.z : u.y);  // north
+    uz[q] = float(g_.georeferenced ? u.y : u.z);   // up
     p[q] = float(s.pressure()[k]);
     nu[q] = float(s.viscosity()[k]);
   }
@@ -168,7 +172,8 @@ void LabFrameWriter::write_xdmf() const {
     if (curvilinear_) {  // the values at the cell centres as they lie (a curved chute)
       x << "    <Topology TopologyType=\"3DSMesh\" Dimensions=\"" << dims.str() << "\"/>\n";
       x << "    <Geometry GeometryType=\"XYZ\">\n     <DataItem Dimensions=\"" << dims.str()
-        << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">fields.h5:/centres</DataItem>\n    </Geometry>\n";
+        << " 3\" NumberType=\"Float\" Precision=\"" << (g.georeferenced ? 8 : 4)
+        << "\" Format=\"HDF\">fields.h5:/centres</DataItem>\n    </Geometry>\n";
     } else if (g.three_d) {
       x << "    <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"" << dims.str() << "\"/>\n";
       x << "    <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n     <DataItem Dimensions=\"3\" Format=\"XML\">" << g.z0 + 0.5 * g.dz << " "

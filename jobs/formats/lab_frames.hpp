@@ -2,7 +2,7 @@
 // Frames of a VOF laboratory run for ParaView: fields.h5 (one group per frame: alpha, velocity,
 // pressure and granular viscosity on the lab block's grid, Float32, blocked cells NaN) plus
 // fields.xmf, a temporal collection on the cell centres (co-rectilinear, or the cell centres as they
-// lie on a curved chute). The depth-averaged engine's counterpart is timeseries.hpp; both hold
+// lie on a curved chute or over terrain, there in the grid's CRS with z up). The depth-averaged engine's counterpart is timeseries.hpp; both hold
 // hdf5_mutex() for every HDF5 call.
 #include <cstdint>
 #include <string>
@@ -19,6 +19,10 @@ struct FrameGrid {
   bool three_d = false;
   double x0 = 0, y0 = 0, z0 = 0, dx = 0, dy = 0, dz = 0;
   std::vector<int> cell;
+  /// Terrain runs: the engine's frame (x east, y up, z south, from `origin`) written in the grid's
+  /// CRS, z up: the cell centres (east, north, elevation; Float64) and the velocity (east, north, up).
+  bool georeferenced = false;
+  double origin_east = 0, origin_north = 0, origin_elevation = 0;
   std::size_t at(int i, int j, int k) const { return (std::size_t(k) * std::size_t(ny) + std::size_t(j)) * std::size_t(nx) + std::size_t(i); }
   int id(int i, int j, int k) const { return cell[at(i, j, k)]; }
 };

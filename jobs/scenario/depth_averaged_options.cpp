@@ -51,7 +51,7 @@ const OptionTable& scenario_options() {
   static const OptionTable t = {
       {"name", T::text, U::as_given, "", {}, {}, "", "free text, copied to the run record", "run record"},
       {"engine", T::choice, U::fill, "depth-averaged", {}, {"depth-averaged", "vof"}, "",
-       "the engine: depth-averaged (Savage-Hutter, on a DEM) or vof (the laboratory set-up of `lab`)", "ResolvedScenario::vof",
+       "the engine: depth-averaged (Savage-Hutter, on a DEM) or vof (3D: on the DEM, or the laboratory set-up of `lab`)", "ResolvedScenario::vof",
        "", [](const S& s, R& r) { r.vof = s.engine() == "vof"; }},
       {"limits.max_wall_s", T::number, U::as_given, "", {}, {}, "s",
        "the service's wall-time limit of one attempt (checked by the server); not part of the hash", "the service's job", "the server's"},

@@ -75,6 +75,7 @@ void check_boundaries(const v1::Lab& l, bool three_d) {
 
 ResolvedScenario resolve_lab(v1::Scenario s) {
   if (!s.has_lab()) bad("lab", "engine \"vof\" needs the lab block (domain, cells, fill, boundaries)");
+  if (s.has_mesh() || s.has_vof()) bad(s.has_mesh() ? "mesh" : "vof", "not used by a laboratory set-up (`lab`)");
   apply_option_rules(lab_options(), s);
   const auto& l = s.lab();
   if (!(l.x_max() > l.x_min())) bad("lab.x_max", "must exceed lab.x_min");

@@ -70,8 +70,11 @@ using OptionTable = std::vector<Option>;
 const OptionTable& scenario_options();
 /// engine "depth-averaged": dem, area_of_interest, grid, releases, material, numerics, outputs.
 const OptionTable& depth_averaged_options();
-/// engine "vof": the `lab` block.
+/// engine "vof" with a `lab` block: the laboratory set-up.
 const OptionTable& lab_options();
+/// engine "vof" without `lab`: the 3D engine on the DEM, blocks `mesh` and `vof` (with the
+/// depth-averaged table's DEM, releases, material, numerics and outputs).
+const OptionTable& terrain_vof_options();
 
 /// A granular material of the laboratory cases (lab.material; validation.md part B).
 struct LabMaterial {

@@ -68,6 +68,15 @@ part on curved terrain unless `numerics.curvature_off`); `engine/friction/` hold
 
 )" + friction_laws_markdown() +
          R"(
+## 3D engine on the DEM (`engine` "vof" without `lab`)
+
+The DEM, area of interest, grid, releases, material, `numerics.end_time_s`,
+`numerics.stop_fraction` and outputs are the depth-averaged engine's fields above; the material must
+be `coulomb` with `internal_friction_deg` (the Coulomb viscosity) and `bed_friction_deg`. The other
+`numerics` fields do not apply. docs/design/vof.md, "Meshes over terrain", describes the mesh.
+
+)" + option_table_markdown(terrain_vof_options()) +
+         R"(
 ## VOF laboratory (`engine` "vof", block `lab`)
 
 )" + option_table_markdown(lab_options()) +

@@ -213,20 +213,37 @@ void check_material(const v1::Material& m, const engine::Material& mat) {
   }
 }
 
+// The 3D engine on the DEM: a Coulomb material with both friction angles.
+void check_terrain_vof(const v1::Scenario& s) {
+  const auto& m = s.material();
+  if (m.rheology() != "coulomb") bad("material.rheology", "the 3D engine takes \"coulomb\" only (got \"" + m.rheology() + "\")");
+  if (!m.has_internal_friction_deg()) bad("material.internal_friction_deg", "needed by the 3D engine's Coulomb viscosity");
+  if (!m.has_bed_friction_deg()) bad("material.bed_friction_deg", "needed by the 3D engine's bed condition");
+  const auto& me = s.mesh();
+  if (me.has_first_layer_m() && me.has_band_height_m() && !(me.band_height_m() > me.first_layer_m()))
+    bad("mesh.band_height_m", "must exceed mesh.first_layer_m");
+}
+
 }  // namespace
 
 ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   apply_option_rules(scenario_options(), s);
-  if (s.engine() == "vof") return resolve_lab(std::move(s));
-  // The option table fills the defaults and checks every field's range or choices; the checks
+  const bool vof = s.engine() == "vof";
+  if (vof && s.has_lab()) return resolve_lab(std::move(s));
+  if (!vof && (s.has_mesh() || s.has_vof()))
+    bad(s.has_mesh() ? "mesh" : "vof", "only for engine \"vof\" (the 3D engine on the DEM)");
+  // The option tables fill the defaults and check every field's range or choices; the checks
   // between fields and the input files follow.
   apply_option_rules(depth_averaged_options(), s);
+  if (vof) apply_option_rules(terrain_vof_options(), s);
   ResolvedScenario r;
   resolve_inputs(s, base, r);
   resolve_releases(s, base, r);
   map_options(scenario_options(), s, r);
   map_options(depth_averaged_options(), s, r);
+  if (vof) check_terrain_vof(s);  // first: the 3D engine takes one friction law
   check_material(s.material(), r.config.material);
+  r.terrain = vof;
   require_finite(s, "");
   r.scenario = std::move(s);
   return r;

@@ -26,7 +26,12 @@ struct ResolvedScenario {
   double outline_threshold = 0.1;
   double timeseries_interval = 0;  ///< [s]; 0: no time series
   std::vector<std::string> input_files;  ///< for hashing
-  bool vof = false;  ///< engine "vof": the `lab` block holds the set-up; DEM and releases unused
+  bool vof = false;  ///< engine "vof": a laboratory set-up (`lab`) or, with `terrain`, on the DEM
+  /// engine "vof" without `lab`: the 3D engine on the DEM and releases (blocks `mesh` and `vof`;
+  /// config holds the material, end time and stop rule as for the depth-averaged engine).
+  bool terrain = false;
+  /// The simulated time the run goes to at most [s].
+  double end_time_s() const { return vof && !terrain ? scenario.lab().end_time_s() : config.time.t_end; }
 };
 
 /// The version of what a VOF run's results contain (run.json, the fields) for an unchanged scenario.

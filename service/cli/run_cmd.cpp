@@ -185,7 +185,7 @@ int run(const std::vector<std::string>& args) {
   opt.iseesnow_id = iseesnow;
   opt.checkpoint_path = checkpoint;
   opt.restart_path = restart;
-  const double t_end = resolved.vof ? resolved.scenario.lab().end_time_s() : resolved.config.time.t_end;
+  const double t_end = resolved.end_time_s();
   opt.progress = [&](const engine::Progress& p) {
     if (!quiet) {
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
@@ -210,7 +210,7 @@ int run(const std::vector<std::string>& args) {
     return kOutput;
   }
   if (!staged.note().empty()) std::cerr << "runout run: note: " << staged.note() << "\n";
-  if (!quiet) print_summary(sum, resolved.vof, dest);
+  if (!quiet) print_summary(sum, resolved.vof && !resolved.terrain, dest);
   return kOk;
 }
 

@@ -168,12 +168,21 @@ TEST(Scenarios, LabPressurePreconditionerIsChosenByName) {
 }
 
 TEST(Scenarios, LabScenarioErrorsNameTheField) {
+  // Without `lab`, engine "vof" is the 3D engine on a DEM: it needs one.
   auto s = jobs::parse_scenario_json(R"({"engine": "vof"})");
   try {
     jobs::resolve_scenario(s, ".");
     FAIL();
   } catch (const jobs::ScenarioError& e) {
-    EXPECT_NE(std::string(e.what()).find("lab"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("dem.path: missing"), std::string::npos) << e.what();
+  }
+  s = jobs::parse_scenario_json(R"({"engine": "vof", "mesh": {"growth": 1.1}, "lab": {"x_max": 1, "y_max": 1, "nx": 10, "ny": 10,
+      "fill": [{"x_max": 0.5, "y_max": 0.5}]}})");
+  try {
+    jobs::resolve_scenario(s, ".");
+    FAIL();
+  } catch (const jobs::ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("mesh: not used by a laboratory set-up"), std::string::npos) << e.what();
   }
   s = jobs::parse_scenario_json(R"({"engine": "vof", "lab": {"x_max": 1, "y_max": 1, "nx": 10, "ny": 10,
       "fill": [{"x_max": 0.5, "y_max": 0.5}], "boundaries": [{"side": "front", "kind": "wall"}]}})");

@@ -94,7 +94,12 @@ std::vector<BadCase> bad_cases() {
       {"dem path outside the roots", [](v1::Scenario& s) { s.mutable_dem()->set_path("/etc/passwd"); }, bad, "dem.path"},
       {"limits above the server's", [](v1::Scenario& s) { s.mutable_limits()->set_max_wall_s(1e12); }, bad, "limits.max_wall_s"},
       {"negative memory limit", [](v1::Scenario& s) { s.mutable_limits()->set_max_memory_bytes(-1); }, bad, "limits.max_memory_bytes"},
-      {"vof without lab", [](v1::Scenario& s) { s.set_engine("vof"); }, bad, "lab"},
+      {"3D engine with a Voellmy material",
+       [](v1::Scenario& s) {
+         s.set_engine("vof");
+         s.mutable_material()->set_rheology("voellmy");
+       },
+       bad, "material.rheology"},
       {"vof fill outside",
        [](v1::Scenario& s) {
          s = coarse_collapse();

@@ -50,7 +50,7 @@ std::string resolve_error(const v1::Scenario& s, const std::string& base) {
 }
 
 std::vector<const jobs::OptionTable*> tables() {
-  return {&jobs::scenario_options(), &jobs::depth_averaged_options(), &jobs::lab_options()};
+  return {&jobs::scenario_options(), &jobs::depth_averaged_options(), &jobs::lab_options(), &jobs::terrain_vof_options()};
 }
 
 // Every scalar field under `d` (paths as the tables spell them; "[]" for lists).
@@ -78,6 +78,12 @@ std::pair<Message*, const FieldDescriptor*> field_at(Message& m, const std::stri
 // The base scenario and its folder of an option's table.
 std::pair<v1::Scenario, std::string> base_of(const jobs::OptionTable* t) {
   if (t == &jobs::lab_options()) return {b10(), kLabDir};
+  if (t == &jobs::terrain_vof_options()) {  // the 3D engine on the same DEM
+    auto s = arelen();
+    s.set_engine("vof");
+    s.mutable_material()->set_internal_friction_deg(20);
+    return {s, kDataDir};
+  }
   return {arelen(), kDataDir};
 }
 

@@ -409,6 +409,8 @@ double sliding_block_acceleration(int non_orth) {
   c.bc["front"].kind = Bc::symmetry;
   c.bc["top"].kind = Bc::atmosphere;
   c.n_non_orthogonal_correctors = non_orth;
+  c.consistent = c.momentum_predictor = true;  // as the terrain runs take it
+  c.n_outer_correctors = 3;
   const Mesh m = plane_terrain_mesh(35);
   VofSolver solver(m, c);
   std::vector<double> a(std::size_t(m.cells()));

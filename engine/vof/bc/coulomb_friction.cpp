@@ -13,17 +13,18 @@ namespace {
 
 class CoulombFriction final : public BoundaryCondition {
  public:
-  explicit CoulombFriction(const PatchBc& bc) : tan_delta_(bc.tan_delta), creep_speed_(bc.friction_creep_speed) {}
+  explicit CoulombFriction(const PatchBc& bc)
+      : tan_delta_(bc.tan_delta), creep_speed_(bc.friction_creep_speed), min_alpha_(bc.friction_min_alpha) {}
   Vec velocity(const BcContext& c, int f) const override {
     const int o = c.mesh.owner[f];
     const Vec Up = c.fields.U[o];
     const Vec n = unit_normal(c.mesh, f);
-    return c.fields.alpha[o] >= 0.5 ? Up - dot(Up, n) * n : Vec{};
+    return c.fields.alpha[o] >= min_alpha_ ? Up - dot(Up, n) * n : Vec{};
   }
   void momentum(const BcContext& c, int f, const Vec& Ub, double& diag, Vec& source) const override {
     const Mesh& m = c.mesh;
     const int o = m.owner[f];
-    if (c.fields.alpha[o] < 0.5) {
+    if (c.fields.alpha[o] < min_alpha_) {
       wall_shear(c, f, Ub, c.wall_viscosity == WallViscosity::face, alpha(c, f), diag, source);
       return;
     }
@@ -38,7 +39,7 @@ class CoulombFriction final : public BoundaryCondition {
   }
 
  private:
-  double tan_delta_, creep_speed_;
+  double tan_delta_, creep_speed_, min_alpha_;
 };
 
 }  // namespace

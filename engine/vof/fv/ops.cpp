@@ -17,6 +17,22 @@ void gauss_gradient(const Mesh& m, const CellField<double>& x, CellField<Vec>& o
   for (int c = 0; c < m.cells(); ++c) out[c] = (1.0 / m.volume[c]) * out[c];
 }
 
+void gauss_gradient_hydrostatic(const Mesh& m, const CellField<double>& p, const CellField<double>& rho, const CellField<double>& gh,
+                                const FaceField<double>& ghf, CellField<Vec>& out) {
+  out.assign(std::size_t(m.cells()), Vec{});
+  for (int f = 0; f < m.faces(); ++f) {
+    const int o = m.owner[f];
+    if (internal(m, f)) {
+      const double pf = interpolate(m, f, p);
+      out[o] = out[o] + pf * m.Sf[f];
+      out[m.neighbour[f]] = out[m.neighbour[f]] - pf * m.Sf[f];
+    } else {
+      out[o] = out[o] + (p[o] + rho[o] * (ghf[f] - gh[o])) * m.Sf[f];
+    }
+  }
+  for (int c = 0; c < m.cells(); ++c) out[c] = (1.0 / m.volume[c]) * out[c];
+}
+
 void CellFaces::build(const Mesh& m) {
   const int nc = m.cells(), nf = m.faces();
   start.assign(std::size_t(nc) + 1, 0);

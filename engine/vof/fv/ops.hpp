@@ -54,6 +54,10 @@ inline double strain_rate(const Tensor& gr) {
 /// fvc::grad(x), Gauss linear over the whole mesh: face values interpolated linearly, the cell's own
 /// on boundary faces (zero gradient), into `out`.
 void gauss_gradient(const Mesh& m, const CellField<double>& x, CellField<Vec>& out);
+/// The same for a pressure p whose boundary faces take the cell's value carried hydrostatically,
+/// p + rho (ghf - gh) (gh = g.x at the cell centres, ghf at the face centres).
+void gauss_gradient_hydrostatic(const Mesh& m, const CellField<double>& p, const CellField<double>& rho, const CellField<double>& gh,
+                                const FaceField<double>& ghf, CellField<Vec>& out);
 
 /// The faces of each cell in ascending order, stored flat.
 struct CellFaces {

@@ -1,7 +1,6 @@
 #include "jobs/drivers/vof_lab/run.hpp"
 
 #include <google/protobuf/util/json_util.h>
-#include <petscsys.h>
 
 #include <chrono>
 #include <cmath>
@@ -9,6 +8,7 @@
 
 #include "jobs/digest/sha256.hpp"
 #include "jobs/drivers/record_head.hpp"
+#include "jobs/drivers/vof_support.hpp"
 #include "jobs/drivers/vof_lab/figures.hpp"
 #include "jobs/drivers/vof_lab/monitors.hpp"
 #include "jobs/drivers/vof_lab/results.hpp"
@@ -50,18 +50,6 @@ LabCheckpoint read_restart(const std::string& path, const std::string& state_has
   if (!(restart.state.t < L.end_time_s()))
     throw ScenarioError("checkpoint " + path + " is at t = " + json_number(restart.state.t) + " s, not before lab.end_time_s");
   return restart;
-}
-
-// PETSc's options database as the run used it (PETSC_OPTIONS and the engine's defaults).
-std::string petsc_options() {
-  PetscBool started = PETSC_FALSE;
-  PetscInitialized(&started);
-  if (!started) return {};
-  char* all = nullptr;
-  if (PetscOptionsGetAll(nullptr, &all) != 0 || !all) return {};
-  std::string s(all);
-  PetscFree(all);
-  return s;
 }
 
 // The run from the first (or restored) step to the end: frames, monitors, checkpoints, progress and
@@ -129,10 +117,7 @@ void write_timings(const RunSummary& sum, const RunningFigures& fig, int cells, 
 }  // namespace
 
 RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt) {
-  // PETSc keeps process-wide state and is not thread-safe: in a server with several workers, VOF
-  // runs take turns (depth-averaged runs are not affected).
-  static std::mutex petsc_turn;
-  std::lock_guard turn(petsc_turn);
+  std::lock_guard turn(petsc_turn());
   const auto t0 = clk::now();
   const auto& L = r.scenario.lab();
   LabSetup su;

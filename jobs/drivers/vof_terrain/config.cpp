@@ -1,0 +1,39 @@
+#include "jobs/drivers/vof_terrain/config.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace runout::jobs::vof_terrain {
+
+namespace vof = engine::vof;
+
+vof::VofConfig terrain_config(const ResolvedScenario& r) {
+  const auto& s = r.scenario;
+  const auto& v = s.vof();
+  vof::VofConfig c;
+  c.rho1 = s.material().density_kg_m3();
+  c.phi_deg = s.material().internal_friction_deg();
+  c.max_co = c.max_alpha_co = v.max_courant();
+  c.dt_max = 1.0;  // the Courant numbers limit the step on a real grid's cells (metres, not centimetres)
+  c.n_outer_correctors = v.outer_correctors();
+  c.n_non_orthogonal_correctors = v.non_orthogonal_correctors();
+  c.non_orthogonal_limiter = v.non_orthogonal_limiter();
+  // Long yielded layers need the consistent coupling: PISO's 1/A holds them back on any mesh
+  // (docs/design/vof.md, "Meshes over terrain").
+  c.consistent = c.momentum_predictor = true;
+  // The band's height is a meshing choice: the air it holds above the flow must not add strength.
+  c.coulomb_pressure = vof::CoulombPressure::excess;
+  c.active_layers = std::max(0, v.active_layers());
+  c.gravity = [](double) { return vof::Vec{0, -9.81, 0}; };
+  vof::PatchBc ground;
+  ground.type = v.bed();
+  std::replace(ground.type.begin(), ground.type.end(), '-', '_');  // the registry's spelling
+  ground.friction_min_alpha = 0.01;
+  ground.tan_delta = std::tan(s.material().bed_friction_deg() * 3.14159265358979323846 / 180);
+  c.bc["ground"] = ground;
+  c.bc["atmosphere"].kind = vof::Bc::atmosphere;
+  c.bc["sides"].kind = vof::Bc::atmosphere;
+  return c;
+}
+
+}  // namespace runout::jobs::vof_terrain

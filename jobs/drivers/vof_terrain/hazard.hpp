@@ -1,0 +1,86 @@
+#pragma once
+// The hazard maps of a 3D run on the scenario's grid: each grid column's cells integrated through
+// the depth after every step. The flow depth normal to the ground is the column's material volume
+// over its plan area (the vertical thickness) times the cosine of the ground's slope, as the
+// depth-averaged engine measures it; the depth-averaged velocity is the material's momentum over its
+// volume; the surface speed the speed of the highest cell at least half full; the ground's normal
+// stress the ground cell's pressure less the column's air above it. The same files as the
+// depth-averaged engine come from these maps (jobs/drivers/hazard_outputs.hpp), plus the surface
+// speed and the ground stress.
+#include <string>
+#include <vector>
+
+#include "engine/sh2d.hpp"
+#include "engine/vof/solver.hpp"
+#include "jobs/formats/checkpoint.hpp"
+#include "terrain/column_mesh.hpp"
+
+namespace runout::jobs::vof_terrain {
+
+/// The engine's cells of each column, bottom up: cell(col, layer), -1 for columns outside the
+/// domain; col = k * ni + i as the grid's rows (row 0 south). Cells numbered as terrain_mesh().
+struct Columns {
+  int ni = 0, nk = 0, layers = 0;
+  double plan_area = 0;        ///< of one column [m2]
+  std::vector<double> levels;  ///< the layer interfaces' heights above the ground (ColumnMesh::levels)
+  std::vector<int> cells;      ///< (col * layers + layer)
+  int cell(std::size_t col, int layer) const { return cells[col * std::size_t(layers) + std::size_t(layer)]; }
+  std::size_t columns() const { return std::size_t(ni) * std::size_t(nk); }
+};
+Columns columns_of(const terrain::ColumnMesh& c);
+
+/// The flow through the depth at a point: [height above the ground, alpha, speed] per layer.
+struct Profile {
+  std::vector<double> height, alpha, speed;
+};
+
+struct HazardSettings {
+  double rho = 300;              ///< material density [kg/m3] (rho u^2)
+  double rho_air = 1;            ///< the air's (the ground stress less the air column)
+  double flow_threshold = 0.01;  ///< [m] normal depth that counts as flowing
+};
+
+class ColumnHazard {
+ public:
+  /// cos_slope: per grid column, the cosine of the ground's slope (normal depth = vertical x cos).
+  ColumnHazard(const Columns& cols, const engine::vof::Mesh& m, std::vector<double> cos_slope, HazardSettings s,
+               std::vector<std::size_t> tracked = {});
+
+  /// After each step (and at t = 0): the running maxima, arrival times and the tracked columns'
+  /// profiles at their deepest.
+  void update(double t, const engine::vof::VofSolver& s);
+  /// The normal depth per column now.
+  std::vector<double> depth(const engine::vof::VofSolver& s) const;
+  /// The final depth (the deposit) from the solver's state at the end.
+  void finish(const engine::vof::VofSolver& s);
+
+  const engine::HazardMaps& maps() const { return hz_; }
+  const std::vector<double>& max_surface_speed() const { return max_surface_; }
+  const std::vector<double>& max_ground_stress() const { return max_stress_; }
+  /// Tracked column n: when it was deepest and its profile then.
+  double deepest_time(std::size_t n) const { return deepest_t_[n]; }
+  const Profile& deepest_profile(std::size_t n) const { return deepest_[n]; }
+
+  void save(LabCheckpoint& cp) const;
+  /// Throws ScenarioError naming `path` when the checkpoint lacks the maps or they are of another grid.
+  void restore(const LabCheckpoint& cp, const std::string& path);
+
+ private:
+  struct Column {
+    double depth = 0, speed = 0, surface_speed = 0, ground_stress = 0;
+  };
+  Column column(std::size_t col, const engine::vof::VofSolver& s) const;
+  Profile profile(std::size_t col, const engine::vof::VofSolver& s) const;
+
+  const Columns& cols_;
+  const engine::vof::Mesh& m_;
+  std::vector<double> cos_;
+  HazardSettings set_;
+  std::vector<std::size_t> tracked_;
+  engine::HazardMaps hz_;
+  std::vector<double> max_surface_, max_stress_;
+  std::vector<double> deepest_t_;
+  std::vector<Profile> deepest_;
+};
+
+}  // namespace runout::jobs::vof_terrain

@@ -1,0 +1,117 @@
+#include "jobs/drivers/vof_terrain/record.hpp"
+
+#include <cmath>
+
+#include "jobs/drivers/record_head.hpp"
+#include "jobs/drivers/vof_support.hpp"
+#include "jobs/formats/run_record.hpp"
+
+namespace runout::jobs::vof_terrain {
+
+namespace {
+
+void write_grid(const TerrainSetup& su, v1::RunRecord& rec) {
+  const auto& d = su.dem;
+  auto* dem = rec.mutable_dem();
+  dem->set_source_crs(d.source_crs);
+  dem->set_source_resolution_m(d.source_resolution_m);
+  dem->set_z_min_m(d.z_min);
+  dem->set_z_max_m(d.z_max);
+  dem->set_slope_mean_deg(d.slope_mean_deg);
+  dem->set_slope_p90_deg(d.slope_p90_deg);
+  dem->set_slope_max_deg(d.slope_max_deg);
+  dem->set_cells_without_data(int(d.cells_without_data));
+  dem->set_cells_outside_area(int(d.cells_outside_area));
+  const auto& g = su.grid;
+  auto* gr = rec.mutable_grid();
+  gr->set_crs(g.crs_name);
+  gr->set_nx(g.nx);
+  gr->set_ny(g.ny);
+  gr->set_cell_size_m(g.dx);
+  gr->set_x_min(g.x_min);
+  gr->set_y_min(g.y_min);
+  gr->add_local_origin(su.frame.x);  // the engine's frame: x east, y up from origin[2], z south
+  gr->add_local_origin(su.frame.y);
+  gr->add_local_origin(su.frame.z);
+  auto* tm = rec.mutable_terrain_mesh();
+  tm->set_columns(su.columns_mesh.kept_columns());
+  tm->set_layers(su.columns.layers);
+  tm->set_cells(su.mesh.cells());
+  tm->set_first_layer_m(su.columns.levels[1]);
+  tm->set_growth(su.spec.growth);
+  tm->set_band_height_m(su.columns.levels.back());
+  const auto& q = su.quality;
+  tm->set_non_orthogonality_max_deg(q.non_orthogonality_max_deg);
+  tm->set_non_orthogonality_mean_deg(q.non_orthogonality_mean_deg);
+  tm->set_skewness_max(q.skewness_max);
+  tm->set_skewness_mean(q.skewness_mean);
+  tm->set_aspect_ratio_max(q.aspect_ratio_max);
+  tm->set_aspect_ratio_mean(q.aspect_ratio_mean);
+}
+
+void write_profiles(const TerrainRunFacts& f, v1::RunRecord& rec) {
+  const auto& su = f.su;
+  const auto& hz = f.hazard.maps();
+  for (std::size_t n = 0; n < su.points.size(); ++n) {
+    const auto& p = su.points[n];
+    auto* pp = rec.add_profiles();
+    pp->set_name(p.name);
+    pp->set_x(p.at.x);
+    pp->set_y(p.at.y);
+    pp->set_ground_m(su.grid.z[p.column]);
+    if (!std::isnan(hz.arrival_time[p.column])) pp->set_arrival_time_s(hz.arrival_time[p.column]);
+    pp->set_max_depth_m(hz.max_depth[p.column]);
+    pp->set_max_depth_time_s(f.hazard.deepest_time(n));
+    pp->set_max_depth_averaged_speed_m_s(hz.max_speed[p.column]);
+    const Profile& pr = f.hazard.deepest_profile(n);
+    for (std::size_t j = 0; j < pr.height.size(); ++j) *pp->add_profile_height_alpha_speed() = profile_point(pr.height[j], pr.alpha[j], pr.speed[j]);
+  }
+}
+
+}  // namespace
+
+void write_terrain_record(const std::string& path, const ResolvedScenario& r, const TerrainRunFacts& f) {
+  const auto& su = f.su;
+  const auto& sum = f.sum;
+  v1::RunRecord rec = run_record_head(r, "vof");
+  write_grid(su, rec);
+  auto* rel = rec.mutable_release();
+  rel->set_polygons(su.release.polygons);
+  rel->set_cells(int(su.release.cells));
+  rel->set_area_m2(su.release.area_m2);
+  rel->set_volume_m3(su.release.volume_m3);
+  rel->set_volume_on_mesh_m3(su.volume_on_mesh);
+  for (const auto& note : su.release.notes) rel->add_notes(note);
+  auto* mb = rec.mutable_mass_balance();
+  mb->set_volume_initial_m3(sum.volume_initial);
+  mb->set_volume_final_m3(sum.volume_final);
+  mb->set_volume_outflow_m3(sum.volume_outflow);
+  mb->set_relative_error(sum.volume_error);
+  f.fig.write(rec);  // solver: steps, alpha bounds, active cells; results: peak speed
+  auto* so = rec.mutable_solver();
+  so->set_simulated_s(sum.t);
+  so->set_stop(sum.stop);
+  if (!std::isnan(f.continued_from)) so->set_continued_from_t_s(f.continued_from);
+  so->set_max_speed_m_s(sum.max_speed);
+  auto* re = rec.mutable_results();
+  re->set_affected_area_m2(sum.affected_area_m2);
+  re->set_outline_polygons(f.outline_polygons);
+  re->set_outline_area_m2(f.outline_area_m2);
+  re->set_runout_from_release_centroid_m(sum.runout_m);
+  re->set_max_depth_m(sum.max_depth);
+  re->set_outline_threshold_m(r.outline_threshold);
+  re->set_frames(f.frames);
+  write_profiles(f, rec);
+  auto* ti = rec.mutable_timings_s();
+  ti->set_prepare(sum.seconds_prepare);
+  ti->set_run(sum.seconds_run);
+  ti->set_write(sum.seconds_write);
+  ti->set_microseconds_per_cell_step(f.fig.steps ? 1e6 * sum.seconds_run / double(f.fig.steps) / su.mesh.cells() : NAN);
+  ti->set_microseconds_per_active_cell_step(f.fig.active_sum > 0 ? 1e6 * sum.seconds_run / f.fig.active_sum : NAN);
+  for (const auto& file : sum.files) rec.add_outputs(file);
+  rec.add_outputs("run.json");
+  rec.mutable_execution()->set_petsc_options(petsc_options());
+  write_run_record(path, rec);
+}
+
+}  // namespace runout::jobs::vof_terrain

@@ -1,0 +1,27 @@
+#pragma once
+// run.json of a 3D run on the DEM: the depth-averaged engine's DEM, grid, release and results
+// sections, the terrain mesh and its quality, the mass balance (outflow through the sides counted),
+// the solver's figures (alpha bounds, active cells), the profiles at the named points and timings.
+#include <string>
+
+#include "jobs/drivers/run.hpp"
+#include "jobs/drivers/vof_lab/monitors.hpp"
+#include "jobs/drivers/vof_terrain/hazard.hpp"
+#include "jobs/drivers/vof_terrain/setup.hpp"
+
+namespace runout::jobs::vof_terrain {
+
+struct TerrainRunFacts {
+  const TerrainSetup& su;
+  const ColumnHazard& hazard;
+  const vof_lab::RunningFigures& fig;
+  const RunSummary& sum;
+  double continued_from = 0;  ///< NaN: not continued
+  int outline_polygons = 0;
+  double outline_area_m2 = 0;
+  int frames = 0;
+};
+
+void write_terrain_record(const std::string& path, const ResolvedScenario& r, const TerrainRunFacts& f);
+
+}  // namespace runout::jobs::vof_terrain

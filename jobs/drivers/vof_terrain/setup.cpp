@@ -1,0 +1,58 @@
+#include "jobs/drivers/vof_terrain/setup.hpp"
+
+#include <algorithm>
+
+#include "engine/sh2d.hpp"
+#include "jobs/drivers/hazard_outputs.hpp"
+#include "jobs/drivers/vof_terrain/release.hpp"
+
+namespace runout::jobs::vof_terrain {
+
+namespace {
+
+// The scenario's mesh block over the defaults chosen from the release.
+terrain::ColumnMeshSpec mesh_spec(const v1::TerrainMesh& m, double max_vertical) {
+  terrain::ColumnMeshSpec s = default_column_mesh(max_vertical);
+  if (m.has_first_layer_m()) s.first_layer_m = m.first_layer_m();
+  s.growth = m.growth();
+  if (m.has_band_height_m()) s.band_height_m = m.band_height_m();
+  if (!(s.band_height_m > s.first_layer_m))
+    throw ScenarioError("mesh.band_height_m: " + json_number(s.band_height_m) + " m must exceed the first layer's " +
+                        json_number(s.first_layer_m) + " m (mesh.first_layer_m)");
+  return s;
+}
+
+}  // namespace
+
+void build_terrain_setup(const ResolvedScenario& r, TerrainSetup& out) {
+  out.grid = terrain::prepare_grid(r.dem, &out.dem);
+  out.h0 = terrain::rasterize_releases(out.grid, r.releases, &out.release);
+  // Vertical thickness and the slope's cosine exactly as the depth-averaged engine takes them.
+  const engine::Terrain2D t = engine_terrain(out.grid);
+  out.vertical = engine::state_from_normal_depth(t, out.h0).H;
+  engine::Sh2dState unit;
+  unit.H.assign(out.grid.cells(), 1.0);
+  unit.HU.assign(out.grid.cells(), 0.0);
+  unit.HV.assign(out.grid.cells(), 0.0);
+  out.cos_slope = engine::normal_depth(t, unit);
+  out.spec = mesh_spec(r.scenario.mesh(), *std::max_element(out.vertical.begin(), out.vertical.end()));
+  out.columns_mesh = terrain::column_mesh(out.grid, out.spec);
+  out.frame = frame_of(out.columns_mesh);
+  out.columns = columns_of(out.columns_mesh);
+  out.mesh = terrain_mesh(out.columns_mesh, out.frame);
+  out.quality = engine::vof::mesh_quality(out.mesh);
+  out.alpha = release_alpha(out.columns_mesh, out.vertical);
+  out.volume_on_mesh = 0;
+  for (std::size_t c = 0; c < out.alpha.size(); ++c) out.volume_on_mesh += out.alpha[c] * out.mesh.volume[c];
+  const auto& pts = r.scenario.vof().profiles();
+  for (int k = 0; k < pts.size(); ++k) {
+    const auto& p = pts[k];
+    NamedPoint np;
+    np.name = p.name();
+    np.at = terrain::place_point(out.grid, p.x(), p.y(), p.crs(), "vof.profiles[" + std::to_string(k) + "]");
+    np.column = std::size_t(np.at.j) * std::size_t(out.grid.nx) + std::size_t(np.at.i);
+    out.points.push_back(np);
+  }
+}
+
+}  // namespace runout::jobs::vof_terrain

@@ -1,0 +1,45 @@
+#pragma once
+// The set-up of a 3D run on the DEM: the scenario's grid and release (as the depth-averaged engine
+// prepares them), the terrain-following mesh over the domain's columns, the release's phase
+// fraction on it, and the named points placed on the grid.
+#include <string>
+#include <vector>
+
+#include "engine/vof/mesh_quality.hpp"
+#include "jobs/drivers/vof_terrain/hazard.hpp"
+#include "jobs/drivers/vof_terrain/mesh.hpp"
+#include "jobs/scenario/scenario.hpp"
+#include "terrain/column_mesh.hpp"
+#include "terrain/points.hpp"
+#include "terrain/terrain.hpp"
+
+namespace runout::jobs::vof_terrain {
+
+struct NamedPoint {
+  std::string name;
+  terrain::GridPoint at;
+  std::size_t column = 0;  ///< j * nx + i
+};
+
+struct TerrainSetup {
+  terrain::Grid grid;
+  terrain::DemReport dem;
+  terrain::ReleaseReport release;
+  std::vector<double> h0;         ///< the release's thickness normal to the ground per grid cell
+  std::vector<double> vertical;   ///< the same vertically (the depth-averaged engine's H)
+  std::vector<double> cos_slope;  ///< per grid cell
+  terrain::ColumnMeshSpec spec;
+  terrain::ColumnMesh columns_mesh;
+  Frame frame;
+  Columns columns;
+  engine::vof::Mesh mesh;
+  engine::vof::MeshQuality quality;
+  std::vector<double> alpha;  ///< the release's phase fraction per cell
+  double volume_on_mesh = 0;  ///< sum alpha V [m3]
+  std::vector<NamedPoint> points;
+};
+
+/// Builds the set-up. Throws ScenarioError or terrain::TerrainError naming the field for bad input.
+void build_terrain_setup(const ResolvedScenario& r, TerrainSetup& out);
+
+}  // namespace runout::jobs::vof_terrain

@@ -1,0 +1,59 @@
+// The option table of the 3D engine on the DEM (engine "vof" without `lab`): the blocks `mesh`
+// (the terrain-following mesh) and `vof` (the run). The DEM, area of interest, grid, releases,
+// material, end time, stop rule and outputs are the depth-averaged engine's options
+// (depth_averaged_options.cpp). The mapping into the engine's configuration lives in the terrain
+// driver (jobs/drivers/vof_terrain/config.cpp), which `maps_to` names.
+#include <string>
+#include <vector>
+
+#include "jobs/scenario/options.hpp"
+
+namespace runout::jobs {
+
+namespace {
+
+using T = OptionType;
+using U = Unset;
+
+constexpr double kTime = 1e5;    // [s]
+constexpr double kHeight = 1e3;  // mesh heights [m]
+
+}  // namespace
+
+const OptionTable& terrain_vof_options() {
+  static const OptionTable t = {
+      {"mesh.first_layer_m", T::number, U::as_given, "", Range{0, kHeight, true}, {}, "m",
+       "vertical thickness of the ground layer; default a fifth of the thickest release column", "ColumnMeshSpec::first_layer_m"},
+      {"mesh.growth", T::number, U::fill, "1.2", Range{1, 3}, {}, "", "each layer this many times the one below it",
+       "ColumnMeshSpec::growth"},
+      {"mesh.band_height_m", T::number, U::as_given, "", Range{0, kHeight, true}, {}, "m",
+       "from the ground to the mesh's top; default eight times the thickest release column", "ColumnMeshSpec::band_height_m"},
+      {"vof.write_interval_s", T::number, U::fill, "10", Range{0, kTime}, {}, "s", "3D frames (fields.h5, fields.xmf) this often",
+       "run control", "none"},
+      {"vof.max_courant", T::number, U::fill, "0.2", Range{0.01, 1}, {}, "", "the time step's Courant number in the material",
+       "VofConfig::max_co, max_alpha_co"},
+      {"vof.bed", T::choice, U::fill, "coulomb-friction", {}, {"coulomb-friction", "coulomb-slip", "wall"}, "",
+       "the ground: Coulomb friction with material.bed_friction_deg as a force, as a slip wall, or stick", "VofConfig::bc[ground]"},
+      {"vof.outer_correctors", T::integer, U::fill, "3", Range{1, 20}, {}, "", "outer correctors per step (PIMPLE's nOuterCorrectors)",
+       "VofConfig::n_outer_correctors"},
+      {"vof.non_orthogonal_correctors", T::integer, U::fill, "1", Range{0, 5}, {}, "",
+       "non-orthogonal correctors per pressure corrector (interFoam's nNonOrthogonalCorrectors)",
+       "VofConfig::n_non_orthogonal_correctors"},
+      {"vof.non_orthogonal_limiter", T::number, U::fill, "1", Range{0, 1}, {}, "",
+       "limits each face's non-orthogonal correction to psi / (1 - psi) times its orthogonal part (1: unlimited)",
+       "VofConfig::non_orthogonal_limiter"},
+      {"vof.active_layers", T::integer, U::fill, "4", Range{-1, 1000}, {}, "",
+       "layers of air cells computed around the material; -1: every cell", "VofConfig::active_layers"},
+      {"vof.checkpoint_interval_s", T::number, U::as_given, "", Range{0, kTime}, {}, "s",
+       "with `runout run --checkpoint`: a checkpoint this often (simulated time)", "run control", "only when interrupted"},
+      {"vof.profiles[].name", T::text, U::required, "", {}, {}, "", "a named point: the flow through the depth there (run.json)",
+       "run record"},
+      {"vof.profiles[].x", T::number, U::as_given, "", Range{}, {}, "", "easting, or longitude in a geographic CRS", "run record"},
+      {"vof.profiles[].y", T::number, U::as_given, "", Range{}, {}, "", "northing, or latitude", "run record"},
+      {"vof.profiles[].crs", T::text, U::as_given, "", {}, {}, "", "the point's CRS (\"EPSG:4326\"); default the grid's",
+       "run record"},
+  };
+  return t;
+}
+
+}  // namespace runout::jobs
