@@ -82,7 +82,8 @@ void add_run_options(CLI::App& app, RunArgs& a) {
       ->type_name("SIMULATION_ID");
   app.add_option("--checkpoint", a.checkpoint,
                  "Write the run's state to FILE when the run is interrupted (Ctrl-C, SIGTERM) and, for VOF runs (engine "
-                 "\"vof\"), every lab.checkpoint_interval_s. VOF runs: the monitors travel in FILE, the frames so far in "
+                 "\"vof\"), every lab.checkpoint_interval_s (on the DEM: vof.checkpoint_interval_s). VOF runs: the monitors (on the "
+                 "DEM: the hazard maps) travel in FILE, the frames so far in "
                  "FILE.fields.h5. Depth-averaged runs: the solver's whole state and hazard maps travel in FILE, the time "
                  "series so far in FILE.timeseries.h5")
       ->type_name("FILE");
