@@ -1,4 +1,5 @@
-// runout regress: the nightly In den Arelen regression through the service (validation.md C1).
+// runout regress: the nightly In den Arelen regression through the service, with both engines
+// (validation.md C1): each case's scenario against its accepted reference.
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
@@ -61,30 +62,88 @@ std::optional<ServiceRun> run_through_service(const service::ClientOptions& opt,
   return ServiceRun{fin, wall};
 }
 
+// A regression case: its name, scenario and accepted reference (in the source tree).
+struct RegressionCase {
+  std::string name, scenario, reference;
+};
+
+// Every engine's case, run one after the other by a plain `runout regress`.
+std::vector<RegressionCase> bundled_cases() {
+  const std::string src = RUNOUT_SOURCE_DIR;
+  return {{"in-den-arelen", src + "/scenarios/in-den-arelen.json", src + "/regression/in-den-arelen"},
+          {"in-den-arelen-3d", src + "/scenarios/in-den-arelen-3d-regress.json", src + "/regression/in-den-arelen-3d"}};
+}
+
+// One case through the service into `out`: the comparison (and the acceptance); true when it passed.
+bool run_case(const service::ClientOptions& opt, const RegressionCase& c, const fs::path& out, bool accept, const std::string& reason) {
+  fs::create_directories(out);
+  const fs::path results = out / "run";
+  const auto run = run_through_service(opt, c.scenario, results);
+  if (!run) return false;
+  const auto& fin = run->fin;
+  fs::copy_file(results / "map.png", out / "map.png", fs::copy_options::overwrite_existing);
+  const auto figures = jobs::measure_run(results.string());
+  if (accept) {
+    jobs::accept_reference(c.reference, figures, (results / "max_depth.tif").string(), reason, fin.scenario_hash(), RUNOUT_VERSION);
+    std::printf("%s: accepted as the reference in %s: runout %.0f m, affected area %.0f m2, max depth %.2f m, max speed %.1f m/s, "
+                "farmhouse %s\n",
+                c.name.c_str(), c.reference.c_str(), figures.runout_m, figures.affected_area_m2, figures.max_depth_m, figures.max_speed_m_s,
+                figures.farmhouse_distance_m == 0 ? "reached" : "not reached");
+  }
+  const auto ref = jobs::read_reference(c.reference);
+  const auto o = jobs::compare_run(figures, ref, (results / "max_depth.tif").string(), c.reference, out.string());
+  jobs::write_report(out.string(), o, ref, fin.id(), fin.scenario_hash(), run->wall);
+  std::printf("%s (%.0f s)\n", c.name.c_str(), run->wall);
+  for (const auto& r : o.rows) std::printf("  %-46s %14.6g %14.6g  %s\n", r.name.c_str(), r.reference, r.value, r.ok ? "ok" : "FAIL");
+  std::printf("%s: report in %s\n", o.ok ? "PASS" : "REGRESSION", (out / "report.md").string().c_str());
+  return o.ok;
+}
+
 }  // namespace
 
 int regress(const std::vector<std::string>& args) {
   service::ClientOptions opt;
   Connection conn;
   bool accept = false;
-  std::string out, reason, scenario = std::string(RUNOUT_SOURCE_DIR) + "/scenarios/in-den-arelen.json",
-                           reference = std::string(RUNOUT_SOURCE_DIR) + "/regression/in-den-arelen";
-  CLI::App app{"The In den Arelen regression: run the scenario through the service (an embedded server on 127.0.0.1\n"
-               "unless --server), compare with the accepted reference, write report.md with the map and a difference\n"
-               "map. Exit 1 on a regression.",
+  std::string out, reason, scenario, reference, only;
+  CLI::App app{"The In den Arelen regression with both engines: each case's scenario through the service (an embedded\n"
+               "server on 127.0.0.1 unless --server), compared with its accepted reference; report.md with the map and a\n"
+               "difference map per case. Exit 1 on a regression.",
                "runout regress"};
   prepare(app);
   add_connection_options(app, opt, conn, false);
-  app.add_option("--out", out, "Report folder (default runs/regress-YYYYMMDD-HHMMSS)")->type_name("DIR");
-  app.add_option("--scenario", scenario, "The scenario (default: scenarios/in-den-arelen.json of the source tree)")->type_name("FILE");
-  app.add_option("--reference", reference, "The accepted reference (default: regression/in-den-arelen of the source tree)")->type_name("DIR");
-  app.add_flag("--accept", accept, "Make this run the reference (needs --reason)");
+  app.add_option("--out", out, "Report folder (default runs/regress-YYYYMMDD-HHMMSS); one folder per case inside it")->type_name("DIR");
+  app.add_option("--case", only, "Run only this case: in-den-arelen (depth-averaged) or in-den-arelen-3d (the 3D engine at 90 m)")
+      ->type_name("NAME");
+  app.add_option("--scenario", scenario, "One case of this scenario instead (its report directly in --out)")->type_name("FILE");
+  app.add_option("--reference", reference, "One case against this reference instead (default: the first case's)")->type_name("DIR");
+  app.add_flag("--accept", accept, "Make this run the reference (needs --reason, and --case or --reference)");
   app.add_option("--reason", reason, "Why this run becomes the reference (recorded with it)")->type_name("TEXT");
   if (const int rc = parse_args(app, args); rc >= 0) return rc;
   if (const int rc = finish_connection_options(app, opt, conn); rc >= 0) return rc;
   const bool remote = app.count("--server") > 0;
   if (accept && reason.empty()) {
     std::cerr << "runout regress: --accept needs --reason TEXT (why this run becomes the reference)\n";
+    return kUsage;
+  }
+  // The cases: one given by --scenario/--reference (reported into --out itself), or the bundled ones
+  // (each into --out/NAME).
+  std::vector<RegressionCase> cases = bundled_cases();
+  const bool single = !scenario.empty() || !reference.empty();
+  if (single) {
+    cases = {{"custom", scenario.empty() ? cases[0].scenario : scenario, reference.empty() ? cases[0].reference : reference}};
+  } else if (!only.empty()) {
+    std::vector<RegressionCase> picked;
+    for (const auto& c : cases)
+      if (c.name == only) picked.push_back(c);
+    if (picked.empty()) {
+      std::cerr << "runout regress: --case: unknown '" << only << "' (valid: in-den-arelen, in-den-arelen-3d)\n";
+      return kUsage;
+    }
+    cases = picked;
+  }
+  if (accept && cases.size() > 1) {
+    std::cerr << "runout regress: --accept takes one case: name it with --case\n";
     return kUsage;
   }
   if (out.empty()) {
@@ -100,7 +159,6 @@ int regress(const std::vector<std::string>& args) {
     return kOutput;
   }
 
-  // The service: the given server, or one started here on a free loopback port.
   std::unique_ptr<service::Server> embedded;
   const fs::path state = fs::path(out) / ".service-state";
   try {
@@ -113,33 +171,14 @@ int regress(const std::vector<std::string>& args) {
       embedded->start();
       opt.server = embedded->address();
     }
-    const fs::path results = fs::path(out) / "run";
-    const auto run = run_through_service(opt, scenario, results);
-    if (!run) return kFailed;
-    const auto& fin = run->fin;
-    const double wall = run->wall;
-    fs::copy_file(results / "map.png", fs::path(out) / "map.png", fs::copy_options::overwrite_existing);
+    bool ok = true;
+    for (const auto& c : cases) ok = run_case(opt, c, single ? fs::path(out) : fs::path(out) / c.name, accept, reason) && ok;
     if (embedded) {
       embedded->shutdown();
       embedded.reset();
       fs::remove_all(state, ec);
     }
-
-    const auto figures = jobs::measure_run(results.string());
-    if (accept) {
-      jobs::accept_reference(reference, figures, (results / "max_depth.tif").string(), reason, fin.scenario_hash(), RUNOUT_VERSION);
-      std::printf("accepted as the reference in %s: runout %.0f m, affected area %.0f m2, max depth %.2f m, max speed %.1f m/s, "
-                  "farmhouse %s\n",
-                  reference.c_str(), figures.runout_m, figures.affected_area_m2, figures.max_depth_m, figures.max_speed_m_s,
-                  figures.farmhouse_distance_m == 0 ? "reached" : "not reached");
-    }
-    const auto ref = jobs::read_reference(reference);
-    const auto o = jobs::compare_run(figures, ref, (results / "max_depth.tif").string(), reference, out);
-    jobs::write_report(out, o, ref, fin.id(), fin.scenario_hash(), wall);
-    for (const auto& r : o.rows)
-      std::printf("%-48s %14.6g %14.6g  %s\n", r.name.c_str(), r.reference, r.value, r.ok ? "ok" : "FAIL");
-    std::printf("%s: report in %s\n", o.ok ? "PASS" : "REGRESSION", (fs::path(out) / "report.md").string().c_str());
-    return o.ok ? kOk : kFailed;
+    return ok ? kOk : kFailed;
   } catch (const service::RpcError& e) {
     std::cerr << "runout regress: " << e.what() << "\n";
     return kService;
