@@ -80,4 +80,30 @@ terrain::OutlineReport write_hazard_outputs(const ResolvedScenario& s, const ter
   return outline;
 }
 
+void record_inputs(v1::RunRecord& rec, const terrain::DemReport& d, const terrain::Grid& g, const terrain::ReleaseReport& r) {
+  auto* dem = rec.mutable_dem();
+  dem->set_source_crs(d.source_crs);
+  dem->set_source_resolution_m(d.source_resolution_m);
+  dem->set_z_min_m(d.z_min);
+  dem->set_z_max_m(d.z_max);
+  dem->set_slope_mean_deg(d.slope_mean_deg);
+  dem->set_slope_p90_deg(d.slope_p90_deg);
+  dem->set_slope_max_deg(d.slope_max_deg);
+  dem->set_cells_without_data(int(d.cells_without_data));
+  dem->set_cells_outside_area(int(d.cells_outside_area));
+  auto* gr = rec.mutable_grid();
+  gr->set_crs(g.crs_name);
+  gr->set_nx(g.nx);
+  gr->set_ny(g.ny);
+  gr->set_cell_size_m(g.dx);
+  gr->set_x_min(g.x_min);
+  gr->set_y_min(g.y_min);
+  auto* rel = rec.mutable_release();
+  rel->set_polygons(r.polygons);
+  rel->set_cells(int(r.cells));
+  rel->set_area_m2(r.area_m2);
+  rel->set_volume_m3(r.volume_m3);
+  for (const auto& note : r.notes) rel->add_notes(note);
+}
+
 }  // namespace runout::jobs

@@ -8,6 +8,7 @@
 
 #include "engine/sh2d.hpp"
 #include "jobs/drivers/run.hpp"
+#include "runout/v1/run_record.pb.h"
 #include "terrain/terrain.hpp"
 
 namespace runout::jobs {
@@ -28,5 +29,8 @@ void require_finite_figures(std::initializer_list<std::pair<const char*, double>
 /// go to sum.files.
 terrain::OutlineReport write_hazard_outputs(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0,
                                             const engine::HazardMaps& hz, const std::string& out_dir, RunSummary& sum);
+
+/// The record's dem, grid (without its local origin, which each engine sets) and release sections.
+void record_inputs(v1::RunRecord& rec, const terrain::DemReport& dem, const terrain::Grid& grid, const terrain::ReleaseReport& release);
 
 }  // namespace runout::jobs

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "jobs/drivers/hazard_outputs.hpp"
 #include "jobs/drivers/record_head.hpp"
 #include "jobs/drivers/vof_support.hpp"
 #include "jobs/formats/run_record.hpp"
@@ -11,25 +12,8 @@ namespace runout::jobs::vof_terrain {
 namespace {
 
 void write_grid(const TerrainSetup& su, v1::RunRecord& rec) {
-  const auto& d = su.dem;
-  auto* dem = rec.mutable_dem();
-  dem->set_source_crs(d.source_crs);
-  dem->set_source_resolution_m(d.source_resolution_m);
-  dem->set_z_min_m(d.z_min);
-  dem->set_z_max_m(d.z_max);
-  dem->set_slope_mean_deg(d.slope_mean_deg);
-  dem->set_slope_p90_deg(d.slope_p90_deg);
-  dem->set_slope_max_deg(d.slope_max_deg);
-  dem->set_cells_without_data(int(d.cells_without_data));
-  dem->set_cells_outside_area(int(d.cells_outside_area));
-  const auto& g = su.grid;
+  record_inputs(rec, su.dem, su.grid, su.release);
   auto* gr = rec.mutable_grid();
-  gr->set_crs(g.crs_name);
-  gr->set_nx(g.nx);
-  gr->set_ny(g.ny);
-  gr->set_cell_size_m(g.dx);
-  gr->set_x_min(g.x_min);
-  gr->set_y_min(g.y_min);
   gr->add_local_origin(su.frame.x);  // the engine's frame: x east, y up from origin[2], z south
   gr->add_local_origin(su.frame.y);
   gr->add_local_origin(su.frame.z);
@@ -76,12 +60,7 @@ void write_terrain_record(const std::string& path, const ResolvedScenario& r, co
   v1::RunRecord rec = run_record_head(r, "vof");
   write_grid(su, rec);
   auto* rel = rec.mutable_release();
-  rel->set_polygons(su.release.polygons);
-  rel->set_cells(int(su.release.cells));
-  rel->set_area_m2(su.release.area_m2);
-  rel->set_volume_m3(su.release.volume_m3);
   rel->set_volume_on_mesh_m3(su.volume_on_mesh);
-  for (const auto& note : su.release.notes) rel->add_notes(note);
   auto* mb = rec.mutable_mass_balance();
   mb->set_volume_initial_m3(sum.volume_initial);
   mb->set_volume_final_m3(sum.volume_final);
