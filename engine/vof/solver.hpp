@@ -63,6 +63,10 @@ struct PatchBc {
   /// wall's shear). 0.5 suits resolved fronts; on coarse terrain grids a front's ground cells are
   /// partly filled and need the friction too (the terrain driver takes 0.01).
   double friction_min_alpha = 0.5;
+  /// Coulomb friction: the normal load is the total normal stress, p less the viscous normal stress
+  /// 2 mu n.grad(U).n of the cell, instead of p alone (a spreading layer carries part of its weight
+  /// by the viscous stress; docs/design/vof.md). The terrain driver takes it.
+  bool friction_total_normal_stress = false;
 };
 
 /// How the viscous stress's transpose part is taken (VofConfig::viscous_transpose).

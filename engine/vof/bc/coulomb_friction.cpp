@@ -14,7 +14,10 @@ namespace {
 class CoulombFriction final : public BoundaryCondition {
  public:
   explicit CoulombFriction(const PatchBc& bc)
-      : tan_delta_(bc.tan_delta), creep_speed_(bc.friction_creep_speed), min_alpha_(bc.friction_min_alpha) {}
+      : tan_delta_(bc.tan_delta),
+        creep_speed_(bc.friction_creep_speed),
+        min_alpha_(bc.friction_min_alpha),
+        total_normal_(bc.friction_total_normal_stress) {}
   Vec velocity(const BcContext& c, int f) const override {
     const int o = c.mesh.owner[f];
     const Vec Up = c.fields.U[o];
@@ -31,7 +34,16 @@ class CoulombFriction final : public BoundaryCondition {
     const Vec n = unit_normal(m, f);
     const Vec U = c.fields.U[o];
     const Vec ut = U - dot(U, n) * n;
-    const double drag = tan_delta_ * std::max(c.hydrostatics.wall_pressure(f, o), 0.0) * m.magSf[f] / std::max(norm(ut), creep_speed_);
+    double load = c.hydrostatics.wall_pressure(f, o);
+    if (total_normal_) {  // less the viscous normal stress 2 mu n.grad(U).n (compression raises the load)
+      const auto& g = c.fields.gradU[o].g;
+      const double nn[3] = {n.x, n.y, n.z};
+      double enn = 0;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) enn += nn[i] * g[i][j] * nn[j];
+      load -= 2 * c.fields.mu[o] * enn;
+    }
+    const double drag = tan_delta_ * std::max(load, 0.0) * m.magSf[f] / std::max(norm(ut), creep_speed_);
     // The drag sits on the diagonal, which both components share; the part it would put on the
     // velocity normal to the bed is given back explicitly, so that it acts along the bed.
     diag += drag;
@@ -40,6 +52,7 @@ class CoulombFriction final : public BoundaryCondition {
 
  private:
   double tan_delta_, creep_speed_, min_alpha_;
+  bool total_normal_;
 };
 
 }  // namespace

@@ -29,6 +29,7 @@ vof::VofConfig terrain_config(const ResolvedScenario& r) {
   ground.type = v.bed();
   std::replace(ground.type.begin(), ground.type.end(), '-', '_');  // the registry's spelling
   ground.friction_min_alpha = 0.01;
+  ground.friction_total_normal_stress = v.bed_normal_stress() == "total";
   ground.tan_delta = std::tan(s.material().bed_friction_deg() * 3.14159265358979323846 / 180);
   c.bc["ground"] = ground;
   c.bc["atmosphere"].kind = vof::Bc::atmosphere;
