@@ -258,10 +258,8 @@ void PressureEqn::pressure_correction(const Fields& F, const Coupling& k) {
     pcorr_[f] = 0;
     if (open_[f] != 0 || !internal(m_, f) || !region_.active(m_.owner[f])) continue;
     const Vec& kv = m_.non_orth[f];
-    const int o = m_.owner[f], nb = m_.neighbour[f];
     const double corr = -(dot(kv, interpolate(m_, f, grad_)) - interpolate(m_, f, F.rho) * dot(kv, g));
-    const double orth = -(hs.ghf(f) * (F.rho[nb] - F.rho[o]) + (F.p_rgh[nb] - F.p_rgh[o])) * m_.delta_coeff[f] * m_.magSf[f];
-    pcorr_[f] = k.rAf[f] * limited_correction(corr, orth, cfg_.non_orthogonal_limiter);
+    pcorr_[f] = k.rAf[f] * limited_correction(corr, hs.orthogonal_force(f) * m_.magSf[f], cfg_.non_orthogonal_limiter);
   }
 }
 

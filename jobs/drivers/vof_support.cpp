@@ -2,6 +2,9 @@
 
 #include <petscsys.h>
 
+#include <algorithm>
+#include <cmath>
+
 namespace runout::jobs {
 
 std::mutex& petsc_turn() {
@@ -18,6 +21,20 @@ std::string petsc_options() {
   std::string s(all);
   PetscFree(all);
   return s;
+}
+
+double next_multiple(double interval, double t) { return interval * (std::floor(t / interval + 1e-9) + 1); }
+
+bool report_step(const RunOptions& opt, const engine::vof::StepStats& st, long steps, int cells) {
+  if (!opt.progress || steps % std::max(1L, opt.progress_every) != 0) return true;
+  engine::Progress p;
+  p.t = st.t;
+  p.dt = st.dt;
+  p.mass = st.granular_volume;
+  p.max_speed = st.max_speed;
+  p.active_fraction = double(st.active_cells) / cells;
+  p.step = steps;
+  return opt.progress(p);
 }
 
 }  // namespace runout::jobs

@@ -40,8 +40,6 @@ struct PlaneCase {
   double dx = 10, block_m = 60, thickness_m = 2;
   double taper_m = 0;  ///< the thickness grows from 0 over this much from the block's edges
   int nx = 40, ny = 24;
-  double limiter = -1;   ///< vof.non_orthogonal_limiter; < 0: the default
-  int non_orth = -1;     ///< vof.non_orthogonal_correctors; < 0: the default
   std::string normal_stress;  ///< vof.bed_normal_stress; empty: the default
 };
 
@@ -98,8 +96,6 @@ PlaneRun run_plane(const PlaneCase& pc, double t_end) {
   r.scenario.mutable_material()->set_density_kg_m3(300);
   r.scenario.mutable_material()->set_internal_friction_deg(pc.phi_deg);
   r.scenario.mutable_material()->set_bed_friction_deg(pc.delta_deg);
-  if (pc.limiter >= 0) r.scenario.mutable_vof()->set_non_orthogonal_limiter(pc.limiter);
-  if (pc.non_orth >= 0) r.scenario.mutable_vof()->set_non_orthogonal_correctors(pc.non_orth);
   if (!pc.normal_stress.empty()) r.scenario.mutable_vof()->set_bed_normal_stress(pc.normal_stress);
   runout::jobs::apply_option_rules(runout::jobs::terrain_vof_options(), r.scenario);
   vof::VofSolver s(m, vt::terrain_config(r));

@@ -87,19 +87,10 @@ struct Stepper {
       write_checkpoint_now();
       next_cp += cp_every;
     }
-    if (opt.progress && fig.steps % std::max(1L, opt.progress_every) == 0) {
-      engine::Progress p;
-      p.t = st.t;
-      p.dt = st.dt;
-      p.mass = st.granular_volume;
-      p.max_speed = st.max_speed;
-      p.active_fraction = double(st.active_cells) / su.m.cells();
-      p.step = fig.steps;
-      if (!opt.progress(p) && st.t < L.end_time_s() - 1e-12) {  // on the last step the run is done anyway
-        cancelled = true;
-        if (checkpoints) write_checkpoint_now();  // the run can continue from here
-        return false;
-      }
+    if (!report_step(opt, st, fig.steps, su.m.cells()) && st.t < L.end_time_s() - 1e-12) {  // on the last step the run is done anyway
+      cancelled = true;
+      if (checkpoints) write_checkpoint_now();  // the run can continue from here
+      return false;
     }
     return true;
   }
@@ -160,12 +151,12 @@ RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const 
     fig.restore(restart, opt.restart_path);
     mon.restore(restart, opt.restart_path);
     if (L.write_interval_s() > 0)  // the next regular frame after the checkpoint
-      step.next_write = L.write_interval_s() * (std::floor(restart.state.t / L.write_interval_s() + 1e-9) + 1);
+      step.next_write = next_multiple(L.write_interval_s(), restart.state.t);
   } else {
     frames.write(0, s);
   }
   step.cp_every = L.checkpoint_interval_s() > 0 ? L.checkpoint_interval_s() : opt.checkpoint_interval_s > 0 ? opt.checkpoint_interval_s : 1e300;
-  step.next_cp = step.cp_every < 1e300 ? step.cp_every * (std::floor(s.time() / step.cp_every + 1e-9) + 1) : 1e300;
+  step.next_cp = step.cp_every < 1e300 ? next_multiple(step.cp_every, s.time()) : 1e300;
   const auto t1 = clk::now();
   s.run(L.end_time_s(), [&step](const vof::StepStats& st) { return step(st); });
   sum.seconds_run = since(t1);

@@ -13,21 +13,10 @@
 #include "engine/sh2d.hpp"
 #include "engine/vof/solver.hpp"
 #include "jobs/formats/checkpoint.hpp"
-#include "terrain/column_mesh.hpp"
+#include "jobs/drivers/vof_terrain/mesh.hpp"
 
 namespace runout::jobs::vof_terrain {
 
-/// The engine's cells of each column, bottom up: cell(col, layer), -1 for columns outside the
-/// domain; col = k * ni + i as the grid's rows (row 0 south). Cells numbered as terrain_mesh().
-struct Columns {
-  int ni = 0, nk = 0, layers = 0;
-  double plan_area = 0;        ///< of one column [m2]
-  std::vector<double> levels;  ///< the layer interfaces' heights above the ground (ColumnMesh::levels)
-  std::vector<int> cells;      ///< (col * layers + layer)
-  int cell(std::size_t col, int layer) const { return cells[col * std::size_t(layers) + std::size_t(layer)]; }
-  std::size_t columns() const { return std::size_t(ni) * std::size_t(nk); }
-};
-Columns columns_of(const terrain::ColumnMesh& c);
 
 /// The flow through the depth at a point: [height above the ground, alpha, speed] per layer.
 struct Profile {

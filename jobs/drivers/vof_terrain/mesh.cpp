@@ -23,4 +23,22 @@ engine::vof::Mesh terrain_mesh(const terrain::ColumnMesh& c, const Frame& frame)
   return engine::vof::structured_hex_mesh(s);
 }
 
+Columns columns_of(const terrain::ColumnMesh& c) {
+  Columns out;
+  out.ni = c.ni;
+  out.nk = c.nk;
+  out.layers = c.layers();
+  out.plan_area = c.dx * c.dx;
+  out.levels = c.levels;
+  out.cells.assign(out.columns() * std::size_t(out.layers), -1);
+  int next = 0;  // terrain_mesh's numbering: i fastest, then the layer, then k; left-out columns skipped
+  for (int k = 0; k < c.nk; ++k)
+    for (int j = 0; j < out.layers; ++j)
+      for (int i = 0; i < c.ni; ++i) {
+        const std::size_t col = std::size_t(k) * std::size_t(c.ni) + std::size_t(i);
+        if (c.kept[col]) out.cells[col * std::size_t(out.layers) + std::size_t(j)] = next++;
+      }
+  return out;
+}
+
 }  // namespace runout::jobs::vof_terrain

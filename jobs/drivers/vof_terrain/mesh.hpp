@@ -4,6 +4,8 @@
 // (gravity along -y): x east, y the elevation above `origin.z`, z south, in metres from the grid's
 // centre. Patches: "ground" (the bottom of every column), "atmosphere" (the top), "sides" (the
 // grid's edges and the faces towards columns outside the domain).
+#include <vector>
+
 #include "engine/vof/mesh.hpp"
 #include "terrain/column_mesh.hpp"
 
@@ -22,5 +24,18 @@ Frame frame_of(const terrain::ColumnMesh& c);
 /// The engine's mesh of the kept columns: i east, j up the layers, k north (cell (i, j, k) of the
 /// engine's structured numbering with left-out columns skipped).
 engine::vof::Mesh terrain_mesh(const terrain::ColumnMesh& c, const Frame& frame);
+
+/// The engine's cells of each column, bottom up: cell(col, layer), -1 for columns outside the
+/// domain; col = k * ni + i as the grid's rows (row 0 south). Cells numbered as terrain_mesh()
+/// numbers them (the one place that numbering is spelt out besides structured_hex_mesh).
+struct Columns {
+  int ni = 0, nk = 0, layers = 0;
+  double plan_area = 0;        ///< of one column [m2]
+  std::vector<double> levels;  ///< the layer interfaces' heights above the ground (ColumnMesh::levels)
+  std::vector<int> cells;      ///< (col * layers + layer)
+  int cell(std::size_t col, int layer) const { return cells[col * std::size_t(layers) + std::size_t(layer)]; }
+  std::size_t columns() const { return std::size_t(ni) * std::size_t(nk); }
+};
+Columns columns_of(const terrain::ColumnMesh& c);
 
 }  // namespace runout::jobs::vof_terrain

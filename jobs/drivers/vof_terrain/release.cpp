@@ -1,5 +1,7 @@
 #include "jobs/drivers/vof_terrain/release.hpp"
 
+#include "jobs/drivers/vof_terrain/mesh.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -16,25 +18,22 @@ std::vector<double> release_alpha(const terrain::ColumnMesh& c, const std::vecto
   if (vertical_m.size() != std::size_t(c.ni) * std::size_t(c.nk))
     throw terrain::TerrainError("release: the thickness raster is not of the mesh's grid");
   const double band = c.levels.back();
-  std::vector<double> alpha;
-  alpha.reserve(std::size_t(c.kept_columns()) * std::size_t(c.layers()));
-  for (int k = 0; k < c.nk; ++k) {
+  const Columns cols = columns_of(c);
+  std::vector<double> alpha(std::size_t(c.kept_columns()) * std::size_t(c.layers()), 0.0);
+  for (std::size_t col = 0; col < cols.columns(); ++col) {
+    const double h = vertical_m[col];
+    const int i = int(col % std::size_t(c.ni)), k = int(col / std::size_t(c.ni));
+    if (!c.kept[col]) {
+      if (h > 0)
+        throw terrain::TerrainError("release: material in the column (" + std::to_string(i) + ", " + std::to_string(k) + ") outside the domain");
+      continue;
+    }
+    if (h > band)
+      throw terrain::TerrainError("mesh.band_height_m: " + std::to_string(band) + " m does not hold the release's " + std::to_string(h) +
+                                  " m in column (" + std::to_string(i) + ", " + std::to_string(k) + ")");
     for (int j = 0; j < c.layers(); ++j) {
       const double lo = c.levels[std::size_t(j)], hi = c.levels[std::size_t(j) + 1];
-      for (int i = 0; i < c.ni; ++i) {
-        const std::size_t col = std::size_t(k) * std::size_t(c.ni) + std::size_t(i);
-        const double h = vertical_m[col];
-        if (!c.kept[col]) {
-          if (j == 0 && h > 0)
-            throw terrain::TerrainError("release: material in the column (" + std::to_string(i) + ", " + std::to_string(k) +
-                                        ") outside the domain");
-          continue;
-        }
-        if (j == 0 && h > band)
-          throw terrain::TerrainError("mesh.band_height_m: " + std::to_string(band) + " m does not hold the release's " +
-                                      std::to_string(h) + " m in column (" + std::to_string(i) + ", " + std::to_string(k) + ")");
-        alpha.push_back(std::clamp((h - lo) / (hi - lo), 0.0, 1.0));
-      }
+      alpha[std::size_t(cols.cell(col, j))] = std::clamp((h - lo) / (hi - lo), 0.0, 1.0);
     }
   }
   return alpha;

@@ -1,13 +1,10 @@
 #include "jobs/drivers/vof_terrain/run.hpp"
 
-#include <google/protobuf/util/json_util.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 
-#include "jobs/digest/sha256.hpp"
 #include "jobs/drivers/hazard_outputs.hpp"
 #include "jobs/drivers/vof_lab/monitors.hpp"
 #include "jobs/drivers/vof_support.hpp"
@@ -120,19 +117,10 @@ struct Stepper {
       write_checkpoint_now();
       next_cp += cp_every;
     }
-    if (opt.progress && fig.steps % std::max(1L, opt.progress_every) == 0) {
-      engine::Progress p;
-      p.t = st.t;
-      p.dt = st.dt;
-      p.mass = st.granular_volume;
-      p.max_speed = st.max_speed;
-      p.active_fraction = double(st.active_cells) / su.mesh.cells();
-      p.step = fig.steps;
-      if (!opt.progress(p) && st.t < t_end - 1e-12 && !settled) {
-        cancelled = true;
-        if (checkpoints) write_checkpoint_now();  // the run can continue from here
-        return false;
-      }
+    if (!report_step(opt, st, fig.steps, su.mesh.cells()) && st.t < t_end - 1e-12 && !settled) {
+      cancelled = true;
+      if (checkpoints) write_checkpoint_now();  // the run can continue from here
+      return false;
     }
     return !settled;
   }
@@ -206,7 +194,7 @@ RunSummary run_terrain_vof(const ResolvedScenario& r, const std::string& out_dir
   step.write_every = write_every;
   if (continued) {
     step.restore(restart, opt.restart_path);
-    if (write_every > 0) step.next_write = write_every * (std::floor(restart.state.t / write_every + 1e-9) + 1);
+    if (write_every > 0) step.next_write = next_multiple(write_every, restart.state.t);
   } else {
     hazard.update(0, s);
     if (frames) frames->write(0, s);
@@ -214,7 +202,7 @@ RunSummary run_terrain_vof(const ResolvedScenario& r, const std::string& out_dir
   }
   const double cp_interval = r.scenario.vof().checkpoint_interval_s();
   step.cp_every = cp_interval > 0 ? cp_interval : opt.checkpoint_interval_s > 0 ? opt.checkpoint_interval_s : 1e300;
-  step.next_cp = step.cp_every < 1e300 ? step.cp_every * (std::floor(s.time() / step.cp_every + 1e-9) + 1) : 1e300;
+  step.next_cp = step.cp_every < 1e300 ? next_multiple(step.cp_every, s.time()) : 1e300;
   const auto t1 = clk::now();
   s.run(r.end_time_s(), [&step](const vof::StepStats& st) { return step(st); });
   sum.seconds_run = since(t1);

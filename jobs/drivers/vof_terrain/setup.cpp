@@ -16,10 +16,7 @@ terrain::ColumnMeshSpec mesh_spec(const v1::TerrainMesh& m, double max_vertical)
   if (m.has_first_layer_m()) s.first_layer_m = m.first_layer_m();
   s.growth = m.growth();
   if (m.has_band_height_m()) s.band_height_m = m.band_height_m();
-  if (!(s.band_height_m > s.first_layer_m))
-    throw ScenarioError("mesh.band_height_m: " + json_number(s.band_height_m) + " m must exceed the first layer's " +
-                        json_number(s.first_layer_m) + " m (mesh.first_layer_m)");
-  return s;
+  return s;  // terrain::layer_levels checks them
 }
 
 }  // namespace
@@ -30,11 +27,7 @@ void build_terrain_setup(const ResolvedScenario& r, TerrainSetup& out) {
   // Vertical thickness and the slope's cosine exactly as the depth-averaged engine takes them.
   const engine::Terrain2D t = engine_terrain(out.grid);
   out.vertical = engine::state_from_normal_depth(t, out.h0).H;
-  engine::Sh2dState unit;
-  unit.H.assign(out.grid.cells(), 1.0);
-  unit.HU.assign(out.grid.cells(), 0.0);
-  unit.HV.assign(out.grid.cells(), 0.0);
-  out.cos_slope = engine::normal_depth(t, unit);
+  out.cos_slope = engine::SurfaceGeometry::from(t).c;
   out.spec = mesh_spec(r.scenario.mesh(), *std::max_element(out.vertical.begin(), out.vertical.end()));
   out.columns_mesh = terrain::column_mesh(out.grid, out.spec);
   out.frame = frame_of(out.columns_mesh);
