@@ -21,10 +21,11 @@ void Hydrostatics::resize() {
   if (non_orth_) non_orth_force_.assign(m_.faces(), 0);
 }
 
-void Hydrostatics::update_non_orthogonal_force() {
+void Hydrostatics::update_non_orthogonal_force(const CellFaces& cell_faces, const std::vector<int>& faces, const std::vector<int>& cells) {
   if (!non_orth_) return;
-  gauss_gradient_hydrostatic(m_, fields_.p, fields_.rho, gh_, ghf_, grad_p_);
-  for (int f = 0; f < m_.n_internal; ++f) {
+  gauss_gradient_hydrostatic(m_, cell_faces, cells, fields_.p, fields_.rho, gh_, ghf_, grad_p_);
+  for (int f : faces) {
+    if (f >= m_.n_internal) continue;
     const Vec& k = m_.non_orth[f];
     const double rho_f = interpolate(m_, f, fields_.rho);
     const double corr = -(dot(k, interpolate(m_, f, grad_p_)) - rho_f * dot(k, g_last_)) / m_.magSf[f];

@@ -84,8 +84,10 @@ class Hydrostatics {
   /// faces), limited by VofConfig::non_orthogonal_limiter against the orthogonal part. The same as
   /// the non-orthogonal parts of -ghf snGrad(rho) - snGrad(p_rgh), but from p, which is continuous
   /// across the interface where p_rgh jumps by (rho1 - rho2) g.(x - x_ref) (docs/design/vof.md).
-  /// Nothing without non-orthogonal correctors.
-  void update_non_orthogonal_force();
+  /// On the listed faces (internal ones; the others skipped), from the gradient in `cells`, which
+  /// must hold both sides of every listed face (the active region's faces and halo). Nothing
+  /// without non-orthogonal correctors.
+  void update_non_orthogonal_force(const CellFaces& cell_faces, const std::vector<int>& faces, const std::vector<int>& cells);
   // The same on an opening (atmosphere, edge of the active region), out of the active cell a, with
   // the outside's p_rgh pout.
   double opening_force(int f, int a, double pout) const { return -(pout - fields_.p_rgh[a]) * m_.delta_coeff[f]; }

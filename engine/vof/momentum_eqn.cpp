@@ -20,7 +20,7 @@ MomentumEqn::MomentumEqn(const Mesh& m, const VofConfig& cfg, const BcContext& b
   force_ = HbyA;
 }
 
-void MomentumEqn::setup_predictor(const std::vector<int>& nnz) { solver_.setup(m_.cells(), nnz, cfg_.momentum_rtol); }
+void MomentumEqn::setup_predictor() { solver_.setup(cfg_.momentum_rtol); }
 
 void MomentumEqn::velocity_gradient(Fields& F) const {
   auto& G = F.gradU;

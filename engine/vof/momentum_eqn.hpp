@@ -18,8 +18,8 @@ class MomentumEqn {
  public:
   MomentumEqn(const Mesh& m, const VofConfig& cfg, const BcContext& bc_ctx, const Boundaries& bcs, const ActiveRegion& region,
               const Reconstruction& reconstruct, int dims);
-  /// The momentum predictor's solver over every cell (nnz per row).
-  void setup_predictor(const std::vector<int>& nnz);
+  /// The momentum predictor's solver.
+  void setup_predictor();
 
   /// The Gauss gradient of the velocity per cell into F.gradU (boundary values from the
   /// conditions; only faces of the active region contribute, the air beyond rests).
@@ -49,6 +49,7 @@ class MomentumEqn {
   void boundary_terms(const Fields& F);
   void coefficients(const Fields& F, double dt);
   void predictor_forces();
+  void predictor_rows(const Fields& F);
 
   const Mesh& m_;
   const VofConfig& cfg_;
@@ -60,7 +61,10 @@ class MomentumEqn {
   FvMatrix<Vec> UEqn_;
   CellField<Vec> H_;
   CellField<double> H1_;
-  CellField<Vec> force_, known_;  // the predictor's force and the known neighbours' share
+  CellField<Vec> force_;          // the predictor's force
+  std::vector<int> rows_, row_of_;  // the predicted cells (ascending); per cell its row or -1
+  std::vector<Vec> known_;        // per row: the share of the neighbours that are not predicted
+  CsrMatrix A_;
   MomentumSolver solver_;
 };
 

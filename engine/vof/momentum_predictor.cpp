@@ -3,6 +3,8 @@
 // step.
 #include "engine/vof/momentum_eqn.hpp"
 
+#include <algorithm>
+
 namespace runout::engine::vof {
 
 // The force per cell, V reconstruct(-ghf snGrad(rho) - snGrad(p_rgh)) |Sf|, over the active region
@@ -37,52 +39,77 @@ void MomentumEqn::predictor_forces() {
   }
 }
 
-// The matrix over every cell, cells outside the active region (or not predicted) as rows of the
-// identity with their velocity (zero for the air at rest outside the region). Every face's entries
-// are set, zero where they are not used, so that the matrix keeps the whole mesh's nonzero
-// structure from one assembly to the next. Under the consistent coupling only the material's cells
-// (alpha >= consistent_alpha) are predicted; the air around them keeps its velocity (the cells'
-// coefficients to it go to the right-hand side), as under PISO. Predicting the air too let the
-// cell-reconstructed buoyancy force drive air currents over a resting heap's stair-stepped surface
-// (0.1 m/s) that dragged it along at 2 mm/s (docs/design/vof.md).
-int MomentumEqn::predict(Fields& F, double t) {
-  predictor_forces();
-  const int nc = m_.cells();
+// The matrix over the predicted cells only, in ascending order: the active region's cells, and
+// under the consistent coupling only the material's (alpha >= consistent_alpha); the air around
+// them keeps its velocity (the cells' coefficients to it go to the right-hand side), as under PISO.
+// Predicting the air too let the cell-reconstructed buoyancy force drive air currents over a
+// resting heap's stair-stepped surface (0.1 m/s) that dragged it along at 2 mm/s
+// (docs/design/vof.md). The system's size follows the material, not the mesh.
+void MomentumEqn::predictor_rows(const Fields& F) {
   const bool material_only = cfg_.consistent;
-  auto solved = [&](int c) { return region_.active(c) && (!material_only || F.alpha[c] >= cfg_.consistent_alpha); };
+  rows_.clear();
+  for (int c : region_.cells)
+    if (!material_only || F.alpha[c] >= cfg_.consistent_alpha) rows_.push_back(c);
+  std::sort(rows_.begin(), rows_.end());
+  if (row_of_.size() != std::size_t(m_.cells())) row_of_.assign(m_.cells(), -1);
+  for (int r = 0; r < int(rows_.size()); ++r) row_of_[rows_[r]] = r;
+  const int n = int(rows_.size());
   const auto& cO = UEqn_.upper;
   const auto& cN = UEqn_.lower;
-  known_.assign(nc, Vec{});
-  solver_.begin();
-  for (int f = 0; f < m_.n_internal; ++f) {
-    const int o = m_.owner[f], nb = m_.neighbour[f];
-    const bool so = solved(o), sn = solved(nb);
-    const bool both = so && sn;
-    solver_.set(o, nb, both ? -cO[f] : 0.0);
-    solver_.set(nb, o, both ? -cN[f] : 0.0);
-    if (so && !sn && region_.active(nb)) known_[o] = known_[o] + cO[f] * F.U[nb];
-    if (sn && !so && region_.active(o)) known_[nb] = known_[nb] + cN[f] * F.U[o];
+  known_.assign(n, Vec{});
+  // Per row: the diagonal and an entry per predicted neighbour; columns sorted afterwards.
+  A_.start.assign(std::size_t(n) + 1, 1);
+  A_.start[0] = 0;
+  for (int f : region_.faces) {
+    if (f >= m_.n_internal) break;
+    const int ro = row_of_[m_.owner[f]], rn = row_of_[m_.neighbour[f]];
+    if (ro >= 0 && rn >= 0) ++A_.start[ro + 1], ++A_.start[rn + 1];
   }
-  for (int c = 0; c < nc; ++c) solver_.set(c, c, solved(c) ? UEqn_.diag[c] : 1.0);
-  solver_.assemble();
-  int its_total = 0;
-  auto b = std::vector<double>(nc), x = b;
-  for (int i = 0; i < dims_; ++i) {
-    for (int c = 0; c < nc; ++c) {
-      double src = 0, x0 = 0;
-      if (solved(c)) {
-        const Vec Fc = reconstruct_(c, force_[c]);
-        src = comp(UEqn_.source[c], i) + m_.volume[c] * comp(Fc, i) + comp(known_[c], i);
-        x0 = comp(F.U[c], i);
-      } else if (region_.active(c)) {
-        src = x0 = comp(F.U[c], i);
+  for (int r = 0; r < n; ++r) A_.start[r + 1] += A_.start[r];
+  A_.col.resize(A_.start[n]);
+  A_.val.resize(A_.start[n]);
+  std::vector<PetscInt> next(A_.start.begin(), A_.start.end() - 1);
+  for (int r = 0; r < n; ++r) A_.col[next[r]] = r, A_.val[next[r]++] = UEqn_.diag[rows_[r]];
+  for (int f : region_.faces) {
+    if (f >= m_.n_internal) break;
+    const int o = m_.owner[f], nb = m_.neighbour[f];
+    const int ro = row_of_[o], rn = row_of_[nb];
+    if (ro >= 0 && rn >= 0) {
+      A_.col[next[ro]] = rn, A_.val[next[ro]++] = -cO[f];
+      A_.col[next[rn]] = ro, A_.val[next[rn]++] = -cN[f];
+    } else if (ro >= 0 && region_.active(nb)) {
+      known_[ro] = known_[ro] + cO[f] * F.U[nb];
+    } else if (rn >= 0 && region_.active(o)) {
+      known_[rn] = known_[rn] + cN[f] * F.U[o];
+    }
+  }
+  for (int r = 0; r < n; ++r) {  // a handful of entries per row: insertion sort
+    for (PetscInt i = A_.start[r] + 1; i < A_.start[r + 1]; ++i)
+      for (PetscInt j = i; j > A_.start[r] && A_.col[j - 1] > A_.col[j]; --j) {
+        std::swap(A_.col[j - 1], A_.col[j]);
+        std::swap(A_.val[j - 1], A_.val[j]);
       }
-      b[c] = src;
-      x[c] = x0;
+  }
+}
+
+int MomentumEqn::predict(Fields& F, double t) {
+  predictor_forces();
+  predictor_rows(F);
+  solver_.set_matrix(A_);
+  const int n = int(rows_.size());
+  int its_total = 0;
+  auto b = std::vector<double>(n), x = b;
+  for (int i = 0; i < dims_; ++i) {
+    for (int r = 0; r < n; ++r) {
+      const int c = rows_[r];
+      const Vec Fc = reconstruct_(c, force_[c]);
+      b[r] = comp(UEqn_.source[c], i) + m_.volume[c] * comp(Fc, i) + comp(known_[r], i);
+      x[r] = comp(F.U[c], i);
     }
     its_total += solver_.solve(b, x, t);
-    for (int c : region_.cells) comp_ref(F.U[c], i) = x[c];
+    for (int r = 0; r < n; ++r) comp_ref(F.U[rows_[r]], i) = x[r];
   }
+  for (int c : rows_) row_of_[c] = -1;
   return its_total;
 }
 

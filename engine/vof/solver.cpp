@@ -33,16 +33,6 @@ double mean_cell_size(const Mesh& m) {
   return std::cbrt(vsum / m.cells());
 }
 
-// The nonzeros per row of a matrix over every cell.
-std::vector<int> cell_nonzeros(const Mesh& m) {
-  std::vector<int> nnz(m.cells(), 1);
-  for (int f = 0; f < m.n_internal; ++f) {
-    ++nnz[m.owner[f]];
-    ++nnz[m.neighbour[f]];
-  }
-  return nnz;
-}
-
 }  // namespace
 
 struct VofSolver::Impl {
@@ -68,7 +58,7 @@ struct VofSolver::Impl {
     F.resize(m.cells(), m.faces(), cfg.nu_max);
     hydrostatics.resize();
     div.assign(m.cells(), 0);
-    UEqn.setup_predictor(cell_nonzeros(m));
+    UEqn.setup_predictor();
   }
 
   const Mesh& m;
@@ -307,11 +297,11 @@ StepStats VofSolver::step() {
     if (outer > 0) I.UEqn.update_viscosity(F);  // grad U, nu1 and mu from the latest velocity and pressure
     else I.UEqn.velocity_gradient(F);
     I.UEqn.build(F, dt_);  // ddt(rho, U) + div(rho_phi, U) - laplacian(mu_f, U) = div(mu_f (grad U)^T) + boundaries
-    I.hydrostatics.update_non_orthogonal_force();  // the last pressure's force (non-orthogonal meshes)
+    I.hydrostatics.update_non_orthogonal_force(I.cell_faces, I.region.faces, I.region.halo);  // the last pressure's force (non-orthogonal meshes)
     if (cfg_.momentum_predictor) st.momentum_iterations += I.UEqn.predict(F, t_);
     for (int k = 0; k < n_corr; ++k) {
       I.UEqn.update_HbyA(F);
-      if (cfg_.consistent && k > 0) I.hydrostatics.update_non_orthogonal_force();
+      if (cfg_.consistent && k > 0) I.hydrostatics.update_non_orthogonal_force(I.cell_faces, I.region.faces, I.region.halo);
       const auto tp = clk::now();
       const bool final = outer + 1 == n_outer && k + 1 == n_corr;
       st.pressure_iterations += I.pEqn.correct(F, I.UEqn, false, k > 0, final, t_);  // p_rgh, phi, U

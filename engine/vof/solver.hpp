@@ -176,7 +176,7 @@ struct VofConfig {
   /// shear about twice the Coulomb stress: B2's toe stopped 6 cells short (validation.md).
   WallViscosity wall_viscosity = WallViscosity::face;
   int alpha_subcycles = 2;
-  std::string pressure_pc = "gamg";  ///< "gamg" or "hypre" (BoomerAMG)
+  std::string pressure_pc = "gamg";  ///< "gamg", "hypre" (BoomerAMG) or "ilu" (ILU(0))
   double pressure_rtol = 1e-8;  ///< relative tolerance of the last corrector's pressure solve
   double pressure_rtol_intermediate = 0.1;  ///< of the correctors before it (1e-2 gave the same B2 figures, 35 % slower)
   int pressure_pc_refresh = 10;  ///< rebuild the pressure preconditioner every this many steps

@@ -136,8 +136,8 @@ const OptionTable& lab_options() {
       {"lab.coulomb_pressure", T::choice, U::keep, "total", {}, names_of(engine::vof::kCoulombPressureNames), "",
        "the Coulomb viscosity's confining pressure: p, or p less the still air's hydrostatic pressure",
        "VofConfig::coulomb_pressure"},
-      {"lab.pressure_preconditioner", T::choice, U::keep, "gamg", {}, {"gamg", "hypre"}, "",
-       "the pressure solve's preconditioner: PETSc's GAMG or hypre's BoomerAMG", "VofConfig::pressure_pc"},
+      {"lab.pressure_preconditioner", T::choice, U::keep, "gamg", {}, {"gamg", "hypre", "ilu"}, "",
+       "the pressure solve's preconditioner: PETSc's GAMG, hypre's BoomerAMG or ILU(0)", "VofConfig::pressure_pc"},
       {"lab.wall_viscosity", T::choice, U::keep, "face", {}, names_of(engine::vof::kWallViscosityNames), "",
        "viscosity on walls and inflows: evaluated on the face (as OpenFOAM) or the cell's", "VofConfig::wall_viscosity"},
   };

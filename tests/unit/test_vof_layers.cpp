@@ -27,7 +27,7 @@ TEST(VofSolver, ConfigurationErrorsNameWhatIsWrong) {
   c.rheology = "mu(I)";
   EXPECT_THROW(VofSolver(box(), c), VofError);
   c = box_config();
-  c.pressure_pc = "ilu";
+  c.pressure_pc = "sor";
   EXPECT_THROW(VofSolver(box(), c), VofError);
   c = box_config();
   c.bc["nowhere"].kind = Bc::wall;

@@ -2,35 +2,22 @@
 
 namespace runout::engine::vof {
 
-void gauss_gradient(const Mesh& m, const CellField<double>& x, CellField<Vec>& out) {
-  out.assign(std::size_t(m.cells()), Vec{});
-  for (int f = 0; f < m.faces(); ++f) {
-    const int o = m.owner[f];
-    if (internal(m, f)) {
-      const double xf = interpolate(m, f, x);
-      out[o] = out[o] + xf * m.Sf[f];
-      out[m.neighbour[f]] = out[m.neighbour[f]] - xf * m.Sf[f];
-    } else {
-      out[o] = out[o] + x[o] * m.Sf[f];
+void gauss_gradient_hydrostatic(const Mesh& m, const CellFaces& cell_faces, const std::vector<int>& cells, const CellField<double>& p,
+                                const CellField<double>& rho, const CellField<double>& gh, const FaceField<double>& ghf,
+                                CellField<Vec>& out) {
+  if (out.size() != std::size_t(m.cells())) out.assign(std::size_t(m.cells()), Vec{});
+  for (int c : cells) {
+    Vec sum{};
+    for (int f : cell_faces[c]) {
+      if (internal(m, f)) {
+        const double pf = interpolate(m, f, p);
+        sum = m.owner[f] == c ? sum + pf * m.Sf[f] : sum - pf * m.Sf[f];
+      } else {
+        sum = sum + (p[c] + rho[c] * (ghf[f] - gh[c])) * m.Sf[f];
+      }
     }
+    out[c] = (1.0 / m.volume[c]) * sum;
   }
-  for (int c = 0; c < m.cells(); ++c) out[c] = (1.0 / m.volume[c]) * out[c];
-}
-
-void gauss_gradient_hydrostatic(const Mesh& m, const CellField<double>& p, const CellField<double>& rho, const CellField<double>& gh,
-                                const FaceField<double>& ghf, CellField<Vec>& out) {
-  out.assign(std::size_t(m.cells()), Vec{});
-  for (int f = 0; f < m.faces(); ++f) {
-    const int o = m.owner[f];
-    if (internal(m, f)) {
-      const double pf = interpolate(m, f, p);
-      out[o] = out[o] + pf * m.Sf[f];
-      out[m.neighbour[f]] = out[m.neighbour[f]] - pf * m.Sf[f];
-    } else {
-      out[o] = out[o] + (p[o] + rho[o] * (ghf[f] - gh[o])) * m.Sf[f];
-    }
-  }
-  for (int c = 0; c < m.cells(); ++c) out[c] = (1.0 / m.volume[c]) * out[c];
 }
 
 void CellFaces::build(const Mesh& m) {

@@ -51,14 +51,6 @@ inline double strain_rate(const Tensor& gr) {
   return std::sqrt(2 * dd);
 }
 
-/// fvc::grad(x), Gauss linear over the whole mesh: face values interpolated linearly, the cell's own
-/// on boundary faces (zero gradient), into `out`.
-void gauss_gradient(const Mesh& m, const CellField<double>& x, CellField<Vec>& out);
-/// The same for a pressure p whose boundary faces take the cell's value carried hydrostatically,
-/// p + rho (ghf - gh) (gh = g.x at the cell centres, ghf at the face centres).
-void gauss_gradient_hydrostatic(const Mesh& m, const CellField<double>& p, const CellField<double>& rho, const CellField<double>& gh,
-                                const FaceField<double>& ghf, CellField<Vec>& out);
-
 /// The faces of each cell in ascending order, stored flat.
 struct CellFaces {
   std::vector<int> start, face_list;
@@ -67,6 +59,14 @@ struct CellFaces {
     return {face_list.data() + start[c], std::size_t(start[std::size_t(c) + 1] - start[c])};
   }
 };
+
+/// fvc::grad(p), Gauss linear, for a pressure p whose boundary faces take the cell's value carried
+/// hydrostatically, p + rho (ghf - gh) (gh = g.x at the cell centres, ghf at the face centres):
+/// into out[c] for the listed cells only (each from its own faces, so any subset and any order
+/// give the same values).
+void gauss_gradient_hydrostatic(const Mesh& m, const CellFaces& cell_faces, const std::vector<int>& cells, const CellField<double>& p,
+                                const CellField<double>& rho, const CellField<double>& gh, const FaceField<double>& ghf,
+                                CellField<Vec>& out);
 
 /// fvc::reconstruct: the cell vector whose face projections best match face values q, from the sum
 /// of q Sf over the cell's faces (the inverse of sum Sf Sf / |Sf| per cell).

@@ -39,18 +39,17 @@ void petsc_init() {
 // ---- the momentum predictor's solver ----
 
 MomentumSolver::~MomentumSolver() {
+  destroy_system();
   if (ksp_) KSPDestroy(&ksp_);
+}
+
+void MomentumSolver::destroy_system() {
   if (M_) MatDestroy(&M_);
   if (x_) VecDestroy(&x_);
   if (b_) VecDestroy(&b_);
 }
 
-void MomentumSolver::setup(int cells, const std::vector<int>& nnz, double rtol) {
-  n_ = cells;
-  const std::vector<PetscInt> nz(nnz.begin(), nnz.end());
-  petsc_check(MatCreateSeqAIJ(PETSC_COMM_SELF, n_, n_, 0, nz.data(), &M_), "MatCreateSeqAIJ");
-  petsc_check(VecCreateSeq(PETSC_COMM_SELF, n_, &x_), "VecCreateSeq");
-  petsc_check(VecDuplicate(x_, &b_), "VecDuplicate");
+void MomentumSolver::setup(double rtol) {
   petsc_check(KSPCreate(PETSC_COMM_SELF, &ksp_), "KSPCreate");
   petsc_check(KSPSetType(ksp_, KSPBCGS), "KSPSetType");
   PC pc;
@@ -63,28 +62,40 @@ void MomentumSolver::setup(int cells, const std::vector<int>& nnz, double rtol) 
   petsc_check(KSPSetFromOptions(ksp_), "KSPSetFromOptions");
 }
 
-void MomentumSolver::begin() { petsc_check(MatZeroEntries(M_), "MatZeroEntries"); }
-
-void MomentumSolver::set(PetscInt row, PetscInt col, double value) {
-  const PetscScalar v = value;
-  petsc_check(MatSetValues(M_, 1, &row, 1, &col, &v, INSERT_VALUES), "MatSetValues");
-}
-
-void MomentumSolver::assemble() {
-  petsc_check(MatAssemblyBegin(M_, MAT_FINAL_ASSEMBLY), "MatAssembly");
-  petsc_check(MatAssemblyEnd(M_, MAT_FINAL_ASSEMBLY), "MatAssembly");
+void MomentumSolver::set_matrix(const CsrMatrix& A) {
+  const int n = A.rows();
+  if (n != n_ || A.start != start_ || A.col != col_) {
+    petsc_check(KSPReset(ksp_), "KSPReset");  // (a new size: the old operators and factors go)
+    destroy_system();
+    n_ = n;
+    start_ = A.start;
+    col_ = A.col;
+    if (n_ == 0) return;
+    petsc_check(MatCreate(PETSC_COMM_SELF, &M_), "MatCreate");
+    petsc_check(MatSetSizes(M_, n_, n_, n_, n_), "MatSetSizes");
+    petsc_check(MatSetType(M_, MATSEQAIJ), "MatSetType");
+    petsc_check(MatSeqAIJSetPreallocationCSR(M_, start_.data(), col_.data(), A.val.data()), "MatSeqAIJSetPreallocationCSR");
+    petsc_check(VecCreateSeq(PETSC_COMM_SELF, n_, &x_), "VecCreateSeq");
+    petsc_check(VecDuplicate(x_, &b_), "VecDuplicate");
+  } else {
+    if (n_ == 0) return;
+    PetscScalar* v = nullptr;
+    petsc_check(MatSeqAIJGetArray(M_, &v), "MatSeqAIJGetArray");
+    std::copy(A.val.begin(), A.val.end(), v);
+    petsc_check(MatSeqAIJRestoreArray(M_, &v), "MatSeqAIJRestoreArray");  // (marks the matrix changed)
+  }
   petsc_check(KSPSetOperators(ksp_, M_, M_), "KSPSetOperators");
 }
 
 int MomentumSolver::solve(const std::vector<double>& b, std::vector<double>& x, double t) {
-  for (PetscInt c = 0; c < n_; ++c) {
-    VecSetValue(b_, c, b[c], INSERT_VALUES);
-    VecSetValue(x_, c, x[c], INSERT_VALUES);
-  }
-  VecAssemblyBegin(b_);
-  VecAssemblyEnd(b_);
-  VecAssemblyBegin(x_);
-  VecAssemblyEnd(x_);
+  if (n_ <= 0) return 0;
+  PetscScalar* v = nullptr;
+  petsc_check(VecGetArray(b_, &v), "VecGetArray");
+  std::copy(b.begin(), b.begin() + n_, v);
+  VecRestoreArray(b_, &v);
+  petsc_check(VecGetArray(x_, &v), "VecGetArray");
+  std::copy(x.begin(), x.begin() + n_, v);
+  VecRestoreArray(x_, &v);
   petsc_check(KSPSolve(ksp_, b_, x_), "KSPSolve (momentum)");
   KSPConvergedReason reason;
   KSPGetConvergedReason(ksp_, &reason);

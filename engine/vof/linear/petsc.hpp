@@ -1,6 +1,6 @@
 #pragma once
 // The VOF engine's linear solvers through PETSc: the process-wide start of PETSc, the momentum
-// predictor's solver (BiCGStab + ILU over every cell) and the pressure solver over the active
+// predictor's solver (BiCGStab + ILU over the cells it predicts) and the pressure solver over the active
 // region (CG with GAMG or hypre BoomerAMG, its preconditioner kept across steps and refreshed
 // every VofConfig::pressure_pc_refresh steps, saved into and restored from a checkpoint). The
 // equations hand them coefficients; nothing else in the engine calls PETSc.
@@ -17,26 +17,39 @@ void petsc_check(PetscErrorCode e, const char* what);
 /// PETSc (and with it MPI) is started once per process, on first use.
 void petsc_init();
 
-/// The momentum predictor's system over every cell: both velocity components share the matrix.
+/// A sparse matrix in compressed rows: row r's entries are col/val[start[r] .. start[r + 1]),
+/// columns ascending.
+struct CsrMatrix {
+  std::vector<PetscInt> start{0}, col;
+  std::vector<double> val;
+  int rows() const { return int(start.size()) - 1; }
+  void clear() {
+    start.assign(1, 0);
+    col.clear();
+    val.clear();
+  }
+};
+
+/// The momentum predictor's system over the cells it predicts (the rows change with the material):
+/// the velocity components share the matrix.
 class MomentumSolver {
  public:
   MomentumSolver() = default;
   MomentumSolver(const MomentumSolver&) = delete;
   MomentumSolver& operator=(const MomentumSolver&) = delete;
   ~MomentumSolver();
-  /// nnz: the nonzeros per row; rtol: VofConfig::momentum_rtol.
-  void setup(int cells, const std::vector<int>& nnz, double rtol);
-  /// Start a new matrix (every entry zero, the structure kept).
-  void begin();
-  void set(PetscInt row, PetscInt col, double value);
-  /// Assemble the matrix and hand it to the solver.
-  void assemble();
-  /// Solve with the right-hand side b and the initial guess x (every cell's); the solution into x.
+  /// rtol: VofConfig::momentum_rtol.
+  void setup(double rtol);
+  /// The matrix for the next solves (made anew when its rows or structure changed).
+  void set_matrix(const CsrMatrix& A);
+  /// Solve with the right-hand side b and the initial guess x (a value per row); the solution into x.
   /// Returns the iterations; throws when the solver does not converge (t: the time, for the message).
   int solve(const std::vector<double>& b, std::vector<double>& x, double t);
 
  private:
-  int n_ = 0;
+  void destroy_system();
+  int n_ = -1;
+  std::vector<PetscInt> start_, col_;  // the structure of M_
   Mat M_ = nullptr;
   ::Vec x_ = nullptr, b_ = nullptr;
   KSP ksp_ = nullptr;

@@ -24,6 +24,7 @@ vof::VofConfig terrain_config(const ResolvedScenario& r) {
   // The band's height is a meshing choice: the air it holds above the flow must not add strength.
   c.coulomb_pressure = vof::CoulombPressure::excess;
   c.active_layers = std::max(0, v.active_layers());
+  c.pressure_pc = v.pressure_preconditioner();
   c.gravity = [](double) { return vof::Vec{0, -9.81, 0}; };
   vof::PatchBc ground;
   ground.type = v.bed();
