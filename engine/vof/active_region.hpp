@@ -35,6 +35,7 @@ class ActiveRegion {
   /// Every cell takes part (the pressure level is free in a closed domain).
   bool whole_mesh() const { return n_active == m_.cells(); }
   bool active(int c) const { return index[c] >= 0; }
+  const CellFaces& cell_faces() const { return cell_faces_; }
 
   CellField<int> index;     ///< per cell: its row in the pressure system, -1 outside the region
   std::vector<int> cells;   ///< the region

@@ -1,6 +1,7 @@
 #include "engine/vof/hydrostatics.hpp"
 
 #include "engine/vof/fv/ops.hpp"
+#include "engine/vof/fv/parallel.hpp"
 
 #include <algorithm>
 
@@ -24,13 +25,13 @@ void Hydrostatics::resize() {
 void Hydrostatics::update_non_orthogonal_force(const CellFaces& cell_faces, const std::vector<int>& faces, const std::vector<int>& cells) {
   if (!non_orth_) return;
   gauss_gradient_hydrostatic(m_, cell_faces, cells, fields_.p, fields_.rho, gh_, ghf_, grad_p_);
-  for (int f : faces) {
-    if (f >= m_.n_internal) continue;
+  parallel_each(faces, [&](int f) {
+    if (f >= m_.n_internal) return;
     const Vec& k = m_.non_orth[f];
     const double rho_f = interpolate(m_, f, fields_.rho);
     const double corr = -(dot(k, interpolate(m_, f, grad_p_)) - rho_f * dot(k, g_last_)) / m_.magSf[f];
     non_orth_force_[f] = limited_correction(corr, orthogonal_force(f), limiter_);
-  }
+  });
 }
 
 void Hydrostatics::update(double t, const std::function<bool(int)>& opening, bool force) {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "engine/vof/fv/parallel.hpp"
+
 namespace runout::engine::vof {
 
 PressureEqn::PressureEqn(const Mesh& m, const VofConfig& cfg, const BcContext& bc_ctx, const Boundaries& bcs, const ActiveRegion& region,
@@ -13,6 +15,7 @@ PressureEqn::PressureEqn(const Mesh& m, const VofConfig& cfg, const BcContext& b
   phig_ = phiHbyA_;
   pout_ = phiHbyA_;
   pcorr_ = phiHbyA_;
+  w_ = phiHbyA_;
   grad_.assign(nc, Vec{});
   p_now_.assign(nc, 0.0);
   open_.assign(nf, 0);
@@ -90,13 +93,13 @@ void PressureEqn::predicted_flux(const MomentumEqn& UEqn, bool initial, const Co
   const auto& HbyA = UEqn.HbyA;
   const auto &rAU = UEqn.rAU, &rAtU = UEqn.rAtU;
   const auto &rAUf = UEqn.rAUf, &rAtUf = UEqn.rAtUf;
-  auto& rec_old = rec_old_;
-  if (k.consistent)
-    for (int c : region_.cells) rec_old[c] = Vec{};
-  for (int f : region_.faces) {
+  const bool non_orth = cfg_.n_non_orthogonal_correctors > 0;
+  // Per face: the predicted flux, and (consistent coupling) the face force that its active cells'
+  // F_old gathers (w_; 0 where it gives none).
+  parallel_each(region_.faces, [&](int f) {
     const int o = m_.owner[f];
     const signed char op = open_[f];
-    double ph = 0;
+    double ph = 0, w = 0;
     if (internal(m_, f)) {
       const int nb = m_.neighbour[f];
       if (op == 0) {  // both cells active (an active face that is no opening)
@@ -104,8 +107,7 @@ void PressureEqn::predicted_flux(const MomentumEqn& UEqn, bool initial, const Co
         if (k.consistent) {
           const double Fold = hs.face_force(f);
           ph += (rAUf[f] - rAtUf[f]) * Fold * m_.magSf[f];
-          rec_old[o] = rec_old[o] + Fold * m_.Sf[f];
-          rec_old[nb] = rec_old[nb] + Fold * m_.Sf[f];
+          w = Fold;
         }
       } else {
         const int a = op > 0 ? o : nb;
@@ -114,7 +116,7 @@ void PressureEqn::predicted_flux(const MomentumEqn& UEqn, bool initial, const Co
           const double sg = op;
           const double Fout = hs.opening_force(f, a, pout_[f]);  // out of a
           ph += sg * (rAU[a] - rAtU[a]) * Fout * m_.magSf[f];
-          rec_old[a] = rec_old[a] + (sg * Fout) * m_.Sf[f];
+          w = sg * Fout;
         }
       }
     } else if (region_.active(o)) {
@@ -122,12 +124,24 @@ void PressureEqn::predicted_flux(const MomentumEqn& UEqn, bool initial, const Co
       if (bcs_[f].opening() && k.consistent) {
         const double Fout = hs.opening_force(f, o, pout_[f]);
         ph += (rAU[o] - rAtU[o]) * Fout * m_.magSf[f];
-        rec_old[o] = rec_old[o] + Fout * m_.Sf[f];
+        w = Fout;
       }
     }
     phiHbyA_[f] = ph + phig_[f];
-    if (cfg_.n_non_orthogonal_correctors > 0) phiHbyA_[f] += pcorr_[f];
-  }
+    if (non_orth) phiHbyA_[f] += pcorr_[f];
+    w_[f] = w;
+  });
+  if (k.consistent) gather_face_forces(rec_old_);
+}
+
+// Per active cell, the sum of w_ Sf over its faces (the faces that give it nothing hold 0).
+void PressureEqn::gather_face_forces(CellField<Vec>& rec) const {
+  const CellFaces& cf = region_.cell_faces();
+  parallel_each(region_.cells, [&](int c) {
+    Vec sum{};
+    for (int f : cf[c]) sum = sum + w_[f] * m_.Sf[f];
+    rec[c] = sum;
+  });
 }
 
 // laplacian(rAUf, p_rgh) = div(phiHbyA), an opening's outside pressure on the right-hand side.
@@ -138,31 +152,27 @@ void PressureEqn::assemble(const Fields& F, bool reuse) {
   const auto& ix = region_.index;
   const auto& coef = pEqn_.upper;
   auto &diag = pEqn_.diag, &rhs = pEqn_.source;
-  if (!reuse)
-    for (int c : region_.cells) diag[c] = 0.0;
-  for (int c : region_.cells) rhs[c] = 0.0;
-  for (int f : region_.faces) {
-    const double c = coef[f];
-    const int o = m_.owner[f];
-    if (open_[f] != 0) {
-      const int a = open_[f] > 0 ? o : m_.neighbour[f];
-      const double sg = open_[f];
-      rhs[a] -= sg * phiHbyA_[f];
-      if (!reuse) diag[a] += c;
-      rhs[a] += c * pout_[f];
-      continue;
-    }
-    if (!region_.active(o)) continue;
-    rhs[o] -= phiHbyA_[f];
-    if (internal(m_, f)) {
-      const int nb = m_.neighbour[f];
-      rhs[nb] += phiHbyA_[f];
-      if (!reuse) {
-        diag[o] += c;
-        diag[nb] += c;
+  const CellFaces& cf = region_.cell_faces();
+  // Per active cell over its faces: the fluxes out of it and its share of the Laplacian.
+  parallel_each(region_.cells, [&](int c) {
+    double r = 0, d = reuse ? diag[c] : 0.0;
+    for (int f : cf[c]) {
+      const double cc = coef[f];
+      if (open_[f] != 0) {  // c is the face's active cell
+        r -= double(open_[f]) * phiHbyA_[f];
+        if (!reuse) d += cc;
+        r += cc * pout_[f];
+      } else if (m_.owner[f] == c) {
+        r -= phiHbyA_[f];
+        if (!reuse && internal(m_, f)) d += cc;
+      } else {
+        r += phiHbyA_[f];
+        if (!reuse) d += cc;
       }
     }
-  }
+    rhs[c] = r;
+    diag[c] = d;
+  });
   solver_.begin_matrix(reuse);
   if (!reuse)
     for (int f : region_.faces)
@@ -171,50 +181,47 @@ void PressureEqn::assemble(const Fields& F, bool reuse) {
   diag_rows_.resize(n);
   rhs_rows_.resize(n);
   x_rows_.resize(n);
-  for (std::size_t r = 0; r < n; ++r) {
-    const int c = region_.cells[r];
-    diag_rows_[r] = diag[c];
-    rhs_rows_[r] = rhs[c];
-    x_rows_[r] = F.p_rgh[c];
-  }
+  parallel_for(int(n), [&](int r) {
+    const int c = region_.cells[std::size_t(r)];
+    diag_rows_[std::size_t(r)] = diag[c];
+    rhs_rows_[std::size_t(r)] = rhs[c];
+    x_rows_[std::size_t(r)] = F.p_rgh[c];
+  });
   solver_.set_rows(diag_rows_, rhs_rows_, x_rows_, reuse);
 }
 
 // phi = phiHbyA + pEqn.flux(); U = H/A + rA reconstruct((phig + pEqn.flux()) / rAf) (plus the
 // consistent coupling's share of F_old).
 void PressureEqn::correct_flux_and_velocity(Fields& F, const MomentumEqn& UEqn, bool initial, const Coupling& k) {
-  auto& rec = rec_;
-  for (int c : region_.cells) rec[c] = Vec{};
-  for (int f : region_.faces) {
+  const bool non_orth = cfg_.n_non_orthogonal_correctors > 0;
+  parallel_each(region_.faces, [&](int f) {
     const int o = m_.owner[f];
     const signed char op = open_[f];
+    double w = 0;
     if (op != 0) {
       // An opening: the flux out of the active cell a follows its pressure and the outside's.
       const int a = op > 0 ? o : m_.neighbour[f];
       const double sg = op;
       const double pflux_out = pEqn_.flux_out(f, F.p_rgh[a], pout_[f]);
       F.phi[f] = phiHbyA_[f] + sg * pflux_out;
-      if (k.rA[a] > 0) {
-        const double q = pflux_out / k.rA[a] / m_.magSf[f];
-        rec[a] = rec[a] + (q * sg) * m_.Sf[f];
+      if (k.rA[a] > 0) w = pflux_out / k.rA[a] / m_.magSf[f] * sg;
+    } else {
+      const double pflux = internal(m_, f) ? pEqn_.flux(m_, f, F.p_rgh) : 0.0;
+      F.phi[f] = phiHbyA_[f] + pflux;
+      if (internal(m_, f) && k.rAf[f] > 0) {
+        const double corr = non_orth ? pcorr_[f] : 0.0;
+        w = (phig_[f] + pflux + corr) / k.rAf[f] / m_.magSf[f];
       }
-      continue;
     }
-    const double pflux = internal(m_, f) ? pEqn_.flux(m_, f, F.p_rgh) : 0.0;
-    F.phi[f] = phiHbyA_[f] + pflux;
-    if (internal(m_, f) && k.rAf[f] > 0) {
-      const double corr = cfg_.n_non_orthogonal_correctors > 0 ? pcorr_[f] : 0.0;
-      const double q = (phig_[f] + pflux + corr) / k.rAf[f] / m_.magSf[f];
-      rec[o] = rec[o] + q * m_.Sf[f];
-      rec[m_.neighbour[f]] = rec[m_.neighbour[f]] + q * m_.Sf[f];
-    }
-  }
+    w_[f] = w;
+  });
   if (initial) return;
-  for (int c : region_.cells) {
-    const Vec R = reconstruct_(c, rec[c]);
+  gather_face_forces(rec_);
+  parallel_each(region_.cells, [&](int c) {
+    const Vec R = reconstruct_(c, rec_[c]);
     F.U[c] = UEqn.HbyA[c] + k.rA[c] * R;
     if (k.consistent) F.U[c] = F.U[c] + (UEqn.rAU[c] - UEqn.rAtU[c]) * reconstruct_(c, rec_old_[c]);
-  }
+  });
 }
 
 // The Gauss gradient of the pressure p over the active region: face values interpolated between
@@ -223,24 +230,20 @@ void PressureEqn::correct_flux_and_velocity(Fields& F, const MomentumEqn& UEqn, 
 // weight's gradient there).
 void PressureEqn::pressure_gradient(const Fields& F, const CellField<double>& p, CellField<Vec>& out) const {
   const Hydrostatics& hs = bc_ctx_.hydrostatics;
-  for (int c : region_.cells) out[c] = Vec{};
-  for (int f : region_.faces) {
-    const int o = m_.owner[f];
-    if (open_[f] != 0) {
-      const int a = open_[f] > 0 ? o : m_.neighbour[f];
-      const double pf = p[a] + F.rho[a] * (hs.ghf(f) - hs.gh(a));
-      out[a] = out[a] + (double(open_[f]) * pf) * m_.Sf[f];
-    } else if (internal(m_, f)) {
-      if (!region_.active(o)) continue;
-      const int nb = m_.neighbour[f];
-      const double pf = interpolate(m_, f, p);
-      out[o] = out[o] + pf * m_.Sf[f];
-      out[nb] = out[nb] - pf * m_.Sf[f];
-    } else if (region_.active(o)) {
-      out[o] = out[o] + (p[o] + F.rho[o] * (hs.ghf(f) - hs.gh(o))) * m_.Sf[f];
+  const CellFaces& cf = region_.cell_faces();
+  parallel_each(region_.cells, [&](int c) {
+    Vec sum{};
+    for (int f : cf[c]) {
+      if (open_[f] != 0 || !internal(m_, f)) {  // an opening out of c, or a wall: p carried to the face
+        const double pf = p[c] + F.rho[c] * (hs.ghf(f) - hs.gh(c));
+        sum = open_[f] != 0 ? sum + (double(open_[f]) * pf) * m_.Sf[f] : sum + pf * m_.Sf[f];
+      } else {
+        const double pf = interpolate(m_, f, p);
+        sum = m_.owner[f] == c ? sum + pf * m_.Sf[f] : sum - pf * m_.Sf[f];
+      }
     }
-  }
-  for (int c : region_.cells) out[c] = (1.0 / m_.volume[c]) * out[c];
+    out[c] = (1.0 / m_.volume[c]) * sum;
+  });
 }
 
 // The face force's non-orthogonal part from the latest pressure, -rAf (non_orth . grad(p)_f -
@@ -251,16 +254,16 @@ void PressureEqn::pressure_gradient(const Fields& F, const CellField<double>& p,
 // the jump into the neighbouring cells (docs/design/vof.md).
 void PressureEqn::pressure_correction(const Fields& F, const Coupling& k) {
   const Hydrostatics& hs = bc_ctx_.hydrostatics;
-  for (int c : region_.cells) p_now_[c] = F.p_rgh[c] + F.rho[c] * hs.gh(c);
+  parallel_each(region_.cells, [&](int c) { p_now_[c] = F.p_rgh[c] + F.rho[c] * hs.gh(c); });
   pressure_gradient(F, p_now_, grad_);
   const Vec& g = hs.gravity();
-  for (int f : region_.faces) {
+  parallel_each(region_.faces, [&](int f) {
     pcorr_[f] = 0;
-    if (open_[f] != 0 || !internal(m_, f) || !region_.active(m_.owner[f])) continue;
+    if (open_[f] != 0 || !internal(m_, f) || !region_.active(m_.owner[f])) return;
     const Vec& kv = m_.non_orth[f];
     const double corr = -(dot(kv, interpolate(m_, f, grad_)) - interpolate(m_, f, F.rho) * dot(kv, g));
     pcorr_[f] = k.rAf[f] * limited_correction(corr, hs.orthogonal_force(f) * m_.magSf[f], cfg_.non_orthogonal_limiter);
-  }
+  });
 }
 
 // A closed domain fixes the pressure only up to a constant, but the Coulomb viscosity needs the

@@ -62,6 +62,8 @@ class PressureEqn {
   CellField<double> p_now_;  // p from the latest p_rgh
   FaceField<signed char> open_;
   CellField<Vec> rec_, rec_old_;  // sums of face forces times Sf for the reconstruction
+  FaceField<double> w_;            // per face: the force it gives its active cells (gather_face_forces)
+  void gather_face_forces(CellField<Vec>& rec) const;
   std::vector<double> diag_rows_, rhs_rows_, x_rows_;
 };
 

@@ -1,12 +1,14 @@
 #include "engine/vof/fv/ops.hpp"
 
+#include "engine/vof/fv/parallel.hpp"
+
 namespace runout::engine::vof {
 
 void gauss_gradient_hydrostatic(const Mesh& m, const CellFaces& cell_faces, const std::vector<int>& cells, const CellField<double>& p,
                                 const CellField<double>& rho, const CellField<double>& gh, const FaceField<double>& ghf,
                                 CellField<Vec>& out) {
   if (out.size() != std::size_t(m.cells())) out.assign(std::size_t(m.cells()), Vec{});
-  for (int c : cells) {
+  parallel_each(cells, [&](int c) {
     Vec sum{};
     for (int f : cell_faces[c]) {
       if (internal(m, f)) {
@@ -17,7 +19,7 @@ void gauss_gradient_hydrostatic(const Mesh& m, const CellFaces& cell_faces, cons
       }
     }
     out[c] = (1.0 / m.volume[c]) * sum;
-  }
+  });
 }
 
 void CellFaces::build(const Mesh& m) {
