@@ -29,6 +29,7 @@ expect_help(cancel JOB ${CONNECTION})
 expect_help(fetch JOB --out --force ${CONNECTION})
 expect_help(health ${CONNECTION})
 expect_help(regress --server --token --token-file --tls-ca --tls --out --scenario --reference --accept --reason)
+expect_help(compare RUN OTHER --out)
 expect_help(version)
 expect_help(worker)
 

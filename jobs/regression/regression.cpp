@@ -80,11 +80,11 @@ std::string fmt(double v, int prec = 6) {
 
 }  // namespace
 
-RegressionFigures measure_run(const std::string& results_dir) {
+RegressionFigures measure_run(const std::string& results_dir, bool farmhouse_optional) {
   const std::string path = (fs::path(results_dir) / "run.json").string();
   const auto rec = read_run_record(path);
   if (!rec.has_results() || !rec.results().has_runout_from_release_centroid_m() || !rec.solver().has_max_speed_m_s() || !rec.has_mass_balance())
-    throw std::runtime_error("run record " + path + " is not a depth-averaged run's (no results, solver or mass balance)");
+    throw std::runtime_error("run record " + path + " is not a finished hazard run's (no results, solver or mass balance)");
   RegressionFigures f;
   f.runout_m = rec.results().runout_from_release_centroid_m();
   f.affected_area_m2 = rec.results().affected_area_m2();
@@ -102,7 +102,11 @@ RegressionFigures measure_run(const std::string& results_dir) {
   double x = kFarmLon, y = kFarmLat;
   if (!ct || !ct->Transform(1, &x, &y)) throw std::runtime_error("cannot place the farmhouse in the run's CRS");
   const int i = int(std::floor((x - r.gt[0]) / r.gt[1])), j = int(std::floor((y - r.gt[3]) / r.gt[5]));
-  if (i < 0 || j < 0 || i >= r.nx || j >= r.ny) throw std::runtime_error("the farmhouse lies outside the run's grid");
+  if (i < 0 || j < 0 || i >= r.nx || j >= r.ny) {
+    if (!farmhouse_optional) throw std::runtime_error("the farmhouse lies outside the run's grid");
+    f.farmhouse_depth_m = f.farmhouse_distance_m = std::numeric_limits<double>::quiet_NaN();
+    return f;
+  }
   const float here = r.v[std::size_t(j) * r.nx + i];
   f.farmhouse_depth_m = here == r.nodata ? 0.0 : double(here);
   double best = std::numeric_limits<double>::infinity();

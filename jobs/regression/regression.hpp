@@ -45,8 +45,9 @@ struct RegressionOutcome {
   std::string note;  ///< e.g. why the depth maps could not be compared
 };
 
-/// Figures of a result folder (run.json, max_depth.tif). Throws std::runtime_error.
-RegressionFigures measure_run(const std::string& results_dir);
+/// Figures of a result folder (run.json, max_depth.tif). Throws std::runtime_error. A farmhouse
+/// outside the run's grid is an error unless `farmhouse_optional` (its figures are then NaN).
+RegressionFigures measure_run(const std::string& results_dir, bool farmhouse_optional = false);
 /// Read reference.json of a reference folder. Throws std::runtime_error when absent or unreadable.
 RegressionReference read_reference(const std::string& reference_dir);
 /// Compare a run with the reference; writes diff.tif and diff.png (run minus reference max depth)
