@@ -127,12 +127,14 @@ void ActiveRegion::set(const std::vector<int>& d) {
   n_active = int(cells.size());
   std::vector<char> in_halo(nc, 0);
   faces.clear();
+  face_in.assign(std::size_t(nf), 0);
   for (int f = 0; f < nf; ++f) {
     const int o = m_.owner[f];
     const bool ao = index[o] >= 0;
     const bool an = f < m_.n_internal && index[m_.neighbour[f]] >= 0;
     if (ao || an) {
       faces.push_back(f);
+      face_in[f] = 1;
       in_halo[o] = 1;
       if (f < m_.n_internal) in_halo[m_.neighbour[f]] = 1;
     } else {

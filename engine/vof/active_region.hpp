@@ -41,6 +41,7 @@ class ActiveRegion {
   std::vector<int> cells;   ///< the region
   std::vector<int> halo;    ///< the region and the cells next to it (alpha may change there)
   std::vector<int> faces;   ///< faces of the region's cells, in ascending order (internal faces first)
+  std::vector<char> face_in;  ///< per face: 1 when it is one of `faces`
   int n_active = 0;
   double frozen_volume = 0, frozen_min = 0, frozen_max = 0;  ///< material outside the halo (unchanging)
 

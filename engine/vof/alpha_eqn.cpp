@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/vof/fv/parallel.hpp"
+
 namespace runout::engine::vof {
 
 AlphaEqn::AlphaEqn(const Mesh& m, const VofConfig& cfg, const BcContext& bc_ctx, const Boundaries& bcs, const ActiveRegion& region,
@@ -11,7 +13,7 @@ AlphaEqn::AlphaEqn(const Mesh& m, const VofConfig& cfg, const BcContext& bc_ctx,
   const auto nc = std::size_t(m.cells()), nf = std::size_t(m.faces());
   FL_.assign(nf, 0);
   AF_ = FL_;
-  for (auto* v : {&amax_, &amin_, &Pp_, &Pm_, &Rp_, &Rm_, &aL_}) v->assign(nc, 0);
+  for (auto* v : {&amax_, &amin_, &Rp_, &Rm_, &aL_}) v->assign(nc, 0);
   grad_alpha_.assign(nc, Vec{});
 }
 
@@ -20,26 +22,27 @@ AlphaEqn::AlphaEqn(const Mesh& m, const VofConfig& cfg, const BcContext& bc_ctx,
 void AlphaEqn::solve(Fields& F, double dt) {
   const int n = std::max(1, cfg_.alpha_subcycles);
   const double dts = dt / n;
-  for (int f : region_.faces) F.alpha_phi[f] = 0;
+  parallel_each(region_.faces, [&](int f) { F.alpha_phi[f] = 0; });
   for (int sub = 0; sub < n; ++sub) {
     interface_normal(F);
     fluxes_and_bounds(F);
     limit_and_update(F, dts, n);
   }
-  for (int f : region_.faces) F.rho_phi[f] = bc_ctx_.mixture.rho_flux(F.alpha_phi[f], F.phi[f]);
+  parallel_each(region_.faces, [&](int f) { F.rho_phi[f] = bc_ctx_.mixture.rho_flux(F.alpha_phi[f], F.phi[f]); });
 }
 
 // The interface normal per cell: the Gauss gradient of alpha.
 void AlphaEqn::interface_normal(const Fields& F) {
-  auto& ga = grad_alpha_;
-  for (int c : region_.halo) ga[c] = Vec{};
-  for (int f : region_.faces) {
-    const int o = m_.owner[f];
-    const double af = internal(m_, f) ? interpolate(m_, f, F.alpha) : bcs_[f].alpha(bc_ctx_, f);
-    ga[o] = ga[o] + af * m_.Sf[f];
-    if (internal(m_, f)) ga[m_.neighbour[f]] = ga[m_.neighbour[f]] - af * m_.Sf[f];
-  }
-  for (int c : region_.halo) ga[c] = (1.0 / m_.volume[c]) * ga[c];
+  const CellFaces& cf = region_.cell_faces();
+  parallel_each(region_.halo, [&](int c) {
+    Vec sum{};
+    for (int f : cf[c]) {
+      if (!region_.face_in[f]) continue;
+      const double af = internal(m_, f) ? interpolate(m_, f, F.alpha) : bcs_[f].alpha(bc_ctx_, f);
+      sum = m_.owner[f] == c ? sum + af * m_.Sf[f] : sum - af * m_.Sf[f];
+    }
+    grad_alpha_[c] = (1.0 / m_.volume[c]) * sum;
+  });
 }
 
 // Per face the upwind flux FL and the antidiffusive flux AF (central value plus compression, less
@@ -47,8 +50,7 @@ void AlphaEqn::interface_normal(const Fields& F) {
 void AlphaEqn::fluxes_and_bounds(const Fields& F) {
   const auto& a = F.alpha;
   const auto& ga = grad_alpha_;
-  for (int c : region_.halo) amax_[c] = amin_[c] = a[c];
-  for (int f : region_.faces) {
+  parallel_each(region_.faces, [&](int f) {
     const int o = m_.owner[f];
     const double ph = F.phi[f];
     if (internal(m_, f)) {
@@ -65,20 +67,31 @@ void AlphaEqn::fluxes_and_bounds(const Fields& F) {
       const double a_up = phir >= 0 ? ao : an, b_up = phir >= 0 ? 1 - an : 1 - ao;
       const double FH = ph * ac + phir * a_up * b_up;
       AF_[f] = FH - FL_[f];
-      amax_[o] = std::max(amax_[o], an);
-      amin_[o] = std::min(amin_[o], an);
-      amax_[nb] = std::max(amax_[nb], ao);
-      amin_[nb] = std::min(amin_[nb], ao);
     } else {
-      const double ab = ph >= 0 ? a[o] : bcs_[f].alpha(bc_ctx_, f);
-      FL_[f] = ph * ab;
+      FL_[f] = ph * (ph >= 0 ? a[o] : bcs_[f].alpha(bc_ctx_, f));
       AF_[f] = 0;
-      if (ph < 0) {
-        amax_[o] = std::max(amax_[o], ab);
-        amin_[o] = std::min(amin_[o], ab);
+    }
+  });
+  // The bounds: the cell's own alpha, its neighbours' across faces of the region, and what enters
+  // through its boundary faces.
+  const CellFaces& cf = region_.cell_faces();
+  parallel_each(region_.halo, [&](int c) {
+    double hi = a[c], lo = a[c];
+    for (int f : cf[c]) {
+      if (!region_.face_in[f]) continue;
+      if (internal(m_, f)) {
+        const double other = a[m_.owner[f] == c ? m_.neighbour[f] : m_.owner[f]];
+        hi = std::max(hi, other);
+        lo = std::min(lo, other);
+      } else if (F.phi[f] < 0) {
+        const double ab = bcs_[f].alpha(bc_ctx_, f);
+        hi = std::max(hi, ab);
+        lo = std::min(lo, ab);
       }
     }
-  }
+    amax_[c] = hi;
+    amin_[c] = lo;
+  });
 }
 
 // Zalesak's limiter: the low-order update, the antidiffusive fluxes into (Pp) and out of (Pm) each
@@ -86,49 +99,58 @@ void AlphaEqn::fluxes_and_bounds(const Fields& F) {
 // antidiffusive flux scaled by the smaller fraction of its two cells.
 void AlphaEqn::limit_and_update(Fields& F, double dts, int subcycles) {
   auto& a = F.alpha;
-  for (int c : region_.halo) {
-    aL_[c] = a[c] * m_.volume[c];
-    Pp_[c] = Pm_[c] = 0;
-  }
-  for (int f : region_.faces) {
-    const int o = m_.owner[f];
-    aL_[o] -= dts * FL_[f];
-    if (internal(m_, f)) {
-      const int nb = m_.neighbour[f];
-      aL_[nb] += dts * FL_[f];
+  const CellFaces& cf = region_.cell_faces();
+  // The low-order update and the antidiffusive fluxes into and out of each cell, per cell over its
+  // faces of the region in ascending order.
+  parallel_each(region_.halo, [&](int c) {
+    double aL = a[c] * m_.volume[c], Pp = 0, Pm = 0;
+    for (int f : cf[c]) {
+      if (!region_.face_in[f]) continue;
+      const bool own = m_.owner[f] == c;
+      if (own) aL -= dts * FL_[f];
+      else aL += dts * FL_[f];
+      if (!internal(m_, f)) continue;
       const double A = AF_[f];
       // A > 0 takes from the owner, gives to the neighbour.
       if (A > 0) {
-        Pm_[o] += A;
-        Pp_[nb] += A;
+        if (own) Pm += A;
+        else Pp += A;
       } else {
-        Pp_[o] -= A;
-        Pm_[nb] -= A;
+        if (own) Pp -= A;
+        else Pm -= A;
       }
     }
-  }
-  for (int c : region_.halo) {
+    aL_[c] = aL;
     const double V = m_.volume[c];
-    const double lo = aL_[c] / V;
+    const double lo = aL / V;
     const double up = std::clamp(amax_[c], 0.0, 1.0), dn = std::clamp(amin_[c], 0.0, 1.0);
     const double Qp = std::max(0.0, (up - lo) * V / dts), Qm = std::max(0.0, (lo - dn) * V / dts);
-    Rp_[c] = Pp_[c] > 0 ? std::min(1.0, Qp / Pp_[c]) : 1.0;
-    Rm_[c] = Pm_[c] > 0 ? std::min(1.0, Qm / Pm_[c]) : 1.0;
-  }
-  for (int f : region_.faces) {
+    Rp_[c] = Pp > 0 ? std::min(1.0, Qp / Pp) : 1.0;
+    Rm_[c] = Pm > 0 ? std::min(1.0, Qm / Pm) : 1.0;
+  });
+  // Each face's antidiffusive flux scaled by the smaller fraction of its two cells.
+  parallel_each(region_.faces, [&](int f) {
     double Fl = FL_[f];
+    double dA = 0;
     if (internal(m_, f)) {
       const int o = m_.owner[f], nb = m_.neighbour[f];
       const double A = AF_[f];
       const double lam = A > 0 ? std::min(Rm_[o], Rp_[nb]) : std::min(Rp_[o], Rm_[nb]);
       Fl += lam * A;
-      const double dA = lam * A * dts;
-      aL_[o] -= dA;
-      aL_[nb] += dA;
+      dA = lam * A * dts;
     }
+    AF_[f] = dA;  // (the antidiffusive flux is spent: its share of this step kept here)
     F.alpha_phi[f] += Fl / subcycles;
-  }
-  for (int c : region_.halo) a[c] = aL_[c] / m_.volume[c];
+  });
+  parallel_each(region_.halo, [&](int c) {
+    double aL = aL_[c];
+    for (int f : cf[c]) {
+      if (f >= m_.n_internal || !region_.face_in[f]) continue;
+      if (m_.owner[f] == c) aL -= AF_[f];
+      else aL += AF_[f];
+    }
+    a[c] = aL / m_.volume[c];
+  });
 }
 
 }  // namespace runout::engine::vof

@@ -27,8 +27,8 @@ class AlphaEqn {
   const Boundaries& bcs_;
   const ActiveRegion& region_;
   const double delta_n_;  // keeps the unit normal's division finite
-  FaceField<double> FL_, AF_;  // low-order flux; antidiffusive flux (high-order less low-order)
-  CellField<double> amax_, amin_, Pp_, Pm_, Rp_, Rm_, aL_;  // local bounds; Zalesak's sums and ratios; alpha V
+  FaceField<double> FL_, AF_;  // low-order flux; antidiffusive flux (high-order less low-order), then its limited share of the step
+  CellField<double> amax_, amin_, Rp_, Rm_, aL_;  // local bounds; Zalesak's ratios; alpha V
   CellField<Vec> grad_alpha_;
 };
 

@@ -1,5 +1,7 @@
 #include "engine/vof/momentum_eqn.hpp"
 
+#include "engine/vof/fv/parallel.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -18,35 +20,43 @@ MomentumEqn::MomentumEqn(const Mesh& m, const VofConfig& cfg, const BcContext& b
   HbyA.assign(nc, Vec{});
   H_ = HbyA;
   force_ = HbyA;
+  diag_o_.assign(nf, 0);
+  diag_n_ = diag_o_;
+  face_vec_.assign(nf, Vec{});
 }
 
 void MomentumEqn::setup_predictor() { solver_.setup(cfg_.momentum_rtol); }
 
 void MomentumEqn::velocity_gradient(Fields& F) const {
   auto& G = F.gradU;
-  for (int c : region_.halo) G[c] = Tensor{};
-  for (int f : region_.faces) {
-    const int o = m_.owner[f];
-    const Vec S = m_.Sf[f];
-    const Vec Uf = internal(m_, f) ? interpolate(m_, f, F.U) : bcs_[f].velocity(bc_ctx_, f);
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        const double v = comp(S, i) * comp(Uf, j);
-        G[o].g[i][j] += v;
-        if (internal(m_, f)) G[m_.neighbour[f]].g[i][j] -= v;
-      }
-  }
-  for (int c : region_.halo)
-    for (auto& row : G[c].g)
+  const CellFaces& cf = region_.cell_faces();
+  // Per cell of the halo over its faces of the region (the outer cells' other faces carry nothing).
+  parallel_each(region_.halo, [&](int c) {
+    Tensor g{};
+    for (int f : cf[c]) {
+      if (!region_.face_in[f]) continue;
+      const Vec S = m_.Sf[f];
+      const Vec Uf = internal(m_, f) ? interpolate(m_, f, F.U) : bcs_[f].velocity(bc_ctx_, f);
+      const bool own = m_.owner[f] == c;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+          const double v = comp(S, i) * comp(Uf, j);
+          if (own) g.g[i][j] += v;
+          else g.g[i][j] -= v;
+        }
+    }
+    for (auto& row : g.g)
       for (double& v : row) v /= m_.volume[c];
+    G[c] = g;
+  });
 }
 
 void MomentumEqn::update_viscosity(Fields& F) const {
   velocity_gradient(F);
-  for (int c : region_.cells) {
+  parallel_each(region_.cells, [&](int c) {
     F.nu1[c] = bc_ctx_.viscosity.nu(bc_ctx_.hydrostatics.confining_pressure(c), strain_rate(F.gradU[c]));
     F.mu[c] = bc_ctx_.mixture.mu(F.alpha[c], F.nu1[c]);
-  }
+  });
 }
 
 // Boundary values and the transpose viscous part are taken from the current velocity.
@@ -61,11 +71,11 @@ void MomentumEqn::build(const Fields& F, double dt) {
 
 // ddt(rho, U), Euler implicit.
 void MomentumEqn::transient(const Fields& F, double dt) {
-  for (int c : region_.halo) {
+  parallel_each(region_.halo, [&](int c) {
     const double V = m_.volume[c];
     UEqn_.diag[c] = F.rho[c] * V / dt;
     UEqn_.source[c] = (F.rho_old[c] * V / dt) * F.U_old[c];
-  }
+  });
 }
 
 // Transpose part of the viscous stress, explicit and in divergence form as interFoam has it: sum
@@ -77,7 +87,7 @@ void MomentumEqn::transpose_stress(const Fields& F) {
   const bool harmonic = cfg_.viscous_transpose == Transpose::harmonic;
   const auto& G = F.gradU;
   auto& b = UEqn_.source;
-  for (int f : region_.faces) {
+  parallel_each(region_.faces, [&](int f) {
     const int o = m_.owner[f];
     const bool in = internal(m_, f);
     const int nb = in ? m_.neighbour[f] : o;
@@ -91,9 +101,18 @@ void MomentumEqn::transpose_stress(const Fields& F) {
       for (int j = 0; j < 3; ++j) v += (w * G[o].g[i][j] + (1 - w) * G[nb].g[i][j]) * comp(S, j);
       add_comp(t, i, muf * v);
     }
-    b[o] = b[o] + t;
-    if (in) b[nb] = b[nb] - t;
-  }
+    face_vec_[f] = t;
+  });
+  // Into the owner (+) and the neighbour (-), per cell over its faces in ascending order.
+  const CellFaces& cf = region_.cell_faces();
+  parallel_each(region_.halo, [&](int c) {
+    Vec sum = b[c];
+    for (int f : cf[c]) {
+      if (!region_.face_in[f]) continue;
+      sum = m_.owner[f] == c ? sum + face_vec_[f] : sum - face_vec_[f];
+    }
+    b[c] = sum;
+  });
 }
 
 // div(rho_phi, U) upwind and laplacian(mu_f, U) with the linear face viscosity (interFoam's
@@ -101,16 +120,26 @@ void MomentumEqn::transpose_stress(const Fields& F) {
 // fraction, gave the same B2 figures to the third digit under PISO), over the internal faces.
 // Row o: + max(F,0) U_o + min(F,0) U_nb + D (U_o - U_nb); row nb: the flux out of nb is -F.
 void MomentumEqn::convection_diffusion(const Fields& F) {
-  for (int f : region_.faces) {
-    if (!internal(m_, f)) break;
-    const int o = m_.owner[f], nb = m_.neighbour[f];
+  const auto& faces = region_.faces;
+  const int n_in = int(std::lower_bound(faces.begin(), faces.end(), m_.n_internal) - faces.begin());
+  parallel_for(n_in, [&](int k) {
+    const int f = faces[std::size_t(k)];
     const double Fm = F.rho_phi[f];
     const double D = interpolate(m_, f, F.mu) * m_.magSf[f] * m_.delta_coeff[f];
-    UEqn_.diag[o] += std::max(Fm, 0.0) + D;
+    diag_o_[f] = std::max(Fm, 0.0) + D;
     UEqn_.upper[f] = D - std::min(Fm, 0.0);
-    UEqn_.diag[nb] += std::max(-Fm, 0.0) + D;
+    diag_n_[f] = std::max(-Fm, 0.0) + D;
     UEqn_.lower[f] = D - std::min(-Fm, 0.0);
-  }
+  });
+  const CellFaces& cf = region_.cell_faces();
+  parallel_each(region_.halo, [&](int c) {
+    double d = UEqn_.diag[c];
+    for (int f : cf[c]) {
+      if (f >= m_.n_internal || !region_.face_in[f]) continue;
+      d += m_.owner[f] == c ? diag_o_[f] : diag_n_[f];
+    }
+    UEqn_.diag[c] = d;
+  });
 }
 
 // limitedLinearV 1 (interFoam's damBreak): the face value moves from upwind towards the linear one
@@ -171,20 +200,20 @@ void MomentumEqn::boundary_terms(const Fields& F) {
 // VofSolver.FlatLayerStaysAtRestWithTheConsistentCoupling); the air keeps 1/A.
 void MomentumEqn::coefficients(const Fields& F, double dt) {
   const auto& A = UEqn_.A();
-  for (int c : region_.halo) rAU[c] = m_.volume[c] / A[c];  // 1 / A per unit volume [m3 s/kg]
-  for (int f : region_.faces) rAUf[f] = interpolate_or_owner(m_, f, rAU);
+  parallel_each(region_.halo, [&](int c) { rAU[c] = m_.volume[c] / A[c]; });  // 1 / A per unit volume [m3 s/kg]
+  parallel_each(region_.faces, [&](int f) { rAUf[f] = interpolate_or_owner(m_, f, rAU); });
   if (!cfg_.consistent) return;
-  UEqn_.H1(m_, region_.halo, region_.faces, H1_);
-  for (int c : region_.halo) {
+  UEqn_.H1(m_, region_.cell_faces(), region_.face_in, region_.halo, H1_);
+  parallel_each(region_.halo, [&](int c) {
     const double V = m_.volume[c];
     rAtU[c] = F.alpha[c] < cfg_.consistent_alpha ? rAU[c] : V / std::max(A[c] - H1_[c], 0.5 * F.rho[c] * V / dt);
-  }
-  for (int f : region_.faces) rAtUf[f] = interpolate_or_owner(m_, f, rAtU);
+  });
+  parallel_each(region_.faces, [&](int f) { rAtUf[f] = interpolate_or_owner(m_, f, rAtU); });
 }
 
 void MomentumEqn::update_HbyA(const Fields& F) {
-  UEqn_.H(m_, F.U, region_.halo, region_.faces, H_);
-  for (int c : region_.halo) HbyA[c] = (1.0 / UEqn_.diag[c]) * H_[c];
+  UEqn_.H(m_, region_.cell_faces(), region_.face_in, F.U, region_.halo, H_);
+  parallel_each(region_.halo, [&](int c) { HbyA[c] = (1.0 / UEqn_.diag[c]) * H_[c]; });
 }
 
 void MomentumEqn::unit_coefficients() {

@@ -62,6 +62,8 @@ class MomentumEqn {
   CellField<Vec> H_;
   CellField<double> H1_;
   CellField<Vec> force_;          // the predictor's force
+  FaceField<double> diag_o_, diag_n_;  // per face: what it adds to its owner's and neighbour's diagonal
+  FaceField<Vec> face_vec_;       // per face: the transpose stress it gives its cells
   std::vector<int> rows_, row_of_;  // the predicted cells (ascending); per cell its row or -1
   std::vector<Vec> known_;        // per row: the share of the neighbours that are not predicted
   CsrMatrix A_;

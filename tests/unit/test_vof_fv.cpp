@@ -68,8 +68,11 @@ TEST(VofFv, MatrixHAndFlux) {
   psi[2] = 100;
   const auto cells = all(3), faces = all(m.faces());
   CellField<double> H(3, 0.0), H1(3, 0.0);
-  M.H(m, psi, cells, faces, H);
-  M.H1(m, cells, faces, H1);
+  CellFaces cf;
+  cf.build(m);
+  const std::vector<char> face_in(std::size_t(m.faces()), 1);
+  M.H(m, cf, face_in, psi, cells, H);
+  M.H1(m, cf, face_in, cells, H1);
   EXPECT_EQ(M.A()[1], 11);
   // Face f joins owner o and neighbour n: H_o += upper psi_n, H_n += lower psi_o.
   std::vector<double> want = {0, 1, 2}, want1 = {0, 0, 0};

@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "engine/vof/fv/field.hpp"
+#include "engine/vof/fv/ops.hpp"
+#include "engine/vof/fv/parallel.hpp"
 #include "engine/vof/mesh.hpp"
 
 namespace runout::engine::vof {
@@ -28,26 +30,31 @@ struct FvMatrix {
   /// The diagonal A (interFoam's UEqn.A(), per cell, not divided by the volume).
   const CellField<double>& A() const { return diag; }
 
-  /// H(psi) = source + sum_nb c_nb psi_nb over `cells`, from the internal faces of `faces` (sorted:
-  /// internal faces first), into `out` (interFoam's UEqn.H()).
-  void H(const Mesh& m, const CellField<T>& psi, const std::vector<int>& cells, const std::vector<int>& faces, CellField<T>& out) const {
-    for (int c : cells) out[c] = source[c];
-    for (int f : faces) {
-      if (f >= m.n_internal) break;
-      const int o = m.owner[f], nb = m.neighbour[f];
-      out[o] = out[o] + upper[f] * psi[nb];
-      out[nb] = out[nb] + lower[f] * psi[o];
-    }
+  /// H(psi) = source + sum_nb c_nb psi_nb over `cells`, from their internal faces marked in
+  /// `face_in` (1: the face takes part), into `out` (interFoam's UEqn.H()). Per cell over its faces
+  /// in ascending order, over the OpenMP threads (fv/parallel.hpp).
+  void H(const Mesh& m, const CellFaces& cf, const std::vector<char>& face_in, const CellField<T>& psi, const std::vector<int>& cells,
+         CellField<T>& out) const {
+    parallel_each(cells, [&](int c) {
+      T sum = source[c];
+      for (int f : cf[c]) {
+        if (f >= m.n_internal || !face_in[f]) continue;
+        sum = m.owner[f] == c ? sum + upper[f] * psi[m.neighbour[f]] : sum + lower[f] * psi[m.owner[f]];
+      }
+      out[c] = sum;
+    });
   }
 
-  /// H1 = sum_nb c_nb (the neighbour coefficients' sum per cell, SIMPLEC's), into `out`.
-  void H1(const Mesh& m, const std::vector<int>& cells, const std::vector<int>& faces, CellField<double>& out) const {
-    for (int c : cells) out[c] = 0;
-    for (int f : faces) {
-      if (f >= m.n_internal) break;
-      out[m.owner[f]] += upper[f];
-      out[m.neighbour[f]] += lower[f];
-    }
+  /// H1 = sum_nb c_nb (the neighbour coefficients' sum per cell, SIMPLEC's), into `out`, as H.
+  void H1(const Mesh& m, const CellFaces& cf, const std::vector<char>& face_in, const std::vector<int>& cells, CellField<double>& out) const {
+    parallel_each(cells, [&](int c) {
+      double sum = 0;
+      for (int f : cf[c]) {
+        if (f >= m.n_internal || !face_in[f]) continue;
+        sum += m.owner[f] == c ? upper[f] : lower[f];
+      }
+      out[c] = sum;
+    });
   }
 
   /// The flux the off-diagonal part carries through internal face f (symmetric matrices such as a
