@@ -11,9 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <functional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -36,6 +34,7 @@ namespace vt = runout::jobs::vof_terrain;
 using runout::terrain::Grid;
 
 constexpr double kPi = 3.14159265358979323846;
+const std::filesystem::path kArelen3d = std::filesystem::path(RUNOUT_SOURCE_DIR) / "scenarios" / "in-den-arelen-3d.json";
 
 struct PlaneCase {
   double slope_deg = 35, turn_deg = 0, delta_deg = 20, phi_deg = 40;
@@ -217,15 +216,11 @@ TEST(TerrainVof, BlockFlatterThanItsBedFrictionIsHeld) {
 // mesh quality, the volumes, the alpha bounds and the profile at the farmhouse.
 TEST(TerrainVof, ArelenCoarseRunWritesTheHazardMapsFramesAndRecord) {
   namespace fs = std::filesystem;
-  const fs::path scen = fs::path(RUNOUT_SOURCE_DIR) / "scenarios" / "in-den-arelen-3d.json";
-  std::ifstream in(scen);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  auto sc = runout::jobs::parse_scenario_json(ss.str());
+  auto sc = runout::jobs::parse_scenario_json(runout::test_support::read_text(kArelen3d));
   sc.mutable_grid()->set_resolution_m(90);
   sc.mutable_numerics()->set_end_time_s(5);
   sc.mutable_vof()->set_write_interval_s(2.5);
-  const auto r = runout::jobs::resolve_scenario(sc, scen.parent_path().string());
+  const auto r = runout::jobs::resolve_scenario(sc, kArelen3d.parent_path().string());
   ASSERT_TRUE(r.vof && r.terrain);
   runout::test_support::TempDir d;
   const auto sum = runout::jobs::run_scenario(r, d.p.string());
@@ -248,27 +243,19 @@ TEST(TerrainVof, ArelenCoarseRunWritesTheHazardMapsFramesAndRecord) {
   EXPECT_EQ(rec.profiles(0).name(), "farmhouse");
   EXPECT_EQ(rec.profiles(0).profile_height_alpha_speed_size() == 0 || rec.profiles(0).profile_height_alpha_speed_size() == tm.layers(), true);
   // The frames lie in the grid's CRS (Float64 centres): east and north inside the grid.
-  std::ifstream x(d.p / "fields.xmf");
-  std::stringstream xs;
-  xs << x.rdbuf();
-  EXPECT_NE(xs.str().find("Precision=\"8\" Format=\"HDF\">fields.h5:/centres"), std::string::npos);
+  EXPECT_NE(runout::test_support::read_text(d.p / "fields.xmf").find("Precision=\"8\" Format=\"HDF\">fields.h5:/centres"), std::string::npos);
   std::printf("Arelen at 90 m, 5 s: %d cells, %ld steps, %.1f s run; volume error %.1e, outflow %.0f m3, runout %.0f m\n", tm.cells(), sum.steps,
               sum.seconds_run, sum.volume_error, sum.volume_outflow, sum.runout_m);
 }
 
 // The 3D engine's options on the DEM are checked before anything runs, each error naming its field.
 TEST(TerrainVof, BadOptionsAreNamed) {
-  namespace fs = std::filesystem;
-  const fs::path scen = fs::path(RUNOUT_SOURCE_DIR) / "scenarios" / "in-den-arelen-3d.json";
-  std::ifstream in(scen);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const auto base = runout::jobs::parse_scenario_json(ss.str());
+  const auto base = runout::jobs::parse_scenario_json(runout::test_support::read_text(kArelen3d));
   auto message = [&](const std::function<void(runout::v1::Scenario&)>& change) {
     auto s = base;
     change(s);
     try {
-      runout::jobs::resolve_scenario(s, scen.parent_path().string());
+      runout::jobs::resolve_scenario(s, kArelen3d.parent_path().string());
     } catch (const runout::jobs::ScenarioError& e) {
       return std::string(e.what());
     }
@@ -289,7 +276,7 @@ TEST(TerrainVof, BadOptionsAreNamed) {
   auto s = base;
   s.mutable_grid()->set_resolution_m(90);
   s.mutable_vof()->mutable_profiles(0)->set_x(8.0);
-  const auto r = runout::jobs::resolve_scenario(s, scen.parent_path().string());
+  const auto r = runout::jobs::resolve_scenario(s, kArelen3d.parent_path().string());
   runout::test_support::TempDir d;
   try {
     runout::jobs::run_scenario(r, d.p.string());
