@@ -1,7 +1,7 @@
 #pragma once
 // The VOF engine's linear solvers through PETSc: the process-wide start of PETSc, the momentum
 // predictor's solver (BiCGStab + ILU over the cells it predicts) and the pressure solver over the active
-// region (CG with GAMG or hypre BoomerAMG, its preconditioner kept across steps and refreshed
+// region (CG with GAMG, hypre BoomerAMG or ILU(0), its preconditioner kept across steps and refreshed
 // every VofConfig::pressure_pc_refresh steps, saved into and restored from a checkpoint). The
 // equations hand them coefficients; nothing else in the engine calls PETSc.
 #include <petscksp.h>
@@ -23,11 +23,6 @@ struct CsrMatrix {
   std::vector<PetscInt> start{0}, col;
   std::vector<double> val;
   int rows() const { return int(start.size()) - 1; }
-  void clear() {
-    start.assign(1, 0);
-    col.clear();
-    val.clear();
-  }
 };
 
 /// The momentum predictor's system over the cells it predicts (the rows change with the material):
