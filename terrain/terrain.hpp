@@ -59,9 +59,12 @@ Grid prepare_grid(const DemRequest& req, DemReport* report = nullptr);
 /// Slope angle [deg] per cell from centred differences (one-sided at the edges).
 std::vector<double> slope_deg(const Grid& g);
 
+/// One release: polygons (path) with a thickness per polygon, or a thickness raster (any GDAL
+/// format and CRS), alone or inside the polygons.
 struct ReleaseRequest {
-  std::string path;
-  std::string crs;  ///< used when the file has none
+  std::string path;  ///< polygons; may be empty when thickness_raster is given
+  std::string crs;   ///< used when the file (polygons or raster) has none
+  std::string thickness_raster;  ///< the thickness per point, resampled bilinearly onto the grid
   bool has_thickness = false;
   double thickness = 0;
   std::string thickness_attribute;
@@ -79,7 +82,7 @@ struct ReleaseReport {
   std::vector<std::string> notes;  ///< e.g. repaired geometries
 };
 
-/// Normal release thickness per cell (row 0 south), maximum over overlapping polygons.
+/// Normal release thickness per cell (row 0 south), maximum over overlapping polygons and releases.
 std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseRequest>& releases,
                                        ReleaseReport* report = nullptr);
 

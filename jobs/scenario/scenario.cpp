@@ -149,16 +149,21 @@ ResolvedScenario load_scenario(const std::string& path) {
 
 namespace {
 
+// A raster input and the companion files that change how it reads (ESRI ASCII .prj, GDAL's PAM
+// file .aux.xml): all part of the input.
+void add_raster(const std::string& path, const std::string& field, ResolvedScenario& r) {
+  r.input_files.push_back(path);
+  for (const char* ext : {".prj", ".hdr", ".tfw"}) {
+    fs::path side = fs::path(path).replace_extension(ext);
+    if (side != fs::path(path) && companion(side, field)) r.input_files.push_back(side.string());
+  }
+  if (companion(path + ".aux.xml", field)) r.input_files.push_back(path + ".aux.xml");
+}
+
 // The input files: the DEM with the companions that change how it reads, the area of interest.
 void resolve_inputs(const v1::Scenario& s, const std::string& base, ResolvedScenario& r) {
   r.dem.dem_path = path_in(base, s.dem().path(), "dem.path");
-  r.input_files.push_back(r.dem.dem_path);
-  // Companion files that change how the DEM reads (ESRI ASCII .prj) are part of the input.
-  for (const char* ext : {".prj", ".hdr", ".tfw"}) {
-    fs::path side = fs::path(r.dem.dem_path).replace_extension(ext);
-    if (side != fs::path(r.dem.dem_path) && companion(side, "dem.path")) r.input_files.push_back(side.string());
-  }
-  if (companion(r.dem.dem_path + ".aux.xml", "dem.path")) r.input_files.push_back(r.dem.dem_path + ".aux.xml");  // GDAL's PAM file
+  add_raster(r.dem.dem_path, "dem.path", r);
   if (!s.area_of_interest().path().empty()) {
     r.dem.aoi_path = path_in(base, s.area_of_interest().path(), "area_of_interest.path");
     r.input_files.push_back(r.dem.aoi_path);
@@ -171,16 +176,28 @@ void resolve_releases(const v1::Scenario& s, const std::string& base, ResolvedSc
     const auto& rl = s.releases(k);
     const std::string f = "releases[" + std::to_string(k) + "]";
     terrain::ReleaseRequest q;
-    q.path = path_in(base, rl.path(), f + ".path");
-    r.input_files.push_back(q.path);
-    for (const char* ext : {".shx", ".dbf", ".prj", ".cpg"}) {
-      fs::path side = fs::path(q.path).replace_extension(ext);
-      if (fs::path(q.path).extension() == ".shp" && companion(side, f + ".path")) r.input_files.push_back(side.string());
+    if (rl.path().empty() && rl.thickness_raster().empty()) bad(f + ".path", "missing (release polygons, or a thickness_raster)");
+    if (!rl.path().empty()) {
+      q.path = path_in(base, rl.path(), f + ".path");
+      r.input_files.push_back(q.path);
+      for (const char* ext : {".shx", ".dbf", ".prj", ".cpg"}) {
+        fs::path side = fs::path(q.path).replace_extension(ext);
+        if (fs::path(q.path).extension() == ".shp" && companion(side, f + ".path")) r.input_files.push_back(side.string());
+      }
     }
     q.has_thickness = rl.has_thickness_m();
     q.thickness = rl.thickness_m();
     q.thickness_attribute = rl.thickness_attribute();
-    if (!q.has_thickness && q.thickness_attribute.empty()) bad(f, "needs thickness_m or thickness_attribute");
+    if (!rl.thickness_raster().empty()) {
+      q.thickness_raster = path_in(base, rl.thickness_raster(), f + ".thickness_raster");
+      add_raster(q.thickness_raster, f + ".thickness_raster", r);
+      if (q.has_thickness || !q.thickness_attribute.empty())
+        bad(f + ".thickness_raster", "gives the thickness: leave thickness_m and thickness_attribute unset");
+      if (q.path.empty() && (!rl.min_slope_attribute().empty() || !rl.max_slope_attribute().empty()))
+        bad(f, "slope-window attributes need polygons (path); give min_slope_deg and max_slope_deg");
+    } else if (!q.has_thickness && q.thickness_attribute.empty()) {
+      bad(f, "needs thickness_m, thickness_attribute or thickness_raster");
+    }
     q.vertical = rl.thickness_measured() == "vertical";
     q.has_min_slope = rl.has_min_slope_deg();
     q.min_slope = rl.min_slope_deg();

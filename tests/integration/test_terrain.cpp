@@ -126,6 +126,116 @@ TEST(Terrain, SlopeWindowAndVerticalThickness) {
   EXPECT_EQ(rep.cells, kept);
 }
 
+// A one-band Float32 GeoTIFF in `epsg`: nx x ny cells of `cell` (its CRS's units) from (x0, y0) at
+// the south-west corner, value v(x, y) at the cells' centres.
+void make_raster(const std::string& path, const char* epsg, double x0, double y0, double cell, int nx, int ny,
+                 const std::function<double(double, double)>& v) {
+  GDALAllRegister();
+  auto* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  GDALDatasetUniquePtr ds(mem->Create("", nx, ny, 1, GDT_Float32, nullptr));
+  double gt[6] = {x0, cell, 0, y0 + ny * cell, 0, -cell};
+  ds->SetGeoTransform(gt);
+  OGRSpatialReference s;
+  s.SetFromUserInput(epsg);
+  ds->SetSpatialRef(&s);
+  std::vector<float> z(std::size_t(nx) * std::size_t(ny));
+  for (int r = 0; r < ny; ++r)
+    for (int i = 0; i < nx; ++i) z[std::size_t(r) * std::size_t(nx) + std::size_t(i)] = float(v(x0 + (i + 0.5) * cell, y0 + (ny - r - 0.5) * cell));
+  ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, nx, ny, z.data(), nx, ny, GDT_Float32, 0, 0), CE_None);
+  GDALDatasetUniquePtr out(GetGDALDriverManager()->GetDriverByName("GTiff")->CreateCopy(path.c_str(), ds.get(), FALSE, nullptr, nullptr, nullptr));
+  ASSERT_TRUE(out);
+}
+
+// A thickness raster at twice the grid's resolution, linear across the slope's fall line: the grid's
+// cells take its value at their centres (bilinear resampling of a linear field), only where the
+// raster lies, and the volume is the sum over them.
+TEST(Terrain, ReleaseThicknessFromARasterIsResampledOntoTheGrid) {
+  TempDir d;
+  make_dem(d / "dem.tif", 100, 20.0, 30);
+  auto t_at = [](double x, double) { return 1.0 + (x - 500200) / 400; };
+  make_raster(d / "t.tif", "EPSG:32632", 500200, 5200600, 10, 40, 40, t_at);
+  terrain::DemRequest rq;
+  rq.dem_path = d / "dem.tif";
+  rq.resolution = 20;
+  const auto g = terrain::prepare_grid(rq);
+  terrain::ReleaseRequest r;
+  r.thickness_raster = d / "t.tif";
+  terrain::ReleaseReport rep;
+  const auto h = terrain::rasterize_releases(g, {r}, &rep);
+  const auto slope = terrain::slope_deg(g);
+  long cells = 0;
+  double volume = 0;
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      const std::size_t k = std::size_t(j) * std::size_t(g.nx) + std::size_t(i);
+      const bool in = g.cx(i) > 500200 && g.cx(i) < 500600 && g.cy(j) > 5200600 && g.cy(j) < 5201000;
+      if (!in) {
+        EXPECT_EQ(h[k], 0.0) << i << " " << j;
+        continue;
+      }
+      ++cells;
+      volume += h[k] * g.dx * g.dx / std::cos(slope[k] * M_PI / 180);
+      const bool edge = g.cx(i) < 500220 || g.cx(i) > 500580 || g.cy(j) < 5200620 || g.cy(j) > 5200980;
+      if (!edge) EXPECT_NEAR(h[k], t_at(g.cx(i), g.cy(j)), 1e-6) << i << " " << j;
+      EXPECT_GE(h[k], 1.0);
+      EXPECT_LE(h[k], 2.0);
+    }
+  EXPECT_EQ(cells, 20 * 20);
+  EXPECT_EQ(rep.cells, cells);
+  EXPECT_EQ(rep.polygons, 0);
+  EXPECT_NEAR(rep.volume_m3, volume, 1e-9 * volume);
+}
+
+// A thickness raster in WGS84 of 2 m everywhere, cut by a polygon in UTM: the same release as the
+// polygon with thickness_m 2.
+TEST(Terrain, ReleaseThicknessRasterInsideAPolygonEqualsThePolygonsThickness) {
+  TempDir d;
+  make_dem(d / "dem.tif", 80, 25.0, 30);
+  make_raster(d / "t_ll.tif", "EPSG:4326", 8.99, 46.94, 0.0005, 60, 60, [](double, double) { return 2.0; });
+  make_polygons(d / "rel.geojson", {square(500300, 5200500, 300)}, "EPSG:32632");
+  terrain::DemRequest rq;
+  rq.dem_path = d / "dem.tif";
+  rq.resolution = 25;
+  const auto g = terrain::prepare_grid(rq);
+  terrain::ReleaseRequest a, b;
+  a.path = b.path = d / "rel.geojson";
+  a.has_thickness = true;
+  a.thickness = 2;
+  b.thickness_raster = d / "t_ll.tif";
+  terrain::ReleaseReport ra, rb;
+  const auto ha = terrain::rasterize_releases(g, {a}, &ra), hb = terrain::rasterize_releases(g, {b}, &rb);
+  ASSERT_GT(ra.cells, 100);
+  EXPECT_EQ(rb.cells, ra.cells);
+  for (std::size_t k = 0; k < ha.size(); ++k) EXPECT_NEAR(hb[k], ha[k], 1e-6) << k;
+  EXPECT_NEAR(rb.volume_m3, ra.volume_m3, 1e-6 * ra.volume_m3);
+}
+
+TEST(Terrain, BadThicknessRastersAreNamed) {
+  TempDir d;
+  make_dem(d / "dem.tif", 60, 25.0, 30);
+  make_raster(d / "deep.tif", "EPSG:32632", 500300, 5200500, 25, 8, 8, [](double x, double) { return x > 500400 ? 600.0 : 1.0; });
+  make_raster(d / "far.tif", "EPSG:32632", 600000, 5300000, 25, 8, 8, [](double, double) { return 1.0; });
+  make_raster(d / "zero.tif", "EPSG:32632", 500300, 5200500, 25, 8, 8, [](double, double) { return 0.0; });
+  make_polygons(d / "rel.geojson", {square(500300, 5200500, 300)}, "EPSG:32632");
+  auto raster_release = [&](const char* raster) {
+    auto s = base_scenario("dem.tif", "rel.geojson");
+    s.mutable_releases(0)->clear_path();
+    s.mutable_releases(0)->clear_thickness_m();
+    s.mutable_releases(0)->set_thickness_raster(raster);
+    return s;
+  };
+  expect_error(raster_release("deep.tif"), d, "release thickness raster '" + (d / "deep.tif") + "': thickness must lie in [0, 500] m, got 5");  // 540.1: resampled
+  expect_error(raster_release("far.tif"), d, "far.tif' lies outside the grid");
+  expect_error(raster_release("zero.tif"), d, "zero.tif' lies outside the grid, outside the area of interest or where the DEM has no data, or is thinner");
+  expect_error(raster_release("missing.tif"), d, "releases[0].thickness_raster: file");
+  auto both = raster_release("deep.tif");
+  both.mutable_releases(0)->set_thickness_m(1);
+  expect_error(both, d, "releases[0].thickness_raster: gives the thickness: leave thickness_m and thickness_attribute unset");
+  auto none = base_scenario("dem.tif", "rel.geojson");
+  none.mutable_releases(0)->clear_path();
+  expect_error(none, d, "releases[0].path: missing (release polygons, or a thickness_raster)");
+}
+
 TEST(Terrain, SelfIntersectingPolygonIsRepairedAndSaid) {
   TempDir d;
   make_dem(d / "dem.tif", 80, 25.0, 30);
