@@ -291,43 +291,8 @@ TEST(Scenarios, LabB10TallerColumnsRunOutFurther) {
   EXPECT_GT(rel[1], 4 * rel[0]);
 }
 
-// B8 (validation.md B8, coarse: 5 cm cells, 4 s): the terrain-following mesh of the curved chute
-// holds the released half cap (its volume within 2 % of pi hc^2 (3 r - hc) / 6), the mass runs down
-// the chute and through the bend onto the run-out, fans out there wider than it was released and
-// comes to rest around the end of the bend with its highest point on the chute side of its
-// centroid; most of it stays in the domain (at 5 cm 27 % leaves over the open sides, 4.5 % at
-// the scenario's 2.5 cm); alpha stays within [0, 1].
-TEST(Scenarios, LabB8CurvedChuteRunsOntoTheRunOutAndFansOut) {
-  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b8-curved-chute.json");
-  auto* lab = r.scenario.mutable_lab();
-  lab->set_nx(lab->nx() / 2);
-  lab->set_ny(lab->ny() / 2);
-  lab->set_nz(lab->nz() / 2);
-  lab->set_write_interval_s(2.0);
-  TempDir d;
-  const auto sum = jobs::run_scenario(r, d.p.string());
-  ASSERT_EQ(sum.stop, "end-time");
-  const auto j = run_record(d / "run.json");
-  const double rc = 0.32, hc = 0.22, cap = 3.14159265358979 * hc * hc * (3 * rc - hc) / 6;
-  std::printf("curved chute: half cap %.5f m3 (exact %.5f), on the run-out %.2f, half-width there %.2f m, deposit %.2f-%.2f m, "
-              "highest at %.2f m, centroid %.2f m, left the domain %.2f\n",
-              record_figure(j, "volume_initial_m3"), cap, record_figure(j, "share_on_runout"), record_figure(j, "half_width_on_runout_m"),
-              record_figure(j, "deposit_from_m"), record_figure(j, "deposit_to_m"), record_figure(j, "highest_x_m"), record_figure(j, "centroid_x_m"),
-              record_figure(j, "volume_relative_error"));
-  EXPECT_NEAR(record_figure(j, "volume_initial_m3"), cap, 0.02 * cap);
-  EXPECT_GT(record_figure(j, "peak_speed_m_s"), 1.0);
-  EXPECT_GT(record_figure(j, "share_on_runout"), 0.5);
-  EXPECT_GT(record_figure(j, "half_width_on_runout_m"), 0.4);  // released 0.30 m wide beside the plane of symmetry
-  EXPECT_LT(record_figure(j, "highest_x_m"), record_figure(j, "centroid_x_m"));
-  EXPECT_LT(record_figure(j, "highest_x_m"), 2.4);  // the bend ends at 2.15 m
-  EXPECT_LT(record_figure(j, "volume_relative_error"), 0.35);
-  EXPECT_GT(record_figure(j, "alpha_min"), -1e-6);
-  EXPECT_LT(record_figure(j, "alpha_max"), 1 + 1e-6);
-  // fields.xmf places the values at the cells' centres as they lie on the bent chute.
-  const std::string xmf = read_text(d / "fields.xmf");
-  EXPECT_NE(xmf.find("TopologyType=\"3DSMesh\""), std::string::npos);
-  EXPECT_NE(xmf.find("fields.h5:/centres"), std::string::npos);
-}
+// B8 (validation.md B8, coarse: 5 cm cells, 4 s) runs beside its DEM-path counterpart in
+// test_b8_dem.cpp.
 
 // B1 (validation.md B1, coarse: 8 mm cells, 0.8 s): below phi the fine sand turns with the box as a
 // rigid body, so the free surface's angle to the horizontal (run.json's monitor) follows the rotation
