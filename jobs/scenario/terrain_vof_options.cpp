@@ -45,6 +45,10 @@ const OptionTable& terrain_vof_options() {
       {"vof.bed_normal_stress", T::choice, U::fill, "pressure", {}, {"pressure", "total"}, "",
        "the bed friction's normal load: the pressure, or the total normal stress (less the viscous normal stress)",
        "PatchBc::friction_total_normal_stress"},
+      {"vof.max_viscosity_m2_s", T::number, U::as_given, "", Range{1, 1e8}, {}, "m2/s",
+       "the Coulomb viscosity's clip nu_max, default 1e2: material at rest creeps at about g sin(theta) h^2 / (3 nu_max) "
+       "(a 2 m layer on 15 deg: 2.7 cm/s at 1e2, 0.3 mm/s at 1e4)",
+       "VofConfig::nu_max"},
       {"vof.pressure_preconditioner", T::choice, U::fill, "ilu", {}, {"ilu", "gamg", "hypre"}, "",
        "the pressure solve's preconditioner: ILU(0) (suits the thin layers), PETSc's GAMG or hypre's BoomerAMG",
        "VofConfig::pressure_pc"},

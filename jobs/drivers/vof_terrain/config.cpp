@@ -25,6 +25,7 @@ vof::VofConfig terrain_config(const ResolvedScenario& r) {
   c.coulomb_pressure = vof::CoulombPressure::excess;
   c.active_layers = std::max(0, v.active_layers());
   c.pressure_pc = v.pressure_preconditioner();
+  if (v.has_max_viscosity_m2_s()) c.nu_max = v.max_viscosity_m2_s();
   c.gravity = [](double) { return vof::Vec{0, -9.81, 0}; };
   vof::PatchBc ground;
   ground.type = v.bed();
