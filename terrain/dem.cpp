@@ -64,23 +64,8 @@ double source_resolution_m(GDALDataset* ds, const OGRSpatialReference& s) {
 
 // The DEM's CRS: the file's own; dem.crs only for a file without one.
 OGRSpatialReference dem_crs(GDALDataset& dem, const DemRequest& req) {
-  OGRSpatialReference src;
-  const bool own = dem.GetSpatialRef() && !dem.GetSpatialRef()->IsEmpty();
-  if (!req.dem_crs.empty()) {
-    if (own) {
-      // The file's own CRS wins; an explicit one is only for files without.
-      src = *dem.GetSpatialRef();
-      src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    } else {
-      src = srs_from(req.dem_crs, "dem.crs");
-    }
-  } else if (own) {
-    src = *dem.GetSpatialRef();
-    src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  } else {
-    throw TerrainError("DEM '" + req.dem_path + "' has no CRS and none is given: set dem.crs (e.g. \"EPSG:2056\")");
-  }
-  return src;
+  return input_crs(dem.GetSpatialRef(), req.dem_crs, "dem.crs",
+                   "DEM '" + req.dem_path + "' has no CRS and none is given: set dem.crs (e.g. \"EPSG:2056\")");
 }
 
 // The centre of the area of interest (else of the DEM) in lon/lat: it picks the UTM zone. Zero for
@@ -224,12 +209,7 @@ std::vector<double> read_native(const DemRequest& req, GDALDataset& dem, const d
 
 // The DEM warped onto the grid by gdalwarp; rows from the north, nodata as -99999.
 std::vector<double> read_warped(const DemRequest& req, GDALDataset& dem, std::vector<std::string>& args, double res, Grid& g) {
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> wopt(
-      GDALWarpAppOptionsNew(argv.data(), nullptr), GDALWarpAppOptionsFree);
-  if (!wopt) throw TerrainError("internal: warp options rejected" + gdal_message());
+  const auto wopt = warp_options(args);
   GDALDatasetH srch = GDALDataset::ToHandle(&dem);
   int usage_error = 0;
   GDALDatasetUniquePtr warped(GDALDataset::FromHandle(GDALWarp("", nullptr, 1, &srch, wopt.get(), &usage_error)));

@@ -48,6 +48,27 @@ OGRSpatialReference srs_from(const std::string& text, const std::string& what) {
   return s;
 }
 
+OGRSpatialReference input_crs(const OGRSpatialReference* own, const std::string& given, const std::string& given_what,
+                              const std::string& no_crs) {
+  if (own && !own->IsEmpty()) {  // the file's own CRS wins; a given one is only for files without
+    OGRSpatialReference s = *own;
+    s.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    return s;
+  }
+  if (given.empty()) throw TerrainError(no_crs);
+  return srs_from(given, given_what);
+}
+
+std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> warp_options(std::vector<std::string> args) {
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> o(GDALWarpAppOptionsNew(argv.data(), nullptr),
+                                                                           GDALWarpAppOptionsFree);
+  if (!o) throw TerrainError("internal: warp options rejected" + gdal_message());
+  return o;
+}
+
 OGRSpatialReference wgs84() {
   OGRSpatialReference s;
   s.importFromEPSG(4326);

@@ -2,10 +2,12 @@
 // What the terrain room's files share about GDAL and OGR: start-up, error text, CRS handling,
 // number formatting for messages and in-memory rasters on a Grid. Internal to terrain/.
 #include <gdal_priv.h>
+#include <gdal_utils.h>
 #include <ogr_spatialref.h>
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "terrain/terrain.hpp"
 
@@ -20,6 +22,10 @@ std::string fmt(double v, int prec = 1);
 /// A CRS from user input ("EPSG:2056", WKT, PROJ, or "local" for local Cartesian metres); errors
 /// name `what`.
 OGRSpatialReference srs_from(const std::string& text, const std::string& what);
+/// An input's CRS: its own (`own`, when it has one), else the user's `given` (errors naming
+/// `given_what`); with neither, a TerrainError saying `no_crs`.
+OGRSpatialReference input_crs(const OGRSpatialReference* own, const std::string& given, const std::string& given_what,
+                              const std::string& no_crs);
 OGRSpatialReference wgs84();
 std::string wkt(const OGRSpatialReference& s);
 /// "EPSG:32632", the CRS's name, or "local metres".
@@ -27,6 +33,8 @@ std::string crs_name(const OGRSpatialReference& s);
 /// A coordinate transformation; nullptr for two local CRSs (the identity: they have no datum to relate).
 std::unique_ptr<OGRCoordinateTransformation> transform(const OGRSpatialReference& from, const OGRSpatialReference& to,
                                                        const std::string& what);
+/// GDAL's warper options from gdalwarp's command-line arguments.
+std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> warp_options(std::vector<std::string> args);
 /// A one-band in-memory raster on the grid (north-up, the grid's CRS).
 GDALDatasetUniquePtr mem_raster(const Grid& g, GDALDataType type);
 

@@ -2,7 +2,6 @@
 // thickness raster (alone or inside the polygons), the slope window, and the released volume.
 #include <gdal_alg.h>
 #include <gdal_priv.h>
-#include <gdal_utils.h>
 #include <ogr_geometry.h>
 #include <ogr_spatialref.h>
 #include <ogrsf_frmts.h>
@@ -100,15 +99,9 @@ std::vector<double> raster_thickness(const Grid& g, const ReleaseRequest& rq, co
   const std::string what = "release thickness raster '" + rq.thickness_raster + "'";
   GDALDatasetUniquePtr src(GDALDataset::Open(rq.thickness_raster.c_str(), GDAL_OF_RASTER));
   if (!src) throw TerrainError(what + ": cannot read it as a raster" + gdal_message());
-  OGRSpatialReference s;
   const OGRSpatialReference* own = src->GetSpatialRef();
-  if (own && !own->IsEmpty()) {
-    s = *own;
-  } else if (!rq.crs.empty()) {
-    s = srs_from(rq.crs, what);
-  } else {
-    throw TerrainError(what + " has no CRS and none is given: set the release's crs (e.g. \"EPSG:2056\")");
-  }
+  const OGRSpatialReference s =
+      input_crs(own, rq.crs, what, what + " has no CRS and none is given: set the release's crs (e.g. \"EPSG:2056\")");
   transform(s, dst, what);  // refuses a local CRS against a georeferenced one
   std::vector<std::string> args = {"-r", "bilinear", "-dstnodata", "-99999", "-wo", "INIT_DEST=NO_DATA"};
   if (s.IsLocal()) {
@@ -117,12 +110,7 @@ std::vector<double> raster_thickness(const Grid& g, const ReleaseRequest& rq, co
     args.push_back("-s_srs");
     args.push_back(wkt(s));
   }
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> wopt(GDALWarpAppOptionsNew(argv.data(), nullptr),
-                                                                                GDALWarpAppOptionsFree);
-  if (!wopt) throw TerrainError("internal: warp options rejected" + gdal_message());
+  const auto wopt = warp_options(args);
   auto out = mem_raster(g, GDT_Float64);
   out->GetRasterBand(1)->SetNoDataValue(-99999);
   GDALDatasetH srch = GDALDataset::ToHandle(src.get());
@@ -146,20 +134,6 @@ std::vector<double> raster_thickness(const Grid& g, const ReleaseRequest& rq, co
   return t;
 }
 
-OGRSpatialReference source_srs(OGRLayer& layer, const ReleaseRequest& rq) {
-  const OGRSpatialReference* ls = layer.GetSpatialRef();
-  OGRSpatialReference src;
-  if (ls && !ls->IsEmpty()) {
-    src = *ls;
-    src.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  } else if (!rq.crs.empty()) {
-    src = srs_from(rq.crs, "release '" + rq.path + "'");
-  } else {
-    throw TerrainError("release '" + rq.path + "' has no CRS and none is given: set the release's crs (e.g. \"EPSG:2056\")");
-  }
-  return src;
-}
-
 // One polygon file's releases, each polygon with its thickness (the release's, its attribute's or
 // the raster's `raster_t`) and its slope window.
 void release_polygons(const ReleaseRequest& rq, const OGRSpatialReference& dst, const std::vector<double>* raster_t, const CellFill& fill,
@@ -168,7 +142,9 @@ void release_polygons(const ReleaseRequest& rq, const OGRSpatialReference& dst, 
   if (!ds) throw TerrainError("release '" + rq.path + "': cannot read it as a vector file" + gdal_message());
   int n = 0;
   for (auto* layer : ds->GetLayers()) {
-    auto ct = transform(source_srs(*layer, rq), dst, "release '" + rq.path + "'");
+    const std::string file = "release '" + rq.path + "'";
+    const auto src = input_crs(layer->GetSpatialRef(), rq.crs, file, file + " has no CRS and none is given: set the release's crs (e.g. \"EPSG:2056\")");
+    auto ct = transform(src, dst, file);
     for (auto& f : layer) {
       ++n;
       const std::string what = "release polygon " + std::to_string(n) + " of '" + rq.path + "'";

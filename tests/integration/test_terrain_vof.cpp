@@ -113,15 +113,17 @@ PlaneRun run_plane(const PlaneCase& pc, double t_end) {
   s.initialise(alpha);
   // Downslope in the engine's frame (x east, y up, z south).
   const vof::Vec down{std::cos(th) * std::cos(a), -std::sin(th), -std::cos(th) * std::sin(a)};
-  auto mean_velocity = [&] {
+  // The material's mean velocity over the cells `in` takes (all by default).
+  auto mean_velocity = [&](const std::function<bool(const vof::Vec&)>& in = nullptr) {
     vof::Vec mom;
     double vol = 0;
     for (int c = 0; c < m.cells(); ++c) {
+      if (in && !in(m.centre[std::size_t(c)])) continue;
       const double w = s.alpha()[std::size_t(c)] * m.volume[std::size_t(c)];
       mom = mom + w * s.velocity()[std::size_t(c)];
       vol += w;
     }
-    return (1.0 / vol) * mom;
+    return vol > 0 ? (1.0 / vol) * mom : vof::Vec{};
   };
   double v0 = 0;
   for (int c = 0; c < m.cells(); ++c) v0 += alpha[std::size_t(c)] * m.volume[std::size_t(c)];
@@ -138,19 +140,8 @@ PlaneRun run_plane(const PlaneCase& pc, double t_end) {
   const vof::Vec u = mean_velocity();
   out.acceleration = (dot(u, down) - u1) / (s.time() - t1);
   out.speed_end = norm(u);
-  {
-    vof::Vec mom;
-    double vol = 0;
-    const double hx = 0.5 * pc.nx * pc.dx - 10 * pc.dx, hz = 0.5 * pc.ny * pc.dx - 10 * pc.dx;
-    for (int c = 0; c < m.cells(); ++c) {
-      const vof::Vec& x = m.centre[std::size_t(c)];
-      if (std::abs(x.x) > hx || std::abs(x.z) > hz) continue;
-      const double w = s.alpha()[std::size_t(c)] * m.volume[std::size_t(c)];
-      mom = mom + w * s.velocity()[std::size_t(c)];
-      vol += w;
-    }
-    out.speed_core = vol > 0 ? norm((1.0 / vol) * mom) : 0.0;
-  }
+  const double hx = 0.5 * pc.nx * pc.dx - 10 * pc.dx, hz = 0.5 * pc.ny * pc.dx - 10 * pc.dx;
+  out.speed_core = norm(mean_velocity([&](const vof::Vec& x) { return std::abs(x.x) <= hx && std::abs(x.z) <= hz; }));
   out.exact = 9.81 * (std::sin(th) - std::tan(pc.delta_deg * kPi / 180) * std::cos(th));
   double v1 = 0;
   for (int c = 0; c < m.cells(); ++c) v1 += s.alpha()[std::size_t(c)] * m.volume[std::size_t(c)];
