@@ -8,7 +8,8 @@ RUNOUT_PACKAGES=(
   petsc-dev libhdf5-openmpi-dev
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libsqlite3-dev libssl-dev openssl
-  libcairo2-dev fonts-dejavu-core
+  libcairo2-dev libpango1.0-dev fonts-dejavu-core
+  python3-grpcio python3-protobuf
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev
 )

@@ -37,5 +37,13 @@ std::unique_ptr<OGRCoordinateTransformation> transform(const OGRSpatialReference
 std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> warp_options(std::vector<std::string> args);
 /// A one-band in-memory raster on the grid (north-up, the grid's CRS).
 GDALDatasetUniquePtr mem_raster(const Grid& g, GDALDataType type);
+/// The rows of a raster, north first (GDAL's order), from `value(k)` of cell k (row 0 south).
+template <class T, class F>
+std::vector<T> north_first(const Grid& g, F value) {
+  std::vector<T> rows(g.cells());
+  for (int r = 0; r < g.ny; ++r)
+    for (int i = 0; i < g.nx; ++i) rows[std::size_t(r) * g.nx + i] = value(std::size_t(g.ny - 1 - r) * g.nx + i);
+  return rows;
+}
 
 }  // namespace runout::terrain::detail

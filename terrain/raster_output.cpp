@@ -1,5 +1,5 @@
-// What a run writes on its grid: COG rasters, the runout outline (GeoJSON in WGS84, GeoPackage in
-// the grid's CRS) and ESRI ASCII grids on another raster's grid.
+// What a run writes on its grid as rasters: COG rasters of values and of classes, and ESRI ASCII
+// grids on another raster's grid.
 #include <gdal_alg.h>
 #include <gdal_utils.h>
 #include <gdal_priv.h>
@@ -23,79 +23,66 @@ namespace runout::terrain {
 
 using namespace detail;
 
-void write_cog(const std::string& path, const Grid& g, const std::vector<double>& values, const std::string& description) {
+namespace {
+
+void describe(GDALRasterBand* band, const BandInfo& info) {
+  band->SetDescription(info.description.c_str());
+  if (!info.unit.empty()) {
+    band->SetUnitType(info.unit.c_str());
+    band->SetMetadataItem("UNITS", info.unit.c_str());
+  }
+}
+
+// The in-memory raster as a cloud-optimised GeoTIFF (DEFLATE; the COG driver adds overviews when the
+// raster is larger than one 512-pixel tile).
+void save_cog(GDALDataset& ds, const std::string& path, const char* predictor) {
+  auto* cog = GetGDALDriverManager()->GetDriverByName("COG");
+  const char* opts[] = {"COMPRESS=DEFLATE", predictor, nullptr};
+  GDALDatasetUniquePtr out(cog->CreateCopy(path.c_str(), &ds, FALSE, const_cast<char**>(opts), nullptr, nullptr));
+  if (!out) throw TerrainError("writing '" + path + "' failed" + gdal_message());
+}
+
+}  // namespace
+
+void write_cog(const std::string& path, const Grid& g, const std::vector<double>& values, const BandInfo& info) {
   init_gdal();
   auto ds = mem_raster(g, GDT_Float32);
   auto* band = ds->GetRasterBand(1);
   const float nodata = -9999.0f;
   band->SetNoDataValue(nodata);
-  band->SetDescription(description.c_str());
-  std::vector<float> rows(g.cells());
-  for (int r = 0; r < g.ny; ++r)
-    for (int i = 0; i < g.nx; ++i) {
-      const double v = values[std::size_t(g.ny - 1 - r) * g.nx + i];
-      rows[std::size_t(r) * g.nx + i] = std::isfinite(v) ? float(v) : nodata;
-    }
+  describe(band, info);
+  auto rows = north_first<float>(g, [&](std::size_t k) { return std::isfinite(values[k]) ? float(values[k]) : nodata; });
   if (band->RasterIO(GF_Write, 0, 0, g.nx, g.ny, rows.data(), g.nx, g.ny, GDT_Float32, 0, 0) != CE_None)
     throw TerrainError("writing '" + path + "' failed" + gdal_message());
-  auto* cog = GetGDALDriverManager()->GetDriverByName("COG");
-  const char* opts[] = {"COMPRESS=DEFLATE", "PREDICTOR=YES", nullptr};
-  GDALDatasetUniquePtr out(cog->CreateCopy(path.c_str(), ds.get(), FALSE, const_cast<char**>(opts), nullptr, nullptr));
-  if (!out) throw TerrainError("writing '" + path + "' failed" + gdal_message());
+  save_cog(*ds, path, "PREDICTOR=YES");
 }
 
-OutlineReport write_outline(const std::string& geojson_path, const std::string& gpkg_path, const Grid& g,
-                            const std::vector<double>& values, double threshold) {
+void write_class_cog(const std::string& path, const Grid& g, const std::vector<std::uint8_t>& cls, const std::vector<ValueClass>& classes,
+                     const BandInfo& info) {
   init_gdal();
-  OutlineReport rep;
-  auto mask = mem_raster(g, GDT_Byte);
-  std::vector<unsigned char> m(g.cells());
-  for (int r = 0; r < g.ny; ++r)
-    for (int i = 0; i < g.nx; ++i) m[std::size_t(r) * g.nx + i] = values[std::size_t(g.ny - 1 - r) * g.nx + i] > threshold;
-  if (mask->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, g.nx, g.ny, m.data(), g.nx, g.ny, GDT_Byte, 0, 0) != CE_None)
-    throw TerrainError("outline: writing the mask failed" + gdal_message());
-  OGRSpatialReference srs;
-  srs.importFromWkt(g.crs_wkt.c_str());
-  srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  auto* gpkg = GetGDALDriverManager()->GetDriverByName("GPKG");
-  GDALDatasetUniquePtr vds(gpkg->Create(gpkg_path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
-  if (!vds) throw TerrainError("writing '" + gpkg_path + "' failed" + gdal_message());
-  OGRLayer* layer = vds->CreateLayer("runout_outline", &srs, wkbPolygon, nullptr);
-  OGRFieldDefn fd("inside", OFTInteger);
-  layer->CreateField(&fd);
-  if (GDALPolygonize(mask->GetRasterBand(1), mask->GetRasterBand(1), layer, 0, nullptr, nullptr, nullptr) != CE_None)
-    throw TerrainError("outline: polygonising failed" + gdal_message());
-  layer->ResetReading();
-  for (auto& f : layer) {
-    if (const OGRGeometry* geom = f->GetGeometryRef()) {
-      rep.area_m2 += geom->toPolygon()->get_Area();
-      ++rep.polygons;
-    }
+  if (classes.size() > 254) throw TerrainError("writing '" + path + "': more than 254 classes");
+  auto ds = mem_raster(g, GDT_Byte);
+  auto* band = ds->GetRasterBand(1);
+  band->SetNoDataValue(255);
+  describe(band, info);
+  GDALColorTable colours;
+  GDALColorEntry none = {255, 255, 255, 0};
+  colours.SetColorEntry(0, &none);
+  std::vector<std::string> names = {"none"};
+  for (std::size_t k = 0; k < classes.size(); ++k) {
+    const GDALColorEntry e = {classes[k].rgb[0], classes[k].rgb[1], classes[k].rgb[2], 255};
+    colours.SetColorEntry(int(k) + 1, &e);
+    names.push_back(classes[k].name);
   }
-  if (srs.IsLocal()) return rep;  // no geographic coordinates: no GeoJSON (RFC 7946 is WGS84)
-  // GeoJSON in WGS84 (RFC 7946) from the same polygons.
-  auto* gj = GetGDALDriverManager()->GetDriverByName("GeoJSON");
-  const char* gjopts[] = {"RFC7946=YES", nullptr};
-  GDALDatasetUniquePtr jds(gj->Create(geojson_path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
-  if (!jds) throw TerrainError("writing '" + geojson_path + "' failed" + gdal_message());
-  auto ll = wgs84();
-  OGRLayer* jl = jds->CreateLayer("runout_outline", &ll, wkbPolygon, const_cast<char**>(gjopts));
-  OGRFieldDefn area("area_m2", OFTReal);
-  jl->CreateField(&area);
-  auto ct = transform(srs, ll, "outline");
-  layer->ResetReading();
-  for (auto& f : layer) {
-    const OGRGeometry* geom = f->GetGeometryRef();
-    if (!geom) continue;
-    std::unique_ptr<OGRGeometry> w(geom->clone());
-    w->transform(ct.get());
-    OGRFeature out(jl->GetLayerDefn());
-    out.SetField("area_m2", geom->toPolygon()->get_Area());
-    out.SetGeometry(w.get());
-    if (jl->CreateFeature(&out) != OGRERR_NONE) throw TerrainError("writing '" + geojson_path + "' failed" + gdal_message());
-  }
-  rep.geojson = true;
-  return rep;
+  band->SetColorTable(&colours);
+  std::vector<char*> cat;
+  for (auto& n : names) cat.push_back(n.data());
+  cat.push_back(nullptr);
+  band->SetCategoryNames(cat.data());
+  auto rows = north_first<std::uint8_t>(g, [&](std::size_t k) { return !g.outside.empty() && g.outside[k] ? std::uint8_t(255) : cls[k]; });
+  if (band->RasterIO(GF_Write, 0, 0, g.nx, g.ny, rows.data(), g.nx, g.ny, GDT_Byte, 0, 0) != CE_None)
+    throw TerrainError("writing '" + path + "' failed" + gdal_message());
+  save_cog(*ds, path, "PREDICTOR=NO");
 }
 
 std::vector<double> masked_outside(const Grid& g, const std::vector<double>& values) {
@@ -113,12 +100,7 @@ void write_ascii_on(const std::string& path, const std::string& template_path, c
   auto src = mem_raster(g, GDT_Float32);
   const float nodata = -9999.0f;
   src->GetRasterBand(1)->SetNoDataValue(nodata);
-  std::vector<float> rows(g.cells());
-  for (int r = 0; r < g.ny; ++r)
-    for (int i = 0; i < g.nx; ++i) {
-      const double v = values[std::size_t(g.ny - 1 - r) * g.nx + i];
-      rows[std::size_t(r) * g.nx + i] = std::isfinite(v) ? float(v) : nodata;
-    }
+  auto rows = north_first<float>(g, [&](std::size_t k) { return std::isfinite(values[k]) ? float(values[k]) : nodata; });
   if (src->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, g.nx, g.ny, rows.data(), g.nx, g.ny, GDT_Float32, 0, 0) != CE_None)
     throw TerrainError("writing '" + path + "' failed");
   auto* mem = GetGDALDriverManager()->GetDriverByName("MEM");

@@ -86,8 +86,38 @@ struct ReleaseReport {
 std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseRequest>& releases,
                                        ReleaseReport* report = nullptr);
 
-/// Cloud-optimised GeoTIFF, Float32, DEFLATE, CRS and nodata set; NaN cells are written as nodata.
-void write_cog(const std::string& path, const Grid& g, const std::vector<double>& values, const std::string& description);
+/// What a raster band says about itself (GDAL's band description, unit type and metadata): QGIS
+/// shows the description as the band's name and the unit beside its values.
+struct BandInfo {
+  std::string description;  ///< e.g. "maximum flow depth normal to the surface"
+  std::string unit;         ///< e.g. "m", "kPa"; "" for classes
+};
+/// Cloud-optimised GeoTIFF, Float32, DEFLATE, CRS and nodata set, overviews when larger than a
+/// tile; NaN cells are written as nodata.
+void write_cog(const std::string& path, const Grid& g, const std::vector<double>& values, const BandInfo& band);
+
+/// One class of a class raster or of class polygons: class k (1-based) is cells whose value lies in
+/// [from, to) (to NaN: no upper bound).
+struct ValueClass {
+  std::string name;
+  double from = 0, to = 0;
+  std::uint8_t rgb[3] = {0, 0, 0};
+};
+/// A class raster as a cloud-optimised GeoTIFF, Byte: 0 in no class, k for `classes[k-1]`, 255
+/// outside the domain (nodata), with the class names as GDAL category names and a colour table.
+void write_class_cog(const std::string& path, const Grid& g, const std::vector<std::uint8_t>& cls,
+                     const std::vector<ValueClass>& classes, const BandInfo& band);
+
+struct ClassArea {
+  int polygons = 0;
+  double area_m2 = 0;
+};
+/// Polygons of each class of `cls` (0: none): a GeoPackage in the grid's CRS and, unless the grid's
+/// CRS is local, GeoJSON in WGS84, with the attributes name, from_<unit>, to_<unit> (null when open)
+/// and area_m2. Returns each class's polygons and area (index k-1 for class k).
+std::vector<ClassArea> write_class_polygons(const std::string& geojson_path, const std::string& gpkg_path, const std::string& layer,
+                                            const Grid& g, const std::vector<std::uint8_t>& cls, const std::vector<ValueClass>& classes,
+                                            const std::string& unit);
 
 struct OutlineReport {
   int polygons = 0;

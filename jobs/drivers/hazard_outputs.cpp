@@ -1,10 +1,13 @@
 #include "jobs/drivers/hazard_outputs.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
 
-#include "jobs/figures/map.hpp"
+#include "jobs/drivers/hazard_maps.hpp"
+#include "jobs/figures/qml.hpp"
+#include "jobs/products/zones.hpp"
 
 namespace runout::jobs {
 namespace fs = std::filesystem;
@@ -55,29 +58,81 @@ void require_finite_figures(std::initializer_list<std::pair<const char*, double>
                                "): the flow state became NaN or infinite; no results written");
 }
 
-// The hazard rasters the scenario asks for (hazard_rasters()), the outline and the map; their names
-// go to sum.files.
-terrain::OutlineReport write_hazard_outputs(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0,
-                                            const engine::HazardMaps& hz, const std::string& out_dir, RunSummary& sum) {
+namespace {
+
+std::string affected_area_criterion(double outline_threshold) { return "max depth > " + json_number(outline_threshold) + " m"; }
+
+// The pressure zones: the class raster with its QGIS style, and the polygons.
+void write_zones(const ResolvedScenario& s, const terrain::Grid& grid, const products::ZoneMap& z, const std::string& out_dir,
+                 RunSummary& sum, HazardOutputs& out) {
+  auto path = [&](const std::string& name) { return (fs::path(out_dir) / name).string(); };
+  terrain::write_class_cog(path("pressure_zones.tif"), grid, z.cls, z.classes,
+                           {"pressure hazard zones by the maximum pressure rho u^2 (0: none)", ""});
+  figures::write_qml_classes(path("pressure_zones.qml"), z.palette);
+  out.zones = s.pressure_zones;
+  out.zone_areas = terrain::write_class_polygons(path("pressure_zones.geojson"), path("pressure_zones.gpkg"), "pressure_zones", grid,
+                                                 z.cls, z.classes, "kpa");
+  // GeoTIFF keeps the zones' names (GDAL's category names) in its sidecar.
+  for (const char* f : {"pressure_zones.tif", "pressure_zones.tif.aux.xml", "pressure_zones.qml"})
+    if (fs::exists(path(f))) sum.files.push_back(f);
+  if (out.outline.geojson) sum.files.push_back("pressure_zones.geojson");
+  sum.files.push_back("pressure_zones.gpkg");
+}
+
+}  // namespace
+
+HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0,
+                                   const engine::HazardMaps& hz, const std::string& out_dir, RunSummary& sum) {
   auto out = [&](const std::string& name) { return (fs::path(out_dir) / name).string(); };
-  for (const auto& name : s.rasters)
-    for (const auto& r : hazard_rasters())
-      if (r.name == name) {
-        terrain::write_cog(out(name + ".tif"), grid, terrain::masked_outside(grid, hz.*r.map), r.description);
-        sum.files.push_back(name + ".tif");
-      }
-  const auto outline = terrain::write_outline(out("outline.geojson"), out("outline.gpkg"), grid, hz.max_depth, s.outline_threshold);
-  if (outline.geojson) sum.files.push_back("outline.geojson");
-  else sum.notes.push_back("outline.geojson not written: the grid's CRS is local (no geographic coordinates)");
+  HazardOutputs res;
+  std::vector<double> pressure_kpa;
+  for (const auto& r : hazard_rasters()) {
+    auto values = terrain::masked_outside(grid, hz.*r.map);
+    for (double& v : values) v *= r.scale;
+    if (r.name == "max_pressure") pressure_kpa = values;
+    if (std::find(s.rasters.begin(), s.rasters.end(), r.name) == s.rasters.end()) continue;
+    terrain::write_cog(out(r.name + ".tif"), grid, values, {r.description, r.unit});
+    figures::write_qml_ramp(out(r.name + ".qml"), figures::hazard_palette(r.name));
+    sum.files.push_back(r.name + ".tif");
+    sum.files.push_back(r.name + ".qml");
+  }
+  for (double v : pressure_kpa)
+    if (std::isfinite(v)) res.max_pressure_kpa = std::max(res.max_pressure_kpa, v);
+  res.outline = terrain::write_outline(out("outline.geojson"), out("outline.gpkg"), grid, hz.max_depth, s.outline_threshold);
+  if (res.outline.geojson) sum.files.push_back("outline.geojson");
+  else sum.notes.push_back("outline.geojson and pressure_zones.geojson not written: the grid's CRS is local (no geographic coordinates)");
   sum.files.push_back("outline.gpkg");
-  figures::MapRequest mreq;
-  mreq.title = s.scenario.name().empty() ? "runout" : s.scenario.name();
-  if (mreq.title.size() > 60) mreq.title = mreq.title.substr(0, 57) + "...";
-  mreq.outline_threshold = s.outline_threshold;
-  mreq.scale = grid.nx * grid.ny > 1000000 ? 1 : 2;
-  figures::write_map_png(out("map.png"), grid, hz.max_depth, h0, mreq);
-  sum.files.push_back("map.png");
-  return outline;
+  // The zones inside the outline: a fringe thinner than the outline's depth exerts no pressure that
+  // a zone should stand for, and a zone outside the outline would contradict it.
+  for (std::size_t k = 0; k < pressure_kpa.size(); ++k)
+    if (!(hz.max_depth[k] > s.outline_threshold)) pressure_kpa[k] = NAN;
+  const auto zones = products::pressure_zones(s.pressure_zones, pressure_kpa);
+  write_zones(s, grid, zones, out_dir, sum, res);
+  const auto points = place_points_of_interest(s, grid);
+  res.points = point_reports(points, hz, zones, s.outline_threshold);
+  write_hazard_maps(s, grid, h0, hz, zones, points, out_dir, sum);
+  return res;
+}
+
+void record_hazard_results(const ResolvedScenario& s, const RunSummary& sum, const HazardOutputs& out, v1::ResultsReport& re) {
+  re.set_affected_area_m2(sum.affected_area_m2);
+  re.set_affected_area_criterion(affected_area_criterion(s.outline_threshold));
+  re.set_outline_polygons(out.outline.polygons);
+  re.set_outline_area_m2(out.outline.area_m2);
+  re.set_runout_from_release_centroid_m(sum.runout_m);
+  re.set_max_depth_m(sum.max_depth);
+  re.set_outline_threshold_m(s.outline_threshold);
+  re.set_max_pressure_kpa(out.max_pressure_kpa);
+  re.set_pressure_zones_criterion("max pressure rho u^2 where " + affected_area_criterion(s.outline_threshold));
+  for (std::size_t k = 0; k < out.zones.size(); ++k) {
+    auto* z = re.add_pressure_zones();
+    z->set_name(out.zones[k].name);
+    z->set_from_kpa(out.zones[k].from_kpa);
+    if (k + 1 < out.zones.size()) z->set_to_kpa(out.zones[k + 1].from_kpa);
+    z->set_polygons(out.zone_areas[k].polygons);
+    z->set_area_m2(out.zone_areas[k].area_m2);
+  }
+  for (const auto& p : out.points) *re.add_points_of_interest() = p;
 }
 
 void record_inputs(v1::RunRecord& rec, const terrain::DemReport& d, const terrain::Grid& g, const terrain::ReleaseReport& r) {

@@ -25,10 +25,24 @@ void hazard_figures(const ResolvedScenario& s, const terrain::Grid& grid, const 
 /// or infinite, and nothing is written.
 void require_finite_figures(std::initializer_list<std::pair<const char*, double>> figures);
 
-/// The hazard rasters the scenario asks for (hazard_rasters()), the outline and the map; their names
+/// What write_hazard_outputs wrote that the run record reports.
+struct HazardOutputs {
+  terrain::OutlineReport outline;
+  double max_pressure_kpa = 0;
+  std::vector<ZoneThreshold> zones;
+  std::vector<terrain::ClassArea> zone_areas;  ///< per zone
+  std::vector<v1::PointReport> points;         ///< outputs.points_of_interest
+};
+
+/// The hazard rasters the scenario asks for (hazard_rasters(), each with its QGIS style), the
+/// pressure zones (raster, polygons, style), the outline and the maps (hazard_maps.hpp); their names
 /// go to sum.files.
-terrain::OutlineReport write_hazard_outputs(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0,
-                                            const engine::HazardMaps& hz, const std::string& out_dir, RunSummary& sum);
+HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0,
+                                   const engine::HazardMaps& hz, const std::string& out_dir, RunSummary& sum);
+
+/// The record's results that both engines on the DEM report alike: affected area and its criterion,
+/// outline, runout, maximum depth and pressure, the pressure zones.
+void record_hazard_results(const ResolvedScenario& s, const RunSummary& sum, const HazardOutputs& out, v1::ResultsReport& re);
 
 /// The record's dem, grid (without its local origin, which each engine sets) and release sections.
 void record_inputs(v1::RunRecord& rec, const terrain::DemReport& dem, const terrain::Grid& grid, const terrain::ReleaseReport& release);

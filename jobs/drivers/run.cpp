@@ -3,6 +3,7 @@
 #include "jobs/digest/sha256.hpp"
 
 #include "jobs/drivers/vof_lab/run.hpp"
+#include "jobs/drivers/hazard_maps.hpp"
 #include "jobs/drivers/hazard_outputs.hpp"
 #include "jobs/drivers/record_head.hpp"
 #include "jobs/drivers/vof_terrain/run.hpp"
@@ -19,7 +20,6 @@
 #include "jobs/formats/iseesnow.hpp"
 #include "jobs/formats/sh_checkpoint.hpp"
 #include "jobs/formats/timeseries.hpp"
-#include "jobs/figures/map.hpp"
 
 namespace runout::jobs {
 namespace fs = std::filesystem;
@@ -33,7 +33,7 @@ double since(std::chrono::steady_clock::time_point t0) {
 // run.json of a depth-averaged run; continued_from: NaN for a run not continued from a checkpoint.
 void write_record(const std::string& path, const ResolvedScenario& s, const terrain::DemReport& dem_rep, const terrain::Grid& grid,
                   const terrain::ReleaseReport& rel_rep, const engine::Sh2dResult& res, const RunSummary& sum, double continued_from,
-                  const terrain::OutlineReport& outline, int frames) {
+                  const HazardOutputs& outputs, int frames) {
   const auto& d = res.diag;
   const bool continued = !std::isnan(continued_from);
   v1::RunRecord rec = run_record_head(s, "depth-averaged");
@@ -58,12 +58,7 @@ void write_record(const std::string& path, const ResolvedScenario& s, const terr
   so->set_mean_active_fraction(d.mean_active_fraction);
   so->set_max_active_fraction(d.max_active_fraction);
   auto* re = rec.mutable_results();
-  re->set_affected_area_m2(sum.affected_area_m2);
-  re->set_outline_polygons(outline.polygons);
-  re->set_outline_area_m2(outline.area_m2);
-  re->set_runout_from_release_centroid_m(sum.runout_m);
-  re->set_max_depth_m(sum.max_depth);
-  re->set_outline_threshold_m(s.outline_threshold);
+  record_hazard_results(s, sum, outputs, *re);
   re->set_timeseries_frames(frames);
   auto* ti = rec.mutable_timings_s();
   ti->set_prepare(sum.seconds_prepare);
@@ -96,6 +91,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   const terrain::Grid grid = terrain::prepare_grid(s.dem, &dem_rep);
   terrain::ReleaseReport rel_rep;
   const auto h0 = terrain::rasterize_releases(grid, s.releases, &rel_rep);
+  place_points_of_interest(s, grid);  // a point outside the domain is refused before the run
   sum.nx = grid.nx;
   sum.ny = grid.ny;
   sum.dx = grid.dx;
@@ -166,7 +162,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
 
   // Outputs.
   const auto t2 = std::chrono::steady_clock::now();
-  const auto outline = write_hazard_outputs(s, grid, h0, res.hazard, out_dir, sum);
+  const auto outputs = write_hazard_outputs(s, grid, h0, res.hazard, out_dir, sum);
   if (series) {
     sum.files.push_back("timeseries.h5");
     sum.files.push_back("timeseries.xmf");
@@ -176,7 +172,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   const std::string record = (fs::path(out_dir) / "run.json").string();
   if (!opt.iseesnow_id.empty())
     for (auto& f : write_iseesnow(s, opt.iseesnow_id, out_dir, grid, res, sum.cpu_seconds)) sum.files.push_back(std::move(f));
-  write_record(record, s, dem_rep, grid, rel_rep, res, sum, continued_from, outline, frames);
+  write_record(record, s, dem_rep, grid, rel_rep, res, sum, continued_from, outputs, frames);
   sum.files.push_back("run.json");
   return sum;
 }

@@ -8,6 +8,7 @@
 #include "engine/sh2d.hpp"
 #include "jobs/scenario/options.hpp"
 #include "jobs/scenario/scenario.hpp"
+#include "jobs/scenario/scenario_impl.hpp"
 
 namespace runout::jobs {
 
@@ -44,6 +45,31 @@ constexpr double kMaxDensity = 1e4;         // [kg/m3]: above any rock or ore
 constexpr double kMaxXi = 1e5;              // Voellmy xi [m/s2]
 constexpr double kMaxEndTime = 1e5;         // numerics.end_time_s, outputs.timeseries_interval_s [s]
 constexpr double kMaxDepthThreshold = 100;  // outline and flow thresholds [m]
+constexpr double kMaxZonePressure = 1e5;    // outputs.pressure_zones_kpa[].from_kpa [kPa]: 100 MPa
+constexpr int kMaxZones = 16;
+
+// outputs.pressure_zones_kpa: named, ascending and distinct; none: the Swiss practice (blue from 3
+// kPa, red from 30 kPa).
+void pressure_zones(const S& s, R& r) {
+  const auto& z = s.outputs().pressure_zones_kpa();
+  r.pressure_zones.clear();
+  if (z.empty()) {
+    r.pressure_zones = {{"blue", 3}, {"red", 30}};
+    return;
+  }
+  if (z.size() > kMaxZones) bad("outputs.pressure_zones_kpa", "at most " + std::to_string(kMaxZones) + " zones, got " + std::to_string(z.size()));
+  for (int k = 0; k < z.size(); ++k) {
+    const std::string at = "outputs.pressure_zones_kpa[" + std::to_string(k) + "]";
+    if (z[k].name().empty()) bad(at + ".name", "missing (each zone needs a name, e.g. \"red\")");
+    if (!(z[k].from_kpa() > 0)) bad(at + ".from_kpa", "missing (the zone's lowest pressure in kPa, > 0)");
+    for (int q = 0; q < k; ++q)
+      if (z[q].name() == z[k].name()) bad(at + ".name", "'" + z[k].name() + "' names zone " + std::to_string(q) + " too");
+    if (k > 0 && !(z[k].from_kpa() > z[k - 1].from_kpa()))
+      bad(at + ".from_kpa", "the zones must ascend: " + json_number(z[k].from_kpa()) + " kPa is not above zone " + std::to_string(k - 1) +
+                                "'s " + json_number(z[k - 1].from_kpa()) + " kPa");
+    r.pressure_zones.push_back({z[k].name(), z[k].from_kpa()});
+  }
+}
 
 }  // namespace
 
@@ -152,6 +178,19 @@ const OptionTable& depth_averaged_options() {
       {"outputs.timeseries_interval_s", T::number, U::as_given, "", Range{0, kMaxEndTime}, {}, "s",
        "HDF5 + XDMF frames of depth and speed this often", "ResolvedScenario::timeseries_interval", "none",
        [](const S& s, R& r) { r.timeseries_interval = s.outputs().timeseries_interval_s(); }},
+      {"outputs.pressure_zones_kpa[].name", T::text, U::as_given, "", {}, {}, "",
+       "a pressure zone's name; a colour name (yellow, blue, red, ...) colours it. No zones given: blue from 3 kPa, red from 30 kPa",
+       "ResolvedScenario::pressure_zones"},
+      {"outputs.pressure_zones_kpa[].from_kpa", T::number, U::as_given, "", Range{0, kMaxZonePressure, true}, {}, "kPa",
+       "the zone's lowest maximum pressure (the zone ends at the next one's); ascending", "ResolvedScenario::pressure_zones", "",
+       pressure_zones},
+      {"outputs.points_of_interest[].name", T::text, U::required, "", {}, {}, "",
+       "a named point (a farmhouse): drawn on the maps, its maxima and zone in run.json", "run record, maps"},
+      {"outputs.points_of_interest[].x", T::number, U::as_given, "", Range{}, {}, "", "easting, or longitude in a geographic CRS",
+       "run record, maps"},
+      {"outputs.points_of_interest[].y", T::number, U::as_given, "", Range{}, {}, "", "northing, or latitude", "run record, maps"},
+      {"outputs.points_of_interest[].crs", T::text, U::as_given, "", {}, {}, "", "the point's CRS (\"EPSG:4326\"); default the grid's",
+       "run record, maps"},
   };
   return t;
 }

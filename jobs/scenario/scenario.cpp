@@ -95,11 +95,11 @@ void require_finite(const google::protobuf::Message& m, const std::string& prefi
 const std::vector<HazardRaster>& hazard_rasters() {
   using M = engine::HazardMaps;
   static const std::vector<HazardRaster> r = {
-      {"max_depth", "maximum flow depth normal to the surface [m]", &M::max_depth},
-      {"max_speed", "maximum flow speed [m/s]", &M::max_speed},
-      {"max_pressure", "maximum pressure rho u^2 [Pa]", &M::max_pressure},
-      {"deposit", "deposit depth normal to the surface at the end [m]", &M::final_depth},
-      {"arrival_time", "arrival time of the flow [s]", &M::arrival_time},
+      {"max_depth", "maximum flow depth normal to the surface [m]", "m", &M::max_depth},
+      {"max_speed", "maximum flow speed [m/s]", "m/s", &M::max_speed},
+      {"max_pressure", "maximum pressure rho u^2 [kPa]", "kPa", &M::max_pressure, 1e-3},
+      {"deposit", "deposit depth normal to the surface at the end [m]", "m", &M::final_depth},
+      {"arrival_time", "arrival time of the flow [s]", "s", &M::arrival_time},
   };
   return r;
 }

@@ -16,6 +16,13 @@ struct ScenarioError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A pressure hazard zone (outputs.pressure_zones_kpa): the cells whose maximum pressure is at least
+/// from_kpa and below the next zone's.
+struct ZoneThreshold {
+  std::string name;
+  double from_kpa = 0;
+};
+
 struct ResolvedScenario {
   v1::Scenario scenario;  ///< as given, with the defaults filled in
   std::string source;     ///< the file it came from (empty when given as a message)
@@ -25,6 +32,7 @@ struct ResolvedScenario {
   std::vector<std::string> rasters;
   double outline_threshold = 0.1;
   double timeseries_interval = 0;  ///< [s]; 0: no time series
+  std::vector<ZoneThreshold> pressure_zones = {{"blue", 3}, {"red", 30}};
   std::vector<std::string> input_files;  ///< for hashing
   bool vof = false;  ///< engine "vof": a laboratory set-up (`lab`) or, with `terrain`, on the DEM
   /// engine "vof" without `lab`: the 3D engine on the DEM and releases (blocks `mesh` and `vof`;
@@ -39,18 +47,20 @@ struct ResolvedScenario {
 /// older kind (2: B6's shock is the bore, no longer the resting deposit's edge; 3: 3D runs add
 /// comparison.png, and a polygon obstacle's shadow window starts behind the polygon; 4: the viscous
 /// stress's transpose part takes the harmonic face viscosity by default; 5: walls and inflows take the
-/// granular viscosity evaluated on the face, lab.wall_viscosity "face"). Adding a
+/// granular viscosity evaluated on the face, lab.wall_viscosity "face"; 6: runs on the DEM write
+/// max_pressure.tif in kPa, the pressure zones and QGIS styles). Adding a
 /// file or a figure counts too: a cached result lacks it. The test
 /// Scenarios.VofResultsMatchTheFingerprintOfTheirVersion holds this version's figures for twelve
 /// short runs and fails when a change to the numerics moves them (options those runs do not take
 /// are not covered); Scenarios.VofHashCarriesTheResultsVersion pins a hash that a bump changes.
-inline constexpr int kVofResultsVersion = 5;
+inline constexpr int kVofResultsVersion = 6;
 
 /// The version of what a depth-averaged run's results contain (rasters, outline, run.json, time
 /// series) for an unchanged scenario; the same rule as kVofResultsVersion (1: run.json's and the
-/// summary's maximum speed is the maximum of max_speed.tif, the flowing cells'). The test
+/// summary's maximum speed is the maximum of max_speed.tif, the flowing cells'; 2: max_pressure.tif in
+/// kPa, the pressure zones, QGIS styles). The test
 /// Scenarios.HashCarriesEachEnginesResultsVersion pins a hash that a bump changes.
-inline constexpr int kDepthAveragedResultsVersion = 1;
+inline constexpr int kDepthAveragedResultsVersion = 2;
 
 /// A number for messages and run records: 10 significant digits, null when not finite.
 std::string json_number(double v);
@@ -62,12 +72,16 @@ std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version 
                           int vof_version = kVofResultsVersion);
 
 /// The raster names an output list may hold.
-/// A hazard raster of the depth-averaged engine: its name in `outputs.rasters`, the description in its
-/// band metadata and the engine's map it holds. A new raster is one line in hazard_rasters().
+/// A hazard raster of both engines on the DEM: its name in `outputs.rasters`, the description and unit
+/// in its band metadata, the engine's map it holds and the factor from the engine's unit to the
+/// raster's (pressure: Pa to kPa, as AvaFrame and RAMMS report it). A new raster is one line in
+/// hazard_rasters().
 struct HazardRaster {
   std::string name;
   std::string description;
+  std::string unit;
   std::vector<double> engine::HazardMaps::*map;
+  double scale = 1;
 };
 /// Every hazard raster, in the order of the outputs' default.
 const std::vector<HazardRaster>& hazard_rasters();

@@ -81,7 +81,7 @@ bool run_case(const service::ClientOptions& opt, const RegressionCase& c, const 
   const auto run = run_through_service(opt, c.scenario, results);
   if (!run) return false;
   const auto& fin = run->fin;
-  fs::copy_file(results / "map.png", out / "map.png", fs::copy_options::overwrite_existing);
+  fs::copy_file(results / "map_max_depth.png", out / "map.png", fs::copy_options::overwrite_existing);
   const auto figures = jobs::measure_run(results.string());
   if (accept) {
     jobs::accept_reference(c.reference, figures, (results / "max_depth.tif").string(), reason, fin.scenario_hash(), RUNOUT_VERSION);

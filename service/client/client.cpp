@@ -1,4 +1,5 @@
 #include "service/client/client.hpp"
+#include "service/scenario_inputs.hpp"
 
 #include <grpcpp/grpcpp.h>
 
@@ -216,9 +217,7 @@ v1::Scenario upload_inputs(Client& c, v1::Scenario s, const std::string& base_di
     }
     *path = c.upload(files).ref();
   };
-  up(s.mutable_dem()->mutable_path());
-  if (s.has_area_of_interest()) up(s.mutable_area_of_interest()->mutable_path());
-  for (auto& r : *s.mutable_releases()) up(r.mutable_path());
+  for_each_input_path(s, [&](const std::string&, std::string* path) { up(path); });
   return s;
 }
 

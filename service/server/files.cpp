@@ -1,5 +1,6 @@
 // Files: uploads (quota, time to live, collection) and results (listing, download).
 #include "service/server/impl.hpp"
+#include "service/scenario_inputs.hpp"
 
 #include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
@@ -53,9 +54,8 @@ std::vector<std::string> Server::Impl::uploads_of(const v1::Scenario& s) const {
   auto take = [&](const std::string& p) {
     if (p.rfind(up, 0) == 0) ids.push_back(p.substr(up.size(), 64));
   };
-  take(s.dem().path());
-  take(s.area_of_interest().path());
-  for (const auto& r : s.releases()) take(r.path());
+  v1::Scenario paths = s;
+  for_each_input_path(paths, [&](const std::string&, std::string* p) { take(*p); });
   return ids;
 }
 

@@ -1,6 +1,7 @@
 // Submissions: the checks at the door (limits, inputs, validation in a worker), retries answered by
 // their request, queueing.
 #include "service/server/impl.hpp"
+#include "service/scenario_inputs.hpp"
 
 #include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
@@ -115,12 +116,11 @@ Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRe
     if (st.ok() && upload) uploads.push_back(fs::path(*path).parent_path().filename().string());
     return st;
   };
-  if (auto st = input("dem.path", s.mutable_dem()->mutable_path()); !st.ok()) return refuse(st);
-  if (s.has_area_of_interest())
-    if (auto st = input("area_of_interest.path", s.mutable_area_of_interest()->mutable_path()); !st.ok()) return refuse(st);
-  for (int k = 0; k < s.releases_size(); ++k)
-    if (auto st = input("releases[" + std::to_string(k) + "].path", s.mutable_releases(k)->mutable_path()); !st.ok())
-      return refuse(st);
+  Status bad_input = Status::OK;
+  for_each_input_path(s, [&](const std::string& field, std::string* path) {
+    if (bad_input.ok()) bad_input = input(field, path);
+  });
+  if (!bad_input.ok()) return refuse(bad_input);
   // The job's limits: within the server's.
   {
     const auto& l = s.limits();

@@ -18,12 +18,16 @@ TEST(Terrain, SyntheticSlopeRunsAndWritesEveryOutput) {
   EXPECT_LT(sum.volume_error, 1e-12);
   EXPECT_GT(sum.runout_m, 500.0);
   for (const char* f : {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "arrival_time.tif",
-                        "outline.geojson", "outline.gpkg", "run.json", "map.png", "timeseries.h5", "timeseries.xmf"})
+                        "outline.geojson", "outline.gpkg", "run.json", "timeseries.h5", "timeseries.xmf", "pressure_zones.tif", "pressure_zones.gpkg",
+                        "pressure_zones.qml", "max_depth.qml"})
     EXPECT_TRUE(fs::exists(fs::path(d / "out") / f)) << f;
-  GDALDatasetUniquePtr png(GDALDataset::Open((d / "out/map.png").c_str(), GDAL_OF_RASTER));
-  ASSERT_TRUE(png);
-  EXPECT_EQ(png->GetRasterCount(), 3);
-  EXPECT_GE(png->GetRasterXSize(), 2 * 120);  // the grid (2400 m / 20 m) upscaled twice, plus the legend
+  for (const char* q : {"max_depth", "max_speed", "max_pressure", "pressure_zones", "deposit", "arrival_time"}) {
+    GDALDatasetUniquePtr png(GDALDataset::Open((fs::path(d / "out") / (std::string("map_") + q + ".png")).c_str(), GDAL_OF_RASTER));
+    ASSERT_TRUE(png) << q;
+    EXPECT_GE(png->GetRasterCount(), 3);
+    EXPECT_GE(png->GetRasterXSize(), 120 * 7);  // the grid (2400 m / 20 m) at 7.5 pixels per cell, plus the legend
+    EXPECT_TRUE(fs::exists(fs::path(d / "out") / (std::string("map_") + q + ".pdf"))) << q;
+  }
   GDALDatasetUniquePtr md(GDALDataset::Open((d / "out/max_depth.tif").c_str(), GDAL_OF_RASTER));
   ASSERT_TRUE(md);
   EXPECT_EQ(md->GetRasterBand(1)->GetRasterDataType(), GDT_Float32);

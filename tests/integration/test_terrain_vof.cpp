@@ -259,7 +259,7 @@ TEST(TerrainVof, ArelenCoarseRunWritesTheHazardMapsFramesAndRecord) {
   runout::test_support::TempDir d;
   const auto sum = runout::jobs::run_scenario(r, d.p.string());
   for (const char* f : {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "arrival_time.tif", "outline.geojson", "outline.gpkg",
-                        "map.png", "max_surface_speed.tif", "max_ground_stress.tif", "fields.h5", "fields.xmf", "run.json"})
+                        "map_max_depth.png", "map_pressure_zones.pdf", "pressure_zones.tif", "max_surface_speed.tif", "max_ground_stress.tif", "fields.h5", "fields.xmf", "run.json"})
     EXPECT_TRUE(fs::is_regular_file(d.p / f)) << f;
   const auto rec = runout::jobs::read_run_record((d.p / "run.json").string());
   EXPECT_EQ(rec.engine(), "vof");

@@ -100,7 +100,7 @@ TEST(Service, SubmitWatchFetchWithUploadsAndServerPaths) {
   const auto files = c.results(j.id());
   std::set<std::string> names;
   for (const auto& f : files.files()) names.insert(f.name());
-  for (const char* n : {"max_depth.tif", "max_speed.tif", "outline.geojson", "map.png", "run.json", "job.log"})
+  for (const char* n : {"max_depth.tif", "max_speed.tif", "outline.geojson", "map_max_depth.png", "run.json", "job.log"})
     EXPECT_TRUE(names.count(n)) << n;
   c.download(j.id(), "max_depth.tif", (d.p / "max_depth.tif").string());
   const auto v = raster(d.p / "max_depth.tif");
@@ -217,6 +217,18 @@ TEST(Service, BadScenariosTokensAndPathsGetTheRightCodes) {
     } catch (const service::RpcError& e) {
       EXPECT_EQ(e.code, int(grpc::StatusCode::INVALID_ARGUMENT)) << p;
       EXPECT_NE(std::string(e.what()).find("dem.path"), std::string::npos) << e.what();
+    }
+  }
+  // Every input field is held to the roots, a release's thickness raster too.
+  for (const std::string p : {"/etc/hostname", "../tests/data/arelen-30m.json"}) {
+    s = arelen();
+    s.mutable_releases(0)->set_thickness_raster(p);
+    try {
+      alpha.submit(s);
+      ADD_FAILURE() << p << " was accepted as a thickness raster";
+    } catch (const service::RpcError& e) {
+      EXPECT_EQ(e.code, int(grpc::StatusCode::INVALID_ARGUMENT)) << p;
+      EXPECT_NE(std::string(e.what()).find("releases[0].thickness_raster"), std::string::npos) << e.what();
     }
   }
   s = arelen();

@@ -121,6 +121,11 @@ inline void flatten(const google::protobuf::Value& v, const std::string& path, s
     for (const auto& [k, x] : v.struct_value().fields()) flatten(x, path.empty() ? k : path + "." + k, out);
     return;
   }
+  if (v.has_list_value()) {  // element by element: a struct's keys come out of JSON in no fixed order
+    for (int k = 0; k < v.list_value().values_size(); ++k) flatten(v.list_value().values(k), path + "[" + std::to_string(k) + "]", out);
+    out[path + ".size"] = std::to_string(v.list_value().values_size());
+    return;
+  }
   std::string j;
   (void)google::protobuf::util::MessageToJsonString(v, &j);
   out[path] = j;

@@ -151,7 +151,8 @@ inline void check_outputs(const TempDir& d, const jobs::RunSummary& sum, const s
   EXPECT_GE(n, 1);
   EXPECT_NEAR(area, sum.affected_area_m2, 1e-6 * area);
   EXPECT_TRUE(fs::exists(d / "run.json"));
-  EXPECT_TRUE(fs::exists(d / "map.png"));
+  EXPECT_TRUE(fs::exists(d / "map_max_depth.png"));
+  EXPECT_TRUE(fs::exists(d / "map_max_depth.pdf"));
 }
 
 // The first lines of an ESRI ASCII grid as key -> value.

@@ -73,12 +73,7 @@ void write_terrain_record(const std::string& path, const ResolvedScenario& r, co
   if (!std::isnan(f.continued_from)) so->set_continued_from_t_s(f.continued_from);
   so->set_max_speed_m_s(sum.max_speed);
   auto* re = rec.mutable_results();
-  re->set_affected_area_m2(sum.affected_area_m2);
-  re->set_outline_polygons(f.outline_polygons);
-  re->set_outline_area_m2(f.outline_area_m2);
-  re->set_runout_from_release_centroid_m(sum.runout_m);
-  re->set_max_depth_m(sum.max_depth);
-  re->set_outline_threshold_m(r.outline_threshold);
+  record_hazard_results(r, sum, f.outputs, *re);
   re->set_frames(f.frames);
   write_profiles(f, rec);
   auto* ti = rec.mutable_timings_s();

@@ -4,6 +4,7 @@
 // the solver's figures (alpha bounds, active cells), the profiles at the named points and timings.
 #include <string>
 
+#include "jobs/drivers/hazard_outputs.hpp"
 #include "jobs/drivers/run.hpp"
 #include "jobs/drivers/vof_lab/monitors.hpp"
 #include "jobs/drivers/vof_terrain/hazard.hpp"
@@ -17,8 +18,7 @@ struct TerrainRunFacts {
   const vof_lab::RunningFigures& fig;
   const RunSummary& sum;
   double continued_from = 0;  ///< NaN: not continued
-  int outline_polygons = 0;
-  double outline_area_m2 = 0;
+  const HazardOutputs& outputs;
   int frames = 0;
 };
 

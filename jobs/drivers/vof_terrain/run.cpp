@@ -129,9 +129,9 @@ struct Stepper {
 // The rasters only the 3D engine gives, beside the depth-averaged engine's.
 void write_3d_rasters(const TerrainSetup& su, const ColumnHazard& hz, const std::string& out_dir, RunSummary& sum) {
   terrain::write_cog(out_dir + "/max_surface_speed.tif", su.grid, terrain::masked_outside(su.grid, hz.max_surface_speed()),
-                     "maximum speed at the flow's surface [m/s]");
+                     {"maximum speed at the flow's surface [m/s]", "m/s"});
   terrain::write_cog(out_dir + "/max_ground_stress.tif", su.grid, terrain::masked_outside(su.grid, hz.max_ground_stress()),
-                     "maximum normal stress of the flow on the ground [Pa]");
+                     {"maximum normal stress of the flow on the ground [Pa]", "Pa"});
   sum.files.push_back("max_surface_speed.tif");
   sum.files.push_back("max_ground_stress.tif");
 }
@@ -223,7 +223,7 @@ RunSummary run_terrain_vof(const ResolvedScenario& r, const std::string& out_dir
   hazard_figures(r, su.grid, su.h0, hazard.maps(), sum);
   require_finite_figures({{"final volume", v_final}, {"outflow volume", step.outflow}, {"maximum speed", sum.max_speed},
                           {"maximum depth", sum.max_depth}, {"runout", sum.runout_m}});
-  const auto outline = write_hazard_outputs(r, su.grid, su.h0, hazard.maps(), out_dir, sum);
+  const auto outputs = write_hazard_outputs(r, su.grid, su.h0, hazard.maps(), out_dir, sum);
   write_3d_rasters(su, hazard, out_dir, sum);
   const int n_frames = frames ? frames->finish() : 0;
   if (frames) {
@@ -232,7 +232,7 @@ RunSummary run_terrain_vof(const ResolvedScenario& r, const std::string& out_dir
   }
   sum.seconds_write = since(t2);
   TerrainRunFacts facts{su, hazard, fig, sum, continued ? restart.state.t : std::numeric_limits<double>::quiet_NaN(),
-                        outline.polygons, outline.area_m2, n_frames};
+                        outputs, n_frames};
   write_terrain_record(out_dir + "/run.json", r, facts);
   sum.files.push_back("run.json");
   return sum;

@@ -1,0 +1,102 @@
+#include "jobs/drivers/hazard_maps.hpp"
+
+#include <cmath>
+#include <filesystem>
+
+#include "jobs/figures/hazard_map.hpp"
+#include "jobs/figures/pen.hpp"
+#include "jobs/formats/run_record.hpp"
+#include "terrain/points.hpp"
+
+namespace runout::jobs {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string num(double v) { return figures::label_number(v); }
+
+}  // namespace
+
+std::vector<PlacedPoint> place_points_of_interest(const ResolvedScenario& s, const terrain::Grid& grid) {
+  std::vector<PlacedPoint> out;
+  const auto& pts = s.scenario.outputs().points_of_interest();
+  for (int k = 0; k < pts.size(); ++k) {
+    const auto at = terrain::place_point(grid, pts[k].x(), pts[k].y(), pts[k].crs(), "outputs.points_of_interest[" + std::to_string(k) + "]");
+    out.push_back({pts[k].name(), at.x, at.y, std::size_t(at.j) * std::size_t(grid.nx) + std::size_t(at.i)});
+  }
+  return out;
+}
+
+std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain::Grid& grid, double release_volume_m3) {
+  const auto& m = s.scenario.material();
+  std::vector<std::string> p;
+  p.push_back(std::string("engine: ") + (s.terrain ? "3D VOF Navier–Stokes (Coulomb viscosity)" : "depth-averaged Savage–Hutter"));
+  if (m.rheology() == "voellmy")
+    p.push_back("friction: Voellmy, μ = " + num(m.voellmy_mu()) + ", ξ = " + num(m.voellmy_xi()) + " m/s²");
+  else
+    p.push_back("friction: Coulomb, δ = " + num(m.bed_friction_deg()) + "°" +
+                (m.has_internal_friction_deg() ? ", φ = " + num(m.internal_friction_deg()) + "°" : ""));
+  p.push_back("density: " + num(m.density_kg_m3()) + " kg/m³");
+  p.push_back("release: " + num(std::round(release_volume_m3)) + " m³ in " + std::to_string(s.releases.size()) +
+              (s.releases.size() == 1 ? " release" : " releases"));
+  p.push_back("grid: " + num(grid.dx) + " m, " + std::to_string(grid.nx) + " × " + std::to_string(grid.ny) + " cells, " + grid.crs_name);
+  const auto sw = this_software();
+  p.push_back("software: runout " + sw.version() + " (" + sw.git_commit().substr(0, 10) + ")");
+  return p;
+}
+
+void write_hazard_maps(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
+                       const products::ZoneMap& zones, const std::vector<PlacedPoint>& points, const std::string& out_dir,
+                       RunSummary& sum) {
+  const std::string name = s.scenario.name().empty() ? "runout" : s.scenario.name();
+  figures::HazardMap base;
+  base.release = h0;
+  base.max_depth = hz.max_depth;
+  base.outline_threshold = s.outline_threshold;
+  base.parameters = map_parameters(s, grid, sum.release_volume_m3);
+  for (const auto& p : points) base.points.push_back({p.name, p.x, p.y});
+  auto draw = [&](const std::string& quantity, figures::HazardMap m) {
+    const std::string stem = "map_" + quantity;
+    figures::draw_hazard_map((fs::path(out_dir) / (stem + ".png")).string(), (fs::path(out_dir) / (stem + ".pdf")).string(), grid, m);
+    sum.files.push_back(stem + ".png");
+    sum.files.push_back(stem + ".pdf");
+  };
+  for (const auto& r : hazard_rasters()) {
+    figures::HazardMap m = base;
+    m.palette = figures::hazard_palette(r.name);
+    m.title = name + ": " + m.palette.title;
+    m.values = hz.*r.map;
+    for (double& v : m.values) v *= r.scale;
+    if (r.name == "max_pressure") m.boundaries.push_back({zones.cls, zones.palette});
+    draw(r.name, std::move(m));
+  }
+  figures::HazardMap z = base;
+  z.palette = zones.palette;
+  z.title = name + ": pressure zones";
+  z.values.assign(zones.cls.begin(), zones.cls.end());
+  // The zone map colours class k + 1 with zone k: its palette's bounds become the class numbers.
+  for (std::size_t k = 0; k < z.palette.classes.size(); ++k) z.palette.classes[k].from = double(k + 1);
+  z.palette.title = "pressure zones (max pressure where max depth > " + num(s.outline_threshold) + " m)";
+  draw("pressure_zones", std::move(z));
+}
+
+std::vector<v1::PointReport> point_reports(const std::vector<PlacedPoint>& points, const engine::HazardMaps& hz, const products::ZoneMap& zones,
+                                           double outline_threshold) {
+  std::vector<v1::PointReport> out;
+  for (const auto& p : points) {
+    auto* r = &out.emplace_back();
+    r->set_name(p.name);
+    r->set_x(p.x);
+    r->set_y(p.y);
+    r->set_max_depth_m(hz.max_depth[p.cell]);
+    r->set_max_speed_m_s(hz.max_speed[p.cell]);
+    r->set_max_pressure_kpa(1e-3 * hz.max_pressure[p.cell]);
+    const int z = zones.cls[p.cell];
+    r->set_zone(z > 0 ? zones.classes[std::size_t(z) - 1].name : "");
+    if (std::isfinite(hz.arrival_time[p.cell])) r->set_arrival_time_s(hz.arrival_time[p.cell]);
+    r->set_inside_outline(hz.max_depth[p.cell] > outline_threshold);
+  }
+  return out;
+}
+
+}  // namespace runout::jobs

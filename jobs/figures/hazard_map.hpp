@@ -1,0 +1,52 @@
+#pragma once
+// The report-ready map of one hazard quantity on the terrain, as PNG and PDF (Cairo, Pango): the
+// hillshade with elevation contours (GDAL's contour generator), the quantity in its palette's
+// classes with a colour bar that shows the same colours, the release and the runout outline,
+// boundaries of classes (e.g. the pressure zones), named points of interest, coordinate ticks in
+// the grid's CRS, a scale bar, a north arrow, the title (wrapped, never cut) and a parameter block.
+#include <array>
+#include <string>
+#include <vector>
+
+#include "jobs/figures/palette.hpp"
+#include "terrain/terrain.hpp"
+
+namespace runout::figures {
+
+struct MapPoint {
+  std::string name;
+  double x = 0, y = 0;  ///< in the grid's CRS
+};
+
+/// Lines around the cells of a class raster's classes (value k + 1 is class k), in the class's colour.
+struct ClassBoundaries {
+  std::vector<std::uint8_t> cls;  ///< per cell, row 0 south
+  Palette palette;
+};
+
+struct HazardMap {
+  std::string title;                    ///< UTF-8, wrapped to the page's width
+  Palette palette;                      ///< the quantity's classes and the colour bar
+  std::vector<double> values;           ///< per cell (row 0 south); NaN or below the first class: not coloured
+  std::vector<double> release;          ///< release thickness per cell (> 0: released)
+  std::vector<double> max_depth;        ///< for the outline
+  double outline_threshold = 0.1;       ///< [m]
+  std::vector<ClassBoundaries> boundaries;
+  std::vector<MapPoint> points;
+  std::vector<std::string> parameters;  ///< the parameter block, one line each
+};
+
+/// Where things were drawn on the PNG (pixels), for checks.
+struct MapLayout {
+  int width = 0, height = 0;
+  double map_x = 0, map_y = 0, cell_px = 0;  ///< the map's top-left corner and pixels per cell
+  std::vector<std::array<double, 4>> swatches;  ///< colour bar boxes x, y, w, h, one per class
+  std::array<double, 4> title{};                ///< the title's box
+  int title_lines = 1, unknown_glyphs = 0;      ///< over every text drawn
+  double contour_interval_m = 0;
+};
+
+/// Draw the map into `png_path` and `pdf_path` (either may be empty). Throws terrain::TerrainError.
+MapLayout draw_hazard_map(const std::string& png_path, const std::string& pdf_path, const terrain::Grid& g, const HazardMap& m);
+
+}  // namespace runout::figures

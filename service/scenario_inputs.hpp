@@ -1,0 +1,28 @@
+#pragma once
+// The scenario fields that name input files, in one list for both ends of the service: the client
+// uploads what they name and puts the upload's reference in their place, the server resolves each
+// (an upload, or a file inside its data roots) before anything reads it. A new input field of the
+// scenario is one more line here.
+#include <string>
+
+#include "runout/v1/scenario.pb.h"
+
+namespace runout::service {
+
+/// Calls f(field, path) for every input file field that is set ("releases[0].thickness_raster",
+/// the path to read or replace).
+template <class F>
+void for_each_input_path(v1::Scenario& s, F f) {
+  auto each = [&](const std::string& field, std::string* path) {
+    if (!path->empty()) f(field, path);
+  };
+  each("dem.path", s.mutable_dem()->mutable_path());
+  if (s.has_area_of_interest()) each("area_of_interest.path", s.mutable_area_of_interest()->mutable_path());
+  for (int k = 0; k < s.releases_size(); ++k) {
+    const std::string at = "releases[" + std::to_string(k) + "]";
+    each(at + ".path", s.mutable_releases(k)->mutable_path());
+    each(at + ".thickness_raster", s.mutable_releases(k)->mutable_thickness_raster());
+  }
+}
+
+}  // namespace runout::service

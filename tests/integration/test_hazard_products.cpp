@@ -1,0 +1,236 @@
+// What a run's hazard maps become for the hazard engineer: pressure in kPa with its unit in the band
+// metadata, the pressure zones (raster, polygons, run.json) and the QGIS styles, on a synthetic slope.
+#include <fstream>
+#include <sstream>
+
+#include "jobs/figures/hazard_map.hpp"
+#include "jobs/figures/palette.hpp"
+#include "jobs/products/zones.hpp"
+#include "tests/support/run_helpers.hpp"
+
+using namespace runout::test_support::run;
+
+namespace {
+
+// A band's cells, row 0 north (GDAL's order).
+std::vector<double> band_values(const fs::path& path, GDALDataType type = GDT_Float64) {
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER));
+  EXPECT_TRUE(ds) << path;
+  if (!ds) return {};
+  const int nx = ds->GetRasterXSize(), ny = ds->GetRasterYSize();
+  std::vector<double> v(std::size_t(nx) * ny);
+  EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, nx, ny, v.data(), nx, ny, type, 0, 0), CE_None);
+  return v;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+TEST(HazardProducts, ZonesClassifyByTheirLowerBoundsInclusive) {
+  const std::vector<jobs::ZoneThreshold> z = {{"yellow", 1}, {"blue", 3}, {"red", 30}};
+  const auto m = jobs::products::pressure_zones(z, {0.0, 0.999, 1.0, 2.9999, 3.0, 29.99, 30.0, 1e4, NAN});
+  EXPECT_EQ(std::vector<int>(m.cls.begin(), m.cls.end()), (std::vector<int>{0, 0, 1, 1, 2, 2, 3, 3, 0}));
+  ASSERT_EQ(m.classes.size(), 3u);
+  EXPECT_EQ(m.classes[1].to, 30.0);
+  EXPECT_TRUE(std::isnan(m.classes[2].to));
+  EXPECT_EQ(jobs::products::zone_label(m.classes[2]), "red: ≥ 30 kPa");
+  // A colour name colours the zone; other names take their rank on the ramp.
+  EXPECT_EQ(figures::hex(m.palette.classes[1].colour), "#005ce6");
+  const auto other = jobs::products::pressure_zones({{"low", 1}, {"high", 10}}, {});
+  EXPECT_NE(other.palette.classes[0].colour, other.palette.classes[1].colour);
+}
+
+TEST(HazardProducts, PressureZonesFollowTheMaxPressureRasterCellForCell) {
+  TempDir d;
+  make_dem(d / "dem.tif", 120, 20.0, 30);
+  make_polygons(d / "rel.geojson", {square(500200, 5201000, 300)}, "EPSG:32632");
+  auto sc = base_scenario(d / "dem.tif", d / "rel.geojson");
+  for (auto [name, from] : {std::pair{"yellow", 1.0}, {"blue", 10.0}, {"red", 100.0}}) {
+    auto* z = sc.mutable_outputs()->add_pressure_zones_kpa();
+    z->set_name(name);
+    z->set_from_kpa(from);
+  }
+  auto r = jobs::resolve_scenario(sc, d.p.string());
+  fs::create_directories(d / "out");
+  const auto sum = jobs::run_scenario(r, d / "out");
+  const fs::path out = d / "out";
+  // Pressure in kPa, said in the band metadata; run.json's maxima are the rasters'.
+  GDALDatasetUniquePtr pr(GDALDataset::Open((out / "max_pressure.tif").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(pr);
+  EXPECT_STREQ(pr->GetRasterBand(1)->GetUnitType(), "kPa");
+  EXPECT_NE(std::string(pr->GetRasterBand(1)->GetDescription()).find("[kPa]"), std::string::npos);
+  const auto p = band_values(out / "max_pressure.tif"), h = band_values(out / "max_depth.tif"), sp = band_values(out / "max_speed.tif");
+  const auto zone = band_values(out / "pressure_zones.tif");
+  const auto rec = run_record(out / "run.json");
+  double pmax = 0, smax = 0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    if (p[k] > -9999) pmax = std::max(pmax, p[k]);
+    if (sp[k] > -9999) smax = std::max(smax, sp[k]);
+  }
+  EXPECT_NEAR(rec.results().max_pressure_kpa(), pmax, 1e-6 * pmax);  // Float32 raster
+  EXPECT_NEAR(rec.solver().max_speed_m_s(), smax, 1e-6 * smax);
+  EXPECT_GT(pmax, 100.0);  // the red zone is reached
+  // Each cell's zone is its maximum pressure's class, inside the outline (max depth > 0.1 m).
+  std::vector<long> count(4, 0);
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    int want = 0;
+    if (h[k] > 0.1) want = p[k] >= 100 ? 3 : p[k] >= 10 ? 2 : p[k] >= 1 ? 1 : 0;
+    ASSERT_EQ(int(zone[k]), want) << "cell " << k << ": " << p[k] << " kPa, " << h[k] << " m";
+    ++count[std::size_t(want)];
+  }
+  // The polygons: per zone, the area of its cells, with the name and bounds as attributes; the same
+  // in run.json.
+  GDALDatasetUniquePtr gp(GDALDataset::Open((out / "pressure_zones.gpkg").c_str(), GDAL_OF_VECTOR));
+  ASSERT_TRUE(gp);
+  std::map<std::string, double> area;
+  for (auto& f : gp->GetLayerByName("pressure_zones")) {
+    ASSERT_TRUE(f->GetGeometryRef()->IsValid());
+    area[f->GetFieldAsString("name")] += OGR_G_Area(OGRGeometry::ToHandle(f->GetGeometryRef()));
+    if (std::string(f->GetFieldAsString("name")) == "red") EXPECT_TRUE(f->IsFieldNull(f->GetFieldIndex("to_kpa")));
+    if (std::string(f->GetFieldAsString("name")) == "blue") EXPECT_EQ(f->GetFieldAsDouble("to_kpa"), 100.0);
+  }
+  ASSERT_EQ(rec.results().pressure_zones_size(), 3);
+  const char* names[] = {"yellow", "blue", "red"};
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(area[names[k]], count[std::size_t(k) + 1] * 400.0, 1e-6) << names[k];
+    EXPECT_EQ(rec.results().pressure_zones(k).name(), names[k]);
+    EXPECT_NEAR(rec.results().pressure_zones(k).area_m2(), count[std::size_t(k) + 1] * 400.0, 1e-6) << names[k];
+  }
+  EXPECT_EQ(rec.results().affected_area_criterion(), "max depth > 0.1 m");
+  EXPECT_EQ(rec.results().pressure_zones_criterion(), "max pressure rho u^2 where max depth > 0.1 m");
+  GDALDatasetUniquePtr gj(GDALDataset::Open((out / "pressure_zones.geojson").c_str(), GDAL_OF_VECTOR));
+  ASSERT_TRUE(gj);
+  EXPECT_GT(gj->GetLayer(0)->GetFeatureCount(), 0);
+  // QGIS styles beside the rasters, in the maps' colours.
+  const std::string qml = slurp(out / "max_pressure.qml"), zq = slurp(out / "pressure_zones.qml");
+  for (const auto& c : figures::hazard_palette("max_pressure").classes)
+    EXPECT_NE(qml.find("color=\"" + figures::hex(c.colour) + "\""), std::string::npos) << c.label;
+  EXPECT_NE(zq.find("label=\"blue: 10 – 100 kPa\""), std::string::npos) << zq;
+  EXPECT_NE(zq.find("color=\"#005ce6\""), std::string::npos) << zq;
+  for (const char* f : {"max_depth.qml", "max_speed.qml", "deposit.qml", "arrival_time.qml"}) EXPECT_TRUE(fs::exists(out / f)) << f;
+  (void)sum;
+}
+
+TEST(HazardProducts, BadPressureZonesAreNamed) {
+  const std::string dir = std::string(RUNOUT_SOURCE_DIR) + "/tests/data";
+  auto refused = [&](std::initializer_list<std::pair<const char*, double>> zones, std::initializer_list<std::string> needles) {
+    v1::Scenario s = jobs::parse_scenario_json(slurp(dir + "/arelen-30m.json"));
+    for (auto [name, from] : zones) {
+      auto* z = s.mutable_outputs()->add_pressure_zones_kpa();
+      z->set_name(name);
+      z->set_from_kpa(from);
+    }
+    try {
+      jobs::resolve_scenario(s, dir);
+      ADD_FAILURE() << "no error, expected one naming " << *needles.begin();
+    } catch (const jobs::ScenarioError& e) {
+      for (const auto& n : needles) EXPECT_NE(std::string(e.what()).find(n), std::string::npos) << e.what();
+    }
+  };
+  refused({{"blue", 30}, {"red", 3}}, {"outputs.pressure_zones_kpa[1].from_kpa", "must ascend"});
+  refused({{"", 3}}, {"outputs.pressure_zones_kpa[0].name", "missing"});
+  refused({{"blue", 3}, {"blue", 30}}, {"outputs.pressure_zones_kpa[1].name", "names zone 0"});
+  refused({{"blue", 0}}, {"outputs.pressure_zones_kpa[0].from_kpa", "missing"});
+  refused({{"blue", -3}}, {"outputs.pressure_zones_kpa[0].from_kpa"});
+}
+
+namespace {
+
+// A plane tilted to the south-west on 100 x 80 cells of 10 m with a value that grows to the east.
+terrain::Grid tilted_grid() {
+  terrain::Grid g;
+  g.nx = 100;
+  g.ny = 80;
+  g.dx = 10;
+  g.x_min = 600000;
+  g.y_min = 5200000;
+  OGRSpatialReference srs;
+  srs.importFromEPSG(32632);
+  char* wkt = nullptr;
+  srs.exportToWkt(&wkt);
+  g.crs_wkt = wkt;
+  CPLFree(wkt);
+  g.crs_name = "EPSG:32632";
+  g.z.resize(g.cells());
+  g.outside.assign(g.cells(), 0);
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) g.z[std::size_t(j) * g.nx + i] = 1000 + 3.0 * i + 5.0 * j + 20 * std::sin(0.1 * i);
+  return g;
+}
+
+}  // namespace
+
+TEST(HazardProducts, MapsShowTheWholeUtf8TitleAndColourBarsMatchTheDrawnColours) {
+  TempDir d;
+  const auto g = tilted_grid();
+  figures::HazardMap m;
+  m.title = "Zürich: 45° slope, 30 % (test)";
+  m.palette = figures::hazard_palette("max_speed");
+  m.values.resize(g.cells());
+  m.max_depth.resize(g.cells());
+  m.release.assign(g.cells(), 0);
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      const std::size_t k = std::size_t(j) * g.nx + i;
+      m.values[k] = j > 10 && j < 70 ? 0.6 * i : NAN;  // 0 to 60 m/s from west to east: every class
+      m.max_depth[k] = j > 10 && j < 70 && i > 5 ? 1.0 : 0.0;
+      if (j > 55 && j < 65 && i > 5 && i < 15) m.release[k] = 2;
+    }
+  m.points.push_back({"Hütte", 600500, 5200400});
+  m.parameters = {"engine: depth-averaged Savage–Hutter", "friction: Coulomb, δ = 20°"};
+  const auto lay = figures::draw_hazard_map(d / "map.png", d / "map.pdf", g, m);
+  // The title whole, on one line, every character drawn.
+  EXPECT_EQ(lay.unknown_glyphs, 0);
+  EXPECT_EQ(lay.title_lines, 1);
+  EXPECT_GT(lay.title[2], 200.0);
+  EXPECT_LE(lay.title[0] + lay.title[2], lay.width);
+  std::ifstream pdf(d / "map.pdf", std::ios::binary);
+  std::string head(5, ' ');
+  pdf.read(head.data(), 5);
+  EXPECT_EQ(head, "%PDF-");
+  // The pixels of the PNG.
+  GDALDatasetUniquePtr png(GDALDataset::Open((d / "map.png").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(png);
+  ASSERT_EQ(png->GetRasterXSize(), lay.width);
+  ASSERT_GE(png->GetRasterCount(), 3);
+  auto pixel = [&](double x, double y) {
+    figures::Rgb8 c{};
+    for (int b = 0; b < 3; ++b)
+      if (png->GetRasterBand(b + 1)->RasterIO(GF_Read, int(x), int(y), 1, 1, &c[std::size_t(b)], 1, 1, GDT_Byte, 0, 0) != CE_None)
+        ADD_FAILURE() << "reading pixel " << x << ", " << y;
+    return c;
+  };
+  // Each colour bar swatch shows its class's colour ...
+  ASSERT_EQ(lay.swatches.size(), m.palette.classes.size());
+  for (std::size_t k = 0; k < lay.swatches.size(); ++k) {
+    const auto& sw = lay.swatches[k];
+    EXPECT_EQ(pixel(sw[0] + sw[2] / 2, sw[1] + sw[3] / 2), m.palette.classes[k].colour) << m.palette.classes[k].label;
+  }
+  // ... and the map shows the same colour at the centres of the cells of that class (all but the few
+  // under a contour line or an outline).
+  for (std::size_t k = 0; k < m.palette.classes.size(); ++k) {
+    int cells = 0, same = 0;
+    for (int j = 15; j < 50; j += 3)
+      for (int i = 1; i < g.nx - 1; ++i) {
+        if (m.palette.class_of(m.values[std::size_t(j) * g.nx + i - 1]) != int(k) ||
+            m.palette.class_of(m.values[std::size_t(j) * g.nx + i + 1]) != int(k))
+          continue;
+        ++cells;
+        same += pixel(lay.map_x + (i + 0.5) * lay.cell_px, lay.map_y + (g.ny - 1 - j + 0.5) * lay.cell_px) == m.palette.classes[k].colour;
+      }
+    ASSERT_GT(cells, 10) << m.palette.classes[k].label;
+    EXPECT_GT(same, 0.8 * cells) << m.palette.classes[k].label << ": " << same << " of " << cells;
+  }
+  // A title longer than the page wraps, and stays whole.
+  m.title = std::string(40, 'x') + " " + std::string(60, 'y') + " Zürich: 45° slope, 30 % (test) " + std::string(50, 'z');
+  const auto wrapped = figures::draw_hazard_map(d / "long.png", "", g, m);
+  EXPECT_GT(wrapped.title_lines, 1);
+  EXPECT_LE(wrapped.title[0] + wrapped.title[2], wrapped.width);
+  EXPECT_EQ(wrapped.unknown_glyphs, 0);
+}
