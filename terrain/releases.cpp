@@ -93,6 +93,25 @@ std::vector<unsigned char> polygon_cells(const Grid& g, OGRGeometry& geom, const
   return m;
 }
 
+// A feature's polygon in the grid's CRS: refused when empty or not a polygon, repaired with GEOS
+// when invalid (`repaired` set), transformed with `ct` (null: as it is). Errors name `what`.
+std::unique_ptr<OGRGeometry> polygon_on_grid(const OGRGeometry* g0, OGRCoordinateTransformation* ct, const Grid& g, const std::string& what,
+                                             bool& repaired) {
+  if (!g0 || g0->IsEmpty()) throw TerrainError(what + ": no geometry");
+  const auto type = wkbFlatten(g0->getGeometryType());
+  if (type != wkbPolygon && type != wkbMultiPolygon) throw TerrainError(what + ": not a polygon");
+  std::unique_ptr<OGRGeometry> geom(g0->clone());
+  repaired = false;
+  if (!geom->IsValid()) {
+    std::unique_ptr<OGRGeometry> fixed(geom->MakeValid());
+    if (!fixed || fixed->IsEmpty()) throw TerrainError(what + ": invalid geometry that GEOS cannot repair");
+    geom = std::move(fixed);
+    repaired = true;
+  }
+  if (ct && geom->transform(ct) != OGRERR_NONE) throw TerrainError(what + ": cannot transform it to " + g.crs_name);
+  return geom;
+}
+
 // The thickness raster at the cells' centres, resampled bilinearly by GDAL's warper (PROJ for the
 // CRS), row 0 south; 0 where it has no data. Values below 0 or above 500 m are refused.
 std::vector<double> raster_thickness(const Grid& g, const ReleaseRequest& rq, const OGRSpatialReference& dst) {
@@ -148,10 +167,9 @@ void release_polygons(const ReleaseRequest& rq, const OGRSpatialReference& dst, 
     for (auto& f : layer) {
       ++n;
       const std::string what = "release polygon " + std::to_string(n) + " of '" + rq.path + "'";
-      const OGRGeometry* g0 = f->GetGeometryRef();
-      if (!g0 || g0->IsEmpty()) throw TerrainError(what + ": no geometry");
-      const auto type = wkbFlatten(g0->getGeometryType());
-      if (type != wkbPolygon && type != wkbMultiPolygon) throw TerrainError(what + ": not a polygon");
+      bool repaired = false;
+      const auto geom = polygon_on_grid(f->GetGeometryRef(), ct.get(), fill.g, what, repaired);
+      if (repaired) rep.notes.push_back(what + ": invalid geometry (e.g. self-intersecting) repaired with GEOS MakeValid");
       double t = rq.has_thickness ? rq.thickness : 0.0;
       if (!rq.has_thickness && !raster_t) {
         if (rq.thickness_attribute.empty()) throw TerrainError(what + ": no thickness (set thickness_m or thickness_attribute)");
@@ -164,14 +182,6 @@ void release_polygons(const ReleaseRequest& rq, const OGRSpatialReference& dst, 
       if (!rq.has_max_slope && !rq.max_slope_attribute.empty()) smax = field_value(*f, rq.max_slope_attribute, what);
       if (!(smin >= 0 && smax <= 90 && smin < smax))
         throw TerrainError(what + ": slope window [" + fmt(smin) + ", " + fmt(smax) + "] deg must satisfy 0 <= min < max <= 90");
-      std::unique_ptr<OGRGeometry> geom(g0->clone());
-      if (!geom->IsValid()) {
-        std::unique_ptr<OGRGeometry> fixed(geom->MakeValid());
-        if (!fixed || fixed->IsEmpty()) throw TerrainError(what + ": invalid geometry that GEOS cannot repair");
-        geom = std::move(fixed);
-        rep.notes.push_back(what + ": invalid geometry (e.g. self-intersecting) repaired with GEOS MakeValid");
-      }
-      if (ct && geom->transform(ct.get()) != OGRERR_NONE) throw TerrainError(what + ": cannot transform it to " + fill.g.crs_name);
       const auto m = polygon_cells(fill.g, *geom, what);
       fill(what + (raster_t ? " with the thickness raster '" + rq.thickness_raster + "'" : ""), rq.vertical, smin, smax,
            [&](std::size_t k) { return m[k] != 0; }, [&](std::size_t k) { return raster_t ? (*raster_t)[k] : t; });
@@ -182,6 +192,32 @@ void release_polygons(const ReleaseRequest& rq, const OGRSpatialReference& dst, 
 }
 
 }  // namespace
+
+std::vector<std::uint8_t> rasterize_polygons(const Grid& g, const std::string& path, const std::string& crs, const std::string& what) {
+  init_gdal();
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR));
+  if (!ds) throw TerrainError(what + ": cannot read '" + path + "' as a vector file" + gdal_message());
+  OGRSpatialReference dst;
+  dst.importFromWkt(g.crs_wkt.c_str());
+  dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  std::vector<std::uint8_t> in(g.cells(), 0);
+  int n = 0;
+  for (auto* layer : ds->GetLayers()) {
+    const std::string file = what + " '" + path + "'";
+    const auto src = input_crs(layer->GetSpatialRef(), crs, file, file + " has no CRS and none is given");
+    auto ct = transform(src, dst, file);
+    for (auto& f : layer) {
+      ++n;
+      const std::string at = "polygon " + std::to_string(n) + " of " + file;
+      bool repaired = false;
+      const auto geom = polygon_on_grid(f->GetGeometryRef(), ct.get(), g, at, repaired);
+      const auto m = polygon_cells(g, *geom, at);
+      for (std::size_t k = 0; k < in.size(); ++k) in[k] |= m[k] && (g.outside.empty() || !g.outside[k]);
+    }
+  }
+  if (n == 0) throw TerrainError(what + " '" + path + "': no polygon in the file");
+  return in;
+}
 
 std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseRequest>& releases, ReleaseReport* report) {
   init_gdal();

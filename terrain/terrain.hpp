@@ -92,7 +92,11 @@ struct BandInfo {
   std::string description;  ///< e.g. "maximum flow depth normal to the surface"
   std::string unit;         ///< e.g. "m", "kPa"; "" for classes
 };
-/// Cloud-optimised GeoTIFF, Float32, DEFLATE, CRS and nodata set, overviews when larger than a
+/// The cells (row 0 south) whose centres lie inside any polygon of the vector file `path` (its own
+/// CRS, else `crs`); cells outside the domain are 0. Errors name `what` (e.g. "observations.outline_path").
+std::vector<std::uint8_t> rasterize_polygons(const Grid& g, const std::string& path, const std::string& crs, const std::string& what);
+
+/// What a raster band says, Float32, DEFLATE, CRS and nodata set, overviews when larger than a
 /// tile; NaN cells are written as nodata.
 void write_cog(const std::string& path, const Grid& g, const std::vector<double>& values, const BandInfo& band);
 

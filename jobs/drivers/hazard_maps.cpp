@@ -1,5 +1,6 @@
 #include "jobs/drivers/hazard_maps.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -15,6 +16,26 @@ namespace {
 
 std::string num(double v) { return figures::label_number(v); }
 
+std::string scenario_name(const ResolvedScenario& s) { return s.scenario.name().empty() ? "runout" : s.scenario.name(); }
+
+// What every map of a run shows besides its quantity: release, outline, points, parameters.
+figures::HazardMap map_base(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
+                            const std::vector<PlacedPoint>& points, const RunSummary& sum) {
+  figures::HazardMap base;
+  base.release = h0;
+  base.max_depth = hz.max_depth;
+  base.outline_threshold = s.outline_threshold;
+  base.parameters = map_parameters(s, grid, sum.release_volume_m3);
+  for (const auto& p : points) base.points.push_back({p.name, p.x, p.y});
+  return base;
+}
+
+void draw_map(const terrain::Grid& grid, const std::string& stem, const figures::HazardMap& m, const std::string& out_dir, RunSummary& sum) {
+  figures::draw_hazard_map((fs::path(out_dir) / (stem + ".png")).string(), (fs::path(out_dir) / (stem + ".pdf")).string(), grid, m);
+  sum.files.push_back(stem + ".png");
+  sum.files.push_back(stem + ".pdf");
+}
+
 }  // namespace
 
 std::vector<PlacedPoint> place_points_of_interest(const ResolvedScenario& s, const terrain::Grid& grid) {
@@ -25,6 +46,18 @@ std::vector<PlacedPoint> place_points_of_interest(const ResolvedScenario& s, con
     out.push_back({pts[k].name(), at.x, at.y, std::size_t(at.j) * std::size_t(grid.nx) + std::size_t(at.i)});
   }
   return out;
+}
+
+std::vector<std::uint8_t> observed_cells(const ResolvedScenario& s, const terrain::Grid& grid) {
+  if (s.observed_outline.empty()) return {};
+  return terrain::rasterize_polygons(grid, s.observed_outline, s.observed_crs, "observations.outline_path");
+}
+
+void check_output_inputs(const ResolvedScenario& s, const terrain::Grid& grid) {
+  place_points_of_interest(s, grid);
+  const auto obs = observed_cells(s, grid);
+  if (!s.observed_outline.empty() && std::find(obs.begin(), obs.end(), 1) == obs.end())
+    throw terrain::TerrainError("observations.outline_path: '" + s.observed_outline + "' covers no cell of the domain");
 }
 
 std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain::Grid& grid, double release_volume_m3) {
@@ -48,19 +81,9 @@ std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain
 void write_hazard_maps(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
                        const products::ZoneMap& zones, const std::vector<PlacedPoint>& points, const std::string& out_dir,
                        RunSummary& sum) {
-  const std::string name = s.scenario.name().empty() ? "runout" : s.scenario.name();
-  figures::HazardMap base;
-  base.release = h0;
-  base.max_depth = hz.max_depth;
-  base.outline_threshold = s.outline_threshold;
-  base.parameters = map_parameters(s, grid, sum.release_volume_m3);
-  for (const auto& p : points) base.points.push_back({p.name, p.x, p.y});
-  auto draw = [&](const std::string& quantity, figures::HazardMap m) {
-    const std::string stem = "map_" + quantity;
-    figures::draw_hazard_map((fs::path(out_dir) / (stem + ".png")).string(), (fs::path(out_dir) / (stem + ".pdf")).string(), grid, m);
-    sum.files.push_back(stem + ".png");
-    sum.files.push_back(stem + ".pdf");
-  };
+  const std::string name = scenario_name(s);
+  const figures::HazardMap base = map_base(s, grid, h0, hz, points, sum);
+  auto draw = [&](const std::string& quantity, figures::HazardMap m) { draw_map(grid, "map_" + quantity, m, out_dir, sum); };
   for (const auto& r : hazard_rasters()) {
     figures::HazardMap m = base;
     m.palette = figures::hazard_palette(r.name);
@@ -78,6 +101,16 @@ void write_hazard_maps(const ResolvedScenario& s, const terrain::Grid& grid, con
   for (std::size_t k = 0; k < z.palette.classes.size(); ++k) z.palette.classes[k].from = double(k + 1);
   z.palette.title = "pressure zones (max pressure where max depth > " + num(s.outline_threshold) + " m)";
   draw("pressure_zones", std::move(z));
+}
+
+void write_score_map(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
+                     const std::vector<std::uint8_t>& cls, const std::vector<PlacedPoint>& points, const std::string& out_dir,
+                     RunSummary& sum) {
+  figures::HazardMap m = map_base(s, grid, h0, hz, points, sum);
+  m.palette = products::score_palette();
+  m.title = scenario_name(s) + ": simulated against the observed outline";
+  m.values.assign(cls.begin(), cls.end());
+  draw_map(grid, "map_observation", m, out_dir, sum);
 }
 
 std::vector<v1::PointReport> point_reports(const std::vector<PlacedPoint>& points, const engine::HazardMaps& hz, const products::ZoneMap& zones,

@@ -7,6 +7,7 @@
 
 #include "engine/sh2d.hpp"
 #include "jobs/drivers/run.hpp"
+#include "jobs/products/scores.hpp"
 #include "jobs/products/zones.hpp"
 #include "runout/v1/run_record.pb.h"
 #include "terrain/terrain.hpp"
@@ -22,6 +23,13 @@ struct PlacedPoint {
 };
 std::vector<PlacedPoint> place_points_of_interest(const ResolvedScenario& s, const terrain::Grid& grid);
 
+/// The cells inside the observed outline (observations.outline_path); empty without one.
+std::vector<std::uint8_t> observed_cells(const ResolvedScenario& s, const terrain::Grid& grid);
+
+/// What the outputs read besides the run (points of interest, the observed outline), checked before
+/// the run so that a bad one is refused at once. Throws TerrainError naming the field.
+void check_output_inputs(const ResolvedScenario& s, const terrain::Grid& grid);
+
 /// The lines of the maps' parameter block: engine, friction, release, grid, software.
 std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain::Grid& grid, double release_volume_m3);
 
@@ -30,6 +38,11 @@ std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain
 void write_hazard_maps(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
                        const products::ZoneMap& zones, const std::vector<PlacedPoint>& points, const std::string& out_dir,
                        RunSummary& sum);
+
+/// map_observation.png and .pdf: hits, false alarms and misses against the observed outline.
+void write_score_map(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
+                     const std::vector<std::uint8_t>& cls, const std::vector<PlacedPoint>& points, const std::string& out_dir,
+                     RunSummary& sum);
 
 /// Each point's figures: the cell's maxima, zone and arrival time.
 std::vector<v1::PointReport> point_reports(const std::vector<PlacedPoint>& points, const engine::HazardMaps& hz, const products::ZoneMap& zones,

@@ -111,6 +111,12 @@ HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Gri
   const auto points = place_points_of_interest(s, grid);
   res.points = point_reports(points, hz, zones, s.outline_threshold);
   write_hazard_maps(s, grid, h0, hz, zones, points, out_dir, sum);
+  if (!s.observed_outline.empty()) {
+    std::vector<std::uint8_t> simulated(grid.cells());
+    for (std::size_t k = 0; k < simulated.size(); ++k) simulated[k] = hz.max_depth[k] > s.outline_threshold;
+    res.scores = products::outline_scores(grid, simulated, observed_cells(s, grid));
+    write_score_map(s, grid, h0, hz, res.scores->cls, points, out_dir, sum);
+  }
   return res;
 }
 
@@ -133,6 +139,20 @@ void record_hazard_results(const ResolvedScenario& s, const RunSummary& sum, con
     z->set_area_m2(out.zone_areas[k].area_m2);
   }
   for (const auto& p : out.points) *re.add_points_of_interest() = p;
+  if (out.scores) {
+    auto* sc = re.mutable_observation_scores();
+    const auto& o = *out.scores;
+    sc->set_criterion(affected_area_criterion(s.outline_threshold));
+    sc->set_observed_area_m2(o.observed_m2);
+    sc->set_simulated_area_m2(o.simulated_m2);
+    sc->set_true_positive_m2(o.tp_m2);
+    sc->set_false_positive_m2(o.fp_m2);
+    sc->set_false_negative_m2(o.fn_m2);
+    sc->set_true_negative_m2(o.tn_m2);
+    sc->set_critical_success_index(o.csi);
+    sc->set_true_positive_rate(o.tpr);
+    sc->set_false_positive_rate(o.fpr);
+  }
 }
 
 void record_inputs(v1::RunRecord& rec, const terrain::DemReport& d, const terrain::Grid& g, const terrain::ReleaseReport& r) {

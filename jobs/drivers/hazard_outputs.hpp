@@ -2,11 +2,13 @@
 // What both engines' runs on a DEM write alike: the engine's local grid, the figures of the hazard
 // map (maximum depth, affected area, runout), the hazard rasters, the outline and the map.
 #include <initializer_list>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "engine/sh2d.hpp"
+#include "jobs/products/scores.hpp"
 #include "jobs/drivers/run.hpp"
 #include "runout/v1/run_record.pb.h"
 #include "terrain/terrain.hpp"
@@ -32,6 +34,7 @@ struct HazardOutputs {
   std::vector<ZoneThreshold> zones;
   std::vector<terrain::ClassArea> zone_areas;  ///< per zone
   std::vector<v1::PointReport> points;         ///< outputs.points_of_interest
+  std::optional<products::OutlineScores> scores;  ///< against observations.outline_path
 };
 
 /// The hazard rasters the scenario asks for (hazard_rasters(), each with its QGIS style), the

@@ -91,7 +91,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   const terrain::Grid grid = terrain::prepare_grid(s.dem, &dem_rep);
   terrain::ReleaseReport rel_rep;
   const auto h0 = terrain::rasterize_releases(grid, s.releases, &rel_rep);
-  place_points_of_interest(s, grid);  // a point outside the domain is refused before the run
+  check_output_inputs(s, grid);  // a point outside the domain, a bad observation: refused before the run
   sum.nx = grid.nx;
   sum.ny = grid.ny;
   sum.dx = grid.dx;

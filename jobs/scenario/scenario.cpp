@@ -160,6 +160,15 @@ void add_raster(const std::string& path, const std::string& field, ResolvedScena
   if (companion(path + ".aux.xml", field)) r.input_files.push_back(path + ".aux.xml");
 }
 
+// A vector input and, for a shapefile, its companions.
+void add_vector(const std::string& path, const std::string& field, ResolvedScenario& r) {
+  r.input_files.push_back(path);
+  for (const char* ext : {".shx", ".dbf", ".prj", ".cpg"}) {
+    fs::path side = fs::path(path).replace_extension(ext);
+    if (fs::path(path).extension() == ".shp" && companion(side, field)) r.input_files.push_back(side.string());
+  }
+}
+
 // The input files: the DEM with the companions that change how it reads, the area of interest.
 void resolve_inputs(const v1::Scenario& s, const std::string& base, ResolvedScenario& r) {
   r.dem.dem_path = path_in(base, s.dem().path(), "dem.path");
@@ -167,6 +176,10 @@ void resolve_inputs(const v1::Scenario& s, const std::string& base, ResolvedScen
   if (!s.area_of_interest().path().empty()) {
     r.dem.aoi_path = path_in(base, s.area_of_interest().path(), "area_of_interest.path");
     r.input_files.push_back(r.dem.aoi_path);
+  }
+  if (!s.observations().outline_path().empty()) {
+    r.observed_outline = path_in(base, s.observations().outline_path(), "observations.outline_path");
+    add_vector(r.observed_outline, "observations.outline_path", r);
   }
 }
 
@@ -179,11 +192,7 @@ void resolve_releases(const v1::Scenario& s, const std::string& base, ResolvedSc
     if (rl.path().empty() && rl.thickness_raster().empty()) bad(f + ".path", "missing (release polygons, or a thickness_raster)");
     if (!rl.path().empty()) {
       q.path = path_in(base, rl.path(), f + ".path");
-      r.input_files.push_back(q.path);
-      for (const char* ext : {".shx", ".dbf", ".prj", ".cpg"}) {
-        fs::path side = fs::path(q.path).replace_extension(ext);
-        if (fs::path(q.path).extension() == ".shp" && companion(side, f + ".path")) r.input_files.push_back(side.string());
-      }
+      add_vector(q.path, f + ".path", r);
     }
     q.has_thickness = rl.has_thickness_m();
     q.thickness = rl.thickness_m();
@@ -270,7 +279,11 @@ std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version,
   v1::Scenario s = r.scenario;
   s.mutable_dem()->clear_path();
   s.mutable_area_of_interest()->clear_path();
-  for (auto& rel : *s.mutable_releases()) rel.clear_path();
+  for (auto& rel : *s.mutable_releases()) {
+    rel.clear_path();
+    rel.clear_thickness_raster();
+  }
+  if (s.has_observations()) s.mutable_observations()->clear_outline_path();
   s.clear_limits();  // a job's limits do not change what it computes
   std::string bytes;
   {

@@ -33,6 +33,7 @@ struct ResolvedScenario {
   double outline_threshold = 0.1;
   double timeseries_interval = 0;  ///< [s]; 0: no time series
   std::vector<ZoneThreshold> pressure_zones = {{"blue", 3}, {"red", 30}};
+  std::string observed_outline, observed_crs;  ///< observations: polygons of the observed runout, their CRS
   std::vector<std::string> input_files;  ///< for hashing
   bool vof = false;  ///< engine "vof": a laboratory set-up (`lab`) or, with `terrain`, on the DEM
   /// engine "vof" without `lab`: the 3D engine on the DEM and releases (blocks `mesh` and `vof`;

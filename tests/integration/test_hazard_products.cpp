@@ -234,3 +234,66 @@ TEST(HazardProducts, MapsShowTheWholeUtf8TitleAndColourBarsMatchTheDrawnColours)
   EXPECT_LE(wrapped.title[0] + wrapped.title[2], wrapped.width);
   EXPECT_EQ(wrapped.unknown_glyphs, 0);
 }
+
+// Scores against an observed outline with known answers: the run's own outline (in WGS84) scores a
+// critical success index of exactly 1; a rectangle scores the cells counted here from max_depth.tif.
+TEST(HazardProducts, ObservedOutlineScoresHaveKnownAnswers) {
+  TempDir d;
+  make_dem(d / "dem.tif", 120, 20.0, 30);
+  make_polygons(d / "rel.geojson", {square(500200, 5201000, 300)}, "EPSG:32632");
+  auto sc = base_scenario(d / "dem.tif", d / "rel.geojson");
+  fs::create_directories(d / "first");
+  const auto first = jobs::run_scenario(jobs::resolve_scenario(sc, d.p.string()), d / "first");
+  // The run's own outline, in WGS84: every simulated cell a hit.
+  sc.mutable_observations()->set_outline_path(d / "first/outline.geojson");
+  fs::create_directories(d / "self");
+  jobs::run_scenario(jobs::resolve_scenario(sc, d.p.string()), d / "self");
+  const auto self = run_record(d / "self/run.json").results().observation_scores();
+  EXPECT_EQ(self.critical_success_index(), 1.0);
+  EXPECT_EQ(self.true_positive_m2(), first.affected_area_m2);
+  EXPECT_EQ(self.false_positive_m2(), 0.0);
+  EXPECT_EQ(self.false_negative_m2(), 0.0);
+  EXPECT_EQ(self.true_positive_rate(), 1.0);
+  EXPECT_EQ(self.false_positive_rate(), 0.0);
+  EXPECT_EQ(self.criterion(), "max depth > 0.1 m");
+  EXPECT_TRUE(fs::exists(d / "self/map_observation.png"));
+  EXPECT_TRUE(fs::exists(d / "self/map_observation.pdf"));
+  // A rectangle over the lower part of the slope: the counts by hand from max_depth.tif.
+  const double x0 = 501000, x1 = 502000, y0 = 5200800, y1 = 5201600;
+  make_polygons(d / "obs.geojson", {{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}, {x0, y0}}}, "EPSG:32632");
+  sc.mutable_observations()->set_outline_path("obs.geojson");
+  fs::create_directories(d / "rect");
+  jobs::run_scenario(jobs::resolve_scenario(sc, d.p.string()), d / "rect");
+  GDALDatasetUniquePtr md(GDALDataset::Open((d / "rect/max_depth.tif").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(md);
+  double gt[6];
+  md->GetGeoTransform(gt);
+  const auto h = band_values(d / "rect/max_depth.tif");
+  const int nx = md->GetRasterXSize(), ny = md->GetRasterYSize();
+  double tp = 0, fp = 0, fn = 0, tn = 0;
+  for (int r = 0; r < ny; ++r)
+    for (int i = 0; i < nx; ++i) {
+      const double v = h[std::size_t(r) * nx + i];
+      if (v == -9999) continue;  // outside the domain
+      const double cx = gt[0] + (i + 0.5) * gt[1], cy = gt[3] + (r + 0.5) * gt[5];
+      const bool sim = v > 0.1, obs = cx > x0 && cx < x1 && cy > y0 && cy < y1;
+      (sim && obs ? tp : sim ? fp : obs ? fn : tn) += gt[1] * gt[1];
+    }
+  ASSERT_GT(tp, 0);
+  ASSERT_GT(fp, 0);
+  ASSERT_GT(fn, 0);
+  const auto rect = run_record(d / "rect/run.json").results().observation_scores();
+  EXPECT_EQ(rect.true_positive_m2(), tp);
+  EXPECT_EQ(rect.false_positive_m2(), fp);
+  EXPECT_EQ(rect.false_negative_m2(), fn);
+  EXPECT_EQ(rect.true_negative_m2(), tn);
+  EXPECT_NEAR(rect.critical_success_index(), tp / (tp + fp + fn), 1e-9);  // run.json: 10 significant digits
+  EXPECT_NEAR(rect.true_positive_rate(), tp / (tp + fn), 1e-9);
+  EXPECT_NEAR(rect.false_positive_rate(), fp / (fp + tn), 1e-9);
+  // An observation that is not there, or covers no cell of the domain, is refused before the run.
+  sc.mutable_observations()->set_outline_path("missing.geojson");
+  expect_error(sc, d, "observations.outline_path");
+  make_polygons(d / "far.geojson", {square(700000, 5300000, 300)}, "EPSG:32632");
+  sc.mutable_observations()->set_outline_path("far.geojson");
+  expect_error(sc, d, "observations.outline_path: '");
+}

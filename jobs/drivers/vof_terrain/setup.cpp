@@ -26,7 +26,7 @@ terrain::ColumnMeshSpec mesh_spec(const v1::TerrainMesh& m, double max_vertical)
 void build_terrain_setup(const ResolvedScenario& r, TerrainSetup& out) {
   out.grid = terrain::prepare_grid(r.dem, &out.dem);
   out.h0 = terrain::rasterize_releases(out.grid, r.releases, &out.release);
-  place_points_of_interest(r, out.grid);  // a point outside the domain is refused before the run
+  check_output_inputs(r, out.grid);  // a point outside the domain, a bad observation: refused before the run
   // Vertical thickness and the slope's cosine exactly as the depth-averaged engine takes them.
   const engine::Terrain2D t = engine_terrain(out.grid);
   out.vertical = engine::state_from_normal_depth(t, out.h0).H;
