@@ -43,6 +43,7 @@
 // so results are bitwise identical for any thread count.
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "engine/limiters.hpp"
@@ -107,11 +108,25 @@ struct Sh2dCheckpoint {
   double kinetic_energy_peak = 0;  ///< the stopping rule's peak [m^5/s^2]
   double cell_updates = 0, active_fraction_sum = 0, max_active_fraction = 0;
   double next_snapshot = 0, last_snapshot = -1;  ///< the time-series schedule
+  /// Per secondary release area: when it was released [s], NaN while it waits; and the volume
+  /// released so far [m^3].
+  std::vector<double> secondary_time;
+  double volume_secondary = 0;
 };
 /// Called with a checkpoint at the end of the first step at or after each multiple of
 /// `checkpoint_interval` (steps are never shortened for it) and when the progress hook cancels the
 /// run (before the final snapshot of the cancelled run). Valid during the call only.
 using CheckpointHook = std::function<void(const Sh2dCheckpoint& cp)>;
+
+/// A secondary release area (AvaFrame's secondary release): snow or debris at rest that is not part
+/// of the flow until the flow reaches it. At the end of the first step after which a cell of the
+/// area flows (normal depth above Sh2dConfig::flow_threshold), its whole thickness is added, at
+/// rest, and moves with the flow from then on.
+struct SecondaryRelease {
+  std::string name;
+  std::vector<std::size_t> cells;  ///< cell indices (i + nx j)
+  std::vector<double> depth;       ///< normal depth per cell of `cells` [m], > 0
+};
 
 struct Sh2dConfig {
   Material material;
@@ -140,6 +155,7 @@ struct Sh2dConfig {
   SnapshotHook snapshot;            ///< optional
   double checkpoint_interval = 0;   ///< [s] of simulated time; 0: checkpoints only when cancelled
   CheckpointHook checkpoint;        ///< optional
+  std::vector<SecondaryRelease> secondary;  ///< released when the flow reaches them
 };
 
 /// Solver state: H = h / cos(theta) and the horizontal momentum H U, H V per horizontal area.
@@ -153,6 +169,8 @@ struct Sh2dDiagnostics {
   double t = 0;
   StopReason stop = StopReason::end_time;
   double volume_initial = 0, volume_final = 0;  ///< [m^3]
+  double volume_secondary = 0;                  ///< added by the secondary releases [m^3]
+  std::vector<double> secondary_time;           ///< per secondary release: when released [s], NaN: never
   double volume_outflow = 0;                    ///< left through outflow boundaries [m^3]
   double kinetic_energy_peak = 0;               ///< per unit density [m^5/s^2]
   /// Mass-averaged horizontal distance travelled: (1/V0) * integral over time and area of H |U| [m]
@@ -166,9 +184,10 @@ struct Sh2dDiagnostics {
   double mean_active_fraction = 0, max_active_fraction = 0;
   double wall_seconds = 0;  ///< whole run, set-up included
   double loop_seconds = 0;  ///< time loop only
-  /// Relative volume error: |final + outflow - initial| / initial.
+  /// Relative volume error: |final + outflow - initial - secondary| / (initial + secondary).
   double volume_error() const {
-    return volume_initial > 0 ? std::abs(volume_final + volume_outflow - volume_initial) / volume_initial : 0.0;
+    const double in = volume_initial + volume_secondary;
+    return in > 0 ? std::abs(volume_final + volume_outflow - in) / in : 0.0;
   }
 };
 

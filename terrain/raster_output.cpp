@@ -31,6 +31,7 @@ void describe(GDALRasterBand* band, const BandInfo& info) {
     band->SetUnitType(info.unit.c_str());
     band->SetMetadataItem("UNITS", info.unit.c_str());
   }
+  for (const auto& [k, v] : info.metadata) band->SetMetadataItem(k.c_str(), v.c_str());
 }
 
 // The in-memory raster as a cloud-optimised GeoTIFF (DEFLATE; the COG driver adds overviews when the
@@ -55,6 +56,36 @@ void write_cog(const std::string& path, const Grid& g, const std::vector<double>
   if (band->RasterIO(GF_Write, 0, 0, g.nx, g.ny, rows.data(), g.nx, g.ny, GDT_Float32, 0, 0) != CE_None)
     throw TerrainError("writing '" + path + "' failed" + gdal_message());
   save_cog(*ds, path, "PREDICTOR=YES");
+}
+
+void write_band_stack(const std::string& path, const Grid& g, const std::vector<BandInfo>& bands,
+                      const std::function<std::vector<double>(std::size_t)>& values,
+                      const std::vector<std::pair<std::string, std::string>>& dataset_metadata) {
+  init_gdal();
+  CPLErrorReset();
+  if (bands.empty()) throw TerrainError("writing '" + path + "': no bands");
+  auto* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
+  const char* opts[] = {"TILED=YES", "COMPRESS=DEFLATE", "PREDICTOR=3", "BIGTIFF=IF_SAFER", "INTERLEAVE=BAND", nullptr};
+  GDALDatasetUniquePtr ds(gtiff->Create(path.c_str(), g.nx, g.ny, int(bands.size()), GDT_Float32, const_cast<char**>(opts)));
+  if (!ds) throw TerrainError("writing '" + path + "' failed" + gdal_message());
+  double gt[6] = {g.x_min, g.dx, 0, g.y_min + g.ny * g.dx, 0, -g.dx};
+  ds->SetGeoTransform(gt);
+  ds->SetProjection(g.crs_wkt.c_str());
+  for (const auto& [k, v] : dataset_metadata) ds->SetMetadataItem(k.c_str(), v.c_str());
+  const float nodata = -9999.0f;
+  for (std::size_t b = 0; b < bands.size(); ++b) {
+    auto* band = ds->GetRasterBand(int(b) + 1);
+    band->SetNoDataValue(nodata);
+    describe(band, bands[b]);
+    const auto v = values(b);
+    auto rows = north_first<float>(g, [&](std::size_t k) {
+      return std::isfinite(v[k]) && (g.outside.empty() || !g.outside[k]) ? float(v[k]) : nodata;
+    });
+    if (band->RasterIO(GF_Write, 0, 0, g.nx, g.ny, rows.data(), g.nx, g.ny, GDT_Float32, 0, 0) != CE_None)
+      throw TerrainError("writing '" + path + "' failed" + gdal_message());
+  }
+  ds.reset();  // closes the file; a failure to flush shows in CPLGetLastErrorType
+  if (CPLGetLastErrorType() == CE_Failure) throw TerrainError("writing '" + path + "' failed" + gdal_message());
 }
 
 void write_class_cog(const std::string& path, const Grid& g, const std::vector<std::uint8_t>& cls, const std::vector<ValueClass>& classes,

@@ -93,6 +93,12 @@ std::vector<unsigned char> polygon_cells(const Grid& g, OGRGeometry& geom, const
   return m;
 }
 
+// "the grid covers x .. , y .. in CRS", for errors.
+std::string grid_extent(const Grid& g) {
+  return "the grid covers x " + fmt(g.x_min, 0) + ".." + fmt(g.x_min + g.nx * g.dx, 0) + ", y " + fmt(g.y_min, 0) + ".." +
+         fmt(g.y_min + g.ny * g.dx, 0) + " in " + g.crs_name;
+}
+
 // A feature's polygon in the grid's CRS: refused when empty or not a polygon, repaired with GEOS
 // when invalid (`repaired` set), transformed with `ct` (null: as it is). Errors name `what`.
 std::unique_ptr<OGRGeometry> polygon_on_grid(const OGRGeometry* g0, OGRCoordinateTransformation* ct, const Grid& g, const std::string& what,
@@ -156,7 +162,7 @@ std::vector<double> raster_thickness(const Grid& g, const ReleaseRequest& rq, co
 // One polygon file's releases, each polygon with its thickness (the release's, its attribute's or
 // the raster's `raster_t`) and its slope window.
 void release_polygons(const ReleaseRequest& rq, const OGRSpatialReference& dst, const std::vector<double>* raster_t, const CellFill& fill,
-                      ReleaseReport& rep) {
+                      ReleaseReport& rep, std::vector<ReleaseArea>* areas = nullptr) {
   GDALDatasetUniquePtr ds(GDALDataset::Open(rq.path.c_str(), GDAL_OF_VECTOR));
   if (!ds) throw TerrainError("release '" + rq.path + "': cannot read it as a vector file" + gdal_message());
   int n = 0;
@@ -183,8 +189,15 @@ void release_polygons(const ReleaseRequest& rq, const OGRSpatialReference& dst, 
       if (!(smin >= 0 && smax <= 90 && smin < smax))
         throw TerrainError(what + ": slope window [" + fmt(smin) + ", " + fmt(smax) + "] deg must satisfy 0 <= min < max <= 90");
       const auto m = polygon_cells(fill.g, *geom, what);
-      fill(what + (raster_t ? " with the thickness raster '" + rq.thickness_raster + "'" : ""), rq.vertical, smin, smax,
-           [&](std::size_t k) { return m[k] != 0; }, [&](std::size_t k) { return raster_t ? (*raster_t)[k] : t; });
+      const std::string named = what + (raster_t ? " with the thickness raster '" + rq.thickness_raster + "'" : "");
+      auto in = [&](std::size_t k) { return m[k] != 0; };
+      auto thick = [&](std::size_t k) { return raster_t ? (*raster_t)[k] : t; };
+      if (areas) {  // a secondary release: each polygon an area of its own
+        areas->push_back({what, std::vector<double>(fill.g.cells(), 0.0), 0});
+        CellFill{fill.g, fill.slope, fill.extent, areas->back().h}(named, rq.vertical, smin, smax, in, thick);
+      } else {
+        fill(named, rq.vertical, smin, smax, in, thick);
+      }
       ++rep.polygons;
     }
   }
@@ -219,6 +232,36 @@ std::vector<std::uint8_t> rasterize_polygons(const Grid& g, const std::string& p
   return in;
 }
 
+std::vector<ReleaseArea> secondary_release_areas(const Grid& g, const std::vector<ReleaseRequest>& releases) {
+  init_gdal();
+  std::vector<ReleaseArea> areas;
+  const auto slope = slope_deg(g);
+  OGRSpatialReference dst;
+  dst.importFromWkt(g.crs_wkt.c_str());
+  dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  const std::string extent = grid_extent(g);
+  std::vector<double> unused(g.cells(), 0.0);
+  ReleaseReport rep;
+  for (const auto& rq : releases) {
+    if (!rq.secondary) continue;
+    std::vector<double> raster_t;
+    if (!rq.thickness_raster.empty()) raster_t = raster_thickness(g, rq, dst);
+    if (!rq.path.empty()) {
+      release_polygons(rq, dst, rq.thickness_raster.empty() ? nullptr : &raster_t, CellFill{g, slope, extent, unused}, rep, &areas);
+      continue;
+    }
+    const std::string what = "secondary release thickness raster '" + rq.thickness_raster + "'";
+    areas.push_back({what, std::vector<double>(g.cells(), 0.0), 0});
+    const double smin = rq.has_min_slope ? rq.min_slope : 0.0, smax = rq.has_max_slope ? rq.max_slope : 90.0;
+    CellFill{g, slope, extent, areas.back().h}(what, rq.vertical, smin, smax, [](std::size_t) { return true; },
+                                               [&](std::size_t k) { return raster_t[k]; });
+  }
+  for (auto& a : areas)
+    for (std::size_t k = 0; k < a.h.size(); ++k)
+      if (a.h[k] > 0) a.volume_m3 += a.h[k] * g.dx * g.dx / std::cos(slope[k] * M_PI / 180);
+  return areas;
+}
+
 std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseRequest>& releases, ReleaseReport* report) {
   init_gdal();
   ReleaseReport rep;
@@ -227,10 +270,10 @@ std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseR
   OGRSpatialReference dst;
   dst.importFromWkt(g.crs_wkt.c_str());
   dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  const std::string extent = "the grid covers x " + fmt(g.x_min, 0) + ".." + fmt(g.x_min + g.nx * g.dx, 0) + ", y " +
-                             fmt(g.y_min, 0) + ".." + fmt(g.y_min + g.ny * g.dx, 0) + " in " + g.crs_name;
+  const std::string extent = grid_extent(g);
   const CellFill fill{g, slope, extent, h};
   for (const auto& rq : releases) {
+    if (rq.secondary) continue;
     std::vector<double> raster_t;
     if (!rq.thickness_raster.empty()) raster_t = raster_thickness(g, rq, dst);
     if (!rq.path.empty()) {

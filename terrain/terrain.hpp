@@ -5,8 +5,10 @@
 // the area of interest, release polygons rasterised onto the grid with thickness and slope windows,
 // and the raster/vector outputs. Errors are `TerrainError` with a message that names the input.
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace runout::terrain {
@@ -72,6 +74,7 @@ struct ReleaseRequest {
   bool has_min_slope = false, has_max_slope = false;
   double min_slope = 0, max_slope = 90;
   std::string min_slope_attribute, max_slope_attribute;
+  bool secondary = false;  ///< released when the flow reaches it (each polygon an area of its own)
 };
 
 struct ReleaseReport {
@@ -82,7 +85,18 @@ struct ReleaseReport {
   std::vector<std::string> notes;  ///< e.g. repaired geometries
 };
 
-/// Normal release thickness per cell (row 0 south), maximum over overlapping polygons and releases.
+/// A secondary release area: one polygon of a secondary release (or its whole thickness raster).
+struct ReleaseArea {
+  std::string name;       ///< e.g. "polygon 2 of 'secondary.geojson'"
+  std::vector<double> h;  ///< normal thickness per cell (row 0 south)
+  double volume_m3 = 0;
+};
+/// The areas of the secondary releases (ReleaseRequest::secondary), each polygon its own, with the
+/// same thickness, slope-window and domain rules as the primary releases. Throws TerrainError.
+std::vector<ReleaseArea> secondary_release_areas(const Grid& g, const std::vector<ReleaseRequest>& releases);
+
+/// Normal release thickness per cell (row 0 south), maximum over overlapping polygons and the
+/// primary releases (secondary ones are left out: secondary_release_areas).
 std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseRequest>& releases,
                                        ReleaseReport* report = nullptr);
 
@@ -91,6 +105,7 @@ std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseR
 struct BandInfo {
   std::string description;  ///< e.g. "maximum flow depth normal to the surface"
   std::string unit;         ///< e.g. "m", "kPa"; "" for classes
+  std::vector<std::pair<std::string, std::string>> metadata = {};  ///< further items (e.g. TIME_S)
 };
 /// The cells (row 0 south) whose centres lie inside any polygon of the vector file `path` (its own
 /// CRS, else `crs`); cells outside the domain are 0. Errors name `what` (e.g. "observations.outline_path").
@@ -99,6 +114,14 @@ std::vector<std::uint8_t> rasterize_polygons(const Grid& g, const std::string& p
 /// What a raster band says, Float32, DEFLATE, CRS and nodata set, overviews when larger than a
 /// tile; NaN cells are written as nodata.
 void write_cog(const std::string& path, const Grid& g, const std::vector<double>& values, const BandInfo& band);
+
+/// A multi-band GeoTIFF on the grid (tiled, DEFLATE, BigTIFF when needed), Float32, nodata -9999
+/// (NaN and the cells outside the domain): band k holds values(k) (row 0 south) and bands[k]'s
+/// description, unit and metadata; `dataset_metadata` goes to the file. Bands are written one at a
+/// time, so that a long series never needs to be in memory at once.
+void write_band_stack(const std::string& path, const Grid& g, const std::vector<BandInfo>& bands,
+                      const std::function<std::vector<double>(std::size_t)>& values,
+                      const std::vector<std::pair<std::string, std::string>>& dataset_metadata);
 
 /// One class of a class raster or of class polygons: class k (1-based) is cells whose value lies in
 /// [from, to) (to NaN: no upper bound).

@@ -36,6 +36,14 @@ void validate(const Terrain2D& t, const Sh2dConfig& cfg, const Sh2dState& s) {
   if (!(cfg.time.t_end >= 0)) bad("end time must be >= 0");
   if (cfg.tile < 4) bad("tile size must be >= 4 cells");
   if (!(cfg.curvature_cap >= 0)) bad("curvature cap must be >= 0");
+  for (const auto& a : cfg.secondary) {
+    if (a.cells.size() != a.depth.size()) bad("secondary release '" + a.name + "': cells and depths differ in number");
+    for (std::size_t q = 0; q < a.cells.size(); ++q) {
+      if (a.cells[q] >= t.cells()) bad("secondary release '" + a.name + "': a cell lies outside the grid");
+      if (!(a.depth[q] > 0 && std::isfinite(a.depth[q]))) bad("secondary release '" + a.name + "': depths must be finite and > 0");
+      if (!t.outside.empty() && t.outside[a.cells[q]]) bad("secondary release '" + a.name + "': a cell lies outside the domain");
+    }
+  }
   cfg.material.validate();
 }
 
@@ -109,6 +117,43 @@ Solver::Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
   hz_.arrival_time.assign(n_, nan);
   for (int tt = 0; tt < ntiles_; ++tt) tile_scan(tt);
   for (std::size_t k = 0; k < n_; ++k) record_hazard(k, 0.0);
+  rebuild_active();
+  secondary_time_.assign(cfg.secondary.size(), nan);
+}
+
+// Each waiting secondary release area that the flow has reached (a cell of it flowing at the end of
+// the step) gets its thickness, at rest; the tiles it touches are scanned and activated again.
+void Solver::release_secondary() {
+  bool added = false;
+  std::vector<std::uint8_t> touched;
+  for (std::size_t a = 0; a < cfg_.secondary.size(); ++a) {
+    if (!std::isnan(secondary_time_[a])) continue;
+    const auto& area = cfg_.secondary[a];
+    bool reached = false;
+    for (std::size_t k : area.cells) reached = reached || H_[cur_][k] * geo_.c[k] > cfg_.flow_threshold;
+    if (!reached) continue;
+    secondary_time_[a] = t_now_;
+    if (touched.empty()) touched.assign(ntiles_, 0);
+    for (std::size_t q = 0; q < area.cells.size(); ++q) {
+      const std::size_t k = area.cells[q];
+      const double dH = area.depth[q] / geo_.c[k];
+      volume_secondary_ += dH * t_.dx * t_.dy;
+      const double H = H_[cur_][k] + dH, HU = HU_[cur_][k], HV = HV_[cur_][k];
+      for (int b = 0; b < 2; ++b) {  // both levels: an inactive tile holds its state in both
+        H_[b][k] = H;
+        HU_[b][k] = HU;
+        HV_[b][k] = HV;
+        U_[b][k] = vel(H, HU);
+        V_[b][k] = vel(H, HV);
+      }
+      const int i = int(k % std::size_t(nx_)), j = int(k / std::size_t(nx_));
+      touched[(j / T_) * ntx_ + i / T_] = 1;
+    }
+    added = true;
+  }
+  if (!added) return;
+  for (int tt = 0; tt < ntiles_; ++tt)
+    if (touched[tt]) tile_scan(tt);
   rebuild_active();
 }
 
@@ -215,6 +260,8 @@ Sh2dCheckpoint Solver::checkpoint() const {
   cp.max_active_fraction = max_active_fraction_;
   cp.next_snapshot = next_snapshot_;
   cp.last_snapshot = last_snapshot_;
+  cp.secondary_time = secondary_time_;
+  cp.volume_secondary = volume_secondary_;
   return cp;
 }
 
@@ -232,6 +279,7 @@ void Solver::restore(const Sh2dCheckpoint& cp) {
       cp.tile_active.size() != nt)
     bad("is damaged (a tile field has the wrong size)");
   if (!(std::isfinite(cp.t) && cp.t >= 0) || cp.steps < 0) bad("is damaged (time or step count)");
+  if (cp.secondary_time.size() != cfg_.secondary.size()) bad("was taken with other secondary releases");
   // Both time levels hold the state: the level a step writes is never read before it is written,
   // and inactive tiles hold the same in both (see rebuild_active).
   cur_ = 0;
@@ -264,6 +312,8 @@ void Solver::restore(const Sh2dCheckpoint& cp) {
   max_active_fraction_ = cp.max_active_fraction;
   next_snapshot_ = cp.next_snapshot;
   last_snapshot_ = cp.last_snapshot;
+  secondary_time_ = cp.secondary_time;
+  volume_secondary_ = cp.volume_secondary;
   restored_ = true;
 }
 
@@ -356,6 +406,7 @@ Sh2dResult Solver::run() {
     }
     const double dt = next_dt();
     const double frac = step_all(dt, work);
+    if (!cfg_.secondary.empty()) release_secondary();
     // Cheap guard on the whole state: a NaN or infinite depth shows in the volume, a NaN or
     // infinite momentum in the kinetic energy.
     const double ke = sum_tiles(tile_ke_);
@@ -399,6 +450,8 @@ Sh2dResult Solver::finish(const Sh2dDiagnostics& loop) {
   d.t = t_now_;
   d.steps = steps_;
   d.volume_initial = volume_initial_;
+  d.volume_secondary = volume_secondary_;
+  d.secondary_time = secondary_time_;
   d.kinetic_energy_peak = ke_peak_;
   d.cell_updates = cell_updates_;
   d.max_active_fraction = max_active_fraction_;

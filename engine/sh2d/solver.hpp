@@ -117,6 +117,7 @@ class Solver {
   double sum_tiles(const std::vector<double>& v) const;
   Sh2dResult finish(const Sh2dDiagnostics& loop);
   void tile_scan(int tt);
+  void release_secondary();
   void record_hazard(std::size_t k, double t);
   void rebuild_active();
   void step_tile(int tt, double t, double dt, TileWork& w);
@@ -158,6 +159,8 @@ class Solver {
   long steps_ = 0;
   double cell_updates_ = 0, max_active_fraction_ = 0, ke_peak_ = 0, volume_initial_ = 0;
   bool restored_ = false;
+  std::vector<double> secondary_time_;  // per secondary release area: when released, NaN while waiting
+  double volume_secondary_ = 0;
 };
 
 }  // namespace runout::engine::sh2d_detail

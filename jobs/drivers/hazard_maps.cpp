@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "jobs/figures/hazard_map.hpp"
@@ -104,12 +105,18 @@ void write_hazard_maps(const ResolvedScenario& s, const terrain::Grid& grid, con
 }
 
 void write_score_map(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
-                     const std::vector<std::uint8_t>& cls, const std::vector<PlacedPoint>& points, const std::string& out_dir,
+                     const products::OutlineScores& scores, const std::vector<PlacedPoint>& points, const std::string& out_dir,
                      RunSummary& sum) {
   figures::HazardMap m = map_base(s, grid, h0, hz, points, sum);
   m.palette = products::score_palette();
   m.title = scenario_name(s) + ": simulated against the observed outline";
-  m.values.assign(cls.begin(), cls.end());
+  m.values.assign(scores.cls.begin(), scores.cls.end());
+  char b[160];
+  std::snprintf(b, sizeof b, "critical success index %.2f; ROC point: false positive rate %.3f, true positive rate %.2f", scores.csi,
+                scores.fpr, scores.tpr);
+  m.parameters.insert(m.parameters.begin(), b);
+  std::snprintf(b, sizeof b, "observed %.0f m², simulated %.0f m², hits %.0f m²", scores.observed_m2, scores.simulated_m2, scores.tp_m2);
+  m.parameters.insert(m.parameters.begin() + 1, b);
   draw_map(grid, "map_observation", m, out_dir, sum);
 }
 

@@ -39,9 +39,10 @@ void write_hazard_maps(const ResolvedScenario& s, const terrain::Grid& grid, con
                        const products::ZoneMap& zones, const std::vector<PlacedPoint>& points, const std::string& out_dir,
                        RunSummary& sum);
 
-/// map_observation.png and .pdf: hits, false alarms and misses against the observed outline.
+/// map_observation.png and .pdf: hits, false alarms and misses against the observed outline, the
+/// scores in the parameter block.
 void write_score_map(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
-                     const std::vector<std::uint8_t>& cls, const std::vector<PlacedPoint>& points, const std::string& out_dir,
+                     const products::OutlineScores& scores, const std::vector<PlacedPoint>& points, const std::string& out_dir,
                      RunSummary& sum);
 
 /// Each point's figures: the cell's maxima, zone and arrival time.

@@ -115,7 +115,7 @@ HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Gri
     std::vector<std::uint8_t> simulated(grid.cells());
     for (std::size_t k = 0; k < simulated.size(); ++k) simulated[k] = hz.max_depth[k] > s.outline_threshold;
     res.scores = products::outline_scores(grid, simulated, observed_cells(s, grid));
-    write_score_map(s, grid, h0, hz, res.scores->cls, points, out_dir, sum);
+    write_score_map(s, grid, h0, hz, *res.scores, points, out_dir, sum);
   }
   return res;
 }

@@ -8,6 +8,7 @@
 #include "jobs/drivers/record_head.hpp"
 #include "jobs/drivers/vof_terrain/run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -33,7 +34,7 @@ double since(std::chrono::steady_clock::time_point t0) {
 // run.json of a depth-averaged run; continued_from: NaN for a run not continued from a checkpoint.
 void write_record(const std::string& path, const ResolvedScenario& s, const terrain::DemReport& dem_rep, const terrain::Grid& grid,
                   const terrain::ReleaseReport& rel_rep, const engine::Sh2dResult& res, const RunSummary& sum, double continued_from,
-                  const HazardOutputs& outputs, int frames) {
+                  const HazardOutputs& outputs, int frames, const std::vector<terrain::ReleaseArea>& secondary) {
   const auto& d = res.diag;
   const bool continued = !std::isnan(continued_from);
   v1::RunRecord rec = run_record_head(s, "depth-averaged");
@@ -46,6 +47,14 @@ void write_record(const std::string& path, const ResolvedScenario& s, const terr
   mb->set_volume_final_m3(d.volume_final);
   mb->set_volume_outflow_m3(d.volume_outflow);
   mb->set_relative_error(d.volume_error());
+  mb->set_volume_secondary_m3(d.volume_secondary);
+  for (std::size_t a = 0; a < secondary.size(); ++a) {
+    auto* sr = rec.mutable_release()->add_secondary();
+    sr->set_name(secondary[a].name);
+    sr->set_cells(int(std::count_if(secondary[a].h.begin(), secondary[a].h.end(), [](double h) { return h > 0; })));
+    sr->set_volume_m3(secondary[a].volume_m3);
+    if (a < d.secondary_time.size() && std::isfinite(d.secondary_time[a])) sr->set_released_at_s(d.secondary_time[a]);
+  }
   auto* so = rec.mutable_solver();
   so->set_steps(int(d.steps));
   so->set_simulated_s(d.t);
@@ -101,6 +110,16 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   sum.notes = rel_rep.notes;
   const engine::Terrain2D t = engine_terrain(grid);
   auto cfg = s.config;
+  const auto secondary = terrain::secondary_release_areas(grid, s.releases);
+  for (const auto& a : secondary) {
+    engine::SecondaryRelease sr{a.name, {}, {}};
+    for (std::size_t k = 0; k < a.h.size(); ++k)
+      if (a.h[k] > 0) {
+        sr.cells.push_back(k);
+        sr.depth.push_back(a.h[k]);
+      }
+    cfg.secondary.push_back(std::move(sr));
+  }
   cfg.time.progress = opt.progress;
   cfg.time.progress_every = opt.progress_every;
   sum.seconds_prepare = since(t0);
@@ -115,8 +134,9 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
 
   std::unique_ptr<TimeSeriesWriter> series;
   if (s.timeseries_interval > 0) {
-    series = continued ? std::make_unique<TimeSeriesWriter>(out_dir, grid, t, opt.restart_path + ".timeseries.h5", restart.timeseries_frames)
-                       : std::make_unique<TimeSeriesWriter>(out_dir, grid, t);
+    series = continued ? std::make_unique<TimeSeriesWriter>(out_dir, grid, t, cfg.flow_threshold, opt.restart_path + ".timeseries.h5",
+                                                                     restart.timeseries_frames)
+                       : std::make_unique<TimeSeriesWriter>(out_dir, grid, t, cfg.flow_threshold);
     cfg.snapshot_interval = s.timeseries_interval;
     cfg.snapshot = [&](double time, const engine::Sh2dStateView& v) { series->write(time, v); };
   }
@@ -164,15 +184,14 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   const auto t2 = std::chrono::steady_clock::now();
   const auto outputs = write_hazard_outputs(s, grid, h0, res.hazard, out_dir, sum);
   if (series) {
-    sum.files.push_back("timeseries.h5");
-    sum.files.push_back("timeseries.xmf");
+    for (const char* f : {"timeseries.h5", "timeseries.xmf", "timeseries_depth.tif", "timeseries_speed.tif"}) sum.files.push_back(f);
   }
   sum.seconds_write = since(t2);
 
   const std::string record = (fs::path(out_dir) / "run.json").string();
   if (!opt.iseesnow_id.empty())
     for (auto& f : write_iseesnow(s, opt.iseesnow_id, out_dir, grid, res, sum.cpu_seconds)) sum.files.push_back(std::move(f));
-  write_record(record, s, dem_rep, grid, rel_rep, res, sum, continued_from, outputs, frames);
+  write_record(record, s, dem_rep, grid, rel_rep, res, sum, continued_from, outputs, frames, secondary);
   sum.files.push_back("run.json");
   return sum;
 }

@@ -22,8 +22,8 @@ using h5::put_attr_string;
 // The scalars, by position in the dataset "scalars" (their names are in its attribute "names").
 constexpr const char* kScalarNames =
     "nx,ny,tile,t,steps,volume_initial,kinetic_energy_peak,cell_updates,active_fraction_sum,max_active_fraction,"
-    "next_snapshot,last_snapshot,timeseries_frames";
-constexpr std::size_t kScalars = 13;
+    "next_snapshot,last_snapshot,timeseries_frames,volume_secondary,secondary_areas";
+constexpr std::size_t kScalars = 15;
 
 struct File {
   hid_t id = -1;
@@ -78,7 +78,8 @@ void write_sh_checkpoint(const std::string& path, const std::string& scenario_ha
       put_attr_string(f.id, "scenario_sha256", scenario_hash);
       const std::vector<double> sc = {double(s.nx), double(s.ny), double(s.tile), s.t, double(s.steps), s.volume_initial,
                                       s.kinetic_energy_peak, s.cell_updates, s.active_fraction_sum, s.max_active_fraction,
-                                      s.next_snapshot, s.last_snapshot, double(timeseries_frames)};
+                                      s.next_snapshot, s.last_snapshot, double(timeseries_frames), s.volume_secondary,
+                                      double(s.secondary_time.size())};
       put(f.id, "scalars", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, sc.data(), sc.size());
       hid_t ds = H5Dopen2(f.id, "scalars", H5P_DEFAULT);
       put_attr_string(ds, "names", kScalarNames);
@@ -96,6 +97,7 @@ void write_sh_checkpoint(const std::string& path, const std::string& scenario_ha
       put(f.id, "tile_limited", H5T_STD_I64LE, H5T_NATIVE_INT64, limited.data(), limited.size());
       put(f.id, "tile_wet", H5T_STD_U8LE, H5T_NATIVE_UINT8, s.tile_wet.data(), s.tile_wet.size());
       put(f.id, "tile_active", H5T_STD_U8LE, H5T_NATIVE_UINT8, s.tile_active.data(), s.tile_active.size());
+      put(f.id, "secondary_time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, s.secondary_time.data(), s.secondary_time.size());
     } catch (...) {
       H5Fclose(f.id);
       f.id = -1;
@@ -143,6 +145,8 @@ ShCheckpoint read_sh_checkpoint(const std::string& path) {
   s.next_snapshot = sc[10];
   s.last_snapshot = sc[11];
   cp.timeseries_frames = int(sc[12]);
+  s.volume_secondary = sc[13];
+  if (!(sc[14] >= 0 && sc[14] < 1e6)) throw ScenarioError("checkpoint " + path + ": damaged (secondary release count)");
   if (!(s.nx > 0 && s.ny > 0 && s.tile > 0 && cp.timeseries_frames >= 0))
     throw ScenarioError("checkpoint " + path + ": damaged (grid or frame count)");
   const std::size_t n = std::size_t(s.nx) * std::size_t(s.ny);
@@ -159,6 +163,7 @@ ShCheckpoint read_sh_checkpoint(const std::string& path) {
   s.tile_limited.assign(limited.begin(), limited.end());
   s.tile_wet = get<std::uint8_t>(f.id, "tile_wet", H5T_NATIVE_UINT8, nt, path);
   s.tile_active = get<std::uint8_t>(f.id, "tile_active", H5T_NATIVE_UINT8, nt, path);
+  s.secondary_time = get<double>(f.id, "secondary_time", H5T_NATIVE_DOUBLE, std::size_t(sc[14]), path);
   return cp;
 }
 

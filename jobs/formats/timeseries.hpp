@@ -1,6 +1,10 @@
 #pragma once
-// Time series of a run for ParaView and friends: HDF5 (one group per frame: normal depth and speed,
-// Float32) plus an XDMF file that describes them as a temporal collection on a co-rectilinear grid.
+// Time series of a run: HDF5 (one group per frame: normal depth and speed, Float32; the terrain
+// surface as x, y, z of the cell centres in the grid's CRS) with an XDMF file that describes them as
+// a temporal collection on the terrain surface, z up (ParaView); and, for QGIS and every GDAL reader,
+// georeferenced multi-band GeoTIFFs of the frames (timeseries_depth.tif, timeseries_speed.tif, one
+// band per frame with its time). Speeds are masked (NaN, nodata) where the depth is at most the flow
+// threshold, as in the maximum-speed map.
 #include <memory>
 #include <mutex>
 #include <string>
@@ -17,11 +21,11 @@ std::mutex& hdf5_mutex();
 class TimeSeriesWriter {
  public:
   /// Creates `<dir>/timeseries.h5` with the grid and the terrain. Throws std::runtime_error.
-  TimeSeriesWriter(const std::string& dir, const terrain::Grid& grid, const engine::Terrain2D& terrain);
+  TimeSeriesWriter(const std::string& dir, const terrain::Grid& grid, const engine::Terrain2D& terrain, double flow_threshold);
   /// Continues the time series of an interrupted run: `<dir>/timeseries.h5` becomes a copy of
   /// `continue_from` (a file save_copy wrote) with its first `frames` frames (later ones are
   /// dropped), and the frames written next follow them. Throws ScenarioError when it lacks them.
-  TimeSeriesWriter(const std::string& dir, const terrain::Grid& grid, const engine::Terrain2D& terrain,
+  TimeSeriesWriter(const std::string& dir, const terrain::Grid& grid, const engine::Terrain2D& terrain, double flow_threshold,
                    const std::string& continue_from, int frames);
   ~TimeSeriesWriter();
   TimeSeriesWriter(const TimeSeriesWriter&) = delete;
@@ -29,7 +33,8 @@ class TimeSeriesWriter {
 
   /// Append one frame (state as the solver holds it).
   void write(double t, const engine::Sh2dStateView& s);
-  /// Close the HDF5 file and write `<dir>/timeseries.xmf`. Returns the number of frames.
+  /// Close the HDF5 file and write `<dir>/timeseries.xmf` and the GeoTIFFs of the frames. Returns the
+  /// number of frames.
   int finish();
   /// Frames written so far.
   int frames() const;

@@ -216,8 +216,11 @@ void resolve_releases(const v1::Scenario& s, const std::string& base, ResolvedSc
     q.crs = rl.crs();
     q.min_slope_attribute = rl.min_slope_attribute();
     q.max_slope_attribute = rl.max_slope_attribute();
+    q.secondary = rl.secondary();
     r.releases.push_back(q);
   }
+  if (std::all_of(r.releases.begin(), r.releases.end(), [](const terrain::ReleaseRequest& q) { return q.secondary; }))
+    bad("releases", "every release is secondary: at least one must start the flow");
 }
 
 // The friction law's parameters (engine/friction: each law lists the material fields it needs),
@@ -248,6 +251,9 @@ void check_terrain_vof(const v1::Scenario& s) {
   const auto& me = s.mesh();
   if (me.has_first_layer_m() && me.has_band_height_m() && !(me.band_height_m() > me.first_layer_m()))
     bad("mesh.band_height_m", "must exceed mesh.first_layer_m");
+  for (int k = 0; k < s.releases_size(); ++k)
+    if (s.releases(k).secondary())
+      bad("releases[" + std::to_string(k) + "].secondary", "the 3D engine takes no secondary releases (the depth-averaged engine does)");
 }
 
 }  // namespace

@@ -65,6 +65,40 @@ TEST(Terrain, SyntheticSlopeRunsAndWritesEveryOutput) {
   GDALDatasetUniquePtr f0(GDALDataset::Open(("HDF5:\"" + d / "out/timeseries.h5" + "\"://frames/00000/depth").c_str(), GDAL_OF_RASTER));
   ASSERT_TRUE(f0);
   EXPECT_EQ(f0->GetRasterXSize(), 120);  // 2400 m of DEM at 20 m
+  // ParaView: the frames on the terrain surface, x, y, z in the grid's CRS.
+  EXPECT_NE(xs.str().find("TopologyType=\"2DSMesh\""), std::string::npos);
+  EXPECT_NE(xs.str().find("timeseries.h5:/surface"), std::string::npos);
+  // QGIS and GDAL: multi-band GeoTIFFs on the rasters' grid, one band per frame with its time; the
+  // last depth band is the deposit; speeds only where the depth exceeds the flow threshold.
+  GDALDatasetUniquePtr td(GDALDataset::Open((d / "out/timeseries_depth.tif").c_str(), GDAL_OF_RASTER));
+  GDALDatasetUniquePtr tv(GDALDataset::Open((d / "out/timeseries_speed.tif").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(td && tv);
+  EXPECT_EQ(td->GetRasterCount(), frames);
+  EXPECT_EQ(tv->GetRasterCount(), frames);
+  double gt_ts[6], gt_md[6];
+  ASSERT_EQ(td->GetGeoTransform(gt_ts), CE_None);
+  md->GetGeoTransform(gt_md);
+  for (int q = 0; q < 6; ++q) EXPECT_EQ(gt_ts[q], gt_md[q]) << q;
+  ASSERT_TRUE(td->GetSpatialRef());
+  EXPECT_STREQ(td->GetSpatialRef()->GetAuthorityCode(nullptr), "32632");
+  EXPECT_STREQ(td->GetRasterBand(1)->GetMetadataItem("TIME_S"), "0");
+  EXPECT_STREQ(td->GetRasterBand(1)->GetUnitType(), "m");
+  EXPECT_NEAR(std::atof(td->GetRasterBand(frames)->GetMetadataItem("TIME_S")), sum.t, 1e-6 * sum.t);
+  const int n = td->GetRasterXSize() * td->GetRasterYSize();
+  std::vector<float> last(n), deposit(n), depth(n), speed(n);
+  ASSERT_EQ(td->GetRasterBand(frames)->RasterIO(GF_Read, 0, 0, 120, 120, last.data(), 120, 120, GDT_Float32, 0, 0), CE_None);
+  GDALDatasetUniquePtr dep(GDALDataset::Open((d / "out/deposit.tif").c_str(), GDAL_OF_RASTER));
+  ASSERT_EQ(dep->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, 120, 120, deposit.data(), 120, 120, GDT_Float32, 0, 0), CE_None);
+  EXPECT_EQ(last, deposit);
+  ASSERT_EQ(td->GetRasterBand(frames / 2)->RasterIO(GF_Read, 0, 0, 120, 120, depth.data(), 120, 120, GDT_Float32, 0, 0), CE_None);
+  ASSERT_EQ(tv->GetRasterBand(frames / 2)->RasterIO(GF_Read, 0, 0, 120, 120, speed.data(), 120, 120, GDT_Float32, 0, 0), CE_None);
+  int flowing = 0;
+  for (int k = 0; k < n; ++k) {
+    if (std::fabs(depth[k] - 0.01f) < 1e-6f) continue;  // at the threshold Float32 rounding decides
+    EXPECT_EQ(speed[k] == -9999.0f, !(depth[k] > 0.01f)) << k << ": depth " << depth[k] << ", speed " << speed[k];
+    flowing += depth[k] > 0.01f;
+  }
+  EXPECT_GT(flowing, 10);
 }
 
 TEST(Terrain, ReleaseInWgs84AndInUtmGiveTheSameGrid) {

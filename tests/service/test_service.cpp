@@ -353,7 +353,7 @@ std::pair<std::string, double> submit_and_stop_after(const fs::path& state, cons
   ServerProcess srv(state, {"--data-root", kScenarios});
   service::Client c(client_options(srv.address(), ""));
   const std::string id = c.submit(s).id();
-  for (int k = 0; k < 2000; ++k) {
+  for (int k = 0; k < 6000; ++k) {  // up to a minute: a loaded machine runs the job slowly
     const auto g = c.get(id);
     if (g.state() == v1::RUNNING && g.progress().simulated_s() > t_min) break;
     std::this_thread::sleep_for(10ms);
