@@ -24,6 +24,7 @@ void for_each_input_path(v1::Scenario& s, F f) {
     each(at + ".thickness_raster", s.mutable_releases(k)->mutable_thickness_raster());
   }
   if (s.has_observations()) each("observations.outline_path", s.mutable_observations()->mutable_outline_path());
+  if (s.has_path()) each("path.line_path", s.mutable_path()->mutable_line_path());
 }
 
 }  // namespace runout::service

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <ogrsf_frmts.h>
+
 #include "terrain/gdal_support.hpp"
 
 namespace runout::terrain {
@@ -30,6 +32,32 @@ GridPoint place_point(const Grid& g, double x, double y, const std::string& crs,
   if (g.outside[std::size_t(p.j) * std::size_t(g.nx) + std::size_t(p.i)])
     throw TerrainError(what + ": (" + detail::fmt(p.x) + ", " + detail::fmt(p.y) + ") lies outside the domain (the area of interest or the DEM's data)");
   return p;
+}
+
+std::vector<std::pair<double, double>> read_line(const Grid& g, const std::string& path, const std::string& crs, const std::string& what) {
+  detail::init_gdal();
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR));
+  if (!ds) throw TerrainError(what + ": cannot read '" + path + "' as a vector file" + detail::gdal_message());
+  OGRSpatialReference dst;
+  dst.importFromWkt(g.crs_wkt.c_str());
+  dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  for (auto* layer : ds->GetLayers()) {
+    const std::string file = what + " '" + path + "'";
+    const auto src = detail::input_crs(layer->GetSpatialRef(), crs, file, file + " has no CRS and none is given");
+    auto ct = detail::transform(src, dst, file);
+    for (auto& f : layer) {
+      const OGRGeometry* geom = f->GetGeometryRef();
+      if (!geom || wkbFlatten(geom->getGeometryType()) != wkbLineString) continue;
+      std::unique_ptr<OGRGeometry> line(geom->clone());
+      if (ct && line->transform(ct.get()) != OGRERR_NONE) throw TerrainError(file + ": cannot transform it to " + g.crs_name);
+      const auto* ls = line->toLineString();
+      std::vector<std::pair<double, double>> out;
+      for (int k = 0; k < ls->getNumPoints(); ++k) out.emplace_back(ls->getX(k), ls->getY(k));
+      if (out.size() < 2) throw TerrainError(file + ": its line has fewer than two vertices");
+      return out;
+    }
+  }
+  throw TerrainError(what + ": '" + path + "' holds no line");
 }
 
 }  // namespace runout::terrain

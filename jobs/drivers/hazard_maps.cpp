@@ -1,5 +1,7 @@
 #include "jobs/drivers/hazard_maps.hpp"
 
+#include "jobs/drivers/hazard_outputs.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -7,6 +9,7 @@
 
 #include "jobs/figures/hazard_map.hpp"
 #include "jobs/figures/pen.hpp"
+#include "jobs/figures/profile_plot.hpp"
 #include "jobs/formats/run_record.hpp"
 #include "terrain/points.hpp"
 
@@ -21,13 +24,15 @@ std::string scenario_name(const ResolvedScenario& s) { return s.scenario.name().
 
 // What every map of a run shows besides its quantity: release, outline, points, parameters.
 figures::HazardMap map_base(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
-                            const std::vector<PlacedPoint>& points, const RunSummary& sum) {
+                            const MapOverlay& overlay, const RunSummary& sum) {
   figures::HazardMap base;
   base.release = h0;
   base.max_depth = hz.max_depth;
   base.outline_threshold = s.outline_threshold;
   base.parameters = map_parameters(s, grid, sum.release_volume_m3);
-  for (const auto& p : points) base.points.push_back({p.name, p.x, p.y});
+  for (const auto& p : overlay.points) base.points.push_back({p.name, p.x, p.y});
+  base.path = overlay.path;
+  base.path_marks = overlay.path_marks;
   return base;
 }
 
@@ -54,8 +59,37 @@ std::vector<std::uint8_t> observed_cells(const ResolvedScenario& s, const terrai
   return terrain::rasterize_polygons(grid, s.observed_outline, s.observed_crs, "observations.outline_path");
 }
 
+products::Line path_line(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0) {
+  if (!s.path.line_path.empty()) return terrain::read_line(grid, s.path.line_path, s.path.crs, "path.line_path");
+  const auto [mx, my] = release_centroid(grid, h0);
+  return std::isfinite(mx) ? products::steepest_descent(grid, mx, my) : products::Line{};
+}
+
+void write_path_outputs(const ResolvedScenario& s, const products::PathProfile& p, const std::string& out_dir, RunSummary& sum) {
+  products::write_profile_csv((fs::path(out_dir) / "path_profile.csv").string(), p);
+  figures::ProfilePlot plot;
+  plot.title = scenario_name(s) + ": profiles along the path";
+  plot.s = p.s;
+  plot.z = p.z;
+  plot.series = {{"max depth [m]", p.depth}, {"max speed [m/s]", p.speed}, {"max pressure [kPa]", p.pressure_kpa}};
+  char note[200];
+  if (p.runout) {
+    plot.runout_s = p.s[*p.runout];
+    plot.alpha_deg = p.alpha_deg;
+    std::snprintf(note, sizeof note, "runout point at %.0f m (%s), alpha %.1f°; the largest of each cross-section %.0f m wide",
+                  plot.runout_s, p.criterion.c_str(), p.alpha_deg, s.path.width_m);
+  } else {
+    std::snprintf(note, sizeof note, "no cross-section reaches %s", p.criterion.c_str());
+  }
+  plot.note = note;
+  if (p.beta) plot.beta_s = p.s[*p.beta];
+  figures::draw_profile_plot((fs::path(out_dir) / "map_path_profile.png").string(), (fs::path(out_dir) / "map_path_profile.pdf").string(), plot);
+  for (const char* f : {"path_profile.csv", "map_path_profile.png", "map_path_profile.pdf"}) sum.files.push_back(f);
+}
+
 void check_output_inputs(const ResolvedScenario& s, const terrain::Grid& grid) {
   place_points_of_interest(s, grid);
+  if (!s.path.line_path.empty()) terrain::read_line(grid, s.path.line_path, s.path.crs, "path.line_path");
   const auto obs = observed_cells(s, grid);
   if (!s.observed_outline.empty() && std::find(obs.begin(), obs.end(), 1) == obs.end())
     throw terrain::TerrainError("observations.outline_path: '" + s.observed_outline + "' covers no cell of the domain");
@@ -80,10 +114,9 @@ std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain
 }
 
 void write_hazard_maps(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
-                       const products::ZoneMap& zones, const std::vector<PlacedPoint>& points, const std::string& out_dir,
-                       RunSummary& sum) {
+                       const products::ZoneMap& zones, const MapOverlay& overlay, const std::string& out_dir, RunSummary& sum) {
   const std::string name = scenario_name(s);
-  const figures::HazardMap base = map_base(s, grid, h0, hz, points, sum);
+  const figures::HazardMap base = map_base(s, grid, h0, hz, overlay, sum);
   auto draw = [&](const std::string& quantity, figures::HazardMap m) { draw_map(grid, "map_" + quantity, m, out_dir, sum); };
   for (const auto& r : hazard_rasters()) {
     figures::HazardMap m = base;
@@ -105,9 +138,8 @@ void write_hazard_maps(const ResolvedScenario& s, const terrain::Grid& grid, con
 }
 
 void write_score_map(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
-                     const products::OutlineScores& scores, const std::vector<PlacedPoint>& points, const std::string& out_dir,
-                     RunSummary& sum) {
-  figures::HazardMap m = map_base(s, grid, h0, hz, points, sum);
+                     const products::OutlineScores& scores, const MapOverlay& overlay, const std::string& out_dir, RunSummary& sum) {
+  figures::HazardMap m = map_base(s, grid, h0, hz, overlay, sum);
   m.palette = products::score_palette();
   m.title = scenario_name(s) + ": simulated against the observed outline";
   m.values.assign(scores.cls.begin(), scores.cls.end());

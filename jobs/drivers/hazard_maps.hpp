@@ -7,6 +7,8 @@
 
 #include "engine/sh2d.hpp"
 #include "jobs/drivers/run.hpp"
+#include "jobs/figures/hazard_map.hpp"
+#include "jobs/products/path.hpp"
 #include "jobs/products/scores.hpp"
 #include "jobs/products/zones.hpp"
 #include "runout/v1/run_record.pb.h"
@@ -33,17 +35,29 @@ void check_output_inputs(const ResolvedScenario& s, const terrain::Grid& grid);
 /// The lines of the maps' parameter block: engine, friction, release, grid, software.
 std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain::Grid& grid, double release_volume_m3);
 
+/// What every map of a run draws besides its quantity.
+struct MapOverlay {
+  std::vector<PlacedPoint> points;
+  products::Line path;
+  std::vector<figures::MapPoint> path_marks;
+};
+
 /// map_<quantity>.png and .pdf for max_depth, max_speed, max_pressure (with the zones' boundaries),
 /// deposit and arrival_time, and map_pressure_zones; their names go to sum.files.
 void write_hazard_maps(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
-                       const products::ZoneMap& zones, const std::vector<PlacedPoint>& points, const std::string& out_dir,
-                       RunSummary& sum);
+                       const products::ZoneMap& zones, const MapOverlay& overlay, const std::string& out_dir, RunSummary& sum);
+
+/// The path line the analysis takes: the scenario's (path.line_path) or the steepest descent from the
+/// release's centroid. Throws TerrainError naming path.line_path.
+products::Line path_line(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0);
+
+/// path_profile.csv and map_path_profile.png and .pdf; their names go to sum.files.
+void write_path_outputs(const ResolvedScenario& s, const products::PathProfile& p, const std::string& out_dir, RunSummary& sum);
 
 /// map_observation.png and .pdf: hits, false alarms and misses against the observed outline, the
 /// scores in the parameter block.
 void write_score_map(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
-                     const products::OutlineScores& scores, const std::vector<PlacedPoint>& points, const std::string& out_dir,
-                     RunSummary& sum);
+                     const products::OutlineScores& scores, const MapOverlay& overlay, const std::string& out_dir, RunSummary& sum);
 
 /// Each point's figures: the cell's maxima, zone and arrival time.
 std::vector<v1::PointReport> point_reports(const std::vector<PlacedPoint>& points, const engine::HazardMaps& hz, const products::ZoneMap& zones,

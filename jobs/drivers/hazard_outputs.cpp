@@ -25,9 +25,7 @@ engine::Terrain2D engine_terrain(const terrain::Grid& grid) {
   return t;
 }
 
-// The maximum depth, the affected area and the runout from the release's centroid.
-void hazard_figures(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
-                    RunSummary& sum) {
+std::pair<double, double> release_centroid(const terrain::Grid& grid, const std::vector<double>& h0) {
   double mx = 0, my = 0, m = 0;
   for (int j = 0; j < grid.ny; ++j)
     for (int i = 0; i < grid.nx; ++i) {
@@ -36,8 +34,13 @@ void hazard_figures(const ResolvedScenario& s, const terrain::Grid& grid, const 
       mx += v * grid.cx(i);
       my += v * grid.cy(j);
     }
-  mx /= m;
-  my /= m;
+  return {mx / m, my / m};
+}
+
+// The maximum depth, the affected area and the runout from the release's centroid.
+void hazard_figures(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
+                    RunSummary& sum) {
+  const auto [mx, my] = release_centroid(grid, h0);
   long affected = 0;
   for (int j = 0; j < grid.ny; ++j)
     for (int i = 0; i < grid.nx; ++i) {
@@ -98,6 +101,19 @@ HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Gri
   }
   for (double v : pressure_kpa)
     if (std::isfinite(v)) res.max_pressure_kpa = std::max(res.max_pressure_kpa, v);
+  // The path analysis reads the maps as written (the pressure before the zones' outline mask).
+  MapOverlay overlay;
+  overlay.path = path_line(s, grid, h0);
+  res.path_source = s.path.line_path.empty() ? "steepest descent from the release's centroid" : s.path.line_path;
+  if (overlay.path.size() >= 2) {
+    const auto depth = terrain::masked_outside(grid, hz.max_depth), speed = terrain::masked_outside(grid, hz.max_speed);
+    res.path = products::analyse_path(grid, overlay.path, {depth, speed, pressure_kpa, h0}, s.path);
+    write_path_outputs(s, *res.path, out_dir, sum);
+    if (res.path->runout) overlay.path_marks.push_back({"runout", res.path->x[*res.path->runout], res.path->y[*res.path->runout]});
+    if (res.path->beta) overlay.path_marks.push_back({"β", res.path->x[*res.path->beta], res.path->y[*res.path->beta]});
+  } else {
+    sum.notes.push_back("no path analysis: the path has no length on the grid");
+  }
   res.outline = terrain::write_outline(out("outline.geojson"), out("outline.gpkg"), grid, hz.max_depth, s.outline_threshold);
   if (res.outline.geojson) sum.files.push_back("outline.geojson");
   else sum.notes.push_back("outline.geojson and pressure_zones.geojson not written: the grid's CRS is local (no geographic coordinates)");
@@ -108,14 +124,14 @@ HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Gri
     if (!(hz.max_depth[k] > s.outline_threshold)) pressure_kpa[k] = NAN;
   const auto zones = products::pressure_zones(s.pressure_zones, pressure_kpa);
   write_zones(s, grid, zones, out_dir, sum, res);
-  const auto points = place_points_of_interest(s, grid);
-  res.points = point_reports(points, hz, zones, s.outline_threshold);
-  write_hazard_maps(s, grid, h0, hz, zones, points, out_dir, sum);
+  overlay.points = place_points_of_interest(s, grid);
+  res.points = point_reports(overlay.points, hz, zones, s.outline_threshold);
+  write_hazard_maps(s, grid, h0, hz, zones, overlay, out_dir, sum);
   if (!s.observed_outline.empty()) {
     std::vector<std::uint8_t> simulated(grid.cells());
     for (std::size_t k = 0; k < simulated.size(); ++k) simulated[k] = hz.max_depth[k] > s.outline_threshold;
     res.scores = products::outline_scores(grid, simulated, observed_cells(s, grid));
-    write_score_map(s, grid, h0, hz, *res.scores, points, out_dir, sum);
+    write_score_map(s, grid, h0, hz, *res.scores, overlay, out_dir, sum);
   }
   return res;
 }
@@ -139,6 +155,24 @@ void record_hazard_results(const ResolvedScenario& s, const RunSummary& sum, con
     z->set_area_m2(out.zone_areas[k].area_m2);
   }
   for (const auto& p : out.points) *re.add_points_of_interest() = p;
+  if (out.path) {
+    const auto& p = *out.path;
+    auto* pr = re.mutable_path();
+    pr->set_source(out.path_source);
+    pr->set_criterion(p.criterion);
+    pr->set_length_m(p.length);
+    pr->set_section_spacing_m(p.spacing);
+    if (p.runout) {
+      pr->set_runout_s_m(p.s[*p.runout]);
+      for (double v : {p.x[*p.runout], p.y[*p.runout], p.z[*p.runout]}) pr->add_runout_xyz(v);
+      pr->set_alpha_deg(p.alpha_deg);
+    }
+    if (p.beta) {
+      pr->set_beta_s_m(p.s[*p.beta]);
+      for (double v : {p.x[*p.beta], p.y[*p.beta], p.z[*p.beta]}) pr->add_beta_xyz(v);
+    }
+    pr->set_runout_zone_area_m2(p.runout_zone_area_m2);
+  }
   if (out.scores) {
     auto* sc = re.mutable_observation_scores();
     const auto& o = *out.scores;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "engine/sh2d.hpp"
+#include "jobs/products/path.hpp"
 #include "jobs/products/scores.hpp"
 #include "jobs/drivers/run.hpp"
 #include "runout/v1/run_record.pb.h"
@@ -17,6 +18,9 @@ namespace runout::jobs {
 
 /// The engine's grid: the prepared grid with its local origin at the grid's centre.
 engine::Terrain2D engine_terrain(const terrain::Grid& grid);
+
+/// The thickness-weighted centroid of the release h0 (NaN without one).
+std::pair<double, double> release_centroid(const terrain::Grid& grid, const std::vector<double>& h0);
 
 /// The maximum depth, the affected area (max_depth above the outline threshold) and the runout from
 /// the centroid of the release h0 into `sum`.
@@ -35,6 +39,8 @@ struct HazardOutputs {
   std::vector<terrain::ClassArea> zone_areas;  ///< per zone
   std::vector<v1::PointReport> points;         ///< outputs.points_of_interest
   std::optional<products::OutlineScores> scores;  ///< against observations.outline_path
+  std::optional<products::PathProfile> path;      ///< the path analysis (none: no line on the grid)
+  std::string path_source;
 };
 
 /// The hazard rasters the scenario asks for (hazard_rasters(), each with its QGIS style), the

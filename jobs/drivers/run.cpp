@@ -78,6 +78,21 @@ void write_record(const std::string& path, const ResolvedScenario& s, const terr
   write_run_record(path, rec);
 }
 
+// The secondary release areas as the engine takes them: the cells of each and their depths.
+std::vector<engine::SecondaryRelease> engine_secondary(const std::vector<terrain::ReleaseArea>& areas) {
+  std::vector<engine::SecondaryRelease> out;
+  for (const auto& a : areas) {
+    engine::SecondaryRelease sr{a.name, {}, {}};
+    for (std::size_t k = 0; k < a.h.size(); ++k)
+      if (a.h[k] > 0) {
+        sr.cells.push_back(k);
+        sr.depth.push_back(a.h[k]);
+      }
+    out.push_back(std::move(sr));
+  }
+  return out;
+}
+
 // The checkpoint a run continues from, checked against the scenario (its hash) and the grid.
 ShCheckpoint load_restart(const RunOptions& opt, const std::string& hash, const engine::Terrain2D& t, int tile) {
   ShCheckpoint restart = read_sh_checkpoint(opt.restart_path);
@@ -111,15 +126,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   const engine::Terrain2D t = engine_terrain(grid);
   auto cfg = s.config;
   const auto secondary = terrain::secondary_release_areas(grid, s.releases);
-  for (const auto& a : secondary) {
-    engine::SecondaryRelease sr{a.name, {}, {}};
-    for (std::size_t k = 0; k < a.h.size(); ++k)
-      if (a.h[k] > 0) {
-        sr.cells.push_back(k);
-        sr.depth.push_back(a.h[k]);
-      }
-    cfg.secondary.push_back(std::move(sr));
-  }
+  cfg.secondary = engine_secondary(secondary);
   cfg.time.progress = opt.progress;
   cfg.time.progress_every = opt.progress_every;
   sum.seconds_prepare = since(t0);

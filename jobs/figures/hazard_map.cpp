@@ -21,7 +21,8 @@ using terrain::TerrainError;
 
 namespace {
 
-const Rgb kInk{0.1, 0.1, 0.1}, kRelease{0.05, 0.05, 0.05}, kOutline{0.43, 0.0, 0.08}, kContour{0.25, 0.22, 0.18};
+const Rgb kInk{0.1, 0.1, 0.1}, kRelease{0.05, 0.05, 0.05}, kOutline{0.43, 0.0, 0.08}, kContour{0.25, 0.22, 0.18},
+    kPath{0.05, 0.2, 0.45};
 constexpr double kPanel = 290, kLeft = 84, kGap = 30, kRight = 20, kBottom = 86;
 
 // The DEM as an in-memory raster (north-up, row 0 north).
@@ -260,6 +261,7 @@ double draw_panel(cairo_t* cr, double x, double y, const HazardMap& m, double co
     for (const auto& c : b.palette.classes) item(c.label, [&](double yy) { legend_line(cr, x, yy, rgb(c.colour), 2.5); });
   if (contour_interval > 0)
     item("contours every " + label_number(contour_interval) + " m", [&](double yy) { legend_line(cr, x, yy, kContour, 1); });
+  if (!m.path.empty()) item("path (runout point, beta point)", [&](double yy) { legend_line(cr, x, yy, kPath, 2, true); });
   if (!m.points.empty()) item("point of interest", [&](double yy) { draw_point(cr, x + 14, yy); });
   // North arrow (the grid is north-up).
   y += 8;
@@ -291,6 +293,7 @@ MapLayout draw_hazard_map(const std::string& png_path, const std::string& pdf_pa
   MapLayout lay;
   lay.contour_interval_m = nice_step(*zmax - *zmin, 12);
   const auto lines = contours(*dem, lay.contour_interval_m);
+  if (lines.empty()) lay.contour_interval_m = 0;  // flat ground (or none given): no contours, none in the legend
 
   // Page layout: the title over the whole width, the map, the panel to its right.
   const double s = std::clamp(std::min(900.0 / g.nx, 800.0 / g.ny), 0.2, 8.0), mw = g.nx * s, mh = g.ny * s;
@@ -325,6 +328,19 @@ MapLayout draw_hazard_map(const std::string& png_path, const std::string& pdf_pa
       draw_edges(cr, f, [&](int i, int j) { return m.max_depth[std::size_t(j) * g.nx + i] > m.outline_threshold; }, kOutline, 1.6);
     if (!m.release.empty())
       draw_edges(cr, f, [&](int i, int j) { return m.release[std::size_t(j) * g.nx + i] > 0; }, kRelease, 1.6, true, true);
+    if (m.path.size() >= 2) {
+      cairo_new_path(cr);
+      for (std::size_t k = 0; k < m.path.size(); ++k)
+        (k ? cairo_line_to : cairo_move_to)(cr, f.px(m.path[k].first), f.py(m.path[k].second));
+      stroke(cr, kPath, 2, true);
+      for (const auto& p : m.path_marks) {
+        cairo_new_path(cr);
+        cairo_arc(cr, f.px(p.x), f.py(p.y), 4, 0, 2 * M_PI);
+        colour(cr, kPath);
+        cairo_fill(cr);
+        l.unknown_glyphs += draw_text(cr, f.px(p.x) + 7, f.py(p.y) + 2, p.name, {11, false, kPath}).unknown_glyphs;
+      }
+    }
     for (const auto& p : m.points) {
       draw_point(cr, f.px(p.x), f.py(p.y));
       l.unknown_glyphs += draw_text(cr, f.px(p.x) + 8, f.py(p.y) - 18, p.name, {12, true, kInk}).unknown_glyphs;

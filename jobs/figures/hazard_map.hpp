@@ -33,6 +33,8 @@ struct HazardMap {
   double outline_threshold = 0.1;       ///< [m]
   std::vector<ClassBoundaries> boundaries;
   std::vector<MapPoint> points;
+  std::vector<std::pair<double, double>> path;  ///< the avalanche path's vertices in the grid's CRS (drawn when given)
+  std::vector<MapPoint> path_marks;             ///< named points on it (the runout point, the beta point)
   std::vector<std::string> parameters;  ///< the parameter block, one line each
 };
 

@@ -1,5 +1,7 @@
 #include "jobs/figures/lab_figure.hpp"
 
+#include "jobs/figures/pen.hpp"
+
 #include <cairo.h>
 
 #include <algorithm>
@@ -11,9 +13,6 @@
 namespace runout::figures {
 namespace {
 
-struct Rgb {
-  double r, g, b;
-};
 Rgb speed_colour(double v) {  // 0..1: blue -> green -> red, as figure.png
   return {v, 1 - std::abs(2 * v - 1), 1 - v};
 }
@@ -26,17 +25,9 @@ std::string fmt(const char* f, double v) {
   return b;
 }
 
+// Text with its baseline at y (the pen places the top: the baseline lies about 0.93 size below it).
 void text(cairo_t* cr, double x, double y, const std::string& s, double size = 12, const Rgb& c = kOurs, bool right = false) {
-  cairo_set_source_rgb(cr, c.r, c.g, c.b);
-  cairo_set_font_size(cr, size);
-  double xx = x;
-  if (right) {
-    cairo_text_extents_t e;
-    cairo_text_extents(cr, s.c_str(), &e);
-    xx -= e.x_advance;
-  }
-  cairo_move_to(cr, xx, y);
-  cairo_show_text(cr, s.c_str());
+  draw_text(cr, x, y - 0.93 * size, s, {size, false, c, -1, 0, right ? 2 : 0});
 }
 
 // A "nice" tick step for the range.
@@ -155,14 +146,9 @@ std::pair<Surface, Context> canvas(int W, int H, const std::string& title, doubl
   cairo_t* cr = ctx.get();
   cairo_set_source_rgb(cr, 1, 1, 1);
   cairo_paint(cr);
-  cairo_select_font_face(cr, "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
   double size = 13;
-  cairo_text_extents_t e;
-  for (; size > 7; size -= 0.5) {
-    cairo_set_font_size(cr, size);
-    cairo_text_extents(cr, title.c_str(), &e);
-    if (left + e.x_advance < W - 10) break;
-  }
+  for (; size > 7; size -= 0.5)
+    if (left + draw_text(nullptr, left, 0, title, {size}).w < W - 10) break;
   text(cr, left, 22, title, size);
   return {std::move(surf), std::move(ctx)};
 }

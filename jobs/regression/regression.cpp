@@ -1,5 +1,8 @@
 #include "jobs/regression/regression.hpp"
 
+#include "jobs/figures/hazard_map.hpp"
+#include "jobs/figures/pen.hpp"
+
 #include <gdal_priv.h>
 #include <google/protobuf/util/json_util.h>
 #include <ogr_spatialref.h>
@@ -91,6 +94,11 @@ RegressionFigures measure_run(const std::string& results_dir, bool farmhouse_opt
   f.max_depth_m = rec.results().max_depth_m();
   f.max_speed_m_s = rec.solver().max_speed_m_s();
   f.volume_error = rec.mass_balance().relative_error();
+  if (rec.results().path().has_runout_s_m()) {
+    f.path_runout_m = rec.results().path().runout_s_m();
+    f.path_alpha_deg = rec.results().path().alpha_deg();
+    f.path_criterion = rec.results().path().criterion() + ", " + rec.results().path().source();
+  }
   const Raster r = read_raster((fs::path(results_dir) / "max_depth.tif").string());
   OGRSpatialReference ll, grid;
   ll.importFromEPSG(4326);
@@ -172,44 +180,42 @@ void write_diff_tif(const Raster& a, std::vector<float>& d, const std::string& o
 }
 
 void write_diff_png(const Raster& a, const Raster& b, const std::vector<float>& d, double scale, const std::string& out_dir) {
-  // diff.png: blue where the run is shallower, red where deeper, white where equal, grey outside;
-  // full colour at max(0.1 m, the largest difference); the reference outline in black.
-  const int s = 2;
-  auto* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-  GDALDatasetUniquePtr img(mem->Create("", a.nx * s, a.ny * s, 3, GDT_Byte, nullptr));
-  std::vector<unsigned char> rgb[3];
-  for (auto& c : rgb) c.assign(std::size_t(a.nx) * s * a.ny * s, 0);
-  for (int q = 0; q < a.ny * s; ++q)
-    for (int p = 0; p < a.nx * s; ++p) {
-      const std::size_t k = std::size_t(q / s) * a.nx + p / s, px = std::size_t(q) * a.nx * s + p;
-      unsigned char r = 200, g = 200, bl = 200;
-      if (d[k] != -9999.0f) {
-        const double x = std::clamp(double(d[k]) / scale, -1.0, 1.0);
-        r = static_cast<unsigned char>(255 * (x < 0 ? 1 + x : 1));
-        g = static_cast<unsigned char>(255 * (1 - std::abs(x)));
-        bl = static_cast<unsigned char>(255 * (x > 0 ? 1 - x : 1));
-        // reference outline: a reference cell above 0.1 m next to one below
-        const int i = p / s, j = q / s;
-        const bool in = b.v[k] > 0.1f;
-        bool edge = false;
-        for (auto [di, dj] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
-          const int ii = i + di, jj = j + dj;
-          if (ii < 0 || jj < 0 || ii >= a.nx || jj >= a.ny) continue;
-          edge |= (b.v[std::size_t(jj) * a.nx + ii] > 0.1f) != in;
-        }
-        if (edge && in) r = g = bl = 0;
-      }
-      rgb[0][px] = r;
-      rgb[1][px] = g;
-      rgb[2][px] = bl;
+  // diff.png, drawn by the map room: the difference in five classes of the scale (full colour at
+  // max(0.1 m, the largest difference)), red where the run is deeper, blue where shallower; the
+  // reference's outline (max depth > 0.1 m). No DEM comes with the rasters: a plain background.
+  terrain::Grid g;
+  g.nx = a.nx;
+  g.ny = a.ny;
+  g.dx = a.gt[1];
+  g.x_min = a.gt[0];
+  g.y_min = a.gt[3] + a.ny * a.gt[5];
+  g.crs_wkt = a.wkt;
+  OGRSpatialReference srs;
+  srs.importFromWkt(a.wkt.c_str());
+  g.crs_name = srs.GetAuthorityCode(nullptr) ? std::string("EPSG:") + srs.GetAuthorityCode(nullptr) : std::string(srs.GetName() ? srs.GetName() : "");
+  g.z.assign(g.cells(), 0.0);
+  g.outside.assign(g.cells(), 0);
+  figures::HazardMap m;
+  m.title = "In den Arelen regression: maximum depth, this run minus the reference";
+  const std::string u = " m";
+  auto n = [](double v) { return figures::label_number(std::round(v * 1000) / 1000); };
+  m.palette = {"difference of the maximum depth", "m",
+               {{-1e300, {{33, 102, 172}}, "< " + n(-scale / 2) + u},
+                {-scale / 2, {{146, 197, 222}}, n(-scale / 2) + " – " + n(-scale / 10) + u},
+                {-scale / 10, {{247, 247, 247}}, "within ±" + n(scale / 10) + u},
+                {scale / 10, {{244, 165, 130}}, n(scale / 10) + " – " + n(scale / 2) + u},
+                {scale / 2, {{178, 24, 43}}, "≥ " + n(scale / 2) + u}}};
+  m.values.assign(g.cells(), NAN);
+  m.max_depth.assign(g.cells(), 0.0);
+  for (int r = 0; r < a.ny; ++r)
+    for (int i = 0; i < a.nx; ++i) {
+      const std::size_t src = std::size_t(r) * a.nx + i, k = std::size_t(a.ny - 1 - r) * a.nx + i;  // rows north first -> south first
+      if (d[src] == -9999.0f) g.outside[k] = 1;
+      else m.values[k] = d[src];
+      m.max_depth[k] = b.v[src] == b.nodata ? 0.0 : b.v[src];
     }
-  for (int c = 0; c < 3; ++c)
-    if (img->GetRasterBand(c + 1)->RasterIO(GF_Write, 0, 0, a.nx * s, a.ny * s, rgb[c].data(), a.nx * s, a.ny * s, GDT_Byte, 0,
-                                            0) != CE_None)
-      throw std::runtime_error("drawing diff.png failed");
-  auto* png = GetGDALDriverManager()->GetDriverByName("PNG");
-  GDALDatasetUniquePtr outp(png->CreateCopy((fs::path(out_dir) / "diff.png").c_str(), img.get(), FALSE, nullptr, nullptr, nullptr));
-  if (!outp) throw std::runtime_error("cannot write diff.png");
+  m.parameters = {"the outline is the reference's", "full colour at " + n(scale) + " m (0.1 m or the largest difference)"};
+  figures::draw_hazard_map((fs::path(out_dir) / "diff.png").string(), "", g, m);
 }
 
 }  // namespace
@@ -228,6 +234,9 @@ RegressionOutcome compare_run(const RegressionFigures& run, const RegressionRefe
   rel("affected area (max depth > 0.1 m)", "m2", rf.affected_area_m2, run.affected_area_m2, t.area_rel);
   rel("maximum depth", "m", rf.max_depth_m, run.max_depth_m, t.max_depth_rel);
   rel("maximum speed", "m/s", rf.max_speed_m_s, run.max_speed_m_s, t.max_speed_rel);
+  if (std::isfinite(run.path_runout_m))
+    o.path_note = "Runout along the path: " + fmt(run.path_runout_m) + " m (" + run.path_criterion + "), runout angle alpha " +
+                  fmt(run.path_alpha_deg, 3) + " deg; reported, not compared.";
   o.rows.push_back({"relative volume error", "", rf.volume_error, run.volume_error, run.volume_error - rf.volume_error,
                     t.volume_error_abs, std::abs(run.volume_error) <= t.volume_error_abs});
   o.rows.push_back({"farmhouse: distance to the flow (0: reached)", "m", rf.farmhouse_distance_m, run.farmhouse_distance_m,
@@ -286,6 +295,7 @@ void write_report(const std::string& out_dir, const RegressionOutcome& o, const 
     r << "| " << row.name << (row.unit.empty() ? "" : " [" + row.unit + "]") << " | " << fmt(row.reference) << " | "
       << fmt(row.value) << " | " << fmt(row.difference, 4) << " | " << tol << " | " << (row.ok ? "ok" : "**FAIL**") << " |\n";
   }
+  if (!o.path_note.empty()) r << "\n" << o.path_note << "\n";
   if (!o.note.empty()) r << "\n" << o.note << "\n";
   r << "\n## Map of this run\n\n![map](map.png)\n";
   if (fs::exists(fs::path(out_dir) / "diff.png")) r << "\n## Difference of the maximum depth (run - reference)\n\n![difference](diff.png)\n";

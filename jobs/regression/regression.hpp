@@ -3,6 +3,7 @@
 // the last accepted reference (regression/in-den-arelen/reference.json and its max_depth.tif), a
 // Markdown report with the map and a difference map, and the promotion of a run to the reference.
 // Works on result folders; getting the run done (through the service) is the caller's business.
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,10 @@ struct RegressionFigures {
   double volume_error = 0;         ///< relative mass-balance error
   double farmhouse_depth_m = 0;    ///< maximum depth at the farmhouse (46.8367 N, 9.8539 E)
   double farmhouse_distance_m = 0; ///< from the farmhouse to the nearest cell with max depth >= 0.1 m (0: reached)
+  /// The runout along the path and its angle (run.json results.path; reported, not compared: the
+  /// references predate it). NaN without one.
+  double path_runout_m = NAN, path_alpha_deg = NAN;
+  std::string path_criterion;
 };
 
 /// Tolerances: relative for the first four, absolute for the rest.
@@ -42,7 +47,8 @@ struct RegressionRow {
 struct RegressionOutcome {
   std::vector<RegressionRow> rows;
   bool ok = true;
-  std::string note;  ///< e.g. why the depth maps could not be compared
+  std::string note;       ///< e.g. why the depth maps could not be compared
+  std::string path_note;  ///< the runout along the path, reported
 };
 
 /// Figures of a result folder (run.json, max_depth.tif). Throws std::runtime_error. A farmhouse

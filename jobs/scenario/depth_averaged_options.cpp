@@ -87,8 +87,65 @@ const OptionTable& scenario_options() {
   return t;
 }
 
+namespace {
+
+// The outputs and the analyses of a run on the DEM (both engines): rasters, thresholds, time series,
+// pressure zones, path, observations, points of interest.
+OptionTable output_options() {
+  return {
+      {"outputs.rasters", T::choice_list, U::fill, "all", {}, raster_names(), "", "the rasters to write",
+       "ResolvedScenario::rasters", "", [](const S& s, R& r) { r.rasters.assign(s.outputs().rasters().begin(), s.outputs().rasters().end()); }},
+      {"outputs.outline_threshold_m", T::number, U::fill, "0.1", Range{0, kMaxDepthThreshold, true}, {}, "m",
+       "the depth that outlines the runout", "ResolvedScenario::outline_threshold", "",
+       [](const S& s, R& r) { r.outline_threshold = s.outputs().outline_threshold_m(); }},
+      {"outputs.flow_threshold_m", T::number, U::fill, "0.01", Range{0, kMaxDepthThreshold, true}, {}, "m",
+       "the depth that counts as flowing (arrival time, speed and pressure maps)", "Sh2dConfig::flow_threshold", "",
+       [](const S& s, R& r) { r.config.flow_threshold = s.outputs().flow_threshold_m(); }},
+      {"outputs.timeseries_interval_s", T::number, U::as_given, "", Range{0, kMaxEndTime}, {}, "s",
+       "HDF5 + XDMF frames of depth and speed this often", "ResolvedScenario::timeseries_interval", "none",
+       [](const S& s, R& r) { r.timeseries_interval = s.outputs().timeseries_interval_s(); }},
+      {"outputs.pressure_zones_kpa[].name", T::text, U::as_given, "", {}, {}, "",
+       "a pressure zone's name; a colour name (yellow, blue, red, ...) colours it. No zones given: blue from 3 kPa, red from 30 kPa",
+       "ResolvedScenario::pressure_zones"},
+      {"outputs.pressure_zones_kpa[].from_kpa", T::number, U::as_given, "", Range{0, kMaxZonePressure, true}, {}, "kPa",
+       "the zone's lowest maximum pressure (the zone ends at the next one's); ascending", "ResolvedScenario::pressure_zones", "",
+       pressure_zones},
+      {"observations.outline_path", T::path, U::as_given, "", {}, {}, "",
+       "polygons of the observed runout (any vector file, any CRS): the run is scored against them (run.json, map_observation)",
+       "ResolvedScenario::observed_outline"},
+      {"observations.crs", T::text, U::as_given, "", {}, {}, "", "the observed polygons' CRS when the file has none",
+       "ResolvedScenario::observed_crs", "", [](const S& s, R& r) { r.observed_crs = s.observations().crs(); }},
+      {"path.line_path", T::path, U::as_given, "", {}, {}, "",
+       "the avalanche path from the top down (any vector file, any CRS; its first line); default: steepest descent from the release's centroid",
+       "ResolvedScenario::path"},
+      {"path.crs", T::text, U::as_given, "", {}, {}, "", "the path line's CRS when the file has none", "ResolvedScenario::path", "",
+       [](const S& s, R& r) { r.path.crs = s.path().crs(); }},
+      {"path.runout_field", T::choice, U::keep, "ppr", {}, {"ppr", "pft", "pfv"}, "",
+       "what marks the runout along the path: max pressure (ppr, kPa), max depth (pft, m) or max speed (pfv, m/s)", "ResolvedScenario::path",
+       "", [](const S& s, R& r) { r.path.field = s.path().runout_field().empty() ? "ppr" : s.path().runout_field(); }},
+      {"path.runout_threshold", T::number, U::keep, "1", Range{0, 1e5, true}, {}, "field's unit",
+       "the runout is the last cross-section where the field reaches this (AIMEC's 1 kPa)", "ResolvedScenario::path", "",
+       [](const S& s, R& r) { r.path.threshold = s.path().has_runout_threshold() ? s.path().runout_threshold() : 1.0; }},
+      {"path.domain_width_m", T::number, U::keep, "600", Range{0, 1e5, true}, {}, "m", "the cross-sections' width (AIMEC's 600 m)",
+       "ResolvedScenario::path", "", [](const S& s, R& r) { r.path.width_m = s.path().has_domain_width_m() ? s.path().domain_width_m() : 600.0; }},
+      {"path.beta_deg", T::number, U::keep, "10", Range{0, 90, true, true}, {}, "deg",
+       "the beta point: where the path's slope first falls below this", "ResolvedScenario::path", "",
+       [](const S& s, R& r) { r.path.beta_deg = s.path().has_beta_deg() ? s.path().beta_deg() : 10.0; }},
+      {"outputs.points_of_interest[].name", T::text, U::required, "", {}, {}, "",
+       "a named point (a farmhouse): drawn on the maps, its maxima and zone in run.json", "run record, maps"},
+      {"outputs.points_of_interest[].x", T::number, U::as_given, "", Range{}, {}, "", "easting, or longitude in a geographic CRS",
+       "run record, maps"},
+      {"outputs.points_of_interest[].y", T::number, U::as_given, "", Range{}, {}, "", "northing, or latitude", "run record, maps"},
+      {"outputs.points_of_interest[].crs", T::text, U::as_given, "", {}, {}, "", "the point's CRS (\"EPSG:4326\"); default the grid's",
+       "run record, maps"},
+  };
+}
+
+}  // namespace
+
 const OptionTable& depth_averaged_options() {
-  static const OptionTable t = {
+  static const OptionTable t = [] {
+    OptionTable v = {
       {"dem.path", T::path, U::required, "", {}, {}, "", "the terrain: any raster GDAL reads (GeoTIFF, ESRI ASCII grid, SRTM .hgt, ...)",
        "DemRequest::dem_path"},
       {"dem.crs", T::text, U::as_given, "", {}, {}, "", "the DEM's CRS when the file has none (\"EPSG:2056\"; \"local\": local metres)",
@@ -170,36 +227,10 @@ const OptionTable& depth_averaged_options() {
        }},
       {"numerics.curvature_off", T::flag, U::as_given, "false", {}, {}, "", "true: no centrifugal term in the friction",
        "Sh2dConfig::curvature (negated)", "", [](const S& s, R& r) { r.config.curvature = !s.numerics().curvature_off(); }},
-      {"outputs.rasters", T::choice_list, U::fill, "all", {}, raster_names(), "", "the rasters to write",
-       "ResolvedScenario::rasters", "", [](const S& s, R& r) { r.rasters.assign(s.outputs().rasters().begin(), s.outputs().rasters().end()); }},
-      {"outputs.outline_threshold_m", T::number, U::fill, "0.1", Range{0, kMaxDepthThreshold, true}, {}, "m",
-       "the depth that outlines the runout", "ResolvedScenario::outline_threshold", "",
-       [](const S& s, R& r) { r.outline_threshold = s.outputs().outline_threshold_m(); }},
-      {"outputs.flow_threshold_m", T::number, U::fill, "0.01", Range{0, kMaxDepthThreshold, true}, {}, "m",
-       "the depth that counts as flowing (arrival time, speed and pressure maps)", "Sh2dConfig::flow_threshold", "",
-       [](const S& s, R& r) { r.config.flow_threshold = s.outputs().flow_threshold_m(); }},
-      {"outputs.timeseries_interval_s", T::number, U::as_given, "", Range{0, kMaxEndTime}, {}, "s",
-       "HDF5 + XDMF frames of depth and speed this often", "ResolvedScenario::timeseries_interval", "none",
-       [](const S& s, R& r) { r.timeseries_interval = s.outputs().timeseries_interval_s(); }},
-      {"outputs.pressure_zones_kpa[].name", T::text, U::as_given, "", {}, {}, "",
-       "a pressure zone's name; a colour name (yellow, blue, red, ...) colours it. No zones given: blue from 3 kPa, red from 30 kPa",
-       "ResolvedScenario::pressure_zones"},
-      {"outputs.pressure_zones_kpa[].from_kpa", T::number, U::as_given, "", Range{0, kMaxZonePressure, true}, {}, "kPa",
-       "the zone's lowest maximum pressure (the zone ends at the next one's); ascending", "ResolvedScenario::pressure_zones", "",
-       pressure_zones},
-      {"observations.outline_path", T::path, U::as_given, "", {}, {}, "",
-       "polygons of the observed runout (any vector file, any CRS): the run is scored against them (run.json, map_observation)",
-       "ResolvedScenario::observed_outline"},
-      {"observations.crs", T::text, U::as_given, "", {}, {}, "", "the observed polygons' CRS when the file has none",
-       "ResolvedScenario::observed_crs", "", [](const S& s, R& r) { r.observed_crs = s.observations().crs(); }},
-      {"outputs.points_of_interest[].name", T::text, U::required, "", {}, {}, "",
-       "a named point (a farmhouse): drawn on the maps, its maxima and zone in run.json", "run record, maps"},
-      {"outputs.points_of_interest[].x", T::number, U::as_given, "", Range{}, {}, "", "easting, or longitude in a geographic CRS",
-       "run record, maps"},
-      {"outputs.points_of_interest[].y", T::number, U::as_given, "", Range{}, {}, "", "northing, or latitude", "run record, maps"},
-      {"outputs.points_of_interest[].crs", T::text, U::as_given, "", {}, {}, "", "the point's CRS (\"EPSG:4326\"); default the grid's",
-       "run record, maps"},
   };
+    for (auto& o : output_options()) v.push_back(std::move(o));
+    return v;
+  }();
   return t;
 }
 

@@ -177,6 +177,10 @@ void resolve_inputs(const v1::Scenario& s, const std::string& base, ResolvedScen
     r.dem.aoi_path = path_in(base, s.area_of_interest().path(), "area_of_interest.path");
     r.input_files.push_back(r.dem.aoi_path);
   }
+  if (!s.path().line_path().empty()) {
+    r.path.line_path = path_in(base, s.path().line_path(), "path.line_path");
+    add_vector(r.path.line_path, "path.line_path", r);
+  }
   if (!s.observations().outline_path().empty()) {
     r.observed_outline = path_in(base, s.observations().outline_path(), "observations.outline_path");
     add_vector(r.observed_outline, "observations.outline_path", r);
@@ -290,6 +294,10 @@ std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version,
     rel.clear_thickness_raster();
   }
   if (s.has_observations()) s.mutable_observations()->clear_outline_path();
+  if (s.has_path()) s.mutable_path()->clear_line_path();
+  // A block left empty (its kept defaults cleared) is the block not given.
+  if (s.has_path() && s.path().ByteSizeLong() == 0) s.clear_path();
+  if (s.has_observations() && s.observations().ByteSizeLong() == 0) s.clear_observations();
   s.clear_limits();  // a job's limits do not change what it computes
   std::string bytes;
   {

@@ -23,6 +23,13 @@ struct ZoneThreshold {
   double from_kpa = 0;
 };
 
+/// The path (thalweg) analysis (scenario `path`); every run on a DEM makes it.
+struct PathSettings {
+  std::string line_path, crs;  ///< the line; empty: steepest descent from the release's centroid
+  std::string field = "ppr";   ///< ppr (max pressure, kPa), pft (max depth, m), pfv (max speed, m/s)
+  double threshold = 1, width_m = 600, beta_deg = 10;
+};
+
 struct ResolvedScenario {
   v1::Scenario scenario;  ///< as given, with the defaults filled in
   std::string source;     ///< the file it came from (empty when given as a message)
@@ -34,6 +41,7 @@ struct ResolvedScenario {
   double timeseries_interval = 0;  ///< [s]; 0: no time series
   std::vector<ZoneThreshold> pressure_zones = {{"blue", 3}, {"red", 30}};
   std::string observed_outline, observed_crs;  ///< observations: polygons of the observed runout, their CRS
+  PathSettings path;
   std::vector<std::string> input_files;  ///< for hashing
   bool vof = false;  ///< engine "vof": a laboratory set-up (`lab`) or, with `terrain`, on the DEM
   /// engine "vof" without `lab`: the 3D engine on the DEM and releases (blocks `mesh` and `vof`;
@@ -49,7 +57,7 @@ struct ResolvedScenario {
 /// comparison.png, and a polygon obstacle's shadow window starts behind the polygon; 4: the viscous
 /// stress's transpose part takes the harmonic face viscosity by default; 5: walls and inflows take the
 /// granular viscosity evaluated on the face, lab.wall_viscosity "face"; 6: runs on the DEM write
-/// max_pressure.tif in kPa, the pressure zones and QGIS styles). Adding a
+/// max_pressure.tif in kPa, the pressure zones, maps, QGIS styles and the path analysis). Adding a
 /// file or a figure counts too: a cached result lacks it. The test
 /// Scenarios.VofResultsMatchTheFingerprintOfTheirVersion holds this version's figures for twelve
 /// short runs and fails when a change to the numerics moves them (options those runs do not take
@@ -59,7 +67,7 @@ inline constexpr int kVofResultsVersion = 6;
 /// The version of what a depth-averaged run's results contain (rasters, outline, run.json, time
 /// series) for an unchanged scenario; the same rule as kVofResultsVersion (1: run.json's and the
 /// summary's maximum speed is the maximum of max_speed.tif, the flowing cells'; 2: max_pressure.tif in
-/// kPa, the pressure zones, QGIS styles). The test
+/// kPa, the pressure zones, maps, QGIS styles, the path analysis, the time series as GeoTIFF). The test
 /// Scenarios.HashCarriesEachEnginesResultsVersion pins a hash that a bump changes.
 inline constexpr int kDepthAveragedResultsVersion = 2;
 

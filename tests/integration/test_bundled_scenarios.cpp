@@ -1,7 +1,65 @@
 // The bundled depth-averaged scenarios, coarsened: In den Arelen, Wolfsgruben and the ISeeSnow cases.
+#include <algorithm>
+#include <cstdio>
+
+#include "terrain/points.hpp"
 #include "tests/support/run_helpers.hpp"
 
 using namespace runout::test_support::run;
+
+namespace {
+
+// The runout along the path by the benchmark's convention, computed here independently of the path
+// analysis: every cell of max_pressure.tif with at least 1 kPa within 300 m of the path line,
+// projected onto the line (its nearest point); the farthest such point's distance along the line.
+// The path analysis (cross-sections every cell) must give it within one cell.
+void check_path_runout(const TempDir& d, const jobs::ResolvedScenario& r) {
+  GDALDatasetUniquePtr pr(GDALDataset::Open((d / "max_pressure.tif").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(pr);
+  double gt[6];
+  pr->GetGeoTransform(gt);
+  const int nx = pr->GetRasterXSize(), ny = pr->GetRasterYSize();
+  terrain::Grid g;
+  g.nx = nx;
+  g.ny = ny;
+  g.dx = gt[1];
+  g.x_min = gt[0];
+  g.y_min = gt[3] + ny * gt[5];
+  g.crs_wkt = pr->GetProjectionRef();
+  const auto line = terrain::read_line(g, r.path.line_path, r.path.crs, "path");
+  std::vector<float> p(std::size_t(nx) * ny);
+  ASSERT_EQ(pr->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, nx, ny, p.data(), nx, ny, GDT_Float32, 0, 0), CE_None);
+  double far = -1;
+  for (int row = 0; row < ny; ++row)
+    for (int i = 0; i < nx; ++i) {
+      if (!(p[std::size_t(row) * nx + i] >= 1.0f)) continue;
+      const double cx = gt[0] + (i + 0.5) * gt[1], cy = gt[3] + (row + 0.5) * gt[5];
+      double best = INFINITY, s_best = 0, s0 = 0;
+      for (std::size_t k = 1; k < line.size(); ++k) {
+        const double ax = line[k - 1].first, ay = line[k - 1].second, bx = line[k].first - ax, by = line[k].second - ay;
+        const double len = std::hypot(bx, by), t = std::clamp(((cx - ax) * bx + (cy - ay) * by) / (len * len), 0.0, 1.0);
+        const double dist = std::hypot(cx - ax - t * bx, cy - ay - t * by);
+        if (dist < best) {
+          best = dist;
+          s_best = s0 + t * len;
+        }
+        s0 += len;
+      }
+      if (best <= 300) far = std::max(far, s_best);
+    }
+  ASSERT_GT(far, 0);
+  const auto rec = run_record(d / "run.json");
+  ASSERT_TRUE(rec.results().path().has_runout_s_m());
+  EXPECT_EQ(rec.results().path().criterion(), "max pressure >= 1 kPa");
+  EXPECT_NEAR(rec.results().path().runout_s_m(), far, g.dx) << "path analysis against the benchmark convention";
+  EXPECT_GT(rec.results().path().alpha_deg(), 5);
+  EXPECT_LT(rec.results().path().alpha_deg(), 45);
+  for (const char* f : {"path_profile.csv", "map_path_profile.png", "map_path_profile.pdf"}) EXPECT_TRUE(fs::exists(d / f)) << f;
+  std::printf("path runout %.1f m, benchmark convention %.1f m, alpha %.2f deg, cell %.0f m\n", rec.results().path().runout_s_m(), far,
+              rec.results().path().alpha_deg(), g.dx);
+}
+
+}  // namespace
 
 TEST(Scenarios, InDenArelenReachesTheValleyFloor) {
   auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/in-den-arelen.json");
@@ -71,6 +129,7 @@ TEST(Scenarios, IseesnowIdealizedTopo) {
   check_iseesnow(d, "release1HS", "01IdealizedTopo",
                  std::string(RUNOUT_SOURCE_DIR) + "/scenarios/data/iseesnow/idealized/DEM_IdealizedTopo.tif",
                  sum.volume_initial);
+  check_path_runout(d, r);
 }
 
 TEST(Scenarios, IseesnowCoulombOnlyRunsFurtherThanVoellmy) {
@@ -89,6 +148,7 @@ TEST(Scenarios, IseesnowCoulombOnlyRunsFurtherThanVoellmy) {
   check_iseesnow(d, "release1HS", "03CoulombOnly",
                  std::string(RUNOUT_SOURCE_DIR) + "/scenarios/data/iseesnow/idealized/DEM_IdealizedTopo.tif",
                  sum.volume_initial);
+  check_path_runout(d, r);
 }
 
 TEST(Scenarios, IseesnowRealTopo) {
@@ -106,4 +166,5 @@ TEST(Scenarios, IseesnowRealTopo) {
   check_iseesnow(d, "relWog", "02RealTopo",
                  std::string(RUNOUT_SOURCE_DIR) + "/scenarios/data/iseesnow/realtopo/DEM_RealTopo.tif",
                  sum.volume_initial);
+  check_path_runout(d, r);
 }

@@ -5,6 +5,7 @@
 
 #include "jobs/figures/hazard_map.hpp"
 #include "jobs/figures/palette.hpp"
+#include "jobs/products/path.hpp"
 #include "jobs/products/zones.hpp"
 #include "tests/support/run_helpers.hpp"
 
@@ -296,4 +297,40 @@ TEST(HazardProducts, ObservedOutlineScoresHaveKnownAnswers) {
   make_polygons(d / "far.geojson", {square(700000, 5300000, 300)}, "EPSG:32632");
   sc.mutable_observations()->set_outline_path("far.geojson");
   expect_error(sc, d, "observations.outline_path: '");
+}
+
+// The path analysis on a slope of 30 deg that runs into a flat: the runout point is the last section
+// reaching the threshold, alpha follows from the ground, beta lies at the slope's foot, and the
+// runout zone's area counts the threshold's cells beyond it.
+TEST(HazardProducts, PathAnalysisHasKnownAnswers) {
+  terrain::Grid g = tilted_grid();  // 100 x 80 cells of 10 m
+  const double t30 = std::tan(30 * M_PI / 180);
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) g.z[std::size_t(j) * g.nx + i] = 1000 - t30 * std::min(g.cx(i) - g.x_min, 500.0);
+  std::vector<double> depth(g.cells(), 0), speed(g.cells(), 0), pressure(g.cells(), 0), release(g.cells(), 0);
+  for (int j = 30; j < 50; ++j)
+    for (int i = 0; i < 72; ++i) {  // a band 200 m wide to x = 720 m (cell centres up to 715 m)
+      const std::size_t k = std::size_t(j) * g.nx + i;
+      pressure[k] = i < 60 ? 50 : 2;
+      depth[k] = 1;
+      speed[k] = 10;
+      if (i < 10) release[k] = 1;
+    }
+  jobs::PathSettings set;
+  const jobs::products::Line line = {{g.x_min + 5, g.y_min + 400}, {g.x_min + 995, g.y_min + 400}};
+  const auto p = jobs::products::analyse_path(g, line, {depth, speed, pressure, release}, set);
+  ASSERT_TRUE(p.runout);
+  EXPECT_NEAR(p.s[*p.runout], 710, 10.0);  // the last cell at least 1 kPa ends at 720 m from x_min (the line starts at 5 m)
+  const double drop = 1000 - t30 * std::min(p.x.front() - g.x_min, 500.0) - (1000 - t30 * 500);
+  EXPECT_NEAR(p.alpha_deg, std::atan(drop / p.s[*p.runout]) * 180 / M_PI, 0.5);
+  ASSERT_TRUE(p.beta);
+  EXPECT_NEAR(p.x[*p.beta] - g.x_min, 500, 20.0);  // the slope's foot (the slope is taken over four sections)
+  // Beyond beta: the band's cells from there to 720 m, 20 cells across.
+  const double expect_area = (720 - std::ceil((p.x[*p.beta] - g.x_min - 5) / 10) * 10 - 0) / 10 * 20 * 100;
+  EXPECT_NEAR(p.runout_zone_area_m2, expect_area, 20 * 100 * 1.0);
+  EXPECT_EQ(p.criterion, "max pressure >= 1 kPa");
+  // With the depth as the marker and a threshold above the band's depth, no runout point.
+  set.field = "pft";
+  set.threshold = 2;
+  EXPECT_FALSE(jobs::products::analyse_path(g, line, {depth, speed, pressure, release}, set).runout);
 }

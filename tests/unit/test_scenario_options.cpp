@@ -180,6 +180,7 @@ TEST(ScenarioOptions, GivingAKeptDefaultKeepsTheHash) {
       const auto h0 = jobs::scenario_hash(jobs::resolve_scenario(s, dir));
       auto [m, f] = field_at(s, o.path);
       if (f->cpp_type() == FieldDescriptor::CPPTYPE_STRING) m->GetReflection()->SetString(m, f, o.default_value);
+      else if (f->cpp_type() == FieldDescriptor::CPPTYPE_DOUBLE) m->GetReflection()->SetDouble(m, f, std::stod(o.default_value));
       else m->GetReflection()->SetInt32(m, f, std::stoi(o.default_value));
       EXPECT_EQ(jobs::scenario_hash(jobs::resolve_scenario(s, dir)), h0) << o.path;
     }

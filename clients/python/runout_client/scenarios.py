@@ -5,7 +5,7 @@ the client uploads each input with its companion files and replaces the path by 
 reference ("upload:ID/NAME"), exactly as the C++ client does (service/client/client.cpp,
 ``upload_inputs``, with the field list of service/scenario_inputs.hpp): the paths uploaded are
 ``dem.path``, ``area_of_interest.path``, every ``releases[].path`` and ``releases[].thickness_raster``,
-and ``observations.outline_path``;
+``observations.outline_path`` and ``path.line_path``;
 the companions are the files beside the input with the same stem and one of
 the extensions in :data:`COMPANION_EXTENSIONS` (``NAME.aux.xml`` for GDAL's PAM file).
 """
@@ -87,7 +87,7 @@ def load_scenario(scenario: ScenarioLike, base_dir: str | os.PathLike | None = N
 def input_fields(s: scenario_pb2.Scenario) -> list[InputField]:
     """The input paths the client uploads, in the C++ client's order (service/scenario_inputs.hpp):
     dem.path, area_of_interest.path (when the scenario has one), releases[k].path and
-    releases[k].thickness_raster, observations.outline_path. Empty paths are left out (the server names
+    releases[k].thickness_raster, observations.outline_path, path.line_path. Empty paths are left out (the server names
     what is missing)."""
     out = [InputField("dem.path", s.dem, s.dem.path)]
     if s.HasField("area_of_interest"):
@@ -97,6 +97,8 @@ def input_fields(s: scenario_pb2.Scenario) -> list[InputField]:
         out.append(InputField(f"releases[{k}].thickness_raster", r, r.thickness_raster, "thickness_raster"))
     if s.HasField("observations"):
         out.append(InputField("observations.outline_path", s.observations, s.observations.outline_path, "outline_path"))
+    if s.HasField("path"):
+        out.append(InputField("path.line_path", s.path, s.path.line_path, "line_path"))
     return [f for f in out if f.path]
 
 
