@@ -21,6 +21,7 @@
 #include "jobs/formats/iseesnow.hpp"
 #include "jobs/formats/sh_checkpoint.hpp"
 #include "jobs/formats/timeseries.hpp"
+#include "jobs/figures/qml.hpp"
 
 namespace runout::jobs {
 namespace fs = std::filesystem;
@@ -191,7 +192,12 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   const auto t2 = std::chrono::steady_clock::now();
   const auto outputs = write_hazard_outputs(s, grid, h0, res.hazard, out_dir, sum);
   if (series) {
-    for (const char* f : {"timeseries.h5", "timeseries.xmf", "timeseries_depth.tif", "timeseries_speed.tif"}) sum.files.push_back(f);
+    // QGIS styles for the frames' GeoTIFFs: the depth and speed maps' classes, on any band chosen.
+    figures::write_qml_ramp((fs::path(out_dir) / "timeseries_depth.qml").string(), figures::hazard_palette("max_depth"));
+    figures::write_qml_ramp((fs::path(out_dir) / "timeseries_speed.qml").string(), figures::hazard_palette("max_speed"));
+    for (const char* f : {"timeseries.h5", "timeseries.xmf", "timeseries_depth.tif", "timeseries_depth.qml", "timeseries_speed.tif",
+                          "timeseries_speed.qml"})
+      sum.files.push_back(f);
   }
   sum.seconds_write = since(t2);
 

@@ -59,15 +59,18 @@ Status resolve_input(const v1::ServerConfig& cfg, const std::string& field, std:
     if (!is_hex64(id) || !plain_name(name))
       return {StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' is not an upload reference (upload:ID/NAME)"};
     const fs::path f = fs::path(cfg.state_dir()) / "uploads" / id / name;
-    if (!fs::is_regular_file(f)) return {StatusCode::NOT_FOUND, field + ": no upload '" + p + "' on this server"};
+    if (!fs::is_regular_file(f))
+      return {StatusCode::NOT_FOUND, field + ": no upload '" + p +
+                                         "' on this server (uploads go when a submission that names them is refused, and when unused past their "
+                                         "time to live): upload the file again"};
     *path = f.string();
     return allowed_format(field, *path);
   }
-  for (const auto& part : fs::path(p))
-    if (part == "..") return {StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' may not contain '..'"};
   if (cfg.data_roots().empty())
     return {StatusCode::INVALID_ARGUMENT,
             field + ": '" + p + "': this server has no data roots; upload the file (runout submit does) and use its upload: reference"};
+  for (const auto& part : fs::path(p))
+    if (part == "..") return {StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' may not contain '..'"};
   // One answer for every refusal, so that it tells nothing about files outside the roots.
   const Status refused{StatusCode::INVALID_ARGUMENT, field + ": '" + p + "' is not a readable file inside the server's data roots"};
   std::error_code ec;

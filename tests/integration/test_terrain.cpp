@@ -70,6 +70,8 @@ TEST(Terrain, SyntheticSlopeRunsAndWritesEveryOutput) {
   EXPECT_NE(xs.str().find("timeseries.h5:/surface"), std::string::npos);
   // QGIS and GDAL: multi-band GeoTIFFs on the rasters' grid, one band per frame with its time; the
   // last depth band is the deposit; speeds only where the depth exceeds the flow threshold.
+  EXPECT_TRUE(fs::exists(d / "out/timeseries_depth.qml"));
+  EXPECT_TRUE(fs::exists(d / "out/timeseries_speed.qml"));
   GDALDatasetUniquePtr td(GDALDataset::Open((d / "out/timeseries_depth.tif").c_str(), GDAL_OF_RASTER));
   GDALDatasetUniquePtr tv(GDALDataset::Open((d / "out/timeseries_speed.tif").c_str(), GDAL_OF_RASTER));
   ASSERT_TRUE(td && tv);
