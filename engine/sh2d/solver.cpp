@@ -124,8 +124,7 @@ Solver::Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
 // Each waiting secondary release area that the flow has reached (a cell of it flowing at the end of
 // the step) gets its thickness, at rest; the tiles it touches are scanned and activated again.
 void Solver::release_secondary() {
-  bool added = false;
-  std::vector<std::uint8_t> touched;
+  std::vector<std::uint8_t> touched;  // per tile; empty while no area was released
   for (std::size_t a = 0; a < cfg_.secondary.size(); ++a) {
     if (!std::isnan(secondary_time_[a])) continue;
     const auto& area = cfg_.secondary[a];
@@ -149,9 +148,8 @@ void Solver::release_secondary() {
       const int i = int(k % std::size_t(nx_)), j = int(k / std::size_t(nx_));
       touched[(j / T_) * ntx_ + i / T_] = 1;
     }
-    added = true;
   }
-  if (!added) return;
+  if (touched.empty()) return;
   for (int tt = 0; tt < ntiles_; ++tt)
     if (touched[tt]) tile_scan(tt);
   rebuild_active();

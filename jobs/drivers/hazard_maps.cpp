@@ -42,8 +42,7 @@ void draw_map(const terrain::Grid& grid, const std::string& stem, const figures:
   sum.files.push_back(stem + ".pdf");
 }
 
-}  // namespace
-
+// The points of interest on the grid.
 std::vector<PlacedPoint> place_points_of_interest(const ResolvedScenario& s, const terrain::Grid& grid) {
   std::vector<PlacedPoint> out;
   const auto& pts = s.scenario.outputs().points_of_interest();
@@ -54,15 +53,23 @@ std::vector<PlacedPoint> place_points_of_interest(const ResolvedScenario& s, con
   return out;
 }
 
-std::vector<std::uint8_t> observed_cells(const ResolvedScenario& s, const terrain::Grid& grid) {
-  if (s.observed_outline.empty()) return {};
-  return terrain::rasterize_polygons(grid, s.observed_outline, s.observed_crs, "observations.outline_path");
-}
+}  // namespace
 
-products::Line path_line(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0) {
-  if (!s.path.line_path.empty()) return terrain::read_line(grid, s.path.line_path, s.path.crs, "path.line_path");
-  const auto [mx, my] = release_centroid(grid, h0);
-  return std::isfinite(mx) ? products::steepest_descent(grid, mx, my) : products::Line{};
+OutputInputs read_output_inputs(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0) {
+  OutputInputs in;
+  in.points = place_points_of_interest(s, grid);
+  if (!s.path.line_path.empty()) {
+    in.path = terrain::read_line(grid, s.path.line_path, s.path.crs, "path.line_path");
+  } else {
+    const auto [mx, my] = release_centroid(grid, h0);
+    if (std::isfinite(mx)) in.path = products::steepest_descent(grid, mx, my);
+  }
+  if (!s.observed_outline.empty()) {
+    in.observed = terrain::rasterize_polygons(grid, s.observed_outline, s.observed_crs, "observations.outline_path");
+    if (std::find(in.observed.begin(), in.observed.end(), 1) == in.observed.end())
+      throw terrain::TerrainError("observations.outline_path: '" + s.observed_outline + "' covers no cell of the domain");
+  }
+  return in;
 }
 
 void write_path_outputs(const ResolvedScenario& s, const products::PathProfile& p, const std::string& out_dir, RunSummary& sum) {
@@ -87,14 +94,6 @@ void write_path_outputs(const ResolvedScenario& s, const products::PathProfile& 
   for (const char* f : {"path_profile.csv", "map_path_profile.png", "map_path_profile.pdf"}) sum.files.push_back(f);
 }
 
-void check_output_inputs(const ResolvedScenario& s, const terrain::Grid& grid) {
-  place_points_of_interest(s, grid);
-  if (!s.path.line_path.empty()) terrain::read_line(grid, s.path.line_path, s.path.crs, "path.line_path");
-  const auto obs = observed_cells(s, grid);
-  if (!s.observed_outline.empty() && std::find(obs.begin(), obs.end(), 1) == obs.end())
-    throw terrain::TerrainError("observations.outline_path: '" + s.observed_outline + "' covers no cell of the domain");
-}
-
 std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain::Grid& grid, double release_volume_m3) {
   const auto& m = s.scenario.material();
   std::vector<std::string> p;
@@ -114,16 +113,17 @@ std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain
 }
 
 void write_hazard_maps(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
-                       const products::ZoneMap& zones, const MapOverlay& overlay, const std::string& out_dir, RunSummary& sum) {
+                       const std::vector<std::vector<double>>& values, const products::ZoneMap& zones, const MapOverlay& overlay,
+                       const std::string& out_dir, RunSummary& sum) {
   const std::string name = scenario_name(s);
   const figures::HazardMap base = map_base(s, grid, h0, hz, overlay, sum);
   auto draw = [&](const std::string& quantity, figures::HazardMap m) { draw_map(grid, "map_" + quantity, m, out_dir, sum); };
-  for (const auto& r : hazard_rasters()) {
+  for (std::size_t q = 0; q < hazard_rasters().size(); ++q) {
+    const auto& r = hazard_rasters()[q];
     figures::HazardMap m = base;
     m.palette = figures::hazard_palette(r.name);
     m.title = name + ": " + m.palette.title;
-    m.values = hz.*r.map;
-    for (double& v : m.values) v *= r.scale;
+    m.values = values[q];
     if (r.name == "max_pressure") m.boundaries.push_back({zones.cls, zones.palette});
     draw(r.name, std::move(m));
   }
@@ -152,8 +152,8 @@ void write_score_map(const ResolvedScenario& s, const terrain::Grid& grid, const
   draw_map(grid, "map_observation", m, out_dir, sum);
 }
 
-std::vector<v1::PointReport> point_reports(const std::vector<PlacedPoint>& points, const engine::HazardMaps& hz, const products::ZoneMap& zones,
-                                           double outline_threshold) {
+std::vector<v1::PointReport> point_reports(const std::vector<PlacedPoint>& points, const engine::HazardMaps& hz,
+                                           const std::vector<double>& pressure_kpa, const products::ZoneMap& zones, double outline_threshold) {
   std::vector<v1::PointReport> out;
   for (const auto& p : points) {
     auto* r = &out.emplace_back();
@@ -162,7 +162,7 @@ std::vector<v1::PointReport> point_reports(const std::vector<PlacedPoint>& point
     r->set_y(p.y);
     r->set_max_depth_m(hz.max_depth[p.cell]);
     r->set_max_speed_m_s(hz.max_speed[p.cell]);
-    r->set_max_pressure_kpa(1e-3 * hz.max_pressure[p.cell]);
+    r->set_max_pressure_kpa(pressure_kpa[p.cell]);
     const int z = zones.cls[p.cell];
     r->set_zone(z > 0 ? zones.classes[std::size_t(z) - 1].name : "");
     if (std::isfinite(hz.arrival_time[p.cell])) r->set_arrival_time_s(hz.arrival_time[p.cell]);

@@ -23,14 +23,19 @@ struct PlacedPoint {
   double x = 0, y = 0;
   std::size_t cell = 0;
 };
-std::vector<PlacedPoint> place_points_of_interest(const ResolvedScenario& s, const terrain::Grid& grid);
 
-/// The cells inside the observed outline (observations.outline_path); empty without one.
-std::vector<std::uint8_t> observed_cells(const ResolvedScenario& s, const terrain::Grid& grid);
-
-/// What the outputs read besides the run (points of interest, the observed outline), checked before
-/// the run so that a bad one is refused at once. Throws TerrainError naming the field.
-void check_output_inputs(const ResolvedScenario& s, const terrain::Grid& grid);
+/// What the outputs read besides the run, read once before the run (so that a bad one is refused at
+/// once) and handed to write_hazard_outputs: the points of interest, the path line (the scenario's
+/// path.line_path, or the steepest descent from the release's centroid) and the cells inside the
+/// observed outline (empty without observations.outline_path).
+struct OutputInputs {
+  std::vector<PlacedPoint> points;
+  products::Line path;
+  std::vector<std::uint8_t> observed;
+};
+/// Throws TerrainError naming the field (a point outside the domain, a line or outline that cannot be
+/// read, an outline that covers no cell of the domain).
+OutputInputs read_output_inputs(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0);
 
 /// The lines of the maps' parameter block: engine, friction, release, grid, software.
 std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain::Grid& grid, double release_volume_m3);
@@ -43,13 +48,11 @@ struct MapOverlay {
 };
 
 /// map_<quantity>.png and .pdf for max_depth, max_speed, max_pressure (with the zones' boundaries),
-/// deposit and arrival_time, and map_pressure_zones; their names go to sum.files.
+/// deposit and arrival_time, and map_pressure_zones; their names go to sum.files. `values[q]` is
+/// hazard raster q (hazard_rasters()) in its raster's unit.
 void write_hazard_maps(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
-                       const products::ZoneMap& zones, const MapOverlay& overlay, const std::string& out_dir, RunSummary& sum);
-
-/// The path line the analysis takes: the scenario's (path.line_path) or the steepest descent from the
-/// release's centroid. Throws TerrainError naming path.line_path.
-products::Line path_line(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0);
+                       const std::vector<std::vector<double>>& values, const products::ZoneMap& zones, const MapOverlay& overlay,
+                       const std::string& out_dir, RunSummary& sum);
 
 /// path_profile.csv and map_path_profile.png and .pdf; their names go to sum.files.
 void write_path_outputs(const ResolvedScenario& s, const products::PathProfile& p, const std::string& out_dir, RunSummary& sum);
@@ -59,8 +62,9 @@ void write_path_outputs(const ResolvedScenario& s, const products::PathProfile& 
 void write_score_map(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
                      const products::OutlineScores& scores, const MapOverlay& overlay, const std::string& out_dir, RunSummary& sum);
 
-/// Each point's figures: the cell's maxima, zone and arrival time.
-std::vector<v1::PointReport> point_reports(const std::vector<PlacedPoint>& points, const engine::HazardMaps& hz, const products::ZoneMap& zones,
-                                           double outline_threshold);
+/// Each point's figures: the cell's maxima (pressure_kpa: the max_pressure raster's values), zone and
+/// arrival time.
+std::vector<v1::PointReport> point_reports(const std::vector<PlacedPoint>& points, const engine::HazardMaps& hz,
+                                           const std::vector<double>& pressure_kpa, const products::ZoneMap& zones, double outline_threshold);
 
 }  // namespace runout::jobs

@@ -66,13 +66,12 @@ namespace {
 std::string affected_area_criterion(double outline_threshold) { return "max depth > " + json_number(outline_threshold) + " m"; }
 
 // The pressure zones: the class raster with its QGIS style, and the polygons.
-void write_zones(const ResolvedScenario& s, const terrain::Grid& grid, const products::ZoneMap& z, const std::string& out_dir,
+void write_zones(const terrain::Grid& grid, const products::ZoneMap& z, const std::string& out_dir,
                  RunSummary& sum, HazardOutputs& out) {
   auto path = [&](const std::string& name) { return (fs::path(out_dir) / name).string(); };
   terrain::write_class_cog(path("pressure_zones.tif"), grid, z.cls, z.classes,
                            {"pressure hazard zones by the maximum pressure rho u^2 (0: none)", ""});
   figures::write_qml_classes(path("pressure_zones.qml"), z.palette);
-  out.zones = s.pressure_zones;
   out.zone_areas = terrain::write_class_polygons(path("pressure_zones.geojson"), path("pressure_zones.gpkg"), "pressure_zones", grid,
                                                  z.cls, z.classes, "kpa");
   // GeoTIFF keeps the zones' names (GDAL's category names) in its sidecar.
@@ -85,29 +84,34 @@ void write_zones(const ResolvedScenario& s, const terrain::Grid& grid, const pro
 }  // namespace
 
 HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0,
-                                   const engine::HazardMaps& hz, const std::string& out_dir, RunSummary& sum) {
+                                   const engine::HazardMaps& hz, const OutputInputs& in, const std::string& out_dir, RunSummary& sum) {
   auto out = [&](const std::string& name) { return (fs::path(out_dir) / name).string(); };
   HazardOutputs res;
-  std::vector<double> pressure_kpa;
+  // Every hazard raster in its unit, once: for the files, the maps, the path and the points.
+  std::vector<std::vector<double>> values;
   for (const auto& r : hazard_rasters()) {
-    auto values = terrain::masked_outside(grid, hz.*r.map);
-    for (double& v : values) v *= r.scale;
-    if (r.name == "max_pressure") pressure_kpa = values;
+    auto& v = values.emplace_back(terrain::masked_outside(grid, hz.*r.map));
+    for (double& x : v) x *= r.scale;
     if (std::find(s.rasters.begin(), s.rasters.end(), r.name) == s.rasters.end()) continue;
-    terrain::write_cog(out(r.name + ".tif"), grid, values, {r.description, r.unit});
+    terrain::write_cog(out(r.name + ".tif"), grid, v, {r.description, r.unit});
     figures::write_qml_ramp(out(r.name + ".qml"), figures::hazard_palette(r.name));
     sum.files.push_back(r.name + ".tif");
     sum.files.push_back(r.name + ".qml");
   }
+  auto raster = [&](const std::string& name) -> const std::vector<double>& {
+    const auto& all = hazard_rasters();
+    return values[std::size_t(std::find_if(all.begin(), all.end(), [&](const HazardRaster& r) { return r.name == name; }) - all.begin())];
+  };
+  const auto& pressure_kpa = raster("max_pressure");
   for (double v : pressure_kpa)
     if (std::isfinite(v)) res.max_pressure_kpa = std::max(res.max_pressure_kpa, v);
   // The path analysis reads the maps as written (the pressure before the zones' outline mask).
   MapOverlay overlay;
-  overlay.path = path_line(s, grid, h0);
+  overlay.points = in.points;
+  overlay.path = in.path;
   res.path_source = s.path.line_path.empty() ? "steepest descent from the release's centroid" : s.path.line_path;
   if (overlay.path.size() >= 2) {
-    const auto depth = terrain::masked_outside(grid, hz.max_depth), speed = terrain::masked_outside(grid, hz.max_speed);
-    res.path = products::analyse_path(grid, overlay.path, {depth, speed, pressure_kpa, h0}, s.path);
+    res.path = products::analyse_path(grid, overlay.path, {raster("max_depth"), raster("max_speed"), pressure_kpa, h0}, s.path);
     write_path_outputs(s, *res.path, out_dir, sum);
     if (res.path->runout) overlay.path_marks.push_back({"runout", res.path->x[*res.path->runout], res.path->y[*res.path->runout]});
     if (res.path->beta) overlay.path_marks.push_back({"β", res.path->x[*res.path->beta], res.path->y[*res.path->beta]});
@@ -120,17 +124,17 @@ HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Gri
   sum.files.push_back("outline.gpkg");
   // The zones inside the outline: a fringe thinner than the outline's depth exerts no pressure that
   // a zone should stand for, and a zone outside the outline would contradict it.
-  for (std::size_t k = 0; k < pressure_kpa.size(); ++k)
-    if (!(hz.max_depth[k] > s.outline_threshold)) pressure_kpa[k] = NAN;
-  const auto zones = products::pressure_zones(s.pressure_zones, pressure_kpa);
-  write_zones(s, grid, zones, out_dir, sum, res);
-  overlay.points = place_points_of_interest(s, grid);
-  res.points = point_reports(overlay.points, hz, zones, s.outline_threshold);
-  write_hazard_maps(s, grid, h0, hz, zones, overlay, out_dir, sum);
-  if (!s.observed_outline.empty()) {
+  std::vector<double> zone_pressure = pressure_kpa;
+  for (std::size_t k = 0; k < zone_pressure.size(); ++k)
+    if (!(hz.max_depth[k] > s.outline_threshold)) zone_pressure[k] = NAN;
+  const auto zones = products::pressure_zones(s.pressure_zones, zone_pressure);
+  write_zones(grid, zones, out_dir, sum, res);
+  res.points = point_reports(in.points, hz, pressure_kpa, zones, s.outline_threshold);
+  write_hazard_maps(s, grid, h0, hz, values, zones, overlay, out_dir, sum);
+  if (!in.observed.empty()) {
     std::vector<std::uint8_t> simulated(grid.cells());
     for (std::size_t k = 0; k < simulated.size(); ++k) simulated[k] = hz.max_depth[k] > s.outline_threshold;
-    res.scores = products::outline_scores(grid, simulated, observed_cells(s, grid));
+    res.scores = products::outline_scores(grid, simulated, in.observed);
     write_score_map(s, grid, h0, hz, *res.scores, overlay, out_dir, sum);
   }
   return res;
@@ -146,11 +150,12 @@ void record_hazard_results(const ResolvedScenario& s, const RunSummary& sum, con
   re.set_outline_threshold_m(s.outline_threshold);
   re.set_max_pressure_kpa(out.max_pressure_kpa);
   re.set_pressure_zones_criterion("max pressure rho u^2 where " + affected_area_criterion(s.outline_threshold));
-  for (std::size_t k = 0; k < out.zones.size(); ++k) {
+  const auto& zones = s.pressure_zones;
+  for (std::size_t k = 0; k < zones.size(); ++k) {
     auto* z = re.add_pressure_zones();
-    z->set_name(out.zones[k].name);
-    z->set_from_kpa(out.zones[k].from_kpa);
-    if (k + 1 < out.zones.size()) z->set_to_kpa(out.zones[k + 1].from_kpa);
+    z->set_name(zones[k].name);
+    z->set_from_kpa(zones[k].from_kpa);
+    if (k + 1 < zones.size()) z->set_to_kpa(zones[k + 1].from_kpa);
     z->set_polygons(out.zone_areas[k].polygons);
     z->set_area_m2(out.zone_areas[k].area_m2);
   }

@@ -8,9 +8,10 @@
 #include <vector>
 
 #include "engine/sh2d.hpp"
+#include "jobs/drivers/hazard_maps.hpp"
+#include "jobs/drivers/run.hpp"
 #include "jobs/products/path.hpp"
 #include "jobs/products/scores.hpp"
-#include "jobs/drivers/run.hpp"
 #include "runout/v1/run_record.pb.h"
 #include "terrain/terrain.hpp"
 
@@ -35,8 +36,7 @@ void require_finite_figures(std::initializer_list<std::pair<const char*, double>
 struct HazardOutputs {
   terrain::OutlineReport outline;
   double max_pressure_kpa = 0;
-  std::vector<ZoneThreshold> zones;
-  std::vector<terrain::ClassArea> zone_areas;  ///< per zone
+  std::vector<terrain::ClassArea> zone_areas;  ///< per zone of the scenario's pressure_zones
   std::vector<v1::PointReport> points;         ///< outputs.points_of_interest
   std::optional<products::OutlineScores> scores;  ///< against observations.outline_path
   std::optional<products::PathProfile> path;      ///< the path analysis (none: no line on the grid)
@@ -46,8 +46,9 @@ struct HazardOutputs {
 /// The hazard rasters the scenario asks for (hazard_rasters(), each with its QGIS style), the
 /// pressure zones (raster, polygons, style), the outline and the maps (hazard_maps.hpp); their names
 /// go to sum.files.
+/// `in`: what read_output_inputs read before the run.
 HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0,
-                                   const engine::HazardMaps& hz, const std::string& out_dir, RunSummary& sum);
+                                   const engine::HazardMaps& hz, const OutputInputs& in, const std::string& out_dir, RunSummary& sum);
 
 /// The record's results that both engines on the DEM report alike: affected area and its criterion,
 /// outline, runout, maximum depth and pressure, the pressure zones.

@@ -116,7 +116,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   const terrain::Grid grid = terrain::prepare_grid(s.dem, &dem_rep);
   terrain::ReleaseReport rel_rep;
   const auto h0 = terrain::rasterize_releases(grid, s.releases, &rel_rep);
-  check_output_inputs(s, grid);  // a point outside the domain, a bad observation: refused before the run
+  const auto output_inputs = read_output_inputs(s, grid, h0);  // a bad point, line or outline: refused before the run
   sum.nx = grid.nx;
   sum.ny = grid.ny;
   sum.dx = grid.dx;
@@ -190,7 +190,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
 
   // Outputs.
   const auto t2 = std::chrono::steady_clock::now();
-  const auto outputs = write_hazard_outputs(s, grid, h0, res.hazard, out_dir, sum);
+  const auto outputs = write_hazard_outputs(s, grid, h0, res.hazard, output_inputs, out_dir, sum);
   if (series) {
     // QGIS styles for the frames' GeoTIFFs: the depth and speed maps' classes, on any band chosen.
     figures::write_qml_ramp((fs::path(out_dir) / "timeseries_depth.qml").string(), figures::hazard_palette("max_depth"));

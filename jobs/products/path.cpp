@@ -24,7 +24,7 @@ double cell_value(const terrain::Grid& g, const std::vector<double>& v, double x
 // The ground at (x, y), bilinear between the cell centres (clamped at the grid's edges).
 double ground(const terrain::Grid& g, double x, double y) {
   const double fi = std::clamp((x - g.x_min) / g.dx - 0.5, 0.0, g.nx - 1.0), fj = std::clamp((y - g.y_min) / g.dx - 0.5, 0.0, g.ny - 1.0);
-  const int i0 = std::min(int(fi), g.nx - 2 < 0 ? 0 : g.nx - 2), j0 = std::min(int(fj), g.ny - 2 < 0 ? 0 : g.ny - 2);
+  const int i0 = std::min(int(fi), std::max(g.nx - 2, 0)), j0 = std::min(int(fj), std::max(g.ny - 2, 0));
   const int i1 = std::min(i0 + 1, g.nx - 1), j1 = std::min(j0 + 1, g.ny - 1);
   const double a = fi - i0, b = fj - j0;
   auto z = [&](int i, int j) { return g.z[std::size_t(j) * g.nx + i]; };

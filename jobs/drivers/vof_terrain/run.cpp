@@ -223,7 +223,7 @@ RunSummary run_terrain_vof(const ResolvedScenario& r, const std::string& out_dir
   hazard_figures(r, su.grid, su.h0, hazard.maps(), sum);
   require_finite_figures({{"final volume", v_final}, {"outflow volume", step.outflow}, {"maximum speed", sum.max_speed},
                           {"maximum depth", sum.max_depth}, {"runout", sum.runout_m}});
-  const auto outputs = write_hazard_outputs(r, su.grid, su.h0, hazard.maps(), out_dir, sum);
+  const auto outputs = write_hazard_outputs(r, su.grid, su.h0, hazard.maps(), su.output_inputs, out_dir, sum);
   write_3d_rasters(su, hazard, out_dir, sum);
   const int n_frames = frames ? frames->finish() : 0;
   if (frames) {

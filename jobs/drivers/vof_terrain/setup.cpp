@@ -1,7 +1,5 @@
 #include "jobs/drivers/vof_terrain/setup.hpp"
 
-#include "jobs/drivers/hazard_maps.hpp"
-
 #include <algorithm>
 
 #include "engine/sh2d.hpp"
@@ -26,7 +24,7 @@ terrain::ColumnMeshSpec mesh_spec(const v1::TerrainMesh& m, double max_vertical)
 void build_terrain_setup(const ResolvedScenario& r, TerrainSetup& out) {
   out.grid = terrain::prepare_grid(r.dem, &out.dem);
   out.h0 = terrain::rasterize_releases(out.grid, r.releases, &out.release);
-  check_output_inputs(r, out.grid);  // a point outside the domain, a bad observation: refused before the run
+  out.output_inputs = read_output_inputs(r, out.grid, out.h0);  // a bad point, line or outline: refused before the run
   // Vertical thickness and the slope's cosine exactly as the depth-averaged engine takes them.
   const engine::Terrain2D t = engine_terrain(out.grid);
   out.vertical = engine::state_from_normal_depth(t, out.h0).H;

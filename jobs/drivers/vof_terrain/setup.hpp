@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "engine/vof/mesh_quality.hpp"
+#include "jobs/drivers/hazard_maps.hpp"
 #include "jobs/drivers/vof_terrain/hazard.hpp"
 #include "jobs/drivers/vof_terrain/mesh.hpp"
 #include "jobs/scenario/scenario.hpp"
@@ -37,6 +38,7 @@ struct TerrainSetup {
   std::vector<double> alpha;  ///< the release's phase fraction per cell
   double volume_on_mesh = 0;  ///< sum alpha V [m3]
   std::vector<NamedPoint> points;
+  OutputInputs output_inputs;  ///< what the hazard outputs read besides the run
 };
 
 /// Builds the set-up. Throws ScenarioError or terrain::TerrainError naming the field for bad input.
