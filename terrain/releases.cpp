@@ -46,15 +46,15 @@ double field_value(OGRFeature& f, const std::string& attr, const std::string& wh
 }
 
 // The cells one release fills: those where `in` holds and the domain has terrain, with a positive
-// thickness `thick` and a slope within [smin, smax]; the normal thickness goes into h (the maximum
-// of what is there). Errors name `what`.
+// thickness `thick` and a slope within [smin, smax]; the normal thickness times `factor` (the
+// release's thickness_factor) goes into h (the maximum of what is there). Errors name `what`.
 struct CellFill {
   const Grid& g;
   const std::vector<double>& slope;
   const std::string& extent;
   std::vector<double>& h;
   void operator()(const std::string& what, bool vertical, double smin, double smax, const std::function<bool(std::size_t)>& in,
-                  const std::function<double(std::size_t)>& thick) const {
+                  const std::function<double(std::size_t)>& thick, double factor) const {
     long inside = 0, kept = 0;
     double smin_seen = 90, smax_seen = 0;
     for (std::size_t k = 0; k < g.cells(); ++k) {
@@ -66,7 +66,7 @@ struct CellFill {
       smax_seen = std::max(smax_seen, slope[k]);
       if (slope[k] < smin || slope[k] > smax) continue;
       ++kept;
-      h[k] = std::max(h[k], vertical ? t * std::cos(slope[k] * M_PI / 180) : t);
+      h[k] = std::max(h[k], factor * (vertical ? t * std::cos(slope[k] * M_PI / 180) : t));
     }
     if (inside == 0)
       throw TerrainError(what + " lies outside the grid, outside the area of interest or where the DEM has no data, or is thinner than a cell (" + extent + ")");
@@ -194,9 +194,9 @@ void release_polygons(const ReleaseRequest& rq, const OGRSpatialReference& dst, 
       auto thick = [&](std::size_t k) { return raster_t ? (*raster_t)[k] : t; };
       if (areas) {  // a secondary release: each polygon an area of its own
         areas->push_back({what, std::vector<double>(fill.g.cells(), 0.0), 0});
-        CellFill{fill.g, fill.slope, fill.extent, areas->back().h}(named, rq.vertical, smin, smax, in, thick);
+        CellFill{fill.g, fill.slope, fill.extent, areas->back().h}(named, rq.vertical, smin, smax, in, thick, rq.thickness_factor);
       } else {
-        fill(named, rq.vertical, smin, smax, in, thick);
+        fill(named, rq.vertical, smin, smax, in, thick, rq.thickness_factor);
       }
       ++rep.polygons;
     }
@@ -254,7 +254,7 @@ std::vector<ReleaseArea> secondary_release_areas(const Grid& g, const std::vecto
     areas.push_back({what, std::vector<double>(g.cells(), 0.0), 0});
     const double smin = rq.has_min_slope ? rq.min_slope : 0.0, smax = rq.has_max_slope ? rq.max_slope : 90.0;
     CellFill{g, slope, extent, areas.back().h}(what, rq.vertical, smin, smax, [](std::size_t) { return true; },
-                                               [&](std::size_t k) { return raster_t[k]; });
+                                               [&](std::size_t k) { return raster_t[k]; }, rq.thickness_factor);
   }
   for (auto& a : areas)
     for (std::size_t k = 0; k < a.h.size(); ++k)
@@ -282,7 +282,7 @@ std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseR
     }
     const double smin = rq.has_min_slope ? rq.min_slope : 0.0, smax = rq.has_max_slope ? rq.max_slope : 90.0;
     fill("release thickness raster '" + rq.thickness_raster + "'", rq.vertical, smin, smax, [](std::size_t) { return true; },
-         [&](std::size_t k) { return raster_t[k]; });
+         [&](std::size_t k) { return raster_t[k]; }, rq.thickness_factor);
   }
   for (std::size_t k = 0; k < h.size(); ++k)
     if (h[k] > 0) {

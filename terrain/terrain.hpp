@@ -75,6 +75,7 @@ struct ReleaseRequest {
   double min_slope = 0, max_slope = 90;
   std::string min_slope_attribute, max_slope_attribute;
   bool secondary = false;  ///< released when the flow reaches it (each polygon an area of its own)
+  double thickness_factor = 1;  ///< every thickness (given, attribute, raster) times this
 };
 
 struct ReleaseReport {
@@ -160,6 +161,10 @@ OutlineReport write_outline(const std::string& geojson_path, const std::string& 
 /// size, extent and CRS; resampled bilinearly where the grids differ), nodata -9999. For benchmark
 /// exports that demand the input DEM's grid (ISeeSnow).
 void write_ascii_on(const std::string& path, const std::string& template_path, const Grid& g, const std::vector<double>& values);
+
+/// Band 1 of the raster `path` on the grid (row 0 south; nodata as NaN): read as it is when it lies
+/// on the grid, else resampled onto it (nearest neighbour, GDAL's warper). Errors name `what`.
+std::vector<double> read_raster_on(const std::string& path, const Grid& g, const std::string& what);
 
 /// `values` with the cells outside the domain (Grid::outside) as NaN: nodata in every raster written.
 std::vector<double> masked_outside(const Grid& g, const std::vector<double>& values);

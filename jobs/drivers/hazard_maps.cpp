@@ -90,8 +90,10 @@ void write_path_outputs(const ResolvedScenario& s, const products::PathProfile& 
   }
   plot.note = note;
   if (p.beta) plot.beta_s = p.s[*p.beta];
+  sum.files.push_back("path_profile.csv");
+  if (!s.maps) return;
   figures::draw_profile_plot((fs::path(out_dir) / "map_path_profile.png").string(), (fs::path(out_dir) / "map_path_profile.pdf").string(), plot);
-  for (const char* f : {"path_profile.csv", "map_path_profile.png", "map_path_profile.pdf"}) sum.files.push_back(f);
+  for (const char* f : {"map_path_profile.png", "map_path_profile.pdf"}) sum.files.push_back(f);
 }
 
 std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain::Grid& grid, double release_volume_m3) {

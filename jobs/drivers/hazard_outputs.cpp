@@ -130,12 +130,12 @@ HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Gri
   const auto zones = products::pressure_zones(s.pressure_zones, zone_pressure);
   write_zones(grid, zones, out_dir, sum, res);
   res.points = point_reports(in.points, hz, pressure_kpa, zones, s.outline_threshold);
-  write_hazard_maps(s, grid, h0, hz, values, zones, overlay, out_dir, sum);
+  if (s.maps) write_hazard_maps(s, grid, h0, hz, values, zones, overlay, out_dir, sum);
   if (!in.observed.empty()) {
     std::vector<std::uint8_t> simulated(grid.cells());
     for (std::size_t k = 0; k < simulated.size(); ++k) simulated[k] = hz.max_depth[k] > s.outline_threshold;
     res.scores = products::outline_scores(grid, simulated, in.observed);
-    write_score_map(s, grid, h0, hz, *res.scores, overlay, out_dir, sum);
+    if (s.maps) write_score_map(s, grid, h0, hz, *res.scores, overlay, out_dir, sum);
   }
   return res;
 }
@@ -205,19 +205,24 @@ void record_inputs(v1::RunRecord& rec, const terrain::DemReport& d, const terrai
   dem->set_slope_max_deg(d.slope_max_deg);
   dem->set_cells_without_data(int(d.cells_without_data));
   dem->set_cells_outside_area(int(d.cells_outside_area));
-  auto* gr = rec.mutable_grid();
-  gr->set_crs(g.crs_name);
-  gr->set_nx(g.nx);
-  gr->set_ny(g.ny);
-  gr->set_cell_size_m(g.dx);
-  gr->set_x_min(g.x_min);
-  gr->set_y_min(g.y_min);
+  *rec.mutable_grid() = grid_report(g);
   auto* rel = rec.mutable_release();
   rel->set_polygons(r.polygons);
   rel->set_cells(int(r.cells));
   rel->set_area_m2(r.area_m2);
   rel->set_volume_m3(r.volume_m3);
   for (const auto& note : r.notes) rel->add_notes(note);
+}
+
+v1::GridReport grid_report(const terrain::Grid& g) {
+  v1::GridReport gr;
+  gr.set_crs(g.crs_name);
+  gr.set_nx(g.nx);
+  gr.set_ny(g.ny);
+  gr.set_cell_size_m(g.dx);
+  gr.set_x_min(g.x_min);
+  gr.set_y_min(g.y_min);
+  return gr;
 }
 
 }  // namespace runout::jobs

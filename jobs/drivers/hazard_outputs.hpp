@@ -57,4 +57,7 @@ void record_hazard_results(const ResolvedScenario& s, const RunSummary& sum, con
 /// The record's dem, grid (without its local origin, which each engine sets) and release sections.
 void record_inputs(v1::RunRecord& rec, const terrain::DemReport& dem, const terrain::Grid& grid, const terrain::ReleaseReport& release);
 
+/// The record's grid: CRS, size, cell size and corner.
+v1::GridReport grid_report(const terrain::Grid& g);
+
 }  // namespace runout::jobs

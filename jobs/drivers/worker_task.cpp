@@ -11,7 +11,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "jobs/drivers/ensemble_aggregate.hpp"
 #include "jobs/drivers/run.hpp"
+#include "jobs/ensemble/variations.hpp"
 #include "jobs/scenario/scenario.hpp"
 #include "runout/v1/worker.pb.h"
 #include "terrain/terrain.hpp"
@@ -43,6 +45,33 @@ bool send_event(int fd, const v1::WorkerEvent& ev) {
   const auto n = std::uint32_t(body.size());
   const char head[4] = {char(n & 255), char((n >> 8) & 255), char((n >> 16) & 255), char((n >> 24) & 255)};
   return write_all(fd, head, 4) && write_all(fd, body.data(), body.size());
+}
+
+// An ensemble's job: its members have run; aggregate their results (the members are expanded
+// again from the scenario, which gives them in the same order as at the submission).
+int aggregate(const ResolvedScenario& r, const v1::WorkerTask& task, int events) {
+  const auto expanded = ensemble::expand(r.scenario);
+  if (task.member_dirs_size() == 0)
+    throw std::invalid_argument("an ensemble (variations) runs as its members: submit it to the job system (runout run or the service)");
+  if (int(expanded.size()) != task.member_dirs_size() || task.member_hashes_size() != task.member_dirs_size())
+    throw std::runtime_error("the ensemble has " + std::to_string(expanded.size()) + " members, the task names " +
+                             std::to_string(task.member_dirs_size()));
+  std::vector<MemberResults> members;
+  for (std::size_t k = 0; k < expanded.size(); ++k)
+    members.push_back({expanded[k], task.member_hashes(int(k)), task.member_dirs(int(k))});
+  v1::WorkerEvent ev;
+  try {
+    const auto rec = aggregate_ensemble(r, members, task.out_dir(), [](int, int) { return g_stop == 0; });
+    auto* d = ev.mutable_done();
+    d->set_stop("aggregated");
+    char b[300];
+    std::snprintf(b, sizeof b, "aggregated %d members into %d files in %.2f s", int(members.size()), rec.outputs_size(),
+                  rec.aggregate_seconds());
+    d->set_summary(b);
+  } catch (const AggregateStopped&) {
+    ev.mutable_interrupted()->set_checkpoint_written(false);
+  }
+  return send_event(events, ev) ? 0 : 3;
 }
 
 }  // namespace
@@ -79,6 +108,7 @@ int worker_main(int in_fd, int out_fd) {
 
   try {
     const ResolvedScenario r = resolve_scenario(task.scenario(), "/");
+    if (ensemble::is_ensemble(r.scenario)) return aggregate(r, task, events);
     RunOptions opt;
     opt.progress_every = 1;  // the stop flag is seen after every step
     opt.checkpoint_path = task.checkpoint_path();

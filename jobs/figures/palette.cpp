@@ -53,6 +53,17 @@ const Palette& hazard_palette(const std::string& raster) {
   return p.at(raster);
 }
 
+const Palette& probability_palette() {
+  static const Palette p = [] {
+    Palette q{"probability", "", {}};
+    const std::vector<double> from = {1e-9, 0.1, 0.3, 0.5, 0.7, 0.9};
+    const char* labels[] = {"> 0 – 0.1", "0.1 – 0.3", "0.3 – 0.5", "0.5 – 0.7", "0.7 – 0.9", "≥ 0.9"};
+    for (std::size_t k = 0; k < from.size(); ++k) q.classes.push_back({from[k], kYlOrRd6[k], labels[k]});
+    return q;
+  }();
+  return p;
+}
+
 Rgb8 zone_colour(const std::string& name, std::size_t k, std::size_t n) {
   static const std::map<std::string, Rgb8> named = {
       {"yellow", {{255, 221, 0}}}, {"blue", {{0, 92, 230}}},   {"red", {{220, 0, 0}}},      {"orange", {{255, 140, 0}}},

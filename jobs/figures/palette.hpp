@@ -29,6 +29,9 @@ struct Palette {
 /// arrival_time). Throws std::out_of_range for another name.
 const Palette& hazard_palette(const std::string& raster);
 
+/// The palette of a probability (0-1; an ensemble's probability of exceedance): 0 is not coloured.
+const Palette& probability_palette();
+
 /// A named colour (yellow, blue, red, orange, green, purple, brown, grey, black, white) or, for
 /// another name, the colour of rank `k` of `n` on a yellow-to-dark-red ramp.
 Rgb8 zone_colour(const std::string& name, std::size_t k, std::size_t n);

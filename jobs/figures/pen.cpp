@@ -1,5 +1,9 @@
 #include "jobs/figures/pen.hpp"
 
+#include <stdexcept>
+
+#include <cairo-pdf.h>
+
 #include <pango/pangocairo.h>
 
 #include <cmath>
@@ -73,6 +77,26 @@ std::string label_number(double v, bool grouped) {
     out += s[k];
   }
   return out;
+}
+
+void render_png_pdf(const std::string& png_path, const std::string& pdf_path, double width, double height,
+                    const std::function<void(cairo_t*)>& draw) {
+  if (!png_path.empty()) {
+    std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> s(
+        cairo_image_surface_create(CAIRO_FORMAT_RGB24, int(std::ceil(width)), int(std::ceil(height))), cairo_surface_destroy);
+    std::unique_ptr<cairo_t, decltype(&cairo_destroy)> cr(cairo_create(s.get()), cairo_destroy);
+    draw(cr.get());
+    if (cairo_surface_write_to_png(s.get(), png_path.c_str()) != CAIRO_STATUS_SUCCESS)
+      throw std::runtime_error("writing '" + png_path + "' failed");
+  }
+  if (!pdf_path.empty()) {
+    std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> s(cairo_pdf_surface_create(pdf_path.c_str(), width, height),
+                                                                         cairo_surface_destroy);
+    std::unique_ptr<cairo_t, decltype(&cairo_destroy)> cr(cairo_create(s.get()), cairo_destroy);
+    draw(cr.get());
+    cairo_surface_finish(s.get());
+    if (cairo_surface_status(s.get()) != CAIRO_STATUS_SUCCESS) throw std::runtime_error("writing '" + pdf_path + "' failed");
+  }
 }
 
 }  // namespace runout::figures

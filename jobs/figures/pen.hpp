@@ -3,6 +3,7 @@
 // tick steps and number labels, for every figure drawn with Cairo.
 #include <cairo.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -37,5 +38,10 @@ double nice_step(double span, int parts);
 
 /// A number for labels: no trailing zeros, thousands apart with thin spaces when `grouped`.
 std::string label_number(double v, bool grouped = false);
+
+/// Draw a page of `width` x `height` with `draw` into a PNG (pixels) and a PDF (points); either path
+/// may be empty. Throws std::runtime_error naming the file that cannot be written.
+void render_png_pdf(const std::string& png_path, const std::string& pdf_path, double width, double height,
+                    const std::function<void(cairo_t*)>& draw);
 
 }  // namespace runout::figures

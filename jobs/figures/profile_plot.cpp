@@ -117,22 +117,7 @@ void draw_profile_plot(const std::string& png_path, const std::string& pdf_path,
   if (p.s.size() < 2 || p.z.size() != p.s.size()) throw std::runtime_error("profile plot: fewer than two stations");
   const double top = 14 + draw_text(nullptr, 20, 12, p.title, {18, true, kInk, kW - 40}).h + 40;
   const double height = top + 1.4 * kPanel + kGap + p.series.size() * (kPanel + kGap) + 30;
-  if (!png_path.empty()) {
-    std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> s(
-        cairo_image_surface_create(CAIRO_FORMAT_RGB24, int(kW), int(std::ceil(height))), cairo_surface_destroy);
-    std::unique_ptr<cairo_t, decltype(&cairo_destroy)> cr(cairo_create(s.get()), cairo_destroy);
-    draw(cr.get(), p, height, top);
-    if (cairo_surface_write_to_png(s.get(), png_path.c_str()) != CAIRO_STATUS_SUCCESS)
-      throw std::runtime_error("writing '" + png_path + "' failed");
-  }
-  if (!pdf_path.empty()) {
-    std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> s(cairo_pdf_surface_create(pdf_path.c_str(), kW, height),
-                                                                         cairo_surface_destroy);
-    std::unique_ptr<cairo_t, decltype(&cairo_destroy)> cr(cairo_create(s.get()), cairo_destroy);
-    draw(cr.get(), p, height, top);
-    cairo_surface_finish(s.get());
-    if (cairo_surface_status(s.get()) != CAIRO_STATUS_SUCCESS) throw std::runtime_error("writing '" + pdf_path + "' failed");
-  }
+  render_png_pdf(png_path, pdf_path, kW, std::ceil(height), [&](cairo_t* cr) { draw(cr, p, height, top); });
 }
 
 }  // namespace runout::figures

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
 #ifndef RUNOUT_VERSION
@@ -67,8 +68,12 @@ std::string read_file(const std::string& path) {
 
 }  // namespace
 
-void write_run_record(const std::string& path, const v1::RunRecord& record) {
-  v1::RunRecord r = record;
+void write_run_record(const std::string& path, const v1::RunRecord& record) { write_record_json(path, record); }
+
+void write_record_json(const std::string& path, const google::protobuf::Message& record) {
+  std::unique_ptr<pb::Message> copy(record.New());
+  copy->CopyFrom(record);
+  pb::Message& r = *copy;
   round_doubles(r);
   pb::util::JsonPrintOptions po;
   po.add_whitespace = true;

@@ -18,6 +18,8 @@ struct RunRecordError : std::runtime_error {
 /// Write `record` to `path` (replaced): every double rounded to 10 significant digits (the
 /// embedded scenario as it is), fields without presence printed even when zero.
 void write_run_record(const std::string& path, const v1::RunRecord& record);
+/// The same for another record of the same JSON form (an ensemble's runout.v1.EnsembleRecord).
+void write_record_json(const std::string& path, const google::protobuf::Message& record);
 
 /// Read a run record. Throws RunRecordError naming `path` when the file is missing or is not a
 /// run record (fields it does not know are ignored).

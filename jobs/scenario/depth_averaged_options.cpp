@@ -131,6 +131,9 @@ OptionTable output_options() {
       {"path.beta_deg", T::number, U::keep, "10", Range{0, 90, true, true}, {}, "deg",
        "the beta point: where the path's slope first falls below this", "ResolvedScenario::path", "",
        [](const S& s, R& r) { r.path.beta_deg = s.path().has_beta_deg() ? s.path().beta_deg() : 10.0; }},
+      {"outputs.maps", T::flag, U::keep, "true", {}, {}, "",
+       "the report maps (map_*.png and .pdf); false: rasters, vectors and run.json only (ensemble members)", "ResolvedScenario::maps", "",
+       [](const S& s, R& r) { r.maps = !s.outputs().has_maps() || s.outputs().maps(); }},
       {"outputs.points_of_interest[].name", T::text, U::required, "", {}, {}, "",
        "a named point (a farmhouse): drawn on the maps, its maxima and zone in run.json", "run record, maps"},
       {"outputs.points_of_interest[].x", T::number, U::as_given, "", Range{}, {}, "", "easting, or longitude in a geographic CRS",
@@ -138,6 +141,51 @@ OptionTable output_options() {
       {"outputs.points_of_interest[].y", T::number, U::as_given, "", Range{}, {}, "", "northing, or latitude", "run record, maps"},
       {"outputs.points_of_interest[].crs", T::text, U::as_given, "", {}, {}, "", "the point's CRS (\"EPSG:4326\"); default the grid's",
        "run record, maps"},
+  };
+}
+
+// The `variations` block (an ensemble, jobs/ensemble): checked here field by field; what the values
+// make (members, the aggregate's settings) is jobs/ensemble/variations.cpp's.
+OptionTable variation_options() {
+  const Range positive{0, kMaxDepthThreshold * 1e3, true};
+  return {
+      {"variations.design", T::choice, U::keep, "cross-product", {}, {"cross-product", "latin-hypercube"}, "",
+       "the members: every combination of the parameters' values, or a latin hypercube of `samples` members", "ensemble members"},
+      {"variations.samples", T::integer, U::as_given, "", Range{0, 100000}, {}, "", "latin-hypercube: the number of members",
+       "ensemble members"},
+      {"variations.seed", T::integer, U::as_given, "1", {}, {}, "", "the random draws' seed (distributions, latin hypercube)",
+       "ensemble members"},
+      {"variations.parameters[].parameter", T::text, U::required, "", {}, {}, "",
+       "the varied number by its path (material.bed_friction_deg, releases[].thickness_factor, grid.resolution_m, releases[0].active, ...)",
+       "ensemble members"},
+      {"variations.parameters[].values[]", T::number, U::as_given, "", Range{}, {}, "parameter's", "a list of values", "ensemble members"},
+      {"variations.parameters[].from", T::number, U::as_given, "", Range{}, {}, "parameter's", "a range's (or distribution's) lower end",
+       "ensemble members"},
+      {"variations.parameters[].to", T::number, U::as_given, "", Range{}, {}, "parameter's", "a range's (or distribution's) upper end",
+       "ensemble members"},
+      {"variations.parameters[].step", T::number, U::as_given, "", Range{0, 1e9, true}, {}, "parameter's",
+       "the range's step (cross product)", "ensemble members"},
+      {"variations.parameters[].percent", T::number, U::as_given, "", Range{0, 100, true, true}, {}, "%",
+       "the scenario's value -percent .. +percent", "ensemble members"},
+      {"variations.parameters[].count", T::integer, U::as_given, "", Range{0, 100000}, {}, "",
+       "values over +-percent (default 3), or draws from the distribution (cross product)", "ensemble members"},
+      {"variations.parameters[].distribution", T::choice, U::as_given, "", {}, {"uniform", "normal"}, "",
+       "uniform (from..to or +-percent) or normal (mean, sd; cut to from..to when given)", "ensemble members"},
+      {"variations.parameters[].mean", T::number, U::as_given, "", Range{}, {}, "parameter's", "the normal distribution's mean",
+       "ensemble members"},
+      {"variations.parameters[].sd", T::number, U::as_given, "", Range{0, 1e9, true}, {}, "parameter's",
+       "the normal distribution's standard deviation", "ensemble members"},
+      {"variations.depth_thresholds_m[]", T::number, U::as_given, "", positive, {}, "m",
+       "probability of max depth > each; default outputs.outline_threshold_m", "ensemble aggregate"},
+      {"variations.speed_thresholds_m_s[]", T::number, U::as_given, "", positive, {}, "m/s", "probability of max speed >= each; default 1",
+       "ensemble aggregate"},
+      {"variations.pressure_thresholds_kpa[]", T::number, U::as_given, "", Range{0, kMaxZonePressure, true}, {}, "kPa",
+       "probability of max pressure >= each; default the pressure zones' lower bounds", "ensemble aggregate"},
+      {"variations.percentiles[]", T::number, U::as_given, "", Range{0, 100}, {}, "%",
+       "percentiles of max depth, speed and pressure per cell; default 5, 50, 95", "ensemble aggregate"},
+      {"variations.member_outputs", T::choice, U::keep, "rasters", {}, {"rasters", "all"}, "",
+       "the members' outputs: hazard rasters and run.json only (no maps, no time series), or all the scenario asks for",
+       "ensemble members"},
   };
 }
 
@@ -168,6 +216,9 @@ const OptionTable& depth_averaged_options() {
        "the release thickness from a raster (any GDAL format and CRS, resampled bilinearly onto the grid; cells of 0 or no data do not "
        "release), inside the polygons of path when given",
        "ReleaseRequest::thickness_raster"},
+      {"releases[].thickness_factor", T::number, U::keep, "1", Range{0, 100, true}, {}, "",
+       "every thickness of the release (given, attribute or raster) times this; ensembles vary it (variations)",
+       "ReleaseRequest::thickness_factor"},
       {"releases[].thickness_attribute", T::text, U::as_given, "", {}, {}, "", "the attribute that holds each polygon's thickness",
        "ReleaseRequest::thickness_attribute"},
       {"releases[].thickness_measured", T::choice, U::as_given, "normal", {}, {"normal", "vertical"}, "",
@@ -229,6 +280,7 @@ const OptionTable& depth_averaged_options() {
        "Sh2dConfig::curvature (negated)", "", [](const S& s, R& r) { r.config.curvature = !s.numerics().curvature_off(); }},
   };
     for (auto& o : output_options()) v.push_back(std::move(o));
+    for (auto& o : variation_options()) v.push_back(std::move(o));
     return v;
   }();
   return t;

@@ -83,6 +83,7 @@ double number(const Location& l) {
       return l.index >= 0 ? refl->GetRepeatedDouble(*l.msg, l.f, l.index) : refl->GetDouble(*l.msg, l.f);
     case FieldDescriptor::CPPTYPE_INT32: return refl->GetInt32(*l.msg, l.f);
     case FieldDescriptor::CPPTYPE_INT64: return double(refl->GetInt64(*l.msg, l.f));
+    case FieldDescriptor::CPPTYPE_UINT64: return double(refl->GetUInt64(*l.msg, l.f));
     default: throw std::logic_error("scenario option table: " + l.label + " is not a number");
   }
 }
@@ -106,6 +107,7 @@ void set_default(const Option& o, const Location& l) {
 bool equals_default(const Option& o, const Location& l) {
   if (o.default_value.empty()) return false;
   if (l.f->cpp_type() == FieldDescriptor::CPPTYPE_STRING) return l.msg->GetReflection()->GetString(*l.msg, l.f) == o.default_value;
+  if (l.f->cpp_type() == FieldDescriptor::CPPTYPE_BOOL) return l.msg->GetReflection()->GetBool(*l.msg, l.f) == (o.default_value == "true");
   return number(l) == std::stod(o.default_value);
 }
 

@@ -16,6 +16,8 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
 
@@ -221,6 +223,7 @@ void resolve_releases(const v1::Scenario& s, const std::string& base, ResolvedSc
     q.min_slope_attribute = rl.min_slope_attribute();
     q.max_slope_attribute = rl.max_slope_attribute();
     q.secondary = rl.secondary();
+    q.thickness_factor = rl.has_thickness_factor() ? rl.thickness_factor() : 1.0;
     r.releases.push_back(q);
   }
   if (std::all_of(r.releases.begin(), r.releases.end(), [](const terrain::ReleaseRequest& q) { return q.secondary; }))
@@ -285,6 +288,30 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   return r;
 }
 
+namespace {
+
+// The digest of an input file, remembered by its path, size and modification time: an ensemble's
+// members share their inputs, and a large DEM is read once, not once per member.
+std::string input_digest(const std::string& path) {
+  static std::mutex mu;
+  static std::map<std::string, std::pair<std::string, std::string>> memo;  // path -> (size:mtime, digest)
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  const auto mtime = fs::last_write_time(path, ec);
+  if (ec) return sha256_file(path);
+  const std::string stamp = std::to_string(size) + ":" + std::to_string(mtime.time_since_epoch().count());
+  {
+    std::lock_guard lk(mu);
+    if (const auto it = memo.find(path); it != memo.end() && it->second.first == stamp) return it->second.second;
+  }
+  std::string d = sha256_file(path);
+  std::lock_guard lk(mu);
+  memo[path] = {stamp, d};
+  return d;
+}
+
+}  // namespace
+
 std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version, int vof_version) {
   v1::Scenario s = r.scenario;
   s.mutable_dem()->clear_path();
@@ -298,6 +325,7 @@ std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version,
   // A block left empty (its kept defaults cleared) is the block not given.
   if (s.has_path() && s.path().ByteSizeLong() == 0) s.clear_path();
   if (s.has_observations() && s.observations().ByteSizeLong() == 0) s.clear_observations();
+  if (s.has_variations() && s.variations().ByteSizeLong() == 0) s.clear_variations();
   s.clear_limits();  // a job's limits do not change what it computes
   std::string bytes;
   {
@@ -316,7 +344,7 @@ std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version,
     h.update("\n");
     h.update(fs::path(f).extension().string());
     h.update(" ");
-    h.update(sha256_file(f));
+    h.update(input_digest(f));
   }
   return h.hex();
 }

@@ -351,6 +351,7 @@ struct Scheduler::JobContext {
       s.cancel_.erase(id);
     }
     s.touch(id);
+    if (!sj.job.parent_id().empty()) s.touch(sj.job.parent_id());  // its ensemble's counts changed
   }
   void finish_and_forget(v1::JobState state, const std::string& reason, const std::string& error, std::int64_t bytes) {
     s.remove_checkpoint(id);
@@ -377,6 +378,7 @@ void Scheduler::run_job(StoredJob job) {
     std::lock_guard lk(mu_);
     live_[id] = Live{jc.sj.job.progress(), ++counter_, true};
     versions_[id] = counter_;
+    if (!jc.sj.job.parent_id().empty()) versions_[jc.sj.job.parent_id()] = ++counter_;  // its ensemble's counts changed
   }
   change_cv_.notify_all();
   std::error_code ec;
@@ -408,6 +410,7 @@ void Scheduler::run_job(StoredJob job) {
   // runs, so that a job interrupted by the server stopping, by its death or by a crash of its worker
   // continues from there.
   v1::WorkerTask task;
+  if (!ensemble_task(jc, task)) return;
   task.set_job_id(id);
   *task.mutable_scenario() = jc.sj.scenario;
   task.set_out_dir(jc.tmp.string());
@@ -425,6 +428,44 @@ void Scheduler::run_job(StoredJob job) {
     const Attempt a = supervise(jc, task);
     if (!conclude(jc, task, a, round)) return;
   }
+}
+
+bool Scheduler::ensemble_task(JobContext& jc, v1::WorkerTask& task) {
+  const auto members = store_.members(jc.id);
+  if (members.empty()) return true;  // a job of its own
+  int failed = 0, cancelled = 0;
+  const StoredJob* first_failed = nullptr;
+  for (const auto& m : members) {
+    if (m.job.state() == v1::FAILED && !failed++) first_failed = &m;
+    if (m.job.state() == v1::CANCELLED) ++cancelled;
+  }
+  if (failed) {
+    jc.finish_and_forget(v1::FAILED, "a member failed",
+                         std::to_string(failed) + " of " + std::to_string(members.size()) + " members failed; member " +
+                             std::to_string(first_failed->job.member_index()) + " (job " + first_failed->job.id() +
+                             "): " + first_failed->job.error(),
+                         0);
+    return false;
+  }
+  if (cancelled) {
+    jc.finish_and_forget(v1::CANCELLED, std::to_string(cancelled) + " of " + std::to_string(members.size()) + " members were cancelled", "", 0);
+    return false;
+  }
+  std::error_code ec;
+  for (const auto& m : members) {
+    const std::string dir = results_dir(m.job.scenario_hash());
+    if (m.results_removed || !fs::exists(fs::path(dir) / "run.json", ec)) {
+      jc.finish_and_forget(v1::FAILED, "a member's results are gone",
+                           "the results of member " + std::to_string(m.job.member_index()) + " (job " + m.job.id() +
+                               ") were removed (retention) before the aggregate; submit the ensemble again",
+                           0);
+      return false;
+    }
+    task.add_member_dirs(dir);
+    task.add_member_hashes(m.job.scenario_hash());
+  }
+  jc.say("aggregating " + std::to_string(members.size()) + " members");
+  return true;
 }
 
 Scheduler::Attempt Scheduler::supervise(JobContext& jc, const v1::WorkerTask& task) {

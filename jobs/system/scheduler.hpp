@@ -94,6 +94,9 @@ class Scheduler {
   struct JobContext;  // one job's run: its log, paths, limits and how it is recorded
   struct Attempt;     // what one worker process of a job did
   void run_job(StoredJob job);
+  /// An ensemble's job: its members' results into the task (true), or the job ended because a member
+  /// failed, was cancelled or lost its results (false). A job of its own: true, nothing added.
+  bool ensemble_task(JobContext& jc, v1::WorkerTask& task);
   /// Run the task in a worker process and follow it to its end (progress, cancel, stop, limits).
   Attempt supervise(JobContext& jc, const v1::WorkerTask& task);
   /// Record what an ended attempt means for the job; true: run it again at once.

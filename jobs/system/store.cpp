@@ -16,7 +16,8 @@ using sql::Transaction;
 
 constexpr const char* kColumns =
     "id, owner, name, hash, request_id, state, created, updated, error, attempts, scenario, progress, result_bytes, "
-    "results_removed, crashes";
+    "results_removed, crashes, parent, member";
+constexpr int kNextColumn = 17;  // the first column a query adds after kColumns
 
 void add_transition(sqlite3* db, const std::string& id, v1::JobState s, const std::string& when, const std::string& reason) {
   Stmt(db, "INSERT INTO transitions(job, time, state, reason) VALUES (?, ?, ?, ?)")
@@ -25,6 +26,51 @@ void add_transition(sqlite3* db, const std::string& id, v1::JobState s, const st
       .bind(3, std::int64_t(s))
       .bind(4, reason)
       .step();
+}
+
+// A new queued job (and its "submitted" transition); `parent` empty and `member` -1 for a job of its own.
+void insert_job(sqlite3* db, const std::string& id, const std::string& owner, const std::string& name, const std::string& hash,
+                const std::string& request_id, const v1::Scenario& scenario, const std::string& request_hash, const std::string& now,
+                const std::string& parent = "", int member = -1) {
+  std::string blob;
+  scenario.SerializeToString(&blob);
+  Stmt ins(db,
+           "INSERT INTO jobs(id, owner, name, hash, request_id, state, created, updated, scenario, request_hash, parent, member) "
+           "VALUES (?, ?, ?, ?, ?, 1, ?, ?, ?, ?, ?, ?)");
+  ins.bind(1, id).bind(2, owner).bind(3, name).bind(4, hash);
+  if (request_id.empty())
+    ins.null(5);
+  else
+    ins.bind(5, request_id);
+  ins.bind(6, now).bind(7, now).blob(8, blob);
+  if (request_hash.empty())
+    ins.null(9);
+  else
+    ins.bind(9, request_hash);
+  ins.bind(10, parent).bind(11, std::int64_t(member));
+  ins.step();
+  add_transition(db, id, v1::QUEUED, now, "submitted");
+}
+
+// The job as submit() returns it after insert_job.
+StoredJob queued_job(const std::string& id, const std::string& owner, const std::string& name, const std::string& hash,
+                     const std::string& request_id, const v1::Scenario& scenario, const std::string& now) {
+  StoredJob out;
+  out.owner = owner;
+  out.scenario = scenario;
+  auto& j = out.job;
+  j.set_id(id);
+  j.set_state(v1::QUEUED);
+  j.set_name(name);
+  j.set_scenario_hash(hash);
+  j.set_created_utc(now);
+  j.set_updated_utc(now);
+  j.set_request_id(request_id);
+  auto* t = j.add_transitions();
+  t->set_state(v1::QUEUED);
+  t->set_time_utc(now);
+  t->set_reason("submitted");
+  return out;
 }
 
 }  // namespace
@@ -126,6 +172,13 @@ JobStore::JobStore(const std::string& path) {
   if (sqlite3_prepare_v2(db_, "SELECT request_hash FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
     exec("ALTER TABLE jobs ADD COLUMN request_hash TEXT");
   sqlite3_finalize(probe);
+  // ... and an ensemble's members: their ensemble's job and their place in it.
+  probe = nullptr;
+  if (sqlite3_prepare_v2(db_, "SELECT parent FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
+    exec("ALTER TABLE jobs ADD COLUMN parent TEXT NOT NULL DEFAULT '';"
+         "ALTER TABLE jobs ADD COLUMN member INTEGER NOT NULL DEFAULT -1");
+  sqlite3_finalize(probe);
+  exec("CREATE INDEX IF NOT EXISTS jobs_parent ON jobs(parent, member)");
   exec(R"(CREATE TABLE IF NOT EXISTS uploads(
            id TEXT NOT NULL,
            owner TEXT NOT NULL,
@@ -164,6 +217,8 @@ StoredJob JobStore::read_row(void* p) const {
   j.job.set_result_bytes(st->i64(12));
   j.results_removed = st->i64(13) != 0;
   j.crashes = int(st->i64(14));
+  j.job.set_parent_id(st->text(15));
+  j.job.set_member_index(int(st->i64(16)));
   return j;
 }
 
@@ -180,6 +235,12 @@ void JobStore::load_transitions(StoredJob& j) const {
 
 SubmitOutcome JobStore::submit(const std::string& owner, const std::string& hash, const std::string& request_id,
                                const v1::Scenario& scenario, int max_queued, const std::string& request_hash) {
+  return submit_ensemble(owner, hash, request_id, scenario, {}, max_queued, request_hash);
+}
+
+SubmitOutcome JobStore::submit_ensemble(const std::string& owner, const std::string& hash, const std::string& request_id,
+                                        const v1::Scenario& scenario, const std::vector<NewMember>& members, int max_queued,
+                                        const std::string& request_hash) {
   std::lock_guard lk(mu_);
   Transaction tx(db_);
   SubmitOutcome out;
@@ -187,6 +248,7 @@ SubmitOutcome JobStore::submit(const std::string& owner, const std::string& hash
     if (!st.step()) return false;
     out.job = read_row(&st);
     load_transitions(out.job);
+    fill_counts(out.job);
     return true;
   };
   if (!request_id.empty()) {
@@ -202,7 +264,7 @@ SubmitOutcome JobStore::submit(const std::string& owner, const std::string& hash
   }
   {
     Stmt st(db_, (std::string("SELECT ") + kColumns +
-                  " FROM jobs WHERE owner = ? AND hash = ? AND state IN (1, 2, 3) AND results_removed = 0 "
+                  " FROM jobs WHERE owner = ? AND hash = ? AND state IN (1, 2, 3) AND results_removed = 0 AND parent = '' "
                   "ORDER BY seq DESC LIMIT 1")
                      .c_str());
     st.bind(1, owner).bind(2, hash);
@@ -212,7 +274,8 @@ SubmitOutcome JobStore::submit(const std::string& owner, const std::string& hash
     }
   }
   {
-    Stmt st(db_, "SELECT COUNT(*) FROM jobs WHERE owner = ? AND state IN (1, 2)");
+    // An ensemble counts once: its members are not the client's submissions.
+    Stmt st(db_, "SELECT COUNT(*) FROM jobs WHERE owner = ? AND state IN (1, 2) AND parent = ''");
     st.bind(1, owner);
     st.step();
     if (st.i64(0) >= max_queued)
@@ -220,39 +283,15 @@ SubmitOutcome JobStore::submit(const std::string& owner, const std::string& hash
                       std::to_string(max_queued) + ")");
   }
   const std::string id = new_job_id(), now = utc_now();
-  std::string blob;
-  scenario.SerializeToString(&blob);
-  Stmt ins(db_,
-           "INSERT INTO jobs(id, owner, name, hash, request_id, state, created, updated, scenario, request_hash) "
-           "VALUES (?, ?, ?, ?, ?, 1, ?, ?, ?, ?)");
-  ins.bind(1, id).bind(2, owner).bind(3, scenario.name()).bind(4, hash);
-  if (request_id.empty())
-    ins.null(5);
-  else
-    ins.bind(5, request_id);
-  ins.bind(6, now).bind(7, now).blob(8, blob);
-  if (request_hash.empty())
-    ins.null(9);
-  else
-    ins.bind(9, request_hash);
-  ins.step();
-  add_transition(db_, id, v1::QUEUED, now, "submitted");
+  insert_job(db_, id, owner, scenario.name(), hash, request_id, scenario, request_hash, now);
+  for (const auto& m : members) {
+    const std::string name = scenario.name() + " [member " + std::to_string(m.index + 1) + " of " + std::to_string(members.size()) + "]";
+    insert_job(db_, new_job_id(), owner, name, m.hash, "", m.scenario, "", now, id, m.index);
+  }
   tx.commit();
   out.created = true;
-  out.job.owner = owner;
-  out.job.scenario = scenario;
-  auto& j = out.job.job;
-  j.set_id(id);
-  j.set_state(v1::QUEUED);
-  j.set_name(scenario.name());
-  j.set_scenario_hash(hash);
-  j.set_created_utc(now);
-  j.set_updated_utc(now);
-  j.set_request_id(request_id);
-  auto* t = j.add_transitions();
-  t->set_state(v1::QUEUED);
-  t->set_time_utc(now);
-  t->set_reason("submitted");
+  out.job = queued_job(id, owner, scenario.name(), hash, request_id, scenario, now);
+  if (!members.empty()) fill_counts(out.job);
   return out;
 }
 
@@ -264,13 +303,42 @@ std::optional<StoredJob> JobStore::get(const std::string& id, const std::string&
   StoredJob j = read_row(&st);
   if (!owner.empty() && j.owner != owner) return std::nullopt;
   load_transitions(j);
+  fill_counts(j);
   return j;
+}
+
+void JobStore::fill_counts(StoredJob& j) const {
+  Stmt st(db_, "SELECT state, COUNT(*) FROM jobs WHERE parent = ? GROUP BY state");
+  st.bind(1, j.job.id());
+  v1::EnsembleCounts c;
+  while (st.step()) {
+    const int n = int(st.i64(1));
+    c.set_total(c.total() + n);
+    switch (v1::JobState(st.i64(0))) {
+      case v1::QUEUED: c.set_queued(n); break;
+      case v1::RUNNING: c.set_running(n); break;
+      case v1::SUCCEEDED: c.set_succeeded(n); break;
+      case v1::FAILED: c.set_failed(n); break;
+      case v1::CANCELLED: c.set_cancelled(n); break;
+      default: break;
+    }
+  }
+  if (c.total() > 0) *j.job.mutable_members() = c;
+}
+
+std::vector<StoredJob> JobStore::members(const std::string& parent) const {
+  std::lock_guard lk(mu_);
+  Stmt st(db_, (std::string("SELECT ") + kColumns + " FROM jobs WHERE parent = ? ORDER BY member").c_str());
+  st.bind(1, parent);
+  std::vector<StoredJob> out;
+  while (st.step()) out.push_back(read_row(&st));
+  return out;
 }
 
 std::vector<StoredJob> JobStore::list(const std::string& owner, const std::vector<v1::JobState>& states, int page_size,
                                       const std::string& page_token, std::string* next_page_token) const {
   std::lock_guard lk(mu_);
-  std::string sql = std::string("SELECT ") + kColumns + ", seq FROM jobs WHERE owner = ? AND seq < ?";
+  std::string sql = std::string("SELECT ") + kColumns + ", seq FROM jobs WHERE owner = ? AND seq < ? AND parent = ''";
   if (!states.empty()) {
     sql += " AND state IN (";
     for (std::size_t k = 0; k < states.size(); ++k) sql += (k ? ", " : "") + std::to_string(int(states[k]));
@@ -296,16 +364,23 @@ std::vector<StoredJob> JobStore::list(const std::string& owner, const std::vecto
       break;
     }
     out.push_back(read_row(&st));
-    last_seq = st.i64(15);
+    last_seq = st.i64(kNextColumn);
   }
-  for (auto& j : out) load_transitions(j);
+  for (auto& j : out) {
+    load_transitions(j);
+    fill_counts(j);
+  }
   return out;
 }
 
 std::optional<StoredJob> JobStore::claim_next() {
   std::lock_guard lk(mu_);
   Transaction tx(db_);
-  Stmt st(db_, (std::string("SELECT ") + kColumns + " FROM jobs WHERE state = 1 ORDER BY seq LIMIT 1").c_str());
+  // An ensemble's job waits until none of its members is queued or running.
+  Stmt st(db_, (std::string("SELECT ") + kColumns +
+                " FROM jobs WHERE state = 1 AND NOT EXISTS (SELECT 1 FROM jobs m WHERE m.parent = jobs.id AND m.state IN (1, 2)) "
+                "ORDER BY seq LIMIT 1")
+                   .c_str());
   if (!st.step()) {
     tx.commit();
     return std::nullopt;
@@ -346,8 +421,19 @@ std::optional<StoredJob> JobStore::cancel(const std::string& id, const std::stri
     Stmt st(db_, "SELECT state FROM jobs WHERE id = ? AND owner = ?");
     st.bind(1, id).bind(2, owner);
     if (!st.step()) return std::nullopt;
+    const std::string now = utc_now();
+    {  // An ensemble's members: the queued ones end now, the running ones are asked to stop.
+      std::vector<std::string> queued;
+      Stmt ms(db_, "SELECT id FROM jobs WHERE parent = ? AND state = 1");
+      ms.bind(1, id);
+      while (ms.step()) queued.push_back(ms.text(0));
+      for (const auto& m : queued) {
+        Stmt(db_, "UPDATE jobs SET state = 5, updated = ? WHERE id = ?").bind(1, now).bind(2, m).step();
+        add_transition(db_, m, v1::CANCELLED, now, "its ensemble was cancelled by the client before it started");
+      }
+      Stmt(db_, "UPDATE jobs SET cancel_requested = 1 WHERE parent = ? AND state = 2").bind(1, id).step();
+    }
     if (v1::JobState(st.i64(0)) == v1::QUEUED) {
-      const std::string now = utc_now();
       Stmt up(db_, "UPDATE jobs SET state = 5, updated = ? WHERE id = ?");
       up.bind(1, now).bind(2, id).step();
       add_transition(db_, id, v1::CANCELLED, now, "cancelled by the client before it started");
@@ -474,7 +560,7 @@ void JobStore::insert_recovered(const StoredJob& j) {
   j.scenario.SerializeToString(&blob);
   Stmt ins(db_,
            "INSERT INTO jobs(id, owner, name, hash, request_id, state, created, updated, error, attempts, scenario, "
-           "result_bytes, results_removed, crashes) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+           "result_bytes, results_removed, crashes, parent, member) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
   ins.bind(1, j.job.id()).bind(2, j.owner).bind(3, j.job.name()).bind(4, j.job.scenario_hash());
   if (j.job.request_id().empty())
     ins.null(5);
@@ -482,7 +568,8 @@ void JobStore::insert_recovered(const StoredJob& j) {
     ins.bind(5, j.job.request_id());
   ins.bind(6, std::int64_t(j.job.state())).bind(7, j.job.created_utc()).bind(8, j.job.updated_utc()).bind(9, j.job.error())
       .bind(10, std::int64_t(j.job.attempts())).blob(11, blob).bind(12, j.job.result_bytes())
-      .bind(13, std::int64_t(j.results_removed ? 1 : 0)).bind(14, std::int64_t(j.crashes));
+      .bind(13, std::int64_t(j.results_removed ? 1 : 0)).bind(14, std::int64_t(j.crashes)).bind(15, j.job.parent_id())
+      .bind(16, std::int64_t(j.job.parent_id().empty() ? -1 : j.job.member_index()));
   ins.step();
   for (const auto& t : j.job.transitions()) add_transition(db_, j.job.id(), t.state(), t.time_utc(), t.reason());
   tx.commit();
@@ -494,7 +581,7 @@ std::optional<std::pair<StoredJob, std::string>> JobStore::find_request(const st
   Stmt st(db_, (std::string("SELECT ") + kColumns + ", COALESCE(request_hash, '') FROM jobs WHERE owner = ? AND request_id = ?").c_str());
   st.bind(1, owner).bind(2, request_id);
   if (!st.step()) return std::nullopt;
-  std::pair<StoredJob, std::string> out{read_row(&st), st.text(15)};
+  std::pair<StoredJob, std::string> out{read_row(&st), st.text(kNextColumn)};
   load_transitions(out.first);
   return out;
 }

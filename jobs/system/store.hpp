@@ -59,12 +59,28 @@ class JobStore {
   /// owner already has `max_queued` queued or running jobs.
   SubmitOutcome submit(const std::string& owner, const std::string& hash, const std::string& request_id,
                        const v1::Scenario& scenario, int max_queued, const std::string& request_hash = "");
+  /// An ensemble's member: its place, scenario hash and scenario.
+  struct NewMember {
+    int index = 0;
+    std::string hash;
+    v1::Scenario scenario;
+  };
+  /// An ensemble: its job (hash: the ensemble's, jobs/ensemble) and its members' jobs, queued in one
+  /// transaction (no member is lost, none is left without its ensemble). An existing ensemble job
+  /// answers as submit() says; the ensemble counts as one job against `max_queued`. The ensemble's
+  /// job is claimed only once none of its members is queued or running (it then aggregates).
+  SubmitOutcome submit_ensemble(const std::string& owner, const std::string& hash, const std::string& request_id,
+                                const v1::Scenario& scenario, const std::vector<NewMember>& members, int max_queued,
+                                const std::string& request_hash = "");
+  /// An ensemble's members, in order.
+  std::vector<StoredJob> members(const std::string& parent) const;
   /// The owner's job with this request id, and the digest of the request that created it ("" for
   /// jobs stored before it was kept).
   std::optional<std::pair<StoredJob, std::string>> find_request(const std::string& owner, const std::string& request_id) const;
   /// The job with this id; with a non-empty owner only if it is that owner's.
   std::optional<StoredJob> get(const std::string& id, const std::string& owner = "") const;
   /// The owner's jobs, newest first, filtered by state (empty: all); `page_token` from the previous page.
+  /// Ensembles' members are not listed (members() lists them).
   std::vector<StoredJob> list(const std::string& owner, const std::vector<v1::JobState>& states, int page_size,
                               const std::string& page_token, std::string* next_page_token) const;
   /// The oldest queued job, now running (attempts + 1); nothing when the queue is empty.
@@ -74,6 +90,7 @@ class JobStore {
   void transition(const std::string& id, v1::JobState state, const std::string& reason, const std::string& error = "",
                   std::int64_t result_bytes = -1, bool crashed = false);
   /// Queued jobs become cancelled here; running ones are left for the worker (returns their state).
+  /// An ensemble's queued members are cancelled with it and its running ones asked to stop.
   std::optional<StoredJob> cancel(const std::string& id, const std::string& owner);
   /// Jobs left running by a server that went down: queued again (cancelled when the client had
   /// asked). The server's death does not count against a job. Returns how many were queued again;
@@ -120,6 +137,7 @@ class JobStore {
 
  private:
   StoredJob read_row(void* stmt) const;
+  void fill_counts(StoredJob& j) const;  ///< an ensemble's members by state (job.members)
   void load_transitions(StoredJob& j) const;
   void exec(const char* sql) const;
   sqlite3* db_ = nullptr;

@@ -16,6 +16,8 @@
 
 #include "jobs/scenario/scenario.hpp"
 #include "service/cli/commands.hpp"
+#include "service/cli/run_ensemble.hpp"
+#include "jobs/system/store.hpp"
 #include "service/cli/output_dir.hpp"
 #include "service/client/client.hpp"
 
@@ -48,6 +50,8 @@ int code_of_state(v1::JobState s) {
 std::string progress_line(const v1::Job& j) {
   const auto& p = j.progress();
   char b[256];
+  if (j.members().total() > 0 && !jobs::is_final(j.state()))
+    return j.id() + " ensemble " + (j.state() == v1::RUNNING ? "aggregating: " : "") + ensemble_progress(j.members(), isatty(fileno(stderr)));
   if (j.state() == v1::RUNNING && p.steps() > 0)
     std::snprintf(b, sizeof b, "%s running: t = %.1f / %.0f s, dt = %.4f s, volume = %.4g m3, max speed = %.1f m/s, active = %.1f %%, left <= %.0f s",
                   j.id().c_str(), p.simulated_s(), p.end_time_s(), p.dt_s(), p.volume_m3(), p.max_speed_m_s(),
@@ -85,7 +89,8 @@ void print_job(const v1::Job& j) {
   std::printf("state      %s\n", service::state_word(j.state()).c_str());
   std::printf("scenario   %s\n", j.scenario_hash().c_str());
   std::printf("created    %s\nupdated    %s\nattempts   %d\n", j.created_utc().c_str(), j.updated_utc().c_str(), j.attempts());
-  if (j.state() == v1::RUNNING) std::printf("progress   %s\n", progress_line(j).c_str());
+  if (j.members().total() > 0) std::printf("members    %s\n", ensemble_progress(j.members(), false).c_str());
+  else if (j.state() == v1::RUNNING) std::printf("progress   %s\n", progress_line(j).c_str());
   if (!j.error().empty()) std::printf("error      %s\n", j.error().c_str());
   if (j.result_bytes() > 0) std::printf("results    %.1f MiB\n", double(j.result_bytes()) / (1 << 20));
   std::printf("history\n");

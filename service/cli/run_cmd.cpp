@@ -15,6 +15,8 @@
 #include "jobs/drivers/run.hpp"
 #include "service/cli/commands.hpp"
 #include "service/cli/output_dir.hpp"
+#include "service/cli/run_ensemble.hpp"
+#include "jobs/ensemble/variations.hpp"
 
 namespace runout::cli {
 namespace fs = std::filesystem;
@@ -63,6 +65,8 @@ constexpr const char* kRunHelp =
 struct RunArgs {
   std::string scenario, out, iseesnow, checkpoint, restart, threads;
   bool force = false, quiet = false;
+  std::string state_dir, workers;  // ensembles
+  bool members = false;
 };
 
 void add_run_options(CLI::App& app, RunArgs& a) {
@@ -91,6 +95,13 @@ void add_run_options(CLI::App& app, RunArgs& a) {
                  "Continue from a --checkpoint FILE of the same scenario exactly as the run would have gone on (run.json "
                  "and fields.h5 are the whole run's; depth-averaged runs: the uninterrupted run's outputs, bit for bit)")
       ->type_name("FILE");
+  app.add_option("--state-dir", a.state_dir,
+                 "Ensembles (scenarios with variations): the local job system's folder (job store, members' results, logs); "
+                 "default $RUNOUT_STATE_DIR, else $XDG_CACHE_HOME/runout, else ~/.cache/runout. Members computed before in it answer "
+                 "from their results, and an interrupted ensemble continues there")
+      ->type_name("DIR");
+  app.add_option("--workers", a.workers, "Ensembles: cores to use (a positive integer; default: all)")->type_name("N");
+  app.add_flag("--members", a.members, "Ensembles: also write each member's results into DIR/members/member_<k>");
 }
 
 // Runs the resolved scenario into `tmp`; kOk, or the exit code of the failure (its message on
@@ -120,7 +131,7 @@ int execute(const jobs::ResolvedScenario& resolved, const fs::path& tmp, const j
 
 int run(const std::vector<std::string>& args) {
   RunArgs a;
-  auto& [scenario, out, iseesnow, checkpoint, restart, threads, force, quiet] = a;
+  auto& [scenario, out, iseesnow, checkpoint, restart, threads, force, quiet, state_dir, workers_text, members] = a;
   CLI::App app{kRunHelp, "runout run"};
   add_run_options(app, a);
   if (const int rc = parse_args(app, args); rc >= 0) return rc;
@@ -161,6 +172,18 @@ int run(const std::vector<std::string>& args) {
     return kBadInput;
   }
 
+  const bool ensemble = jobs::ensemble::is_ensemble(resolved.scenario);
+  if (ensemble && (!checkpoint.empty() || !restart.empty() || !iseesnow.empty()))
+    return usage_error("runout run", "--checkpoint, --restart and --iseesnow are for single runs; an ensemble keeps its members' "
+                                     "checkpoints in its state directory (--state-dir)");
+  if (!ensemble && (app.count("--state-dir") || app.count("--workers") || members))
+    return usage_error("runout run", "--state-dir, --workers and --members are for ensembles (a scenario with variations)");
+  int workers = 0;
+  if (app.count("--workers")) {
+    const auto n = positive_int(a.workers);
+    if (!n) return usage_error("runout run", "--workers takes a positive integer, got '" + a.workers + "'");
+    workers = *n;
+  }
   {  // A previous result that --force replaces must not hold what this run reads or writes.
     std::vector<std::string> used = resolved.input_files;
     for (const auto& f : {fs::absolute(scenario).string(), checkpoint, restart}) used.push_back(f);
@@ -182,6 +205,19 @@ int run(const std::vector<std::string>& args) {
   std::signal(SIGTERM, on_interrupt);
   const auto wall0 = std::chrono::steady_clock::now();
   const bool tty = isatty(fileno(stderr));
+  if (ensemble) {
+    EnsembleRun er{tmp.string(), a.state_dir, workers, quiet, tty, members, [] { return g_interrupted.load(); }};
+    RunSummaryOut es;
+    if (const int rc = run_ensemble(resolved, er, es); rc != kOk) return rc;
+    if (!staged.publish()) {
+      std::cerr << "runout run: " << staged.error() << "\n";
+      return kOutput;
+    }
+    if (!quiet)
+      std::printf("ensemble    %d members in %.1f s (job %s, state %s)\nresults in  %s\n", es.members, es.seconds, es.job.c_str(),
+                  es.state_dir.c_str(), dest.string().c_str());
+    return kOk;
+  }
   jobs::RunOptions opt;
   opt.iseesnow_id = iseesnow;
   opt.checkpoint_path = checkpoint;

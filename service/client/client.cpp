@@ -1,5 +1,5 @@
 #include "service/client/client.hpp"
-#include "service/scenario_inputs.hpp"
+#include "jobs/scenario/inputs.hpp"
 
 #include <grpcpp/grpcpp.h>
 
@@ -217,7 +217,7 @@ v1::Scenario upload_inputs(Client& c, v1::Scenario s, const std::string& base_di
     }
     *path = c.upload(files).ref();
   };
-  for_each_input_path(s, [&](const std::string&, std::string* path) { up(path); });
+  jobs::for_each_input_path(s, [&](const std::string&, std::string* path) { up(path); });
   return s;
 }
 

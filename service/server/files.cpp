@@ -1,6 +1,6 @@
 // Files: uploads (quota, time to live, collection) and results (listing, download).
 #include "service/server/impl.hpp"
-#include "service/scenario_inputs.hpp"
+#include "jobs/scenario/inputs.hpp"
 
 #include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
@@ -55,7 +55,7 @@ std::vector<std::string> Server::Impl::uploads_of(const v1::Scenario& s) const {
     if (p.rfind(up, 0) == 0) ids.push_back(p.substr(up.size(), 64));
   };
   v1::Scenario paths = s;
-  for_each_input_path(paths, [&](const std::string&, std::string* p) { take(*p); });
+  jobs::for_each_input_path(paths, [&](const std::string&, std::string* p) { take(*p); });
   return ids;
 }
 

@@ -1,7 +1,7 @@
 // Submissions: the checks at the door (limits, inputs, validation in a worker), retries answered by
 // their request, queueing.
 #include "service/server/impl.hpp"
-#include "service/scenario_inputs.hpp"
+#include "jobs/scenario/inputs.hpp"
 
 #include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
@@ -32,6 +32,7 @@
 #include <optional>
 #include <sstream>
 
+#include "jobs/ensemble/variations.hpp"
 #include "jobs/scenario/scenario.hpp"
 #include "jobs/system/scheduler.hpp"
 #include "jobs/digest/sha256.hpp"
@@ -117,7 +118,7 @@ Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRe
     return st;
   };
   Status bad_input = Status::OK;
-  for_each_input_path(s, [&](const std::string& field, std::string* path) {
+  jobs::for_each_input_path(s, [&](const std::string& field, std::string* path) {
     if (bad_input.ok()) bad_input = input(field, path);
   });
   if (!bad_input.ok()) return refuse(bad_input);
@@ -134,9 +135,15 @@ Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRe
   }
   const std::vector<std::string> roots(cfg.data_roots().begin(), cfg.data_roots().end());
   std::string hash;
+  std::optional<jobs::ensemble::Plan> plan;  // an ensemble: its members
   try {
     const auto r = jobs::resolve_scenario(s, "/");
-    hash = jobs::scenario_hash(r);
+    if (jobs::ensemble::is_ensemble(r.scenario)) {
+      plan = jobs::ensemble::plan(r);
+      hash = plan->hash;
+    } else {
+      hash = jobs::scenario_hash(r);
+    }
   } catch (const jobs::ScenarioError& e) {
     return refuse({StatusCode::INVALID_ARGUMENT, jobs::client_message(e.what(), cfg.state_dir(), roots)});
   } catch (const terrain::TerrainError& e) {
@@ -155,16 +162,21 @@ Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRe
   if (!known) {
     if (!enter_validation())
       return refuse({StatusCode::RESOURCE_EXHAUSTED, "the server is checking too many submissions at once; try again"});
-    const Status st = check_in_worker(cfg, s, [this](const std::string& l) { log(l); });
+    // An ensemble: its first member stands for the others' inputs (they differ in numbers only).
+    const Status st = check_in_worker(cfg, plan ? plan->members.front().member.scenario : s, [this](const std::string& l) { log(l); });
     leave_validation();
     if (!st.ok()) return refuse(st);
   }
   try {
-    const auto out = store->submit(owner, hash, req->request_id(), s, cfg.max_queued_per_client(), request_hash);
+    std::vector<jobs::JobStore::NewMember> members;
+    if (plan)
+      for (const auto& m : plan->members) members.push_back({m.member.index, m.hash, m.member.scenario});
+    const auto out = store->submit_ensemble(owner, hash, req->request_id(), s, members, cfg.max_queued_per_client(), request_hash);
     *resp = with_live(out.job);
     if (out.created) {
       try {
         sched->write_record(out.job);
+        for (const auto& m : plan ? store->members(out.job.job.id()) : std::vector<jobs::StoredJob>{}) sched->write_record(m);
       } catch (const std::exception& e) {
         log("job " + resp->id() + ": " + e.what() + " (`runout serve --recover` cannot rebuild it)");
       }

@@ -70,9 +70,13 @@ void leaves(const Descriptor* d, const std::string& prefix, std::set<std::string
 // The field at a path without "[]", created on the way.
 std::pair<Message*, const FieldDescriptor*> field_at(Message& m, const std::string& path) {
   const auto dot = path.find('.');
-  const auto* f = m.GetDescriptor()->FindFieldByName(path.substr(0, dot));
+  std::string seg = path.substr(0, dot);
+  const bool each = seg.size() > 2 && seg.compare(seg.size() - 2, 2, "[]") == 0;  // a list of blocks: its first
+  if (each) seg.resize(seg.size() - 2);
+  const auto* f = m.GetDescriptor()->FindFieldByName(seg);
   if (dot == std::string::npos) return {&m, f};
-  return field_at(*m.GetReflection()->MutableMessage(&m, f), path.substr(dot + 1));
+  auto* next = each ? m.GetReflection()->MutableRepeatedMessage(&m, f, 0) : m.GetReflection()->MutableMessage(&m, f);
+  return field_at(*next, path.substr(dot + 1));
 }
 
 // The base scenario and its folder of an option's table.
@@ -181,6 +185,7 @@ TEST(ScenarioOptions, GivingAKeptDefaultKeepsTheHash) {
       auto [m, f] = field_at(s, o.path);
       if (f->cpp_type() == FieldDescriptor::CPPTYPE_STRING) m->GetReflection()->SetString(m, f, o.default_value);
       else if (f->cpp_type() == FieldDescriptor::CPPTYPE_DOUBLE) m->GetReflection()->SetDouble(m, f, std::stod(o.default_value));
+      else if (f->cpp_type() == FieldDescriptor::CPPTYPE_BOOL) m->GetReflection()->SetBool(m, f, o.default_value == "true");
       else m->GetReflection()->SetInt32(m, f, std::stoi(o.default_value));
       EXPECT_EQ(jobs::scenario_hash(jobs::resolve_scenario(s, dir)), h0) << o.path;
     }

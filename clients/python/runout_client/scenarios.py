@@ -3,7 +3,7 @@
 A scenario names its inputs by path (relative to the scenario file's folder). Before submitting,
 the client uploads each input with its companion files and replaces the path by the upload's
 reference ("upload:ID/NAME"), exactly as the C++ client does (service/client/client.cpp,
-``upload_inputs``, with the field list of service/scenario_inputs.hpp): the paths uploaded are
+``upload_inputs``, with the field list of jobs/scenario/inputs.hpp): the paths uploaded are
 ``dem.path``, ``area_of_interest.path``, every ``releases[].path`` and ``releases[].thickness_raster``,
 ``observations.outline_path`` and ``path.line_path``;
 the companions are the files beside the input with the same stem and one of
@@ -85,7 +85,7 @@ def load_scenario(scenario: ScenarioLike, base_dir: str | os.PathLike | None = N
 
 
 def input_fields(s: scenario_pb2.Scenario) -> list[InputField]:
-    """The input paths the client uploads, in the C++ client's order (service/scenario_inputs.hpp):
+    """The input paths the client uploads, in the C++ client's order (jobs/scenario/inputs.hpp):
     dem.path, area_of_interest.path (when the scenario has one), releases[k].path and
     releases[k].thickness_raster, observations.outline_path, path.line_path. Empty paths are left out (the server names
     what is missing)."""

@@ -1,13 +1,14 @@
 #pragma once
-// The scenario fields that name input files, in one list for both ends of the service: the client
-// uploads what they name and puts the upload's reference in their place, the server resolves each
-// (an upload, or a file inside its data roots) before anything reads it. A new input field of the
-// scenario is one more line here.
+// The scenario fields that name input files, in one list: the service's client uploads what they
+// name and puts the upload's reference in their place, the server resolves each (an upload, or a file
+// inside its data roots) before anything reads it, and an ensemble run locally makes them absolute
+// for its members' worker processes. A new input field of the scenario is one more line here.
+#include <filesystem>
 #include <string>
 
 #include "runout/v1/scenario.pb.h"
 
-namespace runout::service {
+namespace runout::jobs {
 
 /// Calls f(field, path) for every input file field that is set ("releases[0].thickness_raster",
 /// the path to read or replace).
@@ -27,4 +28,12 @@ void for_each_input_path(v1::Scenario& s, F f) {
   if (s.has_path()) each("path.line_path", s.mutable_path()->mutable_line_path());
 }
 
-}  // namespace runout::service
+/// Every input path of `s` made absolute against `base_dir` (the scenario file's folder).
+inline void absolute_inputs(v1::Scenario& s, const std::string& base_dir) {
+  for_each_input_path(s, [&](const std::string&, std::string* path) {
+    std::filesystem::path p(*path);
+    if (p.is_relative()) *path = (std::filesystem::absolute(base_dir) / p).lexically_normal().string();
+  });
+}
+
+}  // namespace runout::jobs

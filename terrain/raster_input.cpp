@@ -1,0 +1,47 @@
+// Rasters read back onto the computation grid (an ensemble's members' hazard rasters).
+#include <cmath>
+
+#include "terrain/gdal_support.hpp"
+
+namespace runout::terrain {
+
+using namespace detail;
+
+std::vector<double> read_raster_on(const std::string& path, const Grid& g, const std::string& what) {
+  init_gdal();
+  GDALDatasetUniquePtr src(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
+  if (!src) throw TerrainError(what + ": cannot read '" + path + "' as a raster" + gdal_message());
+  double gt[6] = {0, 1, 0, 0, 0, -1};
+  const bool has_gt = src->GetGeoTransform(gt) == CE_None;
+  const double tol = 1e-6 * g.dx;
+  const bool same = has_gt && src->GetRasterXSize() == g.nx && src->GetRasterYSize() == g.ny && std::abs(gt[0] - g.x_min) < tol &&
+                    std::abs(gt[3] - (g.y_min + g.ny * g.dx)) < tol && std::abs(gt[1] - g.dx) < tol && std::abs(gt[5] + g.dx) < tol &&
+                    gt[2] == 0 && gt[4] == 0;
+  GDALDatasetUniquePtr warped;
+  GDALDataset* ds = src.get();
+  if (!same) {  // another grid (an ensemble member at another resolution): nearest neighbour onto this one
+    auto opt = warp_options({"-of", "MEM", "-t_srs", g.crs_wkt, "-te", fmt(g.x_min, 9), fmt(g.y_min, 9), fmt(g.x_min + g.nx * g.dx, 9),
+                             fmt(g.y_min + g.ny * g.dx, 9), "-ts", std::to_string(g.nx), std::to_string(g.ny), "-r", "near",
+                             "-dstnodata", "nan", "-ot", "Float64"});
+    GDALDatasetH h = GDALDataset::ToHandle(src.get());
+    int usage_error = 0;
+    warped.reset(GDALDataset::FromHandle(GDALWarp("", nullptr, 1, &h, opt.get(), &usage_error)));
+    if (!warped) throw TerrainError(what + ": cannot resample '" + path + "' onto the grid" + gdal_message());
+    ds = warped.get();
+  }
+  auto* band = ds->GetRasterBand(1);
+  std::vector<double> rows(g.cells());
+  if (band->RasterIO(GF_Read, 0, 0, g.nx, g.ny, rows.data(), g.nx, g.ny, GDT_Float64, 0, 0) != CE_None)
+    throw TerrainError(what + ": cannot read '" + path + "'" + gdal_message());
+  int has_nodata = 0;
+  const double nodata = band->GetNoDataValue(&has_nodata);
+  std::vector<double> v(g.cells());
+  for (int r = 0; r < g.ny; ++r)
+    for (int i = 0; i < g.nx; ++i) {
+      const double x = rows[std::size_t(r) * g.nx + i];
+      v[std::size_t(g.ny - 1 - r) * g.nx + i] = (has_nodata && x == nodata) ? NAN : x;
+    }
+  return v;
+}
+
+}  // namespace runout::terrain
