@@ -1,6 +1,6 @@
 // Work-precision and throughput benchmark of the depth-averaged solvers (docs/design/performance.md).
 //
-//   runout_bench_sh [--quick] [--repeat N]
+//   runout_bench_sh [--quick] [--repeat N] [--throughput-only]
 //
 // 1. Work-precision: cases A1 (1D and 2D) and A3 (2D) at four resolutions for each limiter:
 //    error, wall time, cell-updates per second.
@@ -8,6 +8,7 @@
 // 3. Skipping dry work: the same grid with a release that wets about 5 % of it, cost per step
 //    relative to the fully wet grid.
 // Figures are medians over --repeat runs (default 5), all measured in this one process.
+// --throughput-only skips part 1 (for quick before/after comparisons of the 2D step).
 #include <omp.h>
 
 #include <algorithm>
@@ -68,25 +69,8 @@ StepCost measure(const Terrain2D& t, const Sh2dState& init, long steps, int repe
   return {median(per_step), median(rate), last.diag.mean_active_fraction, wet / double(t.cells()), last.diag.steps};
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  bool quick = false;
-  int repeat = 5;
-  for (int k = 1; k < argc; ++k) {
-    if (!std::strcmp(argv[k], "--quick")) {
-      quick = true;
-    } else if (!std::strcmp(argv[k], "--repeat") && k + 1 < argc) {
-      repeat = std::max(1, std::atoi(argv[++k]));
-    } else {
-      std::fprintf(stderr, "usage: runout_bench_sh [--quick] [--repeat N]\n");
-      return 2;
-    }
-  }
-  if (quick) repeat = 1;
-  std::printf("# runout depth-averaged engine benchmark, %d OpenMP threads, median of %d\n\n", omp_get_max_threads(),
-              repeat);
-
+// Part 1: error, wall time and throughput of the verification cases A1 and A3.
+void work_precision(bool quick) {
   std::printf("## Work-precision\n\n");
   std::printf("| case | variant | cells | dx [m] | error | order | wall [s] | Mcell-updates/s |\n");
   std::printf("|---|---|---:|---:|---:|---:|---:|---:|\n");
@@ -105,6 +89,30 @@ int main(int argc, char** argv) {
       }
     }
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  bool quick = false, throughput_only = false;
+  int repeat = 5;
+  for (int k = 1; k < argc; ++k) {
+    if (!std::strcmp(argv[k], "--quick")) {
+      quick = true;
+    } else if (!std::strcmp(argv[k], "--throughput-only")) {
+      throughput_only = true;
+    } else if (!std::strcmp(argv[k], "--repeat") && k + 1 < argc) {
+      repeat = std::max(1, std::atoi(argv[++k]));
+    } else {
+      std::fprintf(stderr, "usage: runout_bench_sh [--quick] [--repeat N] [--throughput-only]\n");
+      return 2;
+    }
+  }
+  if (quick) repeat = 1;
+  std::printf("# runout depth-averaged engine benchmark, %d OpenMP threads, median of %d\n\n", omp_get_max_threads(),
+              repeat);
+
+  if (!throughput_only) work_precision(quick);
 
   const int n = quick ? 400 : 1000;
   const double dx = 5.0;

@@ -1,8 +1,8 @@
 #pragma once
 // The depth-averaged 2D solver's internals (engine/sh2d.hpp is the interface): the tile work space,
 // the face types and the Solver. solver.cpp holds the set-up, the time loop and checkpoints;
-// step.cpp the scheme of one tile's step (predictor, face fluxes, positivity, update), the hot
-// kernels in one translation unit so that they inline into each other.
+// step.cpp the first half of one tile's step (predictor, face fluxes), update.cpp the second
+// (positivity limiter, update, hazard maps, tile sums).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -10,6 +10,14 @@
 #include <vector>
 
 #include "engine/sh2d.hpp"
+
+// The vectorisable kernels are compiled twice, for AVX2 (four doubles per instruction) and for the
+// baseline x86-64 (two), and the loader picks the one the CPU supports.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define RUNOUT_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define RUNOUT_SIMD_CLONES
+#endif
 
 namespace runout::engine::sh2d_detail {
 
@@ -37,6 +45,10 @@ struct TileWork {
   // Face fluxes (mass, x-momentum, y-momentum); Fx*[(j - bj0) * (bw + 1) + (i - bi0)]: face left of
   // cell (i, j), Fy*[(j - bj0) * bw + (i - bi0)]: face below it.
   std::vector<double> Fx0, Fx1, Fx2, Fy0, Fy1, Fy2;
+  // One tile row's terms of the tile sums (index i - i0): kinetic energy, speed of a flowing cell
+  // (else 0), CFL rate; written by the update's cell kernels, summed in cell order afterwards. And
+  // the row kernel's normal depth and pressure of a flowing cell (else 0), for the hazard maps.
+  std::vector<double> cell_ke, cell_speed, cell_rate, cell_h, cell_pressure;
   Face fxf(std::size_t k) const { return Face{Fx0[k], Fx1[k], Fx2[k]}; }
   Face fyf(std::size_t k) const { return Face{Fy0[k], Fy1[k], Fy2[k]}; }
   void reserve(int T) {
@@ -45,6 +57,7 @@ struct TileWork {
     held.assign(n, 0.0);
     for (auto* v : {&Fx0, &Fx1, &Fx2}) v->assign(std::size_t(T + 5) * (T + 4), 0.0);
     for (auto* v : {&Fy0, &Fy1, &Fy2}) v->assign(std::size_t(T + 4) * (T + 5), 0.0);
+    for (auto* v : {&cell_ke, &cell_speed, &cell_rate, &cell_h, &cell_pressure}) v->assign(std::size_t(T), 0.0);
   }
   std::size_t at(int i, int j) const { return std::size_t(j - bj0) * bw + (i - bi0); }
   std::size_t fx(int i, int j) const { return std::size_t(j - bj0) * (bw + 1) + (i - bi0); }
@@ -125,13 +138,16 @@ class Solver {
   void predictor(TileWork& w, double dt) const;
   void earth_pressure(std::size_t k, int i, int j, double U, double V, double& Pxx, double& Pxy, double& Pyy,
                       double& Ps) const;
-  template <Limiter L>
+  template <Limiter L, bool Voellmy>
   void predictor_row(TileWork& w, int j, int ia, int ib, double dt) const;
-  void faces(TileWork& w) const;
+  void faces(TileWork& w, int ci0, int ci1, int cj0, int cj1) const;
   template <bool X>
   Face face(const TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi, Boundary2D blo, Boundary2D bhi) const;
   long positivity(TileWork& w, int i0, int i1, int j0, int j1, double dt) const;
-  void update(int tt, const TileWork& w, double t, double dt);
+  void update(int tt, TileWork& w, double t, double dt);
+  void update_cell(TileWork& w, int i, int j, int i0, double t, double dt, double& out);
+  template <bool Voellmy>
+  void update_row(TileWork& w, int j, int ia, int ib, int i0, double dt);
 
   const Terrain2D& t_;
   const Sh2dConfig& cfg_;

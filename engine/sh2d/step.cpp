@@ -1,19 +1,10 @@
-// One tile's step of the depth-averaged 2D scheme: the predictor to the half step (general loop
-// and branch-free row kernel), the central face fluxes, the positivity limiter and the update with
-// the sources, friction and hazard maps.
+// The first half of one tile's step of the depth-averaged 2D scheme: the predictor to the half step
+// (general loop and branch-free row kernel) and the central face fluxes (update.cpp: the rest).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 
 #include "engine/sh2d/solver.hpp"
-
-// The vectorisable kernels are compiled twice, for AVX2 (four doubles per instruction) and for the
-// baseline x86-64 (two), and the loader picks the one the CPU supports.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define RUNOUT_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define RUNOUT_SIMD_CLONES
-#endif
 
 namespace runout::engine::sh2d_detail {
 namespace {
@@ -102,7 +93,8 @@ void Solver::predictor(TileWork& w, double dt) const {
       if (fast && j > 0 && j < ny_ - 1 && i >= fa && i < fb && !near_outside(idx(i, j))) {
         int e = i + 1;  // a run of cells for the row kernel
         while (e < fb && !near_outside(idx(e, j))) ++e;
-        predictor_row<lim>(w, j, i, e, dt);
+        if (ixi_ > 0) predictor_row<lim, true>(w, j, i, e, dt);
+        else predictor_row<lim, false>(w, j, i, e, dt);
         i = e - 1;
         continue;
       }
@@ -227,8 +219,10 @@ RUNOUT_SIMD_CLONES void face_row(int n, std::ptrdiff_t s, const double* __restri
 
 // The predictor of the branch-free kind for cells (ia..ib-1, j), all away from the domain's edges,
 // K = 1. Same arithmetic as the general loop in Solver::predictor, written with 0/1
-// masks instead of branches so that the compiler can vectorise it.
-template <Limiter lim>
+// masks instead of branches so that the compiler can vectorise it. Voellmy: the turbulent drag is
+// on (1/xi > 0); without it its factor would be exactly 1, and its square root and division are
+// skipped.
+template <Limiter lim, bool Voellmy>
 RUNOUT_SIMD_CLONES void Solver::predictor_row(TileWork& w, int j, int ia, int ib, double dt) const {
   const double* __restrict Hs = H_[cur_].data();
   const double* __restrict HUs = HU_[cur_].data();
@@ -286,10 +280,15 @@ RUNOUT_SIMD_CLONES void Solver::predictor_row(TileWork& w, int j, int ia, int ib
     const double M3 = std::sqrt(Up * Up + Vp * Vp + wp * wp);
     const double f = std::max(0.0, 1.0 - imp / std::max(M3, 1e-300));
     const double rest = M3 <= imp ? 1.0 : 0.0;
-    const double ft = 2.0 / (1.0 + std::sqrt(1.0 + 4.0 * (0.5 * dt * g * ixi / std::max(H * c, 1e-300)) *
-                                                       std::max(M3 - imp, 0.0)));
-    Up *= f * ft;
-    Vp *= f * ft;
+    if constexpr (Voellmy) {
+      const double ft = 2.0 / (1.0 + std::sqrt(1.0 + 4.0 * (0.5 * dt * g * ixi / std::max(H * c, 1e-300)) *
+                                                         std::max(M3 - imp, 0.0)));
+      Up *= f * ft;
+      Vp *= f * ft;
+    } else {
+      Up *= f;
+      Vp *= f;
+    }
     oheld[t] = std::abs(HUs[k]) + std::abs(HVs[k]) == 0.0 ? rest : 0.0;
     oHx[t] = sHx;
     oux[t] = sux;
@@ -307,11 +306,11 @@ RUNOUT_SIMD_CLONES void Solver::predictor_row(TileWork& w, int j, int ia, int ib
   }
 }
 
-void Solver::faces(TileWork& w) const {
-  // Every face of the box whose two cells lie in it, and the domain's edges. A face between an active
-  // tile and an inactive one carries nothing: both its cells hold less than the activation depth and
-  // the inactive side is not updated, so this keeps the volume exact.
-  const int i0 = w.bi0, i1 = w.bi0 + w.bw, j0 = w.bj0, j1 = w.bj0 + w.bh;
+void Solver::faces(TileWork& w, int ci0, int ci1, int cj0, int cj1) const {
+  // Every face of the cells (ci0..ci1-1, cj0..cj1-1) (the tile grown by one, clipped to the grid: what
+  // the positivity limiter and the update read), from the box's predicted values. A face between an
+  // active tile and an inactive one carries nothing: both its cells hold less than the activation
+  // depth and the inactive side is not updated, so this keeps the volume exact.
   auto put_x = [&](int i, int j, const Face& f) {
     const std::size_t k = w.fx(i, j);
     w.Fx0[k] = f.f0;
@@ -324,136 +323,33 @@ void Solver::faces(TileWork& w) const {
     w.Fy1[k] = g.f2;
     w.Fy2[k] = g.f1;
   };
-  // x faces: interior ones (both cells in the box, not a domain edge) by rows, the rest one by one.
-  const int xa = std::max(i0 + 1, 1), xb = std::min(i1 - 1, nx_ - 1);  // interior face range [xa, xb]
-  for (int j = j0; j < j1; ++j) {
-    if (w.all_active && !w.has_outside && xb >= xa) {
+  // Faces between two cells of the domain take the branch-free row kernel where every tile around is
+  // active and no cell is outside; the domain's edges and the rest the general function.
+  const bool rows = w.all_active && !w.has_outside;
+  const int xa = std::max(ci0, 1), xb = std::min(ci1, nx_ - 1);  // x faces [xa, xb] between two cells
+  for (int j = cj0; j < cj1; ++j) {
+    if (rows && xb >= xa) {
       const std::size_t q = w.at(xa, j), f = w.fx(xa, j);
       face_row(xb - xa + 1, 1, &w.Hp[q], &w.sHx[q], &w.Up[q], &w.sux[q], &w.Vp[q], &w.svx[q], &w.Pxx[q], &w.Pxy[q],
                &w.held[q], &w.Fx0[f], &w.Fx1[f], &w.Fx2[f]);
     }
-    for (int i = i0; i <= i1; ++i) {
+    for (int i = ci0; i <= ci1; ++i) {
+      if (rows && i == xa && xb >= xa) i = xb + 1;  // done above
+      if (i > ci1) break;
       const bool west = i == 0, east = i == nx_;
-      if ((i == i0 && !west) || (i == i1 && !east)) continue;  // the other cell lies outside the box
-      if (w.all_active && !w.has_outside && i >= xa && i <= xb) continue;  // done above
       put_x(i, j, face<true>(w, i - 1, j, i, j, west, east, cfg_.west, cfg_.east));
     }
   }
-  // y faces: interior rows of faces (between box rows j-1 and j) in one go, domain edges one by one.
-  for (int j = j0; j <= j1; ++j) {
+  for (int j = cj0; j <= cj1; ++j) {  // y faces: the face below row j
     const bool south = j == 0, north = j == ny_;
-    if ((j == j0 && !south) || (j == j1 && !north)) continue;
-    if (w.all_active && !w.has_outside && !south && !north) {
-      const std::size_t q = w.at(i0, j), f = w.fy(i0, j);
-      face_row(w.bw, w.bw, &w.Hp[q], &w.sHy[q], &w.Vp[q], &w.svy[q], &w.Up[q], &w.suy[q], &w.Pyy[q], &w.Pxy[q],
+    if (rows && !south && !north) {
+      const std::size_t q = w.at(ci0, j), f = w.fy(ci0, j);
+      face_row(ci1 - ci0, w.bw, &w.Hp[q], &w.sHy[q], &w.Vp[q], &w.svy[q], &w.Up[q], &w.suy[q], &w.Pyy[q], &w.Pxy[q],
                &w.held[q], &w.Fy0[f], &w.Fy2[f], &w.Fy1[f]);
       continue;
     }
-    for (int i = i0; i < i1; ++i) put_y(i, j, face<false>(w, i, j - 1, i, j, south, north, cfg_.south, cfg_.north));
+    for (int i = ci0; i < ci1; ++i) put_y(i, j, face<false>(w, i, j - 1, i, j, south, north, cfg_.south, cfg_.north));
   }
-}
-
-long Solver::positivity(TileWork& w, int i0, int i1, int j0, int j1, double dt) const {
-  // Draining-time limiter on the tile grown by one: a cell may not send out more volume than it holds.
-  const auto& Hs = H_[cur_];
-  long limited = 0;
-  for (int j = std::max(j0 - 1, 0); j < std::min(j1 + 1, ny_); ++j)
-    for (int i = std::max(i0 - 1, 0); i < std::min(i1 + 1, nx_); ++i) {
-      const double out = dt / t_.dx * (std::max(w.Fx0[w.fx(i + 1, j)], 0.0) + std::max(-w.Fx0[w.fx(i, j)], 0.0)) +
-                         dt / t_.dy * (std::max(w.Fy0[w.fy(i, j + 1)], 0.0) + std::max(-w.Fy0[w.fy(i, j)], 0.0));
-      const double H = Hs[idx(i, j)];
-      double r = 1.0;
-      if (out > H) {
-        r = H / out;
-        limited += i >= i0 && i < i1 && j >= j0 && j < j1;
-      }
-      w.r[w.at(i, j)] = r;
-    }
-  return limited;
-}
-
-void Solver::update(int tt, const TileWork& w, double t, double dt) {
-  int i0, i1, j0, j1;
-  tile_range(tt, i0, i1, j0, j1);
-  const auto &H0 = H_[cur_], &HU0 = HU_[cur_], &HV0 = HV_[cur_];
-  auto &H1 = H_[1 - cur_], &HU1 = HU_[1 - cur_], &HV1 = HV_[1 - cur_], &U1 = U_[1 - cur_], &V1 = V_[1 - cur_];
-  const double lx = dt / t_.dx, ly = dt / t_.dy, dry = cfg_.dry_depth;
-  double out = 0, travel = 0, mass = 0, ke = 0, vmax = 0, rate = 0;
-  bool wet = false;
-  // Scaled face flux: the limiter factor of the upwind (sending) cell.
-  auto scaled = [&](const Face& f, int il, int jl, int ir, int jr, bool has_l, bool has_r) {
-    double s = 1.0;
-    if (f.f0 > 0 && has_l) s = w.r[w.at(il, jl)];
-    else if (f.f0 < 0 && has_r) s = w.r[w.at(ir, jr)];
-    return Face{f.f0 * s, f.f1 * s, f.f2 * s};
-  };
-  for (int j = j0; j < j1; ++j)
-    for (int i = i0; i < i1; ++i) {
-      const std::size_t k = idx(i, j), q = w.at(i, j);
-      if (w.has_outside && outside(i, j)) continue;  // never holds material (both buffers stay 0)
-      const Face fw = scaled(w.fxf(w.fx(i, j)), i - 1, j, i, j, i > 0, true);
-      const Face fe = scaled(w.fxf(w.fx(i + 1, j)), i, j, i + 1, j, true, i < nx_ - 1);
-      const Face fs = scaled(w.fyf(w.fy(i, j)), i, j - 1, i, j, j > 0, true);
-      const Face fn = scaled(w.fyf(w.fy(i, j + 1)), i, j, i, j + 1, true, j < ny_ - 1);
-      const bool ow = w.has_outside && i > 0 && outside(i - 1, j), oe = w.has_outside && i < nx_ - 1 && outside(i + 1, j);
-      const bool os = w.has_outside && j > 0 && outside(i, j - 1), on = w.has_outside && j < ny_ - 1 && outside(i, j + 1);
-      if (i == 0 || ow) out -= fw.f0 * dt * t_.dy;
-      if (i == nx_ - 1 || oe) out += fe.f0 * dt * t_.dy;
-      if (j == 0 || os) out -= fs.f0 * dt * t_.dx;
-      if (j == ny_ - 1 || on) out += fn.f0 * dt * t_.dx;
-      double H = H0[k] - lx * (fe.f0 - fw.f0) - ly * (fn.f0 - fs.f0);
-      if (H < 0) H = 0;  // round-off only: the limiter above bounds the outflow by the content
-      // Source at the half step (midpoint rule).
-      const double Hp = w.Hp[q], Up = w.Up[q], Vp = w.Vp[q];
-      const double gn = normal_g(k, Up, Vp);
-      const double drive = -Hp * geo_.c[k] * geo_.c[k] * gn;
-      double MU = HU0[k] - lx * (fe.f1 - fw.f1) - ly * (fn.f1 - fs.f1) + dt * drive * geo_.bx[k];
-      double MV = HV0[k] - lx * (fe.f2 - fw.f2) - ly * (fn.f2 - fs.f2) + dt * drive * geo_.by[k];
-      double U = 0, V = 0, sp = 0;
-      if (H > dry) {
-        // Friction at the half step (midpoint rule), as a bounded impulse that never reverses u.
-        const double M3 = m3(k, MU, MV), impulse = dt * resistance(k, Hp, gn);
-        apply_friction(MU, MV, M3, impulse);
-        const double inv = 1.0 / H;
-        sp = std::max(M3 - impulse, 0.0) * inv;  // surface speed after Coulomb friction
-        if (ixi_ > 0) {  // Voellmy drag, implicit in the speed
-          const double f = turbulent_factor(sp, H * geo_.c[k], dt * g_ * ixi_);
-          MU *= f;
-          MV *= f;
-          sp *= f;
-        }
-        U = MU * inv;
-        V = MV * inv;
-      } else {
-        MU = MV = 0;
-      }
-      H1[k] = H;
-      HU1[k] = MU;
-      HV1[k] = MV;
-      U1[k] = U;
-      V1[k] = V;
-      if (cfg_.track_travel) travel += dt * std::sqrt(MU * MU + MV * MV);
-      // Hazard maps and tile sums from the new state.
-      const double h = H * geo_.c[k], sp2 = sp * sp;
-      hz_.max_depth[k] = std::max(hz_.max_depth[k], h);
-      if (h > cfg_.flow_threshold) {
-        hz_.max_speed[k] = std::max(hz_.max_speed[k], sp);
-        hz_.max_pressure[k] = std::max(hz_.max_pressure[k], cfg_.material.density * sp2);
-        if (std::isnan(hz_.arrival_time[k])) hz_.arrival_time[k] = t + dt;
-        vmax = std::max(vmax, sp);  // reported speeds: flowing cells only, as in the map
-      }
-      mass += H;
-      ke += 0.5 * H * sp2;  // the stopping rule sees every cell
-      rate = std::max(rate, std::abs(U) / t_.dx + std::abs(V) / t_.dy + w.Ps[q] * std::sqrt(H));
-      wet = wet || H > cfg_.activation_depth;
-    }
-  tile_out_[tt] += out;
-  tile_travel_[tt] += travel;
-  tile_mass_[tt] = mass;
-  tile_ke_[tt] = ke;
-  tile_speed_[tt] = vmax;
-  tile_rate_[tt] = rate;
-  tile_wet_[tt] = wet;
 }
 
 void Solver::step_tile(int tt, double t, double dt, TileWork& w) {
@@ -476,7 +372,7 @@ void Solver::step_tile(int tt, double t, double dt, TileWork& w) {
     case Limiter::vanleer: predictor<Limiter::vanleer>(w, dt); break;
     case Limiter::superbee: predictor<Limiter::superbee>(w, dt); break;
   }
-  faces(w);
+  faces(w, std::max(i0 - 1, 0), std::min(i1 + 1, nx_), std::max(j0 - 1, 0), std::min(j1 + 1, ny_));
   tile_limited_[tt] += positivity(w, i0, i1, j0, j1, dt);
   update(tt, w, t, dt);
 }
