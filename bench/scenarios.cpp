@@ -1,7 +1,8 @@
 // End-to-end benchmark of the bundled scenarios: wall time and peak memory of `runout run` for each,
 // at its native resolution. Each scenario runs in a child process so that its peak resident memory
 // is its own.
-//   runout_bench_scenarios [--repeat N] [SCENARIO.json ...]   (default: every scenarios/*.json, N = 3)
+//   runout_bench_scenarios [--repeat N] [SCENARIO.json ...]   (default: every scenarios/*.json but the
+//   ensembles, which runout_bench_ensemble measures; N = 3)
 // Prints the median wall time of N runs and its range; peak memory is the largest of the N.
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -35,7 +36,8 @@ int main(int argc, char** argv) {
   }
   if (files.empty()) {
     for (const auto& e : fs::directory_iterator(fs::path(RUNOUT_SOURCE_DIR) / "scenarios"))
-      if (e.path().extension() == ".json") files.push_back(e.path().string());
+      if (e.path().extension() == ".json" && e.path().stem().string().find("ensemble") == std::string::npos)
+        files.push_back(e.path().string());  // ensembles: runout_bench_ensemble
     std::sort(files.begin(), files.end());
   }
   std::printf("| scenario | cells | cell size [m] | steps | simulated [s] | wall, median [s] | wall, range [s] | peak memory [MiB] | affected area [km2] | runout [m] | max speed [m/s] |\n");

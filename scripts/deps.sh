@@ -12,6 +12,7 @@ RUNOUT_PACKAGES=(
   python3-grpcio python3-protobuf
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev
+  munge slurmctld slurmd slurm-client
 )
 
 runout_install_deps() {

@@ -55,6 +55,12 @@ struct DemReport {
   long cells_outside_area = 0;   ///< outside the area-of-interest polygon
 };
 
+/// The terrain cache (grid_cache.cpp): a prepared grid and its report saved (atomically; a cache
+/// that cannot be written is skipped) and read back bit for bit; load_grid is false for a missing
+/// file or one that is not a cache of this version.
+void save_grid(const std::string& path, const Grid& g, const DemReport& r);
+bool load_grid(const std::string& path, Grid& g, DemReport& r);
+
 /// Read, reproject, resample and clip the DEM. Throws TerrainError.
 Grid prepare_grid(const DemRequest& req, DemReport* report = nullptr);
 

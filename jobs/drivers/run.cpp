@@ -105,6 +105,34 @@ ShCheckpoint load_restart(const RunOptions& opt, const std::string& hash, const 
   return restart;
 }
 
+// The grid from the terrain cache (`dir`) when it holds this DEM, area of interest and grid, else
+// prepared and saved there. The key is the request and each input file's path, size and
+// modification time: a file changed in place gets a new entry.
+terrain::Grid cached_grid(const terrain::DemRequest& q, const std::string& dir, terrain::DemReport& rep) {
+  if (dir.empty()) return terrain::prepare_grid(q, &rep);
+  Sha256 h;
+  h.update("runout terrain cache 1\n");
+  for (const auto& f : {q.dem_path, q.aoi_path}) {
+    std::error_code ec;
+    const auto canon = f.empty() ? fs::path() : fs::canonical(f, ec);
+    const auto size = f.empty() ? 0 : fs::file_size(f, ec);
+    const auto mtime = f.empty() ? fs::file_time_type() : fs::last_write_time(f, ec);
+    if (ec) return terrain::prepare_grid(q, &rep);  // the preparation names the file's problem
+    h.update(canon.string() + "\n" + std::to_string(size) + "\n" + std::to_string(mtime.time_since_epoch().count()) + "\n");
+  }
+  char b[200];
+  std::snprintf(b, sizeof b, "%.17g %.17g %.17g\n", q.resolution, q.memory_budget_bytes, q.bytes_per_cell);
+  h.update(q.dem_crs + "\n" + q.target_crs + "\n" + q.resampling + "\n" + b);
+  const std::string path = (fs::path(dir) / (h.hex() + ".grid")).string();
+  terrain::Grid g;
+  if (terrain::load_grid(path, g, rep)) return g;
+  g = terrain::prepare_grid(q, &rep);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  terrain::save_grid(path, g, rep);
+  return g;
+}
+
 }  // namespace
 
 RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt) {
@@ -113,7 +141,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   RunSummary sum;
   const auto t0 = std::chrono::steady_clock::now();
   terrain::DemReport dem_rep;
-  const terrain::Grid grid = terrain::prepare_grid(s.dem, &dem_rep);
+  const terrain::Grid grid = cached_grid(s.dem, opt.terrain_cache_dir, dem_rep);
   terrain::ReleaseReport rel_rep;
   const auto h0 = terrain::rasterize_releases(grid, s.releases, &rel_rep);
   const auto output_inputs = read_output_inputs(s, grid, h0);  // a bad point, line or outline: refused before the run

@@ -30,6 +30,9 @@ struct RunOptions {
   /// runs whose scenario sets no lab.checkpoint_interval_s (0: checkpoints only when the run is
   /// interrupted).
   double checkpoint_interval_s = 0;
+  /// Depth-averaged runs: the terrain cache's folder (the prepared grid of a DEM, area and grid,
+  /// shared by the runs that use them, e.g. an ensemble's members); empty: the grid is prepared.
+  std::string terrain_cache_dir;
 };
 
 struct RunSummary {

@@ -113,6 +113,7 @@ int worker_main(int in_fd, int out_fd) {
     opt.progress_every = 1;  // the stop flag is seen after every step
     opt.checkpoint_path = task.checkpoint_path();
     opt.restart_path = task.restart_path();
+    opt.terrain_cache_dir = task.terrain_cache_dir();
     const double t_end = r.end_time_s();
     opt.checkpoint_interval_s = task.checkpoint_interval_s() < 0 ? t_end / 20 : task.checkpoint_interval_s();
     const double every = task.progress_interval_s() > 0 ? task.progress_interval_s() : 0.5;

@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "jobs/system/state_dir.hpp"
+#include "jobs/system/slurm.hpp"
 #include "jobs/system/worker.hpp"
 #include "runout/v1/worker.pb.h"
 
@@ -43,6 +44,17 @@ Scheduler::Scheduler(JobStore& store, SchedulerConfig cfg) : store_(store), cfg_
   fs::create_directories(fs::path(cfg_.state_dir) / "results");
   fs::create_directories(fs::path(cfg_.state_dir) / "logs");
   fs::create_directories(fs::path(cfg_.state_dir) / "checkpoints");
+  if (cfg_.slurm) {
+    SlurmConfig sc = *cfg_.slurm;
+    std::error_code ec;
+    if (sc.worker_exe.empty()) sc.worker_exe = fs::read_symlink("/proc/self/exe", ec).string();  // as the compute nodes see it
+    if (sc.job_name.empty()) {  // one name per state directory: a restarted server finds what its predecessor left
+      char b[24];
+      std::snprintf(b, sizeof b, "%016zx", std::hash<std::string>{}(fs::absolute(cfg_.state_dir).string()));
+      sc.job_name = std::string("runout-") + b;
+    }
+    slurm_ = std::make_unique<SlurmSubmitter>((fs::path(cfg_.state_dir) / "slurm").string(), sc);
+  }
 }
 
 std::string Scheduler::checkpoint_path(const std::string& id) const {
@@ -72,6 +84,9 @@ std::string Scheduler::log_path(const std::string& id) const {
 }
 
 void Scheduler::start() {
+  // Tasks a server killed outright left on the cluster: cancelled (they end at their step, with a
+  // checkpoint), their jobs queued again below.
+  if (slurm_) slurm_->cancel_all();
   std::vector<JobStore::Change> changed;
   const int n = store_.requeue_running(
       "the server went down during the run; queued to run again (from its last checkpoint where it has one)", &changed);
@@ -168,6 +183,13 @@ void Scheduler::apply_retention() {
     last_retention_ = std::chrono::steady_clock::now();
   }
   remove_orphan_checkpoints();
+  if (cfg_.retention_days > 0) {  // prepared grids no run has written for that long
+    std::error_code ec;
+    const auto cutoff = fs::file_time_type::clock::now() - std::chrono::duration_cast<fs::file_time_type::duration>(
+                                                                std::chrono::duration<double>(cfg_.retention_days * 86400.0));
+    for (const auto& e : fs::directory_iterator(fs::path(cfg_.state_dir) / "cache" / "terrain", ec))
+      if (fs::last_write_time(e.path(), ec) < cutoff) fs::remove(e.path(), ec);
+  }
   if (cfg_.retention_days <= 0 && cfg_.retention_max_bytes <= 0) return;
   auto finished = store_.finished_results();  // oldest first
   const double now = double(std::time(nullptr));
@@ -418,6 +440,7 @@ void Scheduler::run_job(StoredJob job) {
   task.set_progress_interval_s(0.25);
   task.set_checkpoint_path(jc.cp);
   task.set_checkpoint_interval_s(-1);  // a twentieth of the end time (the worker knows it, defaults filled in)
+  if (cfg_.terrain_cache) task.set_terrain_cache_dir((fs::path(cfg_.state_dir) / "cache" / "terrain").string());
   if (fs::exists(jc.cp, ec)) {
     task.set_restart_path(jc.cp);
     jc.say("continuing from its checkpoint");
@@ -473,8 +496,13 @@ Scheduler::Attempt Scheduler::supervise(JobContext& jc, const v1::WorkerTask& ta
   const std::string& id = jc.id;
   Attempt a;
   try {
-    WorkerProcess w(cfg_.worker_exe, task, log_path(id));
-    jc.say("worker process " + std::to_string(w.pid()));
+    std::unique_ptr<Execution> run;
+    if (slurm_)
+      run = std::make_unique<SlurmStep>(*slurm_, task, log_path(id));
+    else
+      run = std::make_unique<WorkerProcess>(cfg_.worker_exe, task, log_path(id));
+    Execution& w = *run;
+    jc.say(w.where());
     const auto t0 = std::chrono::steady_clock::now();
     auto last_check = t0, kill_at = t0, last_saved = t0;
     for (;;) {

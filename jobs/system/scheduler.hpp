@@ -19,12 +19,15 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "jobs/system/slurm.hpp"
 #include "jobs/system/store.hpp"
 #include "runout/v1/worker.pb.h"
 
@@ -43,6 +46,10 @@ struct SchedulerConfig {
   double stop_grace_s = 1;          ///< a stopped or cancelled worker is killed after this long
   int max_crashes = 3;              ///< a job whose worker crashed this often fails
   std::vector<std::string> data_roots;  ///< the server's data roots (left out of messages to clients)
+  bool terrain_cache = true;        ///< depth-averaged runs share prepared grids (STATE/cache/terrain)
+  /// Run the jobs as tasks of Slurm job arrays (jobs/system/slurm.hpp) instead of local worker
+  /// processes; `workers` is then how many tasks may be on the cluster at once.
+  std::optional<SlurmConfig> slurm;
 };
 
 /// A message for a client: the server's upload folders and data roots left out of the paths in it,
@@ -120,6 +127,7 @@ class Scheduler {
   std::chrono::steady_clock::time_point last_retention_{};  // guarded by mu_
   std::mutex retention_mu_;
   std::mutex results_mu_;  // results/<hash> folders: moved in, answered from, removed
+  std::unique_ptr<SlurmSubmitter> slurm_;  // the Slurm backend; null: local worker processes
 };
 
 }  // namespace runout::jobs

@@ -22,8 +22,6 @@ namespace runout::jobs {
 
 namespace {
 
-constexpr std::size_t kMaxEventBytes = 64u << 20;
-
 std::string signal_name(int sig) {
   switch (sig) {
     case SIGSEGV: return "SIGSEGV";
@@ -154,21 +152,12 @@ bool WorkerProcess::fill(std::chrono::milliseconds timeout) {
 std::optional<v1::WorkerEvent> WorkerProcess::next_event(std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
-    if (buf_.size() >= 4) {
-      const auto* u = reinterpret_cast<const unsigned char*>(buf_.data());
-      const std::size_t n = std::size_t(u[0]) | std::size_t(u[1]) << 8 | std::size_t(u[2]) << 16 | std::size_t(u[3]) << 24;
-      if (n > kMaxEventBytes) {  // not our protocol: nothing more can be read from this stream
-        buf_.clear();
-        closed_ = true;
-        return std::nullopt;
-      }
-      if (buf_.size() >= 4 + n) {
-        v1::WorkerEvent ev;
-        const bool ok = ev.ParseFromArray(buf_.data() + 4, int(n));
-        buf_.erase(0, 4 + n);
-        if (ok) return ev;
-        continue;  // a damaged event is skipped; the outcome decides
-      }
+    v1::WorkerEvent ev;
+    const EventParse got = take_event(buf_, ev);
+    if (got == EventParse::event) return ev;
+    if (got == EventParse::broken) {  // not our protocol: nothing more can be read from this stream
+      closed_ = true;
+      return std::nullopt;
     }
     if (closed_) return std::nullopt;
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());

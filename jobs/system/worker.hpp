@@ -16,6 +16,7 @@
 #include <optional>
 #include <string>
 
+#include "jobs/system/execution.hpp"
 #include "runout/v1/worker.pb.h"
 
 namespace runout::jobs {
@@ -24,40 +25,32 @@ namespace runout::jobs {
 /// this very program even after an upgrade replaced its file.
 std::string self_executable();
 
-/// How a worker process ended.
-struct WorkerExit {
-  bool exited = false;  ///< by exit(); else by a signal
-  int code = 0;         ///< exit status when exited
-  int signal = 0;       ///< the signal that ended it
-  bool signal_ours = false;  ///< that signal (or the SIGTERM before it) came from us
-  std::string describe() const;  ///< "exit status 3", "SIGSEGV", ...
-};
-
 /// One worker process as seen from the server.
-class WorkerProcess {
+class WorkerProcess : public Execution {
  public:
   /// Starts `exe worker` with the task on its standard input and its standard error appended to
   /// `log_path`. The process dies with the thread that started it (PR_SET_PDEATHSIG), so a killed
   /// server leaves no worker behind. Throws std::runtime_error when it cannot start.
   WorkerProcess(const std::string& exe, const v1::WorkerTask& task, const std::string& log_path);
   /// Kills a worker that is still running and reaps it.
-  ~WorkerProcess();
+  ~WorkerProcess() override;
   WorkerProcess(const WorkerProcess&) = delete;
   WorkerProcess& operator=(const WorkerProcess&) = delete;
 
   pid_t pid() const { return pid_; }
+  std::string where() const override { return "worker process " + std::to_string(pid_); }
   /// The next event, waiting at most `timeout`; nothing on timeout or once the output is closed.
-  std::optional<v1::WorkerEvent> next_event(std::chrono::milliseconds timeout);
+  std::optional<v1::WorkerEvent> next_event(std::chrono::milliseconds timeout) override;
   /// The worker closed its output (it ended, or is ending).
-  bool output_closed() const { return closed_; }
+  bool output_closed() const override { return closed_; }
   /// Send a signal (recorded: a death by it, or by SIGKILL after it, is ours).
-  void signal(int sig);
+  void signal(int sig) override;
   /// SIGTERM now, SIGKILL when it has not ended after `grace`.
   void stop(std::chrono::milliseconds grace);
   /// Wait for the process to end (at most `timeout`; nothing when it has not).
-  std::optional<WorkerExit> wait(std::chrono::milliseconds timeout);
+  std::optional<WorkerExit> wait(std::chrono::milliseconds timeout) override;
   /// Resident memory of the process [bytes] (0 when it cannot be read).
-  std::int64_t resident_bytes() const;
+  std::int64_t resident_bytes() const override;
 
  private:
   bool fill(std::chrono::milliseconds timeout);

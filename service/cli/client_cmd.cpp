@@ -284,9 +284,11 @@ int fetch(const std::vector<std::string>& args) {
                    "previous fetch of a failed job (job.log alone) to be replaced with --force")
       ->type_name("DIR");
   c.app.add_flag("--force", force, "Replace DIR when it holds a previous result or fetch (see --out)");
+  bool with_members = false;
+  c.app.add_flag("--members", with_members, "An ensemble: also each member's results, into DIR/members/member_<k>");
   if (const int rc = c.parse(args); rc >= 0) return rc;
   if (id.empty() || out.empty())
-    return usage_error("runout fetch", "usage: runout fetch JOB --out DIR [--force] (see runout fetch --help)");
+    return usage_error("runout fetch", "usage: runout fetch JOB --out DIR [--force] [--members] (see runout fetch --help)");
   // DIR: absent, or with --force a previous result or fetch (output_dir.hpp); never anything else.
   const fs::path dest = output_path(out);
   if (const auto why = check_output_dir(dest, force, out); !why.empty()) {
@@ -308,18 +310,32 @@ int fetch(const std::vector<std::string>& args) {
                 << (j.error().empty() ? "" : " (" + j.error() + ")") << "; fetching its log only\n";
     }
     std::int64_t bytes = 0;
-    for (const auto& f : files.files()) {
-      if (f.name().empty() || f.name()[0] == '.' || f.name().find_first_of("/\\") != std::string::npos)
-        throw service::RpcError(int(grpc::StatusCode::DATA_LOSS), "the server named a result '" + f.name() + "': not a plain file name");
-      client.download(id, f.name(), (tmp / f.name()).string());
-      bytes += f.bytes();
+    int count = 0;
+    auto download_all = [&](const std::string& job, const v1::ListResultsResponse& list, const fs::path& into) {
+      for (const auto& f : list.files()) {
+        if (f.name().empty() || f.name()[0] == '.' || f.name().find_first_of("/\\") != std::string::npos)
+          throw service::RpcError(int(grpc::StatusCode::DATA_LOSS), "the server named a result '" + f.name() + "': not a plain file name");
+        client.download(job, f.name(), (into / f.name()).string());
+        bytes += f.bytes();
+        ++count;
+      }
+    };
+    download_all(id, files, tmp);
+    if (with_members) {
+      if (j.members().total() == 0) return usage_error("runout fetch", "--members: job " + id + " is not an ensemble");
+      for (const auto& m : client.members(id)) {
+        if (m.state() != v1::SUCCEEDED) continue;  // a member that did not succeed has no results to fetch
+        const fs::path into = tmp / "members" / ("member_" + std::to_string(m.member_index()));
+        fs::create_directories(into);
+        download_all(m.id(), client.results(m.id()), into);
+      }
     }
     if (!staged.publish()) {
       std::cerr << "runout fetch: " << staged.error() << "\n";
       return kOutput;
     }
     if (!staged.note().empty()) std::cerr << "runout fetch: note: " << staged.note() << "\n";
-    std::printf("%d file(s), %.2f MiB, checksums verified, in %s\n", files.files_size(), double(bytes) / (1 << 20),
+    std::printf("%d file(s), %.2f MiB, checksums verified, in %s\n", count, double(bytes) / (1 << 20),
                 dest.string().c_str());
     return j.state() == v1::SUCCEEDED ? kOk : code_of_state(j.state());
   } catch (const service::RpcError& e) {

@@ -66,7 +66,7 @@ struct RunArgs {
   std::string scenario, out, iseesnow, checkpoint, restart, threads;
   bool force = false, quiet = false;
   std::string state_dir, workers;  // ensembles
-  bool members = false;
+  bool members = false, no_terrain_cache = false;
 };
 
 void add_run_options(CLI::App& app, RunArgs& a) {
@@ -102,6 +102,9 @@ void add_run_options(CLI::App& app, RunArgs& a) {
       ->type_name("DIR");
   app.add_option("--workers", a.workers, "Ensembles: cores to use (a positive integer; default: all)")->type_name("N");
   app.add_flag("--members", a.members, "Ensembles: also write each member's results into DIR/members/member_<k>");
+  app.add_flag("--no-terrain-cache", a.no_terrain_cache,
+               "Ensembles: every member prepares its grid (warp, clip) itself instead of sharing the prepared grid in the state "
+               "directory's terrain cache (for measurements)");
 }
 
 // Runs the resolved scenario into `tmp`; kOk, or the exit code of the failure (its message on
@@ -131,7 +134,7 @@ int execute(const jobs::ResolvedScenario& resolved, const fs::path& tmp, const j
 
 int run(const std::vector<std::string>& args) {
   RunArgs a;
-  auto& [scenario, out, iseesnow, checkpoint, restart, threads, force, quiet, state_dir, workers_text, members] = a;
+  auto& [scenario, out, iseesnow, checkpoint, restart, threads, force, quiet, state_dir, workers_text, members, no_cache] = a;
   CLI::App app{kRunHelp, "runout run"};
   add_run_options(app, a);
   if (const int rc = parse_args(app, args); rc >= 0) return rc;
@@ -176,8 +179,9 @@ int run(const std::vector<std::string>& args) {
   if (ensemble && (!checkpoint.empty() || !restart.empty() || !iseesnow.empty()))
     return usage_error("runout run", "--checkpoint, --restart and --iseesnow are for single runs; an ensemble keeps its members' "
                                      "checkpoints in its state directory (--state-dir)");
-  if (!ensemble && (app.count("--state-dir") || app.count("--workers") || members))
-    return usage_error("runout run", "--state-dir, --workers and --members are for ensembles (a scenario with variations)");
+  if (!ensemble && (app.count("--state-dir") || app.count("--workers") || members || no_cache))
+    return usage_error("runout run",
+                       "--state-dir, --workers, --members and --no-terrain-cache are for ensembles (a scenario with variations)");
   int workers = 0;
   if (app.count("--workers")) {
     const auto n = positive_int(a.workers);
@@ -206,7 +210,7 @@ int run(const std::vector<std::string>& args) {
   const auto wall0 = std::chrono::steady_clock::now();
   const bool tty = isatty(fileno(stderr));
   if (ensemble) {
-    EnsembleRun er{tmp.string(), a.state_dir, workers, quiet, tty, members, [] { return g_interrupted.load(); }};
+    EnsembleRun er{tmp.string(), a.state_dir, workers, quiet, tty, members, !no_cache, [] { return g_interrupted.load(); }};
     RunSummaryOut es;
     if (const int rc = run_ensemble(resolved, er, es); rc != kOk) return rc;
     if (!staged.publish()) {

@@ -81,6 +81,7 @@ int run_ensemble(const jobs::ResolvedScenario& r, const EnsembleRun& a, RunSumma
   // More members than cores: one thread each, side by side; fewer: the cores shared among them.
   cfg.workers = std::max(1, std::min<int>(cores, int(plan.members.size())));
   cfg.threads_per_run = std::max(1, cores / cfg.workers);
+  cfg.terrain_cache = a.terrain_cache;
   jobs::Scheduler sched(store, cfg);
   std::vector<jobs::JobStore::NewMember> members;
   for (const auto& m : plan.members) members.push_back({m.member.index, m.hash, m.member.scenario});

@@ -15,6 +15,7 @@ struct EnsembleRun {
   int workers = 0;        ///< cores to use; 0: all
   bool quiet = false, tty = false;
   bool with_members = false;  ///< also copy each member's results into out_dir/members/member_<k>
+  bool terrain_cache = true;  ///< members share prepared grids (the state directory's cache/terrain)
   std::function<bool()> interrupted;  ///< Ctrl-C or SIGTERM arrived
 };
 

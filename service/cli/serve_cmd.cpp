@@ -19,7 +19,7 @@ int serve(const std::vector<std::string>& args) {
   v1::ServerConfig file_cfg, cli_cfg;
   std::vector<std::string> roots;
   bool recover = false;
-  std::string config, listen, state_dir, tokens, tls_cert, tls_key, log_file, workers, threads_per_run;
+  std::string config, listen, state_dir, tokens, tls_cert, tls_key, log_file, workers, threads_per_run, backend;
   CLI::App app{"Run the gRPC batch server (runout.v1.Runout, health checking, reflection) until SIGINT or SIGTERM.\n"
                "Options override the JSON configuration file (deploy/README.md lists every key). Each job runs in a\n"
                "worker process of its own; jobs left running by a killed server are queued again at the next start.\n"
@@ -41,6 +41,10 @@ int serve(const std::vector<std::string>& args) {
   app.add_option("--workers", workers, "Jobs run at a time, a positive integer (default 1)")->type_name("N");
   app.add_option("--threads-per-run", threads_per_run, "OpenMP threads of each job, a positive integer (default: cores / workers)")->type_name("N");
   app.add_option("--log-file", log_file, "The server's log (default: standard error)")->type_name("FILE");
+  app.add_option("--backend", backend,
+                 "Where jobs run: local (worker processes on this machine, default) or slurm (tasks of Slurm job arrays; the "
+                 "state directory on a filesystem the compute nodes share; --workers: tasks on the cluster at once)")
+      ->type_name("NAME");
   if (const int rc = parse_args(app, args); rc >= 0) return rc;
   auto number = [&](const char* flag, const std::string& v, int* out) {
     const auto n = positive_int(v);
@@ -63,6 +67,7 @@ int serve(const std::vector<std::string>& args) {
   if (app.count("--tls-cert")) cli_cfg.set_tls_cert(tls_cert);
   if (app.count("--tls-key")) cli_cfg.set_tls_key(tls_key);
   if (app.count("--log-file")) cli_cfg.set_log_file(log_file);
+  if (app.count("--backend")) cli_cfg.set_backend(backend);
   if (app.count("--config")) {
     try {
       file_cfg = service::read_config_file(config);

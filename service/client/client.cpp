@@ -119,6 +119,24 @@ v1::ListJobsResponse Client::list(const std::vector<v1::JobState>& states, int p
   return r;
 }
 
+std::vector<v1::Job> Client::members(const std::string& parent_id) {
+  std::vector<v1::Job> out;
+  std::string token;
+  do {
+    grpc::ClientContext ctx;
+    impl_->prepare(ctx);
+    v1::ListJobsRequest req;
+    req.set_parent_id(parent_id);
+    req.set_page_size(500);
+    req.set_page_token(token);
+    v1::ListJobsResponse r;
+    Impl::check(impl_->stub->ListJobs(&ctx, req, &r), "list the ensemble's members");
+    for (auto& j : *r.mutable_jobs()) out.push_back(std::move(j));
+    token = r.next_page_token();
+  } while (!token.empty());
+  return out;
+}
+
 v1::Job Client::cancel(const std::string& id) {
   grpc::ClientContext ctx;
   impl_->prepare(ctx);

@@ -40,6 +40,8 @@ class Client {
   v1::Job get(const std::string& id);
   v1::ListJobsResponse list(const std::vector<v1::JobState>& states = {}, int page_size = 50, const std::string& page_token = "");
   v1::Job cancel(const std::string& id);
+  /// An ensemble's members, in order (every page).
+  std::vector<v1::Job> members(const std::string& parent_id);
   /// Follow a job until it ends; `on_event` sees every event. Returns the final job.
   v1::Job watch(const std::string& id, const std::function<void(const v1::Job&)>& on_event = {});
   v1::ListResultsResponse results(const std::string& id);

@@ -44,6 +44,8 @@ v1::ServerConfig resolve_config(v1::ServerConfig c) {
   if (!(c.stop_grace_s() > 0 && c.stop_grace_s() <= 600)) throw ConfigError("stop_grace_s: must lie in (0, 600] s");
   if (c.max_crashes() == 0) c.set_max_crashes(3);
   if (c.max_crashes() < 0 || c.max_crashes() > 100) throw ConfigError("max_crashes: must lie in 1..100");
+  if (c.backend().empty()) c.set_backend("local");
+  if (c.backend() != "local" && c.backend() != "slurm") throw ConfigError("backend: unknown '" + c.backend() + "' (valid: local, slurm)");
   std::error_code ec;
   fs::create_directories(c.state_dir(), ec);
   if (ec) throw ConfigError("state_dir '" + c.state_dir() + "': " + ec.message());

@@ -1,6 +1,8 @@
 // Job queries: one job, a page of jobs, cancelling, and following a job to its end.
 #include "service/server/impl.hpp"
 
+#include <algorithm>
+
 #include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
 #include <google/protobuf/util/json_util.h>
@@ -63,6 +65,21 @@ Status Server::Impl::ListJobs(grpc::ServerContext* ctx, const v1::ListJobsReques
   for (int s : req->states()) states.push_back(v1::JobState(s));
   try {
     std::string next;
+    if (!req->parent_id().empty()) {  // an ensemble's members, a page from the index in page_token on
+      if (!store->get(req->parent_id(), owner)) return {StatusCode::NOT_FOUND, "no job '" + req->parent_id() + "'"};
+      std::size_t from = 0;
+      try {
+        from = req->page_token().empty() ? 0 : std::stoul(req->page_token());
+      } catch (...) {
+        return {StatusCode::INVALID_ARGUMENT, "page_token: not a token this server gave out"};
+      }
+      const auto members = store->members(req->parent_id());
+      for (std::size_t k = from; k < members.size() && k < from + std::size_t(n); ++k)
+        if (states.empty() || std::find(states.begin(), states.end(), members[k].job.state()) != states.end())
+          *resp->add_jobs() = with_live(members[k]);
+      if (from + std::size_t(n) < members.size()) resp->set_next_page_token(std::to_string(from + std::size_t(n)));
+      return Status::OK;
+    }
     for (const auto& j : store->list(owner, states, n, req->page_token(), &next)) *resp->add_jobs() = with_live(j);
     resp->set_next_page_token(next);
     resp->set_result_bytes_total(store->result_bytes_total(owner));

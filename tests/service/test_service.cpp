@@ -538,3 +538,59 @@ TEST(Service, RetentionRemovesOldResultsAndSaysSo) {
   EXPECT_NE(again.id(), id);
   EXPECT_EQ(c.watch(again.id()).state(), v1::SUCCEEDED);
 }
+
+TEST(Service, EnsembleSurvivesAKilledServerAndEqualsTheLocalAggregate) {
+  TempDir d;
+  const std::string file = std::string(RUNOUT_SOURCE_DIR) + "/tests/data/arelen-ensemble-30m.json";
+  // The same ensemble locally (runout run: the embedded job system), as the reference.
+  const std::string cmd = std::string(RUNOUT_BIN) + " run " + file + " --out " + (d.p / "local").string() + " --state-dir " +
+                          (d.p / "local-state").string() + " --workers 2 --quiet";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  auto s = jobs::parse_scenario_json(read_text(file));
+  s.mutable_dem()->set_path("data/arelen/davos_srtm3.tif");
+  s.mutable_area_of_interest()->set_path("data/arelen/aoi.geojson");
+  s.mutable_releases(0)->set_path("data/arelen/release.geojson");
+  std::string id;
+  {
+    ServerProcess srv(d.p / "state", {"--data-root", kScenarios, "--workers", "1"});
+    service::Client c(client_options(srv.address(), ""));
+    const auto j = c.submit(s);
+    id = j.id();
+    EXPECT_EQ(j.members().total(), 4);
+    // Kill -9 once a member has finished and the next one runs.
+    for (int k = 0; k < 2400 && c.get(id).members().succeeded() < 1; ++k) std::this_thread::sleep_for(25ms);
+    const auto mid = c.get(id);
+    EXPECT_GE(mid.members().succeeded(), 1);
+    EXPECT_LT(mid.members().succeeded(), 4) << "the ensemble finished before the server could be killed";
+    srv.stop(SIGKILL);
+  }
+  ServerProcess srv(d.p / "state", {"--data-root", kScenarios, "--workers", "2"});
+  service::Client c(client_options(srv.address(), ""));
+  const auto fin = c.watch(id);
+  ASSERT_EQ(fin.state(), v1::SUCCEEDED) << fin.error();
+  EXPECT_EQ(fin.members().succeeded(), 4);
+  // No member lost, none run twice to the end: the aggregate is the local one, byte for byte.
+  int compared = 0;
+  const auto listing = c.results(id);
+  for (const auto& f : listing.files()) {
+    const fs::path ext = fs::path(f.name()).extension();
+    if (ext != ".tif" && ext != ".csv") continue;
+    const fs::path got = d.p / ("service-" + f.name());
+    c.download(id, f.name(), got.string());
+    EXPECT_EQ(read_text(got), read_text(d.p / "local" / f.name())) << f.name();
+    ++compared;
+  }
+  EXPECT_EQ(compared, 14);
+  // An ensemble lists as one job; its members are listed on request, in order, each with its results.
+  EXPECT_EQ(c.list().jobs_size(), 1);
+  const auto members = c.members(id);
+  ASSERT_EQ(members.size(), 4u);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(members[std::size_t(k)].member_index(), k);
+    EXPECT_EQ(members[std::size_t(k)].parent_id(), id);
+    EXPECT_EQ(members[std::size_t(k)].state(), v1::SUCCEEDED);
+  }
+  const auto member_files = c.results(members[1].id());
+  EXPECT_TRUE(std::any_of(member_files.files().begin(), member_files.files().end(),
+                          [](const v1::ResultFile& f) { return f.name() == "max_depth.tif"; }));
+}

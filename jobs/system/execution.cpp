@@ -1,0 +1,25 @@
+#include "jobs/system/execution.hpp"
+
+namespace runout::jobs {
+
+namespace {
+constexpr std::size_t kMaxEventBytes = 64u << 20;
+}  // namespace
+
+EventParse take_event(std::string& buf, v1::WorkerEvent& ev) {
+  while (buf.size() >= 4) {
+    const auto* u = reinterpret_cast<const unsigned char*>(buf.data());
+    const std::size_t n = std::size_t(u[0]) | std::size_t(u[1]) << 8 | std::size_t(u[2]) << 16 | std::size_t(u[3]) << 24;
+    if (n > kMaxEventBytes) {
+      buf.clear();
+      return EventParse::broken;
+    }
+    if (buf.size() < 4 + n) break;
+    const bool ok = ev.ParseFromArray(buf.data() + 4, int(n));
+    buf.erase(0, 4 + n);
+    if (ok) return EventParse::event;
+  }
+  return EventParse::need_more;
+}
+
+}  // namespace runout::jobs

@@ -1,0 +1,270 @@
+#include "jobs/system/slurm.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+namespace fs = std::filesystem;
+
+namespace runout::jobs {
+
+namespace {
+
+// A path in single quotes for sh.
+std::string quoted(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// "Key=Value" of scontrol's one-line output; "" when absent.
+std::string field(const std::string& line, const std::string& key) {
+  std::istringstream in(line);
+  for (std::string tok; in >> tok;)
+    if (tok.rfind(key + "=", 0) == 0) return tok.substr(key.size() + 1);
+  return "";
+}
+
+bool is_final(const std::string& state) {
+  for (const char* s : {"COMPLETED", "FAILED", "CANCELLED", "TIMEOUT", "NODE_FAIL", "OUT_OF_MEMORY", "BOOT_FAIL", "DEADLINE", "PREEMPTED"})
+    if (state == s) return true;
+  return false;
+}
+
+}  // namespace
+
+SlurmSubmitter::SlurmSubmitter(std::string dir, SlurmConfig cfg) : dir_(std::move(dir)), cfg_(std::move(cfg)) {
+  fs::create_directories(dir_);
+}
+
+std::string SlurmSubmitter::command(const std::string& name, const std::vector<std::string>& args, int& rc) const {
+  const std::string exe = cfg_.commands_dir.empty() ? name : (fs::path(cfg_.commands_dir) / name).string();
+  int out[2];
+  if (pipe2(out, O_CLOEXEC) != 0) throw std::runtime_error(std::string("cannot run ") + name + ": " + std::strerror(errno));
+  std::vector<std::string> a = {exe};
+  a.insert(a.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& s : a) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid == 0) {
+    dup2(out[1], 1);
+    dup2(out[1], 2);
+    const int null = ::open("/dev/null", O_RDONLY);
+    if (null >= 0) dup2(null, 0);
+    execvp(argv[0], argv.data());
+    _exit(127);
+  }
+  close(out[1]);
+  std::string text;
+  char b[4096];
+  for (ssize_t n; (n = ::read(out[0], b, sizeof b)) != 0;) {
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) break;
+    text.append(b, std::size_t(n));
+  }
+  close(out[0]);
+  int st = 0;
+  while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {
+  }
+  rc = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+  if (rc == 127) text = name + ": not found (Slurm's client commands are needed: apt-get install slurm-client)";
+  return text;
+}
+
+SlurmSubmitter::Submitted SlurmSubmitter::submit(const v1::WorkerTask& task, const std::string& log_path) {
+  auto p = std::make_shared<Pending>();
+  p->task = task;
+  p->log_path = log_path;
+  std::unique_lock lk(mu_);
+  pending_.push_back(p);
+  if (!leader_) {
+    // The first of a batch waits for the others, then submits them all as one array.
+    leader_ = true;
+    lk.unlock();
+    std::this_thread::sleep_for(std::chrono::milliseconds(long(cfg_.batch_window_s * 1000)));
+    lk.lock();
+    auto batch = std::move(pending_);
+    pending_.clear();
+    leader_ = false;
+    lk.unlock();
+    submit_batch(batch);
+    lk.lock();
+    cv_.notify_all();
+  }
+  cv_.wait(lk, [&] { return p->done; });
+  if (!p->error.empty()) throw std::runtime_error(p->error);
+  return p->out;
+}
+
+void SlurmSubmitter::submit_batch(std::vector<std::shared_ptr<Pending>> batch) {
+  std::string error;
+  std::string dir;
+  try {
+    long seq;
+    {
+      std::lock_guard lk(mu_);
+      seq = ++arrays_;
+    }
+    dir = (fs::path(dir_) / (std::to_string(getpid()) + "-" + std::to_string(seq))).string();
+    fs::create_directories(dir);
+    int threads = 1;
+    for (std::size_t k = 0; k < batch.size(); ++k) {
+      std::string bytes;
+      batch[k]->task.SerializeToString(&bytes);
+      std::ofstream(fs::path(dir) / (std::to_string(k) + ".task"), std::ios::binary) << bytes;
+      std::ofstream(fs::path(dir) / (std::to_string(k) + ".log")) << batch[k]->log_path;
+      threads = std::max(threads, batch[k]->task.threads());
+    }
+    // Each task: its task file in, its events out (a file per Slurm attempt), its log appended.
+    const std::string script = (fs::path(dir) / "run.sh").string();
+    std::ofstream(script) << "#!/bin/sh\n"
+                          << "d=" << quoted(dir) << "\n"
+                          << "k=\"$SLURM_ARRAY_TASK_ID\"\n"
+                          << "exec " << quoted(cfg_.worker_exe) << " worker < \"$d/$k.task\" >> \"$d/$k.events.${SLURM_RESTART_COUNT:-0}\""
+                          << " 2>> \"$(cat \"$d/$k.log\")\"\n";
+    fs::permissions(script, fs::perms::owner_all | fs::perms::group_read | fs::perms::others_read);
+    std::vector<std::string> args = {"--parsable", "--array=0-" + std::to_string(batch.size() - 1), "--job-name=" + cfg_.job_name,
+                                     "--chdir=" + dir, "--output=" + (fs::path(dir) / "slurm-%A_%a.out").string(),
+                                     "--open-mode=append", "--requeue", "--ntasks=1", "--cpus-per-task=" + std::to_string(threads)};
+    if (!cfg_.partition.empty()) args.push_back("--partition=" + cfg_.partition);
+    args.insert(args.end(), cfg_.sbatch_args.begin(), cfg_.sbatch_args.end());
+    args.push_back(script);
+    int rc = 0;
+    std::string out = command("sbatch", args, rc);
+    while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+    const std::string id = out.substr(0, out.find(';'));
+    if (rc != 0 || id.empty() || id.find_first_not_of("0123456789") != std::string::npos)
+      throw std::runtime_error("Slurm refused the job array (sbatch exit status " + std::to_string(rc) + "): " + out);
+    for (std::size_t k = 0; k < batch.size(); ++k) batch[k]->out = {id + "_" + std::to_string(k), dir, int(k)};
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  std::lock_guard lk(mu_);
+  for (auto& p : batch) {
+    p->error = error;
+    p->done = true;
+  }
+}
+
+void SlurmSubmitter::cancel_all() {
+  int rc = 0;
+  command("scancel", {"--name=" + cfg_.job_name}, rc);
+}
+
+SlurmStep::SlurmStep(SlurmSubmitter& s, const v1::WorkerTask& task, const std::string& log_path) : s_(s), sub_(s.submit(task, log_path)) {}
+
+void SlurmStep::poll_state() {
+  last_poll_ = std::chrono::steady_clock::now();
+  int rc = 0;
+  const std::string out = s_.command("scontrol", {"show", "job", "-o", sub_.id}, rc);
+  if (rc != 0) {
+    // Slurm forgets an ended job after MinJobAge: it has ended, and its events say how.
+    if (out.find("Invalid job id") != std::string::npos) final_ = gone_ = true;
+    return;
+  }
+  const std::string line = out.substr(0, out.find('\n'));
+  state_ = field(line, "JobState");
+  exit_code_ = field(line, "ExitCode");
+  const std::string r = field(line, "Restarts");
+  if (!r.empty() && r.find_first_not_of("0123456789") == std::string::npos) restarts_ = std::stoi(r);
+  final_ = is_final(state_);
+}
+
+bool SlurmStep::read_more() {
+  if (restarts_ > reading_) {  // Slurm ran the task again (its node failed): the new attempt's events
+    reading_ = restarts_;
+    offset_ = 0;
+    buf_.clear();
+  }
+  std::ifstream f(fs::path(sub_.dir) / (std::to_string(sub_.index) + ".events." + std::to_string(reading_)), std::ios::binary);
+  if (!f) return false;
+  f.seekg(std::streamoff(offset_));
+  char b[65536];
+  bool got = false;
+  while (f.read(b, sizeof b) || f.gcount() > 0) {
+    buf_.append(b, std::size_t(f.gcount()));
+    offset_ += std::size_t(f.gcount());
+    got = true;
+  }
+  return got;
+}
+
+std::optional<v1::WorkerEvent> SlurmStep::next_event(std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    v1::WorkerEvent ev;
+    const EventParse got = take_event(buf_, ev);
+    if (got == EventParse::event) return ev;
+    if (got == EventParse::broken) {  // not our protocol: nothing more can be read from this stream
+      closed_ = true;
+      return std::nullopt;
+    }
+    if (closed_) return std::nullopt;
+    if (read_more()) continue;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_poll_ > std::chrono::seconds(1)) {
+      const bool was_final = final_;
+      poll_state();
+      if (was_final && final_ && !read_more()) {  // ended, and every event it wrote has been read
+        closed_ = true;
+        return std::nullopt;
+      }
+      continue;
+    }
+    if (now >= deadline) return std::nullopt;
+    std::this_thread::sleep_for(std::min(std::chrono::milliseconds(50),
+                                         std::chrono::duration_cast<std::chrono::milliseconds>(deadline - now)));
+  }
+}
+
+void SlurmStep::signal(int sig) {
+  int rc = 0;
+  if (sig == SIGTERM && state_ == "RUNNING") {
+    s_.command("scancel", {"--signal=TERM", "--batch", sub_.id}, rc);  // the worker ends at its step, with a checkpoint
+  } else {
+    s_.command("scancel", {sub_.id}, rc);
+  }
+  sent_ = sig;
+}
+
+std::optional<WorkerExit> SlurmStep::wait(std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (!final_) {
+    poll_state();
+    if (final_ || std::chrono::steady_clock::now() >= deadline) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+  if (!final_) return std::nullopt;
+  WorkerExit e;
+  const auto colon = exit_code_.find(':');
+  const int code = std::atoi(exit_code_.substr(0, colon).c_str());
+  const int sig = colon == std::string::npos ? 0 : std::atoi(exit_code_.substr(colon + 1).c_str());
+  if (gone_ || state_ == "COMPLETED") {
+    e.exited = true;
+    e.code = code;
+  } else if (state_ == "FAILED") {
+    e.exited = sig == 0;
+    e.code = code;
+    e.signal = sig;
+    e.signal_ours = sent_ != 0;
+  } else if (state_ == "CANCELLED") {
+    e.signal = sent_ ? sent_ : SIGTERM;  // cancelled by someone else: stopped from outside
+    e.signal_ours = sent_ != 0;
+  } else {  // the node failed, memory or time ran out: killed
+    e.signal = SIGKILL;
+    e.signal_ours = false;
+  }
+  return e;
+}
+
+}  // namespace runout::jobs
