@@ -13,7 +13,12 @@ chmod 755 "$DIR"  # munged refuses a socket folder under a folder others cannot 
 CLUSTER="$SRC/tests/support/slurm_cluster.sh"
 SCENARIO="$SRC/tests/data/arelen-ensemble-30m.json"
 SERVER_PID=
-fail() { echo "slurm_backend: FAILED: $*"; [[ -f $DIR/server.log ]] && tail -30 "$DIR/server.log"; exit 1; }
+fail() {
+  echo "slurm_backend: FAILED: $*"
+  [[ -f $DIR/server.log ]] && tail -30 "$DIR/server.log"
+  tail -n 8 "$DIR"/state/logs/*.log 2>/dev/null
+  exit 1
+}
 cleanup() {
   [[ -n $SERVER_PID ]] && kill "$SERVER_PID" 2>/dev/null && wait "$SERVER_PID" 2>/dev/null
   bash "$CLUSTER" stop "$DIR/cluster" >/dev/null 2>&1
@@ -49,6 +54,10 @@ for _ in $(seq 600); do
 done
 [[ -n $KILLED ]] || fail "no member ran on the cluster"
 echo "killed the step of $KILLED"
+# The scheduler sees the step's end (a crash of its worker, or a stop from outside) and queues the
+# member again; only then the node fails (a node failure would requeue the killed task in Slurm too).
+for _ in $(seq 300); do grep -q "crashed\|stopped from outside" "$DIR/state/logs/"*.log 2>/dev/null && break; sleep 0.1; done
+grep -q "crashed\|stopped from outside" "$DIR/state/logs/"*.log || fail "the killed step left no trace in the jobs' logs"
 # Fail the node under another running task: Slurm runs it again (--requeue) once the node is back.
 NODE=
 for _ in $(seq 600); do
@@ -68,7 +77,6 @@ timeout 600 "$RUNOUT" watch "$JOB" >/dev/null 2>&1
 grep -q "^state *succeeded" "$DIR/status.txt" || fail "the ensemble did not succeed: $(cat "$DIR/status.txt")"
 grep -q "4 of 4 members done" "$DIR/status.txt" || fail "members: $(grep members "$DIR/status.txt")"
 grep -q "Slurm job" "$DIR/state/logs/"*.log || fail "no job ran on Slurm"
-grep -q "crashed\|stopped from outside" "$DIR/state/logs/"*.log || fail "the killed step left no trace in the jobs' logs"
 grep -q "Restarts=1" <(scontrol show job -o "$TASK" 2>/dev/null) || ls "$DIR"/state/slurm/*/*.events.1 >/dev/null 2>&1 ||
   fail "the task under the failed node was not run again by Slurm"
 "$RUNOUT" fetch "$JOB" --out "$DIR/slurm" >/dev/null || fail "fetch failed"
