@@ -41,7 +41,7 @@ commands:
         resolutions. --resolutions overrides a case's cell sizes in metres (A2: cells across the cap).
         Limiters: minmod (default), vanleer, superbee.
   serve [--recover] [--config FILE] [--listen HOST:PORT] [--state-dir DIR] [--data-root DIR]... [--tokens FILE]
-        [--tls-cert FILE --tls-key FILE] [--workers N] [--threads-per-run N] [--log-file FILE]
+        [--tls-cert FILE --tls-key FILE] [--workers N] [--threads-per-run N] [--log-file FILE] [--backend local|slurm]
         Run the gRPC batch server (runout.v1.Runout, health checking, reflection) until SIGINT or
         SIGTERM; options override the JSON configuration file (deploy/README.md lists every key).
         Each job runs in a worker process of its own; jobs left running by a killed server are
@@ -58,7 +58,7 @@ commands:
         Follow a job's progress until it ends.
   cancel JOB
         Cancel a queued or running job.
-  fetch JOB --out DIR [--force]
+  fetch JOB --out DIR [--force] [--members]
         Download a job's results (checksums verified) into DIR; for a failed job, its log. DIR as for
         run: --force replaces a previous result or a previous fetch of a failed job (job.log alone).
   health
