@@ -246,7 +246,10 @@ Param read_param(const v1::Variation& v, std::size_t index, const v1::Scenario& 
       if (!v.has_step()) bad(field + ".step", "missing: a range from..to in the cross product needs a step");
       const double n = std::floor((v.to() - v.from()) / v.step() + 1e-9) + 1;
       if (n > kMaxMembers) bad(field + ".step", "makes " + num(n) + " values; at most " + std::to_string(kMaxMembers));
-      for (int k = 0; k < int(n); ++k) p.values.push_back(v.from() + k * v.step());
+      for (int k = 0; k < int(n); ++k) {  // the last value is `to` when the steps reach it (no 17.500000000000004)
+        const double x = v.from() + k * v.step();
+        p.values.push_back(std::abs(x - v.to()) <= 1e-9 * v.step() ? v.to() : x);
+      }
     }
   } else {  // a distribution
     if (v.distribution() == "uniform") {
@@ -406,6 +409,8 @@ AggregateSettings aggregate_settings(const ResolvedScenario& r) {
     for (const auto& z : r.pressure_zones) a.pressure_kpa.push_back(z.from_kpa);
   a.percentiles.assign(v.percentiles().begin(), v.percentiles().end());
   if (a.percentiles.empty()) a.percentiles = {5, 50, 95};
+  a.maps = r.maps;
+  a.name = r.scenario.name();
   for (auto* list : {&a.depth_m, &a.speed_m_s, &a.pressure_kpa, &a.percentiles}) {
     std::sort(list->begin(), list->end());
     list->erase(std::unique(list->begin(), list->end()), list->end());
@@ -425,6 +430,7 @@ std::string ensemble_hash(const std::vector<std::string>& member_hashes, const A
   list("speed_m_s", a.speed_m_s);
   list("pressure_kpa", a.pressure_kpa);
   list("percentiles", a.percentiles);
+  h.update(std::string("maps ") + (a.maps ? "1" : "0") + "\nname " + a.name + "\n");  // the maps and their titles
   for (const auto& m : member_hashes) h.update(m + "\n");
   return h.hex();
 }

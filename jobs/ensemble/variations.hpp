@@ -32,6 +32,8 @@ struct AggregateSettings {
   std::vector<double> speed_m_s;     ///< probability of max speed >= each
   std::vector<double> pressure_kpa;  ///< probability of max pressure >= each
   std::vector<double> percentiles;   ///< of max depth, speed and pressure per cell, ascending, in [0, 100]
+  bool maps = true;                  ///< the aggregate's maps (outputs.maps)
+  std::string name;                  ///< the scenario's name (the maps' titles)
 };
 
 /// The most members one ensemble may have.
@@ -51,8 +53,8 @@ std::vector<Member> expand(const v1::Scenario& s);
 /// The aggregate's settings of a resolved ensemble scenario.
 AggregateSettings aggregate_settings(const ResolvedScenario& r);
 
-/// The ensemble's hash: its members' hashes in order, the aggregate's settings and its results
-/// version. Two ensembles with the same hash have the same aggregate.
+/// The ensemble's hash: its members' hashes in order, the aggregate's settings (thresholds,
+/// percentiles, maps and the name in their titles) and its results version. Two ensembles with the same hash have the same aggregate.
 std::string ensemble_hash(const std::vector<std::string>& member_hashes, const AggregateSettings& a);
 
 /// An ensemble ready to be queued: each member resolved (validated) and hashed, and the ensemble's hash.

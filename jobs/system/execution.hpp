@@ -41,6 +41,8 @@ class Execution {
   virtual void signal(int sig) = 0;
   /// Wait for the worker to end (at most `timeout`; nothing when it has not).
   virtual std::optional<WorkerExit> wait(std::chrono::milliseconds timeout) = 0;
+  /// The worker runs (a cluster's task has left its queue): its wall time counts from here.
+  virtual bool started() const { return true; }
   /// Resident memory of the worker [bytes]; 0 when it cannot be read (a cluster enforces its own).
   virtual std::int64_t resident_bytes() const = 0;
 };

@@ -11,6 +11,8 @@
 #include <fstream>
 #include <csignal>
 #include <optional>
+#include <random>
+#include <thread>
 
 #include "jobs/system/state_dir.hpp"
 #include "jobs/system/slurm.hpp"
@@ -48,10 +50,18 @@ Scheduler::Scheduler(JobStore& store, SchedulerConfig cfg) : store_(store), cfg_
     SlurmConfig sc = *cfg_.slurm;
     std::error_code ec;
     if (sc.worker_exe.empty()) sc.worker_exe = fs::read_symlink("/proc/self/exe", ec).string();  // as the compute nodes see it
-    if (sc.job_name.empty()) {  // one name per state directory: a restarted server finds what its predecessor left
-      char b[24];
-      std::snprintf(b, sizeof b, "%016zx", std::hash<std::string>{}(fs::absolute(cfg_.state_dir).string()));
-      sc.job_name = std::string("runout-") + b;
+    if (sc.job_name.empty()) {  // one name per state directory, kept in it: a restarted server finds what its predecessor left
+      const fs::path name_file = fs::path(cfg_.state_dir) / "slurm" / "job-name";
+      std::ifstream in(name_file);
+      std::getline(in, sc.job_name);
+      if (sc.job_name.rfind("runout-", 0) != 0) {
+        std::random_device rd;
+        char b[24];
+        std::snprintf(b, sizeof b, "%08x%08x", unsigned(rd()), unsigned(rd()));
+        sc.job_name = std::string("runout-") + b;
+        fs::create_directories(name_file.parent_path(), ec);
+        std::ofstream(name_file) << sc.job_name << "\n";
+      }
     }
     slurm_ = std::make_unique<SlurmSubmitter>((fs::path(cfg_.state_dir) / "slurm").string(), sc);
   }
@@ -121,7 +131,7 @@ void Scheduler::notify() {
     std::lock_guard lk(mu_);
     ++work_seq_;
   }
-  work_cv_.notify_one();
+  work_cv_.notify_all();  // an ensemble queues many jobs at once: every idle worker claims one
 }
 
 bool Scheduler::cancel_running(const std::string& id) {
@@ -505,6 +515,7 @@ Scheduler::Attempt Scheduler::supervise(JobContext& jc, const v1::WorkerTask& ta
     jc.say(w.where());
     const auto t0 = std::chrono::steady_clock::now();
     auto last_check = t0, kill_at = t0, last_saved = t0;
+    std::optional<std::chrono::steady_clock::time_point> running;  // the wall time counts once it runs (a cluster queues first)
     for (;;) {
       // Every event the worker wrote is read, also after its output closed (the outcome may be
       // the last of several events that arrived at once).
@@ -542,7 +553,8 @@ Scheduler::Attempt Scheduler::supervise(JobContext& jc, const v1::WorkerTask& ta
           std::lock_guard lk(mu_);
           if (cancel) cancel_.insert(id);
         }
-        if (a.why == Why::none && std::chrono::duration<double>(now - t0).count() > jc.wall_limit) a.why = Why::wall;
+        if (!running && w.started()) running = now;
+        if (a.why == Why::none && running && std::chrono::duration<double>(now - *running).count() > jc.wall_limit) a.why = Why::wall;
         if (a.why == Why::none && jc.mem_limit > 0 && w.resident_bytes() > jc.mem_limit) {
           a.why = Why::memory;
           w.signal(SIGKILL);  // memory is not given time
@@ -577,6 +589,11 @@ bool Scheduler::conclude(JobContext& jc, v1::WorkerTask& task, const Attempt& a,
   std::error_code ec;
   if (!a.start_error.empty()) {
     fs::remove_all(jc.tmp, ec);
+    if (slurm_ && jc.sj.crashes + 1 < cfg_.max_crashes) {  // the cluster may refuse for a while (limits, a restart)
+      std::this_thread::sleep_for(std::chrono::seconds(5));
+      jc.finish(v1::QUEUED, "the cluster did not take the task (" + a.start_error + "); queued to run again", "", 0, true);
+      return false;
+    }
     jc.finish_and_forget(v1::FAILED, "the worker process could not be started", a.start_error, 0);
     return false;
   }

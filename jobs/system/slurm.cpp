@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -46,19 +47,29 @@ SlurmSubmitter::SlurmSubmitter(std::string dir, SlurmConfig cfg) : dir_(std::mov
   fs::create_directories(dir_);
 }
 
-std::string SlurmSubmitter::command(const std::string& name, const std::vector<std::string>& args, int& rc) const {
+std::string SlurmSubmitter::command(const std::string& name, const std::vector<std::string>& args, int& rc, std::string* err) const {
   const std::string exe = cfg_.commands_dir.empty() ? name : (fs::path(cfg_.commands_dir) / name).string();
   int out[2];
   if (pipe2(out, O_CLOEXEC) != 0) throw std::runtime_error(std::string("cannot run ") + name + ": " + std::strerror(errno));
+  // Standard error apart (sites' submit filters print notes there): parsed output is standard output only.
+  char errpath[] = "/tmp/runout-slurm-err-XXXXXX";
+  const int efd = mkostemp(errpath, O_CLOEXEC);
+  if (efd >= 0) ::unlink(errpath);
   std::vector<std::string> a = {exe};
   a.insert(a.end(), args.begin(), args.end());
   std::vector<char*> argv;
-  for (auto& s : a) argv.push_back(s.data());
+  for (auto& x : a) argv.push_back(x.data());
   argv.push_back(nullptr);
   const pid_t pid = fork();
+  if (pid < 0) {
+    close(out[0]);
+    close(out[1]);
+    if (efd >= 0) close(efd);
+    throw std::runtime_error(std::string("cannot run ") + name + ": fork: " + std::strerror(errno));
+  }
   if (pid == 0) {
     dup2(out[1], 1);
-    dup2(out[1], 2);
+    if (efd >= 0) dup2(efd, 2);
     const int null = ::open("/dev/null", O_RDONLY);
     if (null >= 0) dup2(null, 0);
     execvp(argv[0], argv.data());
@@ -77,7 +88,14 @@ std::string SlurmSubmitter::command(const std::string& name, const std::vector<s
   while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {
   }
   rc = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-  if (rc == 127) text = name + ": not found (Slurm's client commands are needed: apt-get install slurm-client)";
+  std::string etext;
+  if (efd >= 0) {
+    lseek(efd, 0, SEEK_SET);
+    for (ssize_t n; (n = ::read(efd, b, sizeof b)) > 0;) etext.append(b, std::size_t(n));
+    close(efd);
+  }
+  if (rc == 127) etext = name + ": not found (Slurm's client commands are needed: apt-get install slurm-client)";
+  if (err) *err = etext;
   return text;
 }
 
@@ -115,8 +133,16 @@ void SlurmSubmitter::submit_batch(std::vector<std::shared_ptr<Pending>> batch) {
       std::lock_guard lk(mu_);
       seq = ++arrays_;
     }
-    dir = (fs::path(dir_) / (std::to_string(getpid()) + "-" + std::to_string(seq))).string();
-    fs::create_directories(dir);
+    // A name no earlier server used (a container's server often has the same pid every time).
+    std::random_device rd;
+    char tag[20];
+    std::snprintf(tag, sizeof tag, "%08x", unsigned(rd()));
+    dir = (fs::path(dir_) / (std::to_string(getpid()) + "-" + std::to_string(seq) + "-" + tag)).string();
+    if (!fs::create_directories(dir)) throw std::runtime_error("the job array's folder " + dir + " exists already");
+    {
+      std::lock_guard lk(mu_);
+      open_[dir] = int(batch.size());
+    }
     int threads = 1;
     for (std::size_t k = 0; k < batch.size(); ++k) {
       std::string bytes;
@@ -140,11 +166,17 @@ void SlurmSubmitter::submit_batch(std::vector<std::shared_ptr<Pending>> batch) {
     args.insert(args.end(), cfg_.sbatch_args.begin(), cfg_.sbatch_args.end());
     args.push_back(script);
     int rc = 0;
-    std::string out = command("sbatch", args, rc);
-    while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
-    const std::string id = out.substr(0, out.find(';'));
-    if (rc != 0 || id.empty() || id.find_first_not_of("0123456789") != std::string::npos)
-      throw std::runtime_error("Slurm refused the job array (sbatch exit status " + std::to_string(rc) + "): " + out);
+    std::string err;
+    const std::string out = command("sbatch", args, rc, &err);
+    // --parsable: the job id (";cluster"), the last such line (a site's filter may print before it).
+    std::string id;
+    std::istringstream lines(out);
+    for (std::string l; std::getline(lines, l);) {
+      const std::string head = l.substr(0, l.find(';'));
+      if (!head.empty() && head.find_first_not_of("0123456789") == std::string::npos) id = head;
+    }
+    if (rc != 0 || id.empty())
+      throw std::runtime_error("Slurm refused the job array (sbatch exit status " + std::to_string(rc) + "): " + err + out);
     for (std::size_t k = 0; k < batch.size(); ++k) batch[k]->out = {id + "_" + std::to_string(k), dir, int(k)};
   } catch (const std::exception& e) {
     error = e.what();
@@ -159,20 +191,55 @@ void SlurmSubmitter::submit_batch(std::vector<std::shared_ptr<Pending>> batch) {
 void SlurmSubmitter::cancel_all() {
   int rc = 0;
   command("scancel", {"--name=" + cfg_.job_name}, rc);
+  // They end at their step (with a checkpoint); their jobs run again only once none is left, so
+  // that no old task writes beside the new attempt.
+  for (int k = 0; k < 600; ++k) {
+    const std::string out = command("squeue", {"-h", "--name=" + cfg_.job_name, "-o", "%i"}, rc);
+    if (rc != 0 || out.find_first_not_of(" \n") == std::string::npos) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  }
+}
+
+void SlurmSubmitter::release(const std::string& dir) {
+  std::lock_guard lk(mu_);
+  const auto it = open_.find(dir);
+  if (it == open_.end() || --it->second > 0) return;
+  open_.erase(it);
+  std::error_code ec;
+  fs::remove_all(dir, ec);  // every task of the array has ended: its files go
 }
 
 SlurmStep::SlurmStep(SlurmSubmitter& s, const v1::WorkerTask& task, const std::string& log_path) : s_(s), sub_(s.submit(task, log_path)) {}
 
+SlurmStep::~SlurmStep() {
+  if (!final_) {  // followed no further (the scheduler gave up on it): it must not run on unseen
+    int rc = 0;
+    try {
+      s_.command("scancel", {sub_.id}, rc);
+    } catch (...) {
+    }
+  }
+  s_.release(sub_.dir);
+}
+
 void SlurmStep::poll_state() {
   last_poll_ = std::chrono::steady_clock::now();
   int rc = 0;
-  const std::string out = s_.command("scontrol", {"show", "job", "-o", sub_.id}, rc);
+  std::string err;
+  const std::string out = s_.command("scontrol", {"show", "job", "-o", sub_.id}, rc, &err);
   if (rc != 0) {
     // Slurm forgets an ended job after MinJobAge: it has ended, and its events say how.
-    if (out.find("Invalid job id") != std::string::npos) final_ = gone_ = true;
+    if ((err + out).find("Invalid job id") != std::string::npos) final_ = gone_ = true;
     return;
   }
-  const std::string line = out.substr(0, out.find('\n'));
+  std::string line;
+  std::istringstream lines(out);
+  for (std::string l; std::getline(lines, l);)
+    if (l.find("JobId=") != std::string::npos) {
+      line = l;
+      break;
+    }
+  if (line.empty()) return;
   state_ = field(line, "JobState");
   exit_code_ = field(line, "ExitCode");
   const std::string r = field(line, "Restarts");
@@ -257,12 +324,18 @@ std::optional<WorkerExit> SlurmStep::wait(std::chrono::milliseconds timeout) {
     e.code = code;
     e.signal = sig;
     e.signal_ours = sent_ != 0;
-  } else if (state_ == "CANCELLED") {
-    e.signal = sent_ ? sent_ : SIGTERM;  // cancelled by someone else: stopped from outside
+  } else if (state_ == "CANCELLED" || state_ == "PREEMPTED" || state_ == "NODE_FAIL" || state_ == "BOOT_FAIL") {
+    // Cancelled by someone else, preempted, or its node failed without Slurm running it again:
+    // stopped from outside (queued again, not counted against the job).
+    e.signal = sent_ ? sent_ : SIGTERM;
     e.signal_ours = sent_ != 0;
-  } else {  // the node failed, memory or time ran out: killed
+  } else {  // memory or time ran out: killed
     e.signal = SIGKILL;
     e.signal_ours = false;
+  }
+  if (state_ != "COMPLETED" && state_ != "FAILED" && !gone_) {
+    int rc = 0;
+    s_.command("scancel", {sub_.id}, rc);  // nothing of it may run on while its job runs again
   }
   return e;
 }

@@ -19,6 +19,7 @@
 // scheduler goes on following it (the next attempt's events file).
 #include <condition_variable>
 #include <deque>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -57,7 +58,9 @@ class SlurmSubmitter {
   const SlurmConfig& config() const { return cfg_; }
   /// Run a Slurm command (sbatch, scontrol, scancel) with arguments; its standard output, and its
   /// exit status in `rc`.
-  std::string command(const std::string& name, const std::vector<std::string>& args, int& rc) const;
+  std::string command(const std::string& name, const std::vector<std::string>& args, int& rc, std::string* err = nullptr) const;
+  /// A task of the array in `dir` will not be followed any more; the folder goes with the last.
+  void release(const std::string& dir);
 
  private:
   struct Pending {
@@ -75,12 +78,15 @@ class SlurmSubmitter {
   std::vector<std::shared_ptr<Pending>> pending_;
   bool leader_ = false;
   long arrays_ = 0;
+  std::map<std::string, int> open_;  // array folder -> its tasks still followed
 };
 
 /// One task of a Slurm job array as the scheduler follows it.
 class SlurmStep : public Execution {
  public:
   SlurmStep(SlurmSubmitter& s, const v1::WorkerTask& task, const std::string& log_path);
+  ~SlurmStep() override;
+  bool started() const override { return state_ != "PENDING" && state_ != "CONFIGURING"; }
   std::string where() const override { return "Slurm job " + sub_.id; }
   std::optional<v1::WorkerEvent> next_event(std::chrono::milliseconds timeout) override;
   bool output_closed() const override { return closed_; }

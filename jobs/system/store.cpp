@@ -507,8 +507,9 @@ std::int64_t JobStore::result_bytes_total(const std::string& owner) const {
 std::vector<JobStore::Finished> JobStore::finished_results() const {
   std::lock_guard lk(mu_);
   Stmt st(db_,
-          "SELECT hash, MAX(updated), MAX(result_bytes) FROM jobs WHERE state = 3 AND results_removed = 0 GROUP BY hash "
-          "ORDER BY MAX(updated)");
+          "SELECT hash, MAX(updated), MAX(result_bytes) FROM jobs WHERE state = 3 AND results_removed = 0 "
+          "AND hash NOT IN (SELECT m.hash FROM jobs m JOIN jobs p ON p.id = m.parent WHERE p.state IN (1, 2)) "
+          "GROUP BY hash ORDER BY MAX(updated)");
   std::vector<Finished> out;
   while (st.step()) out.push_back({st.text(0), st.text(1), st.i64(2)});
   return out;

@@ -106,7 +106,8 @@ class JobStore {
   void save_progress(const std::string& id, const v1::Progress& p);
   /// Disk used by the owner's results (each result folder counted once).
   std::int64_t result_bytes_total(const std::string& owner) const;
-  /// Succeeded jobs whose results still exist, oldest first: (hash, updated time, bytes).
+  /// Succeeded jobs whose results still exist, oldest first: (hash, updated time, bytes); results an
+  /// ensemble still waiting for its aggregate needs are left out (retention must not take them).
   struct Finished {
     std::string hash, updated;
     std::int64_t bytes = 0;

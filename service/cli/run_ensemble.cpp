@@ -82,6 +82,8 @@ int run_ensemble(const jobs::ResolvedScenario& r, const EnsembleRun& a, RunSumma
   cfg.workers = std::max(1, std::min<int>(cores, int(plan.members.size())));
   cfg.threads_per_run = std::max(1, cores / cfg.workers);
   cfg.terrain_cache = a.terrain_cache;
+  cfg.max_job_wall_s = 1e12;  // a local run has no wall limit (the service's is an operator's choice)
+  cfg.stop_grace_s = 10;      // Ctrl-C: members end at their step with a checkpoint; a stuck one is killed after this
   jobs::Scheduler sched(store, cfg);
   std::vector<jobs::JobStore::NewMember> members;
   for (const auto& m : plan.members) members.push_back({m.member.index, m.hash, m.member.scenario});

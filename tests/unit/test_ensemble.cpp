@@ -214,12 +214,26 @@ TEST(Ensemble, AMemberOutsideTheValidRangeIsNamedByThePlan) {
 }
 
 TEST(Ensemble, EnsembleHashFollowsTheMembersAndTheSettings) {
-  ens::AggregateSettings a{{0.1}, {1}, {3, 30}, {5, 50, 95}};
+  ens::AggregateSettings a{{0.1}, {1}, {3, 30}, {5, 50, 95}, true, "arelen"};
   const auto h = ens::ensemble_hash({"m1", "m2"}, a);
   EXPECT_EQ(h, ens::ensemble_hash({"m1", "m2"}, a));
   EXPECT_NE(h, ens::ensemble_hash({"m2", "m1"}, a));
   a.percentiles = {50};
   EXPECT_NE(h, ens::ensemble_hash({"m1", "m2"}, a));
+  a.percentiles = {5, 50, 95};
+  a.maps = false;  // an aggregate without maps is another result
+  EXPECT_NE(h, ens::ensemble_hash({"m1", "m2"}, a));
+}
+
+TEST(Ensemble, ARangeEndsOnItsUpperBound) {
+  auto s = arelen();
+  auto* r = vary(s, "material.bed_friction_deg");
+  r->set_from(13);
+  r->set_to(17.5);
+  r->set_step(0.1);
+  const auto m = ens::expand(s);
+  ASSERT_EQ(m.size(), 46u);
+  EXPECT_EQ(m.back().values[0].value, 17.5);
 }
 
 TEST(EnsembleStatistics, IdenticalMembersGiveProbabilitiesOfExactlyZeroOrOne) {
