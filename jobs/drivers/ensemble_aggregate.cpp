@@ -216,8 +216,11 @@ v1::EnsembleRecord aggregate_ensemble(const ResolvedScenario& e, const std::vect
   figures::HazardMap base;
   base.release = terrain::rasterize_releases(g, e.releases);
   base.parameters = map_block(e, members, g);
-  const auto pct = ensemble::percentiles(stack[0], {50}, g.outside);  // the median's outline on the maps
-  base.max_depth = pct[0];
+  // The members' percentiles of max depth (written below), and the median's outline on the maps.
+  const auto depth_pct = ensemble::percentiles(stack[0], settings.percentiles, g.outside);
+  const auto p50 = std::find(settings.percentiles.begin(), settings.percentiles.end(), 50.0);
+  base.max_depth = p50 != settings.percentiles.end() ? depth_pct[std::size_t(p50 - settings.percentiles.begin())]
+                                                      : ensemble::percentiles(stack[0], {50}, g.outside)[0];
   base.outline_threshold = e.outline_threshold;
   const auto& pois = e.scenario.outputs().points_of_interest();
   for (int k = 0; k < pois.size(); ++k) {
@@ -279,7 +282,7 @@ v1::EnsembleRecord aggregate_ensemble(const ResolvedScenario& e, const std::vect
       for (const char* ext : {".png", ".pdf"}) files.Add("map_" + stem + ext);
     }
     // Percentiles of the maximum.
-    const auto pv = ensemble::percentiles(stack[q], settings.percentiles, g.outside);
+    const auto pv = q == 0 ? depth_pct : ensemble::percentiles(stack[q], settings.percentiles, g.outside);
     for (std::size_t k = 0; k < settings.percentiles.size(); ++k) {
       const std::string stem = std::string(Q.raster) + "_" + percentile_tag(settings.percentiles[k]);
       terrain::write_cog(out(stem + ".tif"), g, pv[k],

@@ -215,20 +215,21 @@ Param read_param(const v1::Variation& v, std::size_t index, const v1::Scenario& 
   if (ways > 1) bad(field, "give one of values, from/to/step, percent or a distribution");
   if (active && v.values_size() == 0) bad(field, "releases[K].active takes values (0: left out, 1: in)");
   const int count = v.count() > 0 ? v.count() : 3;
+  // What a percentage is of: the scenario's own value, or the option's default.
+  auto base_value = [&] {
+    double base = 0;
+    if (number_at(s, p.path, base)) return base;
+    if (!opt || opt->default_value.empty())
+      bad(field + ".percent", "'" + p.path + "' is not set in the scenario: give its value, or values instead of percent");
+    return std::stod(opt->default_value);
+  };
   if (v.values_size() > 0) {
     p.values.assign(v.values().begin(), v.values().end());
     if (active)
       for (double x : p.values)
         if (x != 0 && x != 1) bad(field + ".values", "releases[K].active takes 0 (left out) or 1 (in), got " + num(x));
   } else if (v.has_percent()) {
-    // The scenario's own value (or the option's default) -percent .. +percent.
-    double base = 0;
-    if (!number_at(s, p.path, base)) {
-      if (!opt || opt->default_value.empty())
-        bad(field + ".percent", "'" + p.path + "' is not set in the scenario: give its value, or values instead of percent");
-      base = std::stod(opt->default_value);
-    }
-    const double f = v.percent() / 100;
+    const double base = base_value(), f = v.percent() / 100;
     if (lhs) {
       p.law = Param::Law::uniform;
       p.lo = base * (1 - f), p.hi = base * (1 + f);
@@ -257,11 +258,7 @@ Param read_param(const v1::Variation& v, std::size_t index, const v1::Scenario& 
       if (v.has_from() && v.has_to()) {
         p.lo = v.from(), p.hi = v.to();
       } else if (v.has_percent()) {
-        double base = 0;
-        if (!number_at(s, p.path, base)) {
-          if (!opt || opt->default_value.empty()) bad(field + ".percent", "'" + p.path + "' is not set in the scenario");
-          base = std::stod(opt->default_value);
-        }
+        const double base = base_value();
         p.lo = base * (1 - v.percent() / 100), p.hi = base * (1 + v.percent() / 100);
       } else {
         bad(field, "a uniform distribution needs from and to, or percent");

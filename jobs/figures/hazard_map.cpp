@@ -91,16 +91,6 @@ struct Frame {
 void colour(cairo_t* cr, const Rgb& c, double alpha = 1) { cairo_set_source_rgba(cr, c.r, c.g, c.b, alpha); }
 Rgb rgb(const Rgb8& c) { return {c[0] / 255.0, c[1] / 255.0, c[2] / 255.0}; }
 
-// Stroke the path in `c`, solid or dashed.
-void stroke(cairo_t* cr, const Rgb& c, double width, bool dashed) {
-  const double dash[] = {4, 3};
-  cairo_set_dash(cr, dash, dashed ? 2 : 0, 0);
-  colour(cr, c);
-  cairo_set_line_width(cr, width);
-  cairo_stroke(cr);
-  cairo_set_dash(cr, nullptr, 0, 0);
-}
-
 // The cells: hillshade grey, pale outside the domain, the palette's colour (opaque) where classed.
 void draw_cells(cairo_t* cr, const Frame& f, const HazardMap& m, const std::vector<std::uint8_t>& shade) {
   const Grid& g = f.g;

@@ -57,12 +57,7 @@ void draw(cairo_t* cr, const Histogram& h, double top) {
     if (!std::isfinite(v)) continue;
     cairo_move_to(cr, px(v), y0);
     cairo_line_to(cr, px(v), y0 + ht);
-    const double dash[] = {4, 3};
-    cairo_set_dash(cr, dash, 2, 0);
-    cairo_set_source_rgb(cr, kMark.r, kMark.g, kMark.b);
-    cairo_set_line_width(cr, 1.2);
-    cairo_stroke(cr);
-    cairo_set_dash(cr, nullptr, 0, 0);
+    stroke(cr, kMark, 1.2, true);
     draw_text(cr, px(v) + 3, y0 + 4, name, {11, false, kMark});
   }
 }

@@ -79,6 +79,15 @@ std::string label_number(double v, bool grouped) {
   return out;
 }
 
+void stroke(cairo_t* cr, const Rgb& c, double width, bool dashed) {
+  const double dash[] = {4, 3};
+  cairo_set_dash(cr, dash, dashed ? 2 : 0, 0);
+  cairo_set_source_rgb(cr, c.r, c.g, c.b);
+  cairo_set_line_width(cr, width);
+  cairo_stroke(cr);
+  cairo_set_dash(cr, nullptr, 0, 0);
+}
+
 void render_png_pdf(const std::string& png_path, const std::string& pdf_path, double width, double height,
                     const std::function<void(cairo_t*)>& draw) {
   if (!png_path.empty()) {

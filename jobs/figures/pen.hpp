@@ -39,6 +39,9 @@ double nice_step(double span, int parts);
 /// A number for labels: no trailing zeros, thousands apart with thin spaces when `grouped`.
 std::string label_number(double v, bool grouped = false);
 
+/// Stroke the current path in `c`, solid or dashed (4 on, 3 off), `width` wide.
+void stroke(cairo_t* cr, const Rgb& c, double width, bool dashed = false);
+
 /// Draw a page of `width` x `height` with `draw` into a PNG (pixels) and a PDF (points); either path
 /// may be empty. Throws std::runtime_error naming the file that cannot be written.
 void render_png_pdf(const std::string& png_path, const std::string& pdf_path, double width, double height,

@@ -60,12 +60,7 @@ void marks(cairo_t* cr, const Axes& a, const ProfilePlot& p) {
     if (s < 0) continue;
     cairo_move_to(cr, a.px(s), a.y0);
     cairo_line_to(cr, a.px(s), a.y0 + a.h);
-    const double dash[] = {4, 3};
-    cairo_set_dash(cr, dash, 2, 0);
-    cairo_set_source_rgb(cr, c.r, c.g, c.b);
-    cairo_set_line_width(cr, 1.2);
-    cairo_stroke(cr);
-    cairo_set_dash(cr, nullptr, 0, 0);
+    stroke(cr, c, 1.2, true);
   }
 }
 

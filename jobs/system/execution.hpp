@@ -21,12 +21,11 @@ struct WorkerExit {
   std::string describe() const;  ///< "exit status 3", "SIGSEGV", ...
 };
 
-/// What take_event found at the front of a worker's event stream.
-enum class EventParse { event, need_more, broken };
 /// Take the first whole length-prefixed event (4 bytes of length, little endian, then the message)
-/// off `buf`. A damaged message is skipped (the outcome decides); a length beyond any event means
-/// the stream is not our protocol (`broken`: nothing more can be read from it).
-EventParse take_event(std::string& buf, v1::WorkerEvent& ev);
+/// off `buf`; nothing while it is incomplete. A damaged message is skipped (the outcome decides); a
+/// length beyond any event means the stream is not our protocol: `closed` becomes true, nothing more
+/// can be read from it.
+std::optional<v1::WorkerEvent> take_event(std::string& buf, bool& closed);
 
 class Execution {
  public:

@@ -269,13 +269,7 @@ bool SlurmStep::read_more() {
 std::optional<v1::WorkerEvent> SlurmStep::next_event(std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
-    v1::WorkerEvent ev;
-    const EventParse got = take_event(buf_, ev);
-    if (got == EventParse::event) return ev;
-    if (got == EventParse::broken) {  // not our protocol: nothing more can be read from this stream
-      closed_ = true;
-      return std::nullopt;
-    }
+    if (auto ev = take_event(buf_, closed_)) return ev;
     if (closed_) return std::nullopt;
     if (read_more()) continue;
     const auto now = std::chrono::steady_clock::now();

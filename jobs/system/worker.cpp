@@ -152,13 +152,7 @@ bool WorkerProcess::fill(std::chrono::milliseconds timeout) {
 std::optional<v1::WorkerEvent> WorkerProcess::next_event(std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
-    v1::WorkerEvent ev;
-    const EventParse got = take_event(buf_, ev);
-    if (got == EventParse::event) return ev;
-    if (got == EventParse::broken) {  // not our protocol: nothing more can be read from this stream
-      closed_ = true;
-      return std::nullopt;
-    }
+    if (auto ev = take_event(buf_, closed_)) return ev;
     if (closed_) return std::nullopt;
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) return std::nullopt;
