@@ -149,7 +149,10 @@ struct Sh2dConfig {
   /// resolved, and integrated explicitly they pump energy into the flow without bound; smooth terrain
   /// stays below it (a 100 m radius at 30 m/s gives 0.9 g).
   double curvature_cap = 1.0;
-  bool skip_inactive = true;        ///< false: compute every tile every step (for comparison)
+  bool skip_inactive = true;        ///< false: compute every cell of every tile every step (for comparison)
+  /// false: compute the whole of every active tile, also its cells beyond the reach of material
+  /// (for comparison: the results are the same bits)
+  bool skip_empty = true;
   bool track_travel = false;        ///< accumulate Sh2dDiagnostics::mean_travel (costs a sqrt per cell)
   double snapshot_interval = 0;     ///< [s]; 0: no snapshots
   SnapshotHook snapshot;            ///< optional

@@ -117,6 +117,8 @@ Solver::Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
   hz_.arrival_time.assign(n_, nan);
   for (int tt = 0; tt < ntiles_; ++tt) tile_scan(tt);
   for (std::size_t k = 0; k < n_; ++k) record_hazard(k, 0.0);
+  for (auto& f : filled_) f.resize(std::size_t(ntiles_));
+  for (int tt = 0; tt < ntiles_; ++tt) fill_whole(tt);
   rebuild_active();
   secondary_time_.assign(cfg.secondary.size(), nan);
 }
@@ -147,6 +149,7 @@ void Solver::release_secondary() {
       }
       const int i = int(k % std::size_t(nx_)), j = int(k / std::size_t(nx_));
       touched[(j / T_) * ntx_ + i / T_] = 1;
+      fill_whole((j / T_) * ntx_ + i / T_);
     }
   }
   if (touched.empty()) return;
@@ -220,6 +223,7 @@ void Solver::rebuild_active() {
         }
       tile_ke_[tt] = 0;
       tile_speed_[tt] = 0;
+      fill_whole(tt);
     }
     active_flag_[tt] = next[tt];
     if (next[tt]) active_.push_back(tt);
@@ -346,14 +350,9 @@ double Solver::next_dt() const {
 double Solver::step_all(double dt, std::vector<TileWork>& work) {
   const double t = t_now_;
   const int na = int(active_.size());
-  std::size_t ncells = 0;
-  for (int tt : active_) {
-    int i0, i1, j0, j1;
-    tile_range(tt, i0, i1, j0, j1);
-    ncells += std::size_t(i1 - i0) * (j1 - j0);
-  }
-#pragma omp parallel for schedule(dynamic, 1)
-  for (int a = 0; a < na; ++a) step_tile(active_[a], t, dt, work[omp_get_thread_num()]);
+  long ncells = 0;  // the cells computed: those of the active tiles within reach of material
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : ncells)
+  for (int a = 0; a < na; ++a) ncells += step_tile(active_[a], t, dt, work[omp_get_thread_num()]);
   cur_ = 1 - cur_;
   t_now_ += dt;
   ++steps_;

@@ -21,6 +21,11 @@
 
 namespace runout::engine::sh2d_detail {
 
+// A box of cells [i0, i1) x [j0, j1).
+struct CellBox {
+  int i0, i1, j0, j1;
+};
+
 struct Face {
   double f0, f1, f2;
 };
@@ -133,7 +138,10 @@ class Solver {
   void release_secondary();
   void record_hazard(std::size_t k, double t);
   void rebuild_active();
-  void step_tile(int tt, double t, double dt, TileWork& w);
+  long step_tile(int tt, double t, double dt, TileWork& w);  // returns the cells it computed
+  CellBox material_box(int i0, int i1, int j0, int j1) const;
+  void clear_outside(int tt, const CellBox& c);
+  void fill_whole(int tt);
   template <Limiter L>
   void predictor(TileWork& w, double dt) const;
   void earth_pressure(std::size_t k, int i, int j, double U, double V, double& Pxx, double& Pxy, double& Pyy,
@@ -144,7 +152,7 @@ class Solver {
   template <bool X>
   Face face(const TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi, Boundary2D blo, Boundary2D bhi) const;
   long positivity(TileWork& w, int i0, int i1, int j0, int j1, double dt) const;
-  void update(int tt, TileWork& w, double t, double dt);
+  void update(int tt, TileWork& w, const CellBox& c, double t, double dt);
   void update_cell(TileWork& w, int i, int j, int i0, double t, double dt, double& out);
   template <bool Voellmy>
   void update_row(TileWork& w, int j, int ia, int ib, int i0, double dt);
@@ -169,6 +177,9 @@ class Solver {
   std::vector<long> tile_limited_;
   std::vector<std::uint8_t> tile_wet_, active_flag_;
   std::vector<int> active_;
+  // Per time level and tile: the box of the tile's cells that may hold material or momentum in that
+  // level; every other cell of the tile is empty there (see clear_outside).
+  std::vector<CellBox> filled_[2];
   HazardMaps hz_;
   // The time loop's running figures (members so that a checkpoint can carry them).
   double t_now_ = 0, active_sum_ = 0, next_snapshot_ = 0, last_snapshot_ = -1;

@@ -210,9 +210,8 @@ RUNOUT_SIMD_CLONES void Solver::update_row(TileWork& w, int j, int ia, int ib, i
   }
 }
 
-void Solver::update(int tt, TileWork& w, double t, double dt) {
-  int i0, i1, j0, j1;
-  tile_range(tt, i0, i1, j0, j1);
+void Solver::update(int tt, TileWork& w, const CellBox& c, double t, double dt) {
+  const int i0 = c.i0, i1 = c.i1, j0 = c.j0, j1 = c.j1;
   const auto &H1 = H_[1 - cur_], &HU1 = HU_[1 - cur_], &HV1 = HV_[1 - cur_];
   double out = 0, travel = 0, mass = 0, ke = 0, vmax = 0, rate = 0;
   bool wet = false;
