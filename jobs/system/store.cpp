@@ -414,7 +414,12 @@ void JobStore::transition(const std::string& id, v1::JobState state, const std::
   tx.commit();
 }
 
-std::optional<StoredJob> JobStore::cancel(const std::string& id, const std::string& owner) {
+namespace {
+constexpr const char* kCancelledQueued = "cancelled by the client before it started";
+constexpr const char* kMemberCancelled = "its ensemble was cancelled by the client before it started";
+}  // namespace
+
+std::optional<StoredJob> JobStore::cancel(const std::string& id, const std::string& owner, std::vector<Change>* ended) {
   {
     std::lock_guard lk(mu_);
     Transaction tx(db_);
@@ -429,14 +434,16 @@ std::optional<StoredJob> JobStore::cancel(const std::string& id, const std::stri
       while (ms.step()) queued.push_back(ms.text(0));
       for (const auto& m : queued) {
         Stmt(db_, "UPDATE jobs SET state = 5, updated = ? WHERE id = ?").bind(1, now).bind(2, m).step();
-        add_transition(db_, m, v1::CANCELLED, now, "its ensemble was cancelled by the client before it started");
+        add_transition(db_, m, v1::CANCELLED, now, kMemberCancelled);
+        if (ended) ended->push_back({m, v1::CANCELLED, kMemberCancelled});
       }
       Stmt(db_, "UPDATE jobs SET cancel_requested = 1 WHERE parent = ? AND state = 2").bind(1, id).step();
     }
     if (v1::JobState(st.i64(0)) == v1::QUEUED) {
       Stmt up(db_, "UPDATE jobs SET state = 5, updated = ? WHERE id = ?");
       up.bind(1, now).bind(2, id).step();
-      add_transition(db_, id, v1::CANCELLED, now, "cancelled by the client before it started");
+      add_transition(db_, id, v1::CANCELLED, now, kCancelledQueued);
+      if (ended) ended->push_back({id, v1::CANCELLED, kCancelledQueued});
     } else if (v1::JobState(st.i64(0)) == v1::RUNNING) {
       // Kept in the store, so that neither a worker that has just claimed the job nor a restart
       // after a crash loses it.

@@ -89,17 +89,20 @@ class JobStore {
   /// ended because its worker process crashed (counted in StoredJob::crashes).
   void transition(const std::string& id, v1::JobState state, const std::string& reason, const std::string& error = "",
                   std::int64_t result_bytes = -1, bool crashed = false);
-  /// Queued jobs become cancelled here; running ones are left for the worker (returns their state).
-  /// An ensemble's queued members are cancelled with it and its running ones asked to stop.
-  std::optional<StoredJob> cancel(const std::string& id, const std::string& owner);
-  /// Jobs left running by a server that went down: queued again (cancelled when the client had
-  /// asked). The server's death does not count against a job. Returns how many were queued again;
-  /// `changed` (optional) receives each job's id, new state and reason.
+  /// A job's change of state, for its log.
   struct Change {
     std::string id;
     v1::JobState state;
     std::string reason;
   };
+  /// Queued jobs become cancelled here; running ones are left for the worker (returns their state).
+  /// An ensemble's queued members are cancelled with it and its running ones asked to stop.
+  /// `ended` (when given) receives each job this call moved to CANCELLED: the job itself when it
+  /// was queued, and an ensemble's queued members (their logs want the line).
+  std::optional<StoredJob> cancel(const std::string& id, const std::string& owner, std::vector<Change>* ended = nullptr);
+  /// Jobs left running by a server that went down: queued again (cancelled when the client had
+  /// asked). The server's death does not count against a job. Returns how many were queued again;
+  /// `changed` (optional) receives each job's id, new state and reason.
   int requeue_running(const std::string& reason, std::vector<Change>* changed = nullptr);
   /// Whether the client asked to cancel this (running) job.
   bool cancel_requested(const std::string& id) const;

@@ -92,15 +92,16 @@ Status Server::Impl::ListJobs(grpc::ServerContext* ctx, const v1::ListJobsReques
 Status Server::Impl::CancelJob(grpc::ServerContext* ctx, const v1::CancelJobRequest* req, v1::Job* resp) {
   std::string owner;
   if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
-  auto j = store->cancel(req->id(), owner);
+  std::vector<jobs::JobStore::Change> ended;
+  auto j = store->cancel(req->id(), owner, &ended);
   if (!j) return {StatusCode::NOT_FOUND, "no job '" + req->id() + "'"};
   if (j->job.state() == v1::RUNNING) {
     sched->cancel_running(req->id());
     log("job " + req->id() + ": cancel requested");
-  } else if (j->job.state() == v1::CANCELLED && !j->job.transitions().empty() &&
-             j->job.transitions(j->job.transitions_size() - 1).reason() == "cancelled by the client before it started") {
-    std::ofstream lg(sched->log_path(req->id()), std::ios::app);  // `runout serve --recover` reads it
-    lg << jobs::utc_now() << " cancelled: cancelled by the client before it started\n";
+  }
+  for (const auto& e : ended) {  // each log keeps its job's history (`runout serve --recover` reads it)
+    std::ofstream lg(sched->log_path(e.id), std::ios::app);
+    lg << jobs::utc_now() << " cancelled: " << e.reason << "\n";
   }
   sched->touch(req->id());
   *resp = with_live(*j);

@@ -88,3 +88,37 @@ TEST(JobStore, RunningJobsAreQueuedAgainAfterARestartWithoutCountingACrash) {
   EXPECT_EQ(j->job.state(), v1::QUEUED);
   EXPECT_EQ(j->crashes, 0);
 }
+
+// Cancelling an ensemble ends its queued members with it, and says which jobs it ended (the server
+// writes each one's log line, which `runout serve --recover` reads); a running member is asked to
+// stop instead, and its worker ends it.
+TEST(JobStore, CancellingAnEnsembleEndsItsQueuedMembersAndNamesThem) {
+  test_support::TempDir dir;
+  JobStore st(dir / "jobs.db");
+  std::vector<JobStore::NewMember> members;
+  for (int k = 0; k < 3; ++k) members.push_back({k, "member-hash-" + std::to_string(k), named("m" + std::to_string(k))});
+  const auto e = st.submit_ensemble("alice", "ensemble-hash", "req-e", named("e"), members, 10);
+  ASSERT_TRUE(e.created);
+  const auto running = st.claim_next();  // the first member
+  ASSERT_TRUE(running);
+  std::vector<JobStore::Change> ended;
+  const auto parent = st.cancel(e.job.job.id(), "alice", &ended);
+  ASSERT_TRUE(parent);
+  EXPECT_EQ(parent->job.state(), v1::CANCELLED);
+  ASSERT_EQ(ended.size(), 3u);  // the two queued members and the ensemble itself
+  const auto listed = st.members(e.job.job.id());
+  ASSERT_EQ(listed.size(), 3u);
+  EXPECT_EQ(listed[0].job.id(), running->job.id());
+  EXPECT_EQ(listed[0].job.state(), v1::RUNNING);
+  EXPECT_TRUE(st.cancel_requested(running->job.id()));
+  for (int k = 1; k < 3; ++k) {
+    EXPECT_EQ(listed[std::size_t(k)].job.state(), v1::CANCELLED);
+    EXPECT_EQ(ended[std::size_t(k) - 1].id, listed[std::size_t(k)].job.id());
+    EXPECT_EQ(ended[std::size_t(k) - 1].state, v1::CANCELLED);
+    EXPECT_NE(ended[std::size_t(k) - 1].reason.find("ensemble was cancelled"), std::string::npos);
+  }
+  EXPECT_EQ(ended[2].id, e.job.job.id());
+  std::vector<JobStore::Change> again;
+  st.cancel(e.job.job.id(), "alice", &again);
+  EXPECT_TRUE(again.empty());  // nothing left to end
+}
