@@ -29,6 +29,8 @@ const CaseEntry kCases[] = {
     {"V2", "VOF engine: plane Poiseuille flow of a Newtonian fluid down an inclined channel, parabolic profile", case_v2},
     {"V3", "VOF engine: granular layer under air at rest in a closed box, hydrostatic pressure, no spurious currents", case_v3},
     {"V4", "VOF engine: start-up of plane Couette flow from rest (series solution)", case_v4},
+    {"V5", "VOF engine: steady Bagnold flow of the mu(I) rheology down an inclined plane, under air", case_v5},
+    {"V6", "VOF engine: Bagnold flow at low inertial number, mu(I) regularised (converges) and not (does not)", case_v6},
 };
 
 }  // namespace

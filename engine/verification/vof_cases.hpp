@@ -1,7 +1,7 @@
 #pragma once
-// Verification cases V1-V4 of the VOF engine (engine/vof/, docs/validation/verification.md): Newtonian flows
-// with exact solutions (plane Couette, plane Poiseuille, Couette's start-up) and a two-layer column
-// at rest (hydrostatic pressure, no spurious currents). Same rows and registry as A1-A7 (cases.cpp).
+// Verification cases V1-V6 of the VOF engine (engine/vof/, docs/validation/verification.md): Newtonian flows
+// with exact solutions (plane Couette, plane Poiseuille, Couette's start-up), a two-layer column
+// at rest (hydrostatic pressure, no spurious currents) and the Bagnold flow of the mu(I) rheology, with and without its regularisation. Same rows and registry as A1-A7 (cases.cpp).
 #include <vector>
 
 #include "engine/verification/cases.hpp"
@@ -12,5 +12,7 @@ std::vector<Row> case_v1(const Options& o);  ///< plane Couette flow, steady
 std::vector<Row> case_v2(const Options& o);  ///< plane Poiseuille flow down an inclined channel
 std::vector<Row> case_v3(const Options& o);  ///< still two-layer column in a closed box
 std::vector<Row> case_v4(const Options& o);  ///< start-up of plane Couette flow (transient)
+std::vector<Row> case_v5(const Options& o);  ///< Bagnold flow of the mu(I) rheology down an inclined plane
+std::vector<Row> case_v6(const Options& o);  ///< the same at low I: regularised against unregularised
 
 }  // namespace runout::engine::verification

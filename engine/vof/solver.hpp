@@ -99,6 +99,18 @@ struct VofConfig {
   double nu2 = 1.48e-5;        ///< air kinematic viscosity [m2/s]
   double phi_deg = 32;         ///< internal friction angle of the granular phase
   std::string rheology = "coulomb";  ///< the granular phase's viscosity model, by name
+  /// The mu(I) rheology (rheology "mu_i", models/mu_i.cpp): mu = mu_s + (mu_2 - mu_s) / (I_0 / I + 1),
+  /// I = d |strain rate| / sqrt(p / rho_s). Defaults: the glass beads of Jop, Forterre & Pouliquen
+  /// (2006): mu_s = tan 20.9 deg, mu_2 = tan 32.76 deg, I_0 = 0.279, d = 0.5 mm, rho_s = 2450 kg/m3.
+  struct MuI {
+    double mu_s = 0.381863;        ///< static friction coefficient (I -> 0, unregularised)
+    double mu_2 = 0.643468;        ///< limiting friction coefficient (I -> infinity)
+    double i0 = 0.279;             ///< inertial number where mu is halfway between mu_s and mu_2
+    double grain_diameter = 5e-4;  ///< d [m]
+    double grain_density = 2450;   ///< rho_s [kg/m3]; rho1 / rho_s is the solid fraction
+    /// Barker & Gray (2017)'s alpha of the regularised branch sqrt(alpha / ln(A / I)) below I_1.
+    double alpha = 1.9;
+  } mu_i;
   double nu_min = 1e-15, nu_max = 1e2;  ///< viscosity limits [m2/s]
   std::function<Vec(double)> gravity = [](double) { return Vec{0, -9.81, 0}; };
   double max_co = 0.2;         ///< target Courant number (velocity) in cells with material

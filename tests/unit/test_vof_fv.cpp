@@ -130,17 +130,78 @@ TEST(VofFv, CoulombViscosityByName) {
   EXPECT_NEAR(nu->nu(1000, 2.0), 1000 / (c.rho1 * 2.0), 1e-12);
   EXPECT_EQ(nu->nu(1000, 0.0), c.nu_max);  // at rest: the clip
   EXPECT_EQ(nu->nu(-1000, 1.0), c.nu_min);
-  EXPECT_EQ(granular_viscosity_names(), std::vector<std::string>{"coulomb"});
+  EXPECT_EQ(granular_viscosity_names(), (std::vector<std::string>{"coulomb", "mu_i", "mu_i_unregularised"}));
+}
+
+// mu(I) through the viscosity: nu rho1 |strain rate| / p is mu(I) at I = d |strain rate| / sqrt(p / rho_s).
+namespace {
+double mu_at(const GranularViscosity& v, const VofConfig& c, double I, double p = 500) {
+  const double sr = I * std::sqrt(p / c.mu_i.grain_density) / c.mu_i.grain_diameter;
+  return v.nu(p, sr) * c.rho1 * sr / p;
+}
+}  // namespace
+
+TEST(VofFv, MuIViscosityFollowsTheLawAndItsRegularisation) {
+  VofConfig c;
+  c.rho1 = 1470;
+  c.rheology = "mu_i_unregularised";
+  const auto raw = make_granular_viscosity(c);
+  c.rheology = "mu_i";
+  const auto reg = make_granular_viscosity(c);
+  const auto& m = c.mu_i;
+  auto law = [&](double I) { return m.mu_s + (m.mu_2 - m.mu_s) / (m.i0 / I + 1); };
+  for (double I : {1e-4, 1e-2, 0.1, 0.279, 1.0, 10.0}) EXPECT_NEAR(mu_at(*raw, c, I), law(I), 1e-12 * law(I)) << I;
+  EXPECT_NEAR(mu_at(*raw, c, 0.279), 0.5 * (m.mu_s + m.mu_2), 1e-12);  // halfway at I_0
+  for (double I : {0.05, 0.1, 1.0}) EXPECT_NEAR(mu_at(*reg, c, I), law(I), 1e-12 * law(I)) << I;  // above I_1 = 0.0207
+  // Below I_1 the regularised friction is smaller and falls towards 0; it joins the law with the
+  // same value and slope at I_1.
+  EXPECT_LT(mu_at(*reg, c, 1e-3), law(1e-3) - 0.02);
+  EXPECT_LT(mu_at(*reg, c, 1e-12), 0.25);
+  double lo = 1e-4, hi = 0.2;  // I_1: where the regularised branch starts to differ from the law
+  for (int k = 0; k < 100; ++k) {
+    const double mid = std::sqrt(lo * hi);
+    (std::abs(mu_at(*reg, c, mid) - law(mid)) > 1e-13 ? lo : hi) = mid;
+  }
+  EXPECT_NEAR(hi, 0.0207, 1e-4);
+  const double e = 1e-6 * hi;
+  EXPECT_NEAR(mu_at(*reg, c, hi - e), mu_at(*reg, c, hi + e), 1e-6);  // continuous (the slope is about 0.8)
+  const double slope_below = (mu_at(*reg, c, hi - e) - mu_at(*reg, c, hi - 3 * e)) / (2 * e);
+  const double slope_above = (mu_at(*reg, c, hi + 3 * e) - mu_at(*reg, c, hi + e)) / (2 * e);
+  EXPECT_NEAR(slope_below, slope_above, 1e-3 * slope_above);  // and smooth
+  // No pressure, or a tension: the clip, as the Coulomb viscosity has it.
+  EXPECT_EQ(reg->nu(-1000, 1.0), c.nu_min);
+  EXPECT_EQ(reg->nu(1000, 0.0), c.nu_max);
+}
+
+TEST(VofFv, MuIParametersAreChecked) {
+  auto bad = [](auto change, const char* expected) {
+    VofConfig c;
+    c.rho1 = 1470;
+    c.rheology = "mu_i";
+    change(c);
+    try {
+      make_granular_viscosity(c);
+      ADD_FAILURE() << "accepted: " << expected;
+    } catch (const VofError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  };
+  bad([](VofConfig& c) { c.mu_i.mu_2 = 0.3; }, "mu_2 must be at least mu_s");
+  bad([](VofConfig& c) { c.mu_i.mu_s = 0; }, "mu_s must be > 0");
+  bad([](VofConfig& c) { c.mu_i.i0 = -1; }, "I_0 must be > 0");
+  bad([](VofConfig& c) { c.mu_i.grain_diameter = 0; }, "grain diameter");
+  bad([](VofConfig& c) { c.mu_i.grain_density = 1000; }, "grain density must be at least the bulk density");
+  bad([](VofConfig& c) { c.mu_i.mu_2 = c.mu_i.mu_s + 1e-3; }, "too small for alpha");
 }
 
 TEST(VofFv, UnknownRheologyListsTheValidNames) {
   auto c = walls_and_top(Bc::atmosphere);
-  c.rheology = "mu_i";
+  c.rheology = "bingham";
   try {
     VofSolver s(row_of_cells(4), c);
     FAIL() << "an unknown rheology was accepted";
   } catch (const VofError& e) {
-    EXPECT_STREQ(e.what(), "rheology: unknown 'mu_i' (valid: coulomb)");
+    EXPECT_STREQ(e.what(), "rheology: unknown 'bingham' (valid: coulomb, mu_i, mu_i_unregularised)");
   }
 }
 

@@ -8,6 +8,8 @@
 namespace runout::engine::vof {
 
 std::unique_ptr<GranularViscosity> make_coulomb_viscosity(const VofConfig&);
+std::unique_ptr<GranularViscosity> make_mu_i_viscosity(const VofConfig&);
+std::unique_ptr<GranularViscosity> make_mu_i_unregularised_viscosity(const VofConfig&);
 
 namespace {
 
@@ -18,6 +20,8 @@ struct Entry {
 
 constexpr std::array kModels = {
     Entry{"coulomb", make_coulomb_viscosity},
+    Entry{"mu_i", make_mu_i_viscosity},
+    Entry{"mu_i_unregularised", make_mu_i_unregularised_viscosity},
 };
 
 }  // namespace
