@@ -29,11 +29,13 @@
 // The code: solver.cpp (the step), alpha_eqn, momentum_eqn (+ momentum_predictor), pressure_eqn,
 // active_region and hydrostatics, over the finite-volume vocabulary of fv/ (cell and face fields,
 // interpolate, reconstruct, FvMatrix) and the fields of fields.hpp.
+#include <array>
 #include <functional>
 #include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "engine/names.hpp"
@@ -92,6 +94,10 @@ inline constexpr NameTable<WallViscosity, 2> kWallViscosityNames{{{"face", WallV
 /// The pressure-velocity coupling: PISO with 1/A (false) or the consistent 1/(A - H1) with the
 /// momentum predictor (true; VofConfig::consistent and momentum_predictor).
 inline constexpr NameTable<bool, 2> kPressureCouplingNames{{{"piso", false}, {"consistent", true}}};
+
+/// The granular viscosity models' names (VofConfig::rheology), as models/registry.cpp has them (a
+/// test keeps the two the same): for the scenario's checks, which do not link the solver.
+inline constexpr std::array<std::string_view, 3> kGranularViscosityNames{"coulomb", "mu_i", "mu_i_unregularised"};
 
 struct VofConfig {
   double rho1 = 936.17;        ///< granular bulk density [kg/m3]

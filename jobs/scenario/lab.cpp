@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "engine/vof/models/mu_i_law.hpp"
 #include "jobs/scenario/options.hpp"
 #include "jobs/scenario/scenario.hpp"
 #include "jobs/scenario/scenario_impl.hpp"
@@ -71,7 +72,35 @@ void check_boundaries(const v1::Lab& l, bool three_d) {
   }
 }
 
+// mu(I): the checks between its fields (each one's range is the option table's) and the
+// regularisation's join, which the model makes when it is built.
+void check_rheology(const v1::Lab& l) {
+  if (l.rheology().empty() || l.rheology() == "coulomb") return;
+  engine::vof::VofConfig c;
+  c.rho1 = lab_material(l.material()).rho;
+  apply_lab_rheology(l, c);
+  const auto& m = c.mu_i;
+  if (m.mu_2 < m.mu_s) bad("lab.mu_2", "must be at least lab.mu_s (" + num(m.mu_s) + "), got " + num(m.mu_2));
+  if (m.grain_density < c.rho1)
+    bad("lab.grain_density_kg_m3", "must be at least the material's density " + num(c.rho1) + " kg/m3, got " + num(m.grain_density));
+  try {
+    const engine::vof::MuILaw law(m, c.rho1, c.rheology == "mu_i");  // it checks and joins when built
+    (void)law;
+  } catch (const engine::vof::VofError& e) {
+    bad("lab.mu_2", e.what());
+  }
+}
+
 }  // namespace
+
+void apply_lab_rheology(const v1::Lab& l, engine::vof::VofConfig& c) {
+  if (!l.rheology().empty()) c.rheology = l.rheology();
+  if (l.has_mu_s()) c.mu_i.mu_s = l.mu_s();
+  if (l.has_mu_2()) c.mu_i.mu_2 = l.mu_2();
+  if (l.has_mu_i0()) c.mu_i.i0 = l.mu_i0();
+  if (l.has_grain_diameter_m()) c.mu_i.grain_diameter = l.grain_diameter_m();
+  if (l.has_grain_density_kg_m3()) c.mu_i.grain_density = l.grain_density_kg_m3();
+}
 
 ResolvedScenario resolve_lab(v1::Scenario s) {
   if (!s.has_lab()) bad("lab", "engine \"vof\" needs the lab block (domain, cells, fill, boundaries)");
@@ -90,6 +119,7 @@ ResolvedScenario resolve_lab(v1::Scenario s) {
   if (l.has_chute()) check_chute(l, three_d);
   check_fill(l, three_d);
   check_boundaries(l, three_d);
+  check_rheology(l);
   const auto& ref = l.reference();
   if (ref.has_front_x_min() != ref.has_front_x_max() || (ref.has_front_x_min() && ref.front_x_max() < ref.front_x_min()))
     bad("lab.reference.front_x_max", "the front is a range: give front_x_min and front_x_max >= front_x_min");

@@ -140,6 +140,17 @@ const OptionTable& lab_options() {
        "the pressure solve's preconditioner: PETSc's GAMG, hypre's BoomerAMG or ILU(0)", "VofConfig::pressure_pc"},
       {"lab.wall_viscosity", T::choice, U::keep, "face", {}, names_of(engine::vof::kWallViscosityNames), "",
        "viscosity on walls and inflows: evaluated on the face (as OpenFOAM) or the cell's", "VofConfig::wall_viscosity"},
+      {"lab.rheology", T::choice, U::keep, "coulomb", {}, std::vector<std::string>(engine::vof::kGranularViscosityNames.begin(), engine::vof::kGranularViscosityNames.end()), "",
+       "the granular viscosity: Coulomb (tan(phi) p) or mu(I), regularised at low I or not", "VofConfig::rheology"},
+      {"lab.mu_s", T::number, U::as_given, "", Range{0, 5, true}, {}, "", "mu(I): static friction coefficient mu_s (default tan 20.9 deg)",
+       "VofConfig::mu_i.mu_s"},
+      {"lab.mu_2", T::number, U::as_given, "", Range{0, 5, true}, {}, "",
+       "mu(I): limiting friction coefficient mu_2 >= mu_s (default tan 32.76 deg)", "VofConfig::mu_i.mu_2"},
+      {"lab.mu_i0", T::number, U::as_given, "", Range{0, 10, true}, {}, "", "mu(I): I_0 (default 0.279)", "VofConfig::mu_i.i0"},
+      {"lab.grain_diameter_m", T::number, U::as_given, "", Range{0, 0.1, true}, {}, "m", "mu(I): grain diameter d (default 0.5 mm)",
+       "VofConfig::mu_i.grain_diameter"},
+      {"lab.grain_density_kg_m3", T::number, U::as_given, "", Range{100, 20000}, {}, "kg/m3",
+       "mu(I): grain density rho_s, at least the material's density (default 2450)", "VofConfig::mu_i.grain_density"},
   };
   return t;
 }

@@ -18,12 +18,6 @@ namespace {
 using google::protobuf::FieldDescriptor;
 using google::protobuf::Message;
 
-std::string num(double v) {
-  std::ostringstream o;
-  o << v;
-  return o.str();
-}
-
 // One place an option occurs: a field of a message, or one element of a repeated scalar field.
 struct Location {
   Message* msg;

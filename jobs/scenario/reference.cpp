@@ -5,16 +5,11 @@
 
 #include "engine/friction/registry.hpp"
 #include "jobs/scenario/options.hpp"
+#include "jobs/scenario/scenario_impl.hpp"
 
 namespace runout::jobs {
 
 namespace {
-
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
-}
 
 std::string friction_laws_markdown() {
   std::string s = "| `material.rheology` | Basal shear stress | Needs |\n|---|---|---|\n";

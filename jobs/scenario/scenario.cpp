@@ -35,12 +35,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string num(double v) {
-  std::ostringstream o;
-  o << v;
-  return o.str();
-}
-
 // An input file: it must exist and be a regular file (symbolic links followed). A FIFO or device
 // would block the reader (GDAL's open, which SIGTERM does not interrupt); a folder cannot be hashed.
 std::string path_in(const std::string& base, const std::string& p, const std::string& field) {

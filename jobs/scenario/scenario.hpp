@@ -10,6 +10,10 @@
 #include "runout/v1/scenario.pb.h"
 #include "terrain/terrain.hpp"
 
+namespace runout::engine::vof {
+struct VofConfig;
+}
+
 namespace runout::jobs {
 
 struct ScenarioError : std::runtime_error {
@@ -104,5 +108,9 @@ v1::Scenario parse_scenario_json(const std::string& json);
 ResolvedScenario load_scenario(const std::string& path);
 /// Resolve and validate a message; relative paths are taken from `base_dir`. Throws ScenarioError.
 ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base_dir);
+
+/// The laboratory block's granular rheology into the engine's configuration: lab.rheology and the
+/// mu(I) parameters that are set (the rest keep the engine's defaults, the glass beads).
+void apply_lab_rheology(const v1::Lab& lab, engine::vof::VofConfig& c);
 
 }  // namespace runout::jobs

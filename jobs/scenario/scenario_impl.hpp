@@ -2,11 +2,19 @@
 // Inside jobs/scenario: what the resolvers of both engines share.
 #include <google/protobuf/message.h>
 
+#include <sstream>
 #include <string>
 
 #include "jobs/scenario/scenario.hpp"
 
 namespace runout::jobs {
+
+// A number as messages and the reference print it (6 significant digits, as %g).
+inline std::string num(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
 
 [[noreturn]] inline void bad(const std::string& field, const std::string& problem) { throw ScenarioError(field + ": " + problem); }
 

@@ -351,3 +351,30 @@ TEST(LabOptions, BoundaryKindsAreTheEngineRegistrys) {
               name);
   }
 }
+
+// lab.rheology: "coulomb" by default (left unset), "mu_i" accepted and reaching the run (coarse B2:
+// the mu(I) beads, with their lower static friction, run further than PVC's Coulomb phi); the mu(I)
+// parameters checked between each other and against the material, each error naming the field.
+TEST(Scenarios, LabRheologyIsValidatedAndReachesTheRun) {
+  expect_unset_default_option("rheology", "coulomb", "mu_i", "bingham", [](const v1::Lab& l) { return l.rheology(); });
+  const std::string head = R"({"engine": "vof", "lab": {"x_max": 1, "y_max": 1, "nx": 10, "ny": 10,
+      "fill": [{"x_max": 0.5, "y_max": 0.5}], "rheology": "mu_i")";
+  auto with = [&](const std::string& more) { return jobs::parse_scenario_json(head + more + "}}"); };
+  EXPECT_NO_THROW(jobs::resolve_scenario(with(R"(, "mu_s": 0.5, "mu_2": 0.9, "mu_i0": 0.3, "grain_diameter_m": 0.001)"), "."));
+  expect_resolve_error(with(R"(, "mu_s": 0.6, "mu_2": 0.5)"), {"lab.mu_2", "at least lab.mu_s"});
+  expect_resolve_error(with(R"(, "grain_density_kg_m3": 500)"), {"lab.grain_density_kg_m3", "material's density"});
+  expect_resolve_error(with(R"(, "mu_2": 0.382)"), {"lab.mu_2", "too small"});
+  expect_resolve_error(with(R"(, "grain_diameter_m": 0)"), {"lab.grain_diameter_m"});
+  double front[2] = {0, 0};
+  for (int k = 0; k < 2; ++k) {
+    auto r = coarse_b2(0.4);
+    r.scenario.mutable_lab()->set_write_interval_s(0);
+    if (k == 1) r.scenario.mutable_lab()->set_rheology("mu_i");
+    r = jobs::resolve_scenario(r.scenario, std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab");
+    TempDir d;
+    ASSERT_EQ(jobs::run_scenario(r, d.p.string()).stop, "end-time");
+    front[k] = record_figure(d / "run.json", "front_x_m");
+  }
+  std::printf("coarse B2 to 0.4 s: front %.4f m (coulomb), %.4f m (mu_i, glass beads)\n", front[0], front[1]);
+  EXPECT_GT(std::abs(front[1] - front[0]), 0.005);  // at least half a cell apart
+}

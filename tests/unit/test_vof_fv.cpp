@@ -131,6 +131,8 @@ TEST(VofFv, CoulombViscosityByName) {
   EXPECT_EQ(nu->nu(1000, 0.0), c.nu_max);  // at rest: the clip
   EXPECT_EQ(nu->nu(-1000, 1.0), c.nu_min);
   EXPECT_EQ(granular_viscosity_names(), (std::vector<std::string>{"coulomb", "mu_i", "mu_i_unregularised"}));
+  EXPECT_EQ(granular_viscosity_names(),
+            std::vector<std::string>(kGranularViscosityNames.begin(), kGranularViscosityNames.end()));  // the scenario's list
 }
 
 // mu(I) through the viscosity: nu rho1 |strain rate| / p is mu(I) at I = d |strain rate| / sqrt(p / rho_s).

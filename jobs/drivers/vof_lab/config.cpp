@@ -49,6 +49,7 @@ vof::VofConfig lab_config(const v1::Lab& L, const Material& mat) {
   c.momentum_convection = choose(L.momentum_convection(), "lab.momentum_convection", vof::kConvectionNames, vof::Convection::upwind);
   c.coulomb_pressure = choose(L.coulomb_pressure(), "lab.coulomb_pressure", vof::kCoulombPressureNames, vof::CoulombPressure::total);
   c.wall_viscosity = choose(L.wall_viscosity(), "lab.wall_viscosity", vof::kWallViscosityNames, vof::WallViscosity::face);
+  apply_lab_rheology(L, c);  // checked when the scenario was resolved
   if (!L.pressure_preconditioner().empty()) c.pressure_pc = L.pressure_preconditioner();
   c.active_layers = L.active_layers() < 0 ? 0 : L.active_layers();
   c.consistent = c.momentum_predictor = choose(L.pressure_coupling(), "lab.pressure_coupling", vof::kPressureCouplingNames, false);
