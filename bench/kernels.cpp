@@ -1,13 +1,16 @@
-// Google Benchmark micro-benchmarks of the depth-averaged engine's building blocks:
+// Google Benchmark micro-benchmarks of the engines' building blocks (the depth-averaged engine's
+// limiters and steps, the VOF engine's granular viscosities):
 //   runout_bench_kernels [--benchmark_filter=...]
 // The figures that matter for users are in runout_bench_sh (work-precision, throughput).
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "engine/limiters.hpp"
 #include "engine/sh2d.hpp"
+#include "engine/vof/models/granular_viscosity.hpp"
 
 using namespace runout::engine;
 
@@ -26,6 +29,28 @@ void BM_Limiter(benchmark::State& state) {
   state.SetLabel(std::string(name_of(kLimiterNames, lim)));
 }
 BENCHMARK(BM_Limiter)->Arg(0)->Arg(1)->Arg(2);
+
+// The VOF engine's granular viscosity per cell (what its momentum equation evaluates once per cell
+// and step), over pressures and strain rates spanning a flow: resting to fast, shallow to deep.
+void BM_GranularViscosity(benchmark::State& state) {
+  vof::VofConfig c;
+  c.rho1 = 1470;
+  c.rheology = std::string(vof::kGranularViscosityNames[std::size_t(state.range(0))]);
+  const auto model = vof::make_granular_viscosity(c);
+  std::vector<double> p(4096), sr(4096);
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    p[k] = 1000 * (0.5 + 0.5 * std::sin(0.013 * double(k)));
+    sr[k] = std::pow(10.0, -4 + 6 * (0.5 + 0.5 * std::sin(0.7 * double(k))));
+  }
+  for (auto _ : state) {
+    double s = 0;
+    for (std::size_t k = 0; k < p.size(); ++k) s += model->nu(p[k], sr[k]);
+    benchmark::DoNotOptimize(s);
+  }
+  state.SetItemsProcessed(state.iterations() * std::int64_t(p.size()));
+  state.SetLabel(c.rheology);
+}
+BENCHMARK(BM_GranularViscosity)->Arg(0)->Arg(1)->Arg(2);
 
 // Forty steps of the 2D solver on a fully wet n x n grid on a rough 35 degree slope (set-up included).
 void BM_Sh2dSteps(benchmark::State& state) {
