@@ -1,6 +1,6 @@
 // Work-precision and throughput benchmark of the depth-averaged solvers (docs/design/performance.md).
 //
-//   runout_bench_sh [--quick] [--repeat N] [--throughput-only]
+//   runout_bench_sh [--quick] [--repeat N] [--throughput-only] [--friction LAW]
 //
 // 1. Work-precision: cases A1 (1D and 2D) and A3 (2D) at four resolutions for each limiter:
 //    error, wall time, cell-updates per second.
@@ -8,7 +8,8 @@
 // 3. Skipping dry work: the same grid with a release that wets about 5 % of it, cost per step
 //    relative to the fully wet grid.
 // Figures are medians over --repeat runs (default 5), all measured in this one process.
-// --throughput-only skips part 1 (for quick before/after comparisons of the 2D step).
+// --throughput-only skips part 1 (for quick before/after comparisons of the 2D step). --friction
+// runs parts 2 and 3 with another basal friction (friction_material: coulomb by default).
 #include <omp.h>
 
 #include <algorithm>
@@ -52,9 +53,29 @@ struct StepCost {
   long steps;
 };
 
-StepCost measure(const Terrain2D& t, const Sh2dState& init, long steps, int repeat) {
+// The throughput runs' material: each friction law with parameters of a dense flow on the 5 m grid;
+// pouliquen_forterre without, pouliquen_forterre_start with the start/stop term (its own kernel).
+bool friction_material(const std::string& law, Material& m) {
+  const double deg = M_PI / 180;
+  m = Material{};
+  m.delta = 25 * deg;
+  if (law == "voellmy") {
+    m.rheology = &friction::voellmy;
+    m.mu = 0.25;
+    m.xi = 2000;
+  } else if (law == "pouliquen_forterre" || law == "pouliquen_forterre_start") {
+    m = pouliquen_forterre_material(20 * deg, 32 * deg, (law == "pouliquen_forterre" ? 20 : 23) * deg, 0.136, 0.2, 0.05);
+  } else if (law == "mu_i") {
+    m = mu_i_material(0.38, 0.64, 0.279, 0.02, 2500, 1500);
+  } else if (law != "coulomb") {
+    return false;
+  }
+  return true;
+}
+
+StepCost measure(const Terrain2D& t, const Sh2dState& init, const Material& material, long steps, int repeat) {
   Sh2dConfig cfg;
-  cfg.material.delta = 25 * M_PI / 180;
+  cfg.material = material;
   cfg.time.t_end = 1e9;
   cfg.time.max_steps = steps;
   std::vector<double> per_step, rate;
@@ -96,6 +117,8 @@ void work_precision(bool quick) {
 int main(int argc, char** argv) {
   bool quick = false, throughput_only = false;
   int repeat = 5;
+  std::string law = "coulomb";
+  Material material;
   for (int k = 1; k < argc; ++k) {
     if (!std::strcmp(argv[k], "--quick")) {
       quick = true;
@@ -103,10 +126,17 @@ int main(int argc, char** argv) {
       throughput_only = true;
     } else if (!std::strcmp(argv[k], "--repeat") && k + 1 < argc) {
       repeat = std::max(1, std::atoi(argv[++k]));
+    } else if (!std::strcmp(argv[k], "--friction") && k + 1 < argc) {
+      law = argv[++k];
     } else {
-      std::fprintf(stderr, "usage: runout_bench_sh [--quick] [--repeat N] [--throughput-only]\n");
+      std::fprintf(stderr, "usage: runout_bench_sh [--quick] [--repeat N] [--throughput-only] [--friction LAW]\n");
       return 2;
     }
+  }
+  if (!friction_material(law, material)) {
+    std::fprintf(stderr, "unknown --friction '%s' (valid: coulomb, voellmy, pouliquen_forterre, pouliquen_forterre_start, mu_i)\n",
+                 law.c_str());
+    return 2;
   }
   if (quick) repeat = 1;
   std::printf("# runout depth-averaged engine benchmark, %d OpenMP threads, median of %d\n\n", omp_get_max_threads(),
@@ -129,9 +159,9 @@ int main(int argc, char** argv) {
     }
   const auto part = state_from_normal_depth(t, h);
   const long steps = quick ? 20 : 60;
-  const auto full = measure(t, wet, steps, repeat);
-  const auto small = measure(t, part, steps * 4, repeat);
-  std::printf("\n## Throughput (%d x %d grid, %ld steps)\n\n", n, n, full.steps);
+  const auto full = measure(t, wet, material, steps, repeat);
+  const auto small = measure(t, part, material, steps * 4, repeat);
+  std::printf("\n## Throughput (%d x %d grid, %ld steps, friction %s)\n\n", n, n, full.steps, law.c_str());
   std::printf("| run | ever wet | mean active | ms/step | Mcell-updates/s (of active cells) | grid cells/s |\n");
   std::printf("|---|---:|---:|---:|---:|---:|\n");
   std::printf("| fully wet | %.1f %% | %.1f %% | %.2f | %.1f | %.1f M |\n", 100 * full.ever_wet, 100 * full.active_fraction,

@@ -1,9 +1,10 @@
 #pragma once
 // Basal friction and earth pressure of the depth-averaged model.
 //
-// The friction laws (Coulomb, Voellmy) are entries of engine/friction/registry.hpp; each gives
-// tau_b = mu * N + rho * g * |u|^2 * inv_xi with N the basal normal stress, which on curved terrain
-// includes the centrifugal part rho * h * kappa * |u|^2 (Savage & Hutter 1991, dissertation eq. 3.48).
+// The friction laws (Coulomb, Voellmy, Pouliquen-Forterre, mu(I)) are entries of
+// engine/friction/registry.hpp; each gives tau_b = mu * N + rho * g * |u|^2 * inv_xi with N the basal
+// normal stress, which on curved terrain includes the centrifugal part rho * h * kappa * |u|^2
+// (Savage & Hutter 1991, dissertation eq. 3.48), and mu constant or mu(h, Fr) (engine/friction/law.hpp).
 //
 // Earth-pressure coefficient (Savage & Hutter 1989, dissertation eq. 3.36), active where the flow
 // extends (du/dx >= 0), passive where it is compressed:
@@ -26,16 +27,16 @@ inline constexpr NameTable<EarthPressure, 2> kEarthPressureNames{
     {{"unity", EarthPressure::unity}, {"active-passive", EarthPressure::active_passive}}};
 
 /// The flowing material: its friction law (engine/friction/registry.hpp) with that law's parameters
-/// (FrictionParams: delta, mu, xi), the earth pressure and the density.
+/// and the bulk density (FrictionParams), and the earth pressure.
 struct Material : FrictionParams {
   const FrictionLaw* rheology = &friction::coulomb;
   double phi = 0.0;        ///< internal friction angle [rad] (earth pressure)
   EarthPressure earth_pressure = EarthPressure::unity;
-  double density = 300.0;  ///< bulk density [kg/m^3], for pressure outputs only
 
   /// The law's coefficients, computed once before a run.
   BasalFriction friction() const { return rheology->coefficients(*this); }
-  /// Basal Coulomb coefficient: tan(delta) for Coulomb, mu for Voellmy.
+  /// Basal Coulomb coefficient: tan(delta) for Coulomb, mu for Voellmy, the lowest one (tan delta_1,
+  /// mu_s) for a flow-dependent law; the earth pressure's delta is its arc tangent.
   double coulomb_coefficient() const { return friction().mu; }
   /// 1/xi, zero for pure Coulomb friction.
   double inv_xi() const { return friction().inv_xi; }
@@ -53,6 +54,33 @@ struct Material : FrictionParams {
     if (!(density > 0.0)) bad("density must be > 0");
   }
 };
+
+/// A Pouliquen-Forterre material: delta_1, delta_2, delta_3 [rad] (NaN: delta_1), beta, L [m], gamma.
+inline Material pouliquen_forterre_material(double delta1, double delta2, double delta3, double beta, double length,
+                                            double gamma) {
+  Material m;
+  m.rheology = &friction::pouliquen_forterre;
+  m.delta1 = delta1;
+  m.delta2 = delta2;
+  m.delta3 = delta3;
+  m.pf_beta = beta;
+  m.pf_length = length;
+  m.pf_gamma = gamma;
+  return m;
+}
+
+/// A mu(I) material: mu_s, mu_2, I_0, grain diameter [m], grain density and bulk density [kg/m^3].
+inline Material mu_i_material(double mu_s, double mu_2, double i0, double diameter, double grain_density, double density) {
+  Material m;
+  m.rheology = &friction::mu_i;
+  m.mu_s = mu_s;
+  m.mu_2 = mu_2;
+  m.mu_i0 = i0;
+  m.grain_diameter = diameter;
+  m.grain_density = grain_density;
+  m.density = density;
+  return m;
+}
 
 /// K_x active (extension) or passive (compression) from phi and delta [rad].
 inline double k_x(double phi, double delta, bool active) {

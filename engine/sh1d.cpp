@@ -90,9 +90,9 @@ class Sh1dSolver {
   Sh1dSolver(const Channel1D& ch, const Sh1dConfig& cfg, const Sh1dState& init)
       : cfg_(cfg), n(ch.n), dx(ch.dx), g(cfg.gravity), hdry(cfg.dry_depth), lim(cfg.limiter),
         open(cfg.left != Boundary1D::wall || cfg.right != Boundary1D::wall), curv(cfg.curvature ? 1.0 : 0.0), w(ch.n) {
-    const BasalFriction friction = cfg.material.friction();  // the law, resolved once (engine/friction)
-    mu = friction.mu;
-    ixi = friction.inv_xi;
+    fr = cfg.material.friction();  // the law, resolved once (engine/friction)
+    mu = fr.mu;
+    ixi = fr.inv_xi;
     kap = cfg.material.earth_pressure == EarthPressure::active_passive;
     kact = kap ? k_x(cfg.material.phi, std::atan(mu), true) : 1.0;
     kpas = kap ? k_x(cfg.material.phi, std::atan(mu), false) : 1.0;
@@ -127,8 +127,12 @@ class Sh1dSolver {
   void fill_side(Boundary1D b, bool left, double t);
   void set_beta();
   double next_dt(double t) const;
+  template <MuForm M>
+  void step(double dt, double lam, Sh1dResult& r);
+  template <MuForm M>
   void predictor(double dt, double lam);
   void positivity(double lam);
+  template <MuForm M>
   void corrector(double dt, double lam, Sh1dResult& r);
   void average_back();
   // Slope of the discharge m = h u from the limited slopes of h and of the velocity (product rule):
@@ -139,9 +143,14 @@ class Sh1dSolver {
     const double u = M[k] / H[k];
     return u * sh + H[k] * limited_slope(lim, u - M[k - 1] / H[k - 1], M[k + 1] / H[k + 1] - u);
   }
-  // Coulomb resistance per unit width; Voellmy's drag is applied implicitly (turbulent_factor).
+  // Coulomb resistance per unit width, h mu g_n with g_n = (g cos(zeta) + kappa u^2)_+ and mu the
+  // law's (constant, or mu(h, Fr) at this state, Fr = |u| / sqrt(g_n h)); Voellmy's drag is applied
+  // implicitly (turbulent_factor).
+  template <MuForm M>
   double resistance(double h, double u, double zeta, double kappa) const {
-    return h * mu * std::max(0.0, g * std::cos(zeta) + curv * kappa * u * u);
+    const double gn = std::max(0.0, g * std::cos(zeta) + curv * kappa * u * u);
+    if constexpr (M == MuForm::constant) return h * mu * gn;
+    else return h * flow_mu<M == MuForm::hysteresis>(fr, h, std::abs(u), gn) * gn;
   }
   void drag(double& m, double h, double span) const {
     if (ixi > 0 && h > hdry) m *= turbulent_factor(std::abs(m) / h, h, span * g * ixi);
@@ -163,6 +172,7 @@ class Sh1dSolver {
   const Limiter lim;
   const bool open;
   const double curv;
+  BasalFriction fr;
   double mu = 0, ixi = 0, kact = 1, kpas = 1;
   bool kap = false;
   Work w;
@@ -224,7 +234,18 @@ double Sh1dSolver::next_dt(double t) const {
   return dt;
 }
 
-// Predictor (4.78): limited slopes and a half step with the flux Jacobian (4.79, 4.86).
+// One step of the scheme, with the friction coefficient's form M.
+template <MuForm M>
+void Sh1dSolver::step(double dt, double lam, Sh1dResult& r) {
+  predictor<M>(dt, lam);
+  positivity(lam);
+  corrector<M>(dt, lam, r);
+  average_back();
+}
+
+// Predictor (4.78): limited slopes and a half step with the flux Jacobian (4.79, 4.86); the friction
+// (its load and mu) from the state at t.
+template <MuForm M>
 void Sh1dSolver::predictor(double dt, double lam) {
   for (int k = 1; k < n + 2 * G - 1; ++k) {
     w.sh[k] = limited_slope(lim, w.h[k] - w.h[k - 1], w.h[k + 1] - w.h[k]);
@@ -234,7 +255,7 @@ void Sh1dSolver::predictor(double dt, double lam) {
     double mp = w.m[k] - 0.5 * lam * ((b * h - u * u) * w.sh[k] + 2.0 * u * w.sm[k]) +
                 0.5 * dt * h * g * std::sin(w.zeta[k]);
     double dummy = 0;
-    apply_friction(mp, dummy, std::abs(mp), 0.5 * dt * resistance(h, u, w.zeta[k], w.kappa[k]));
+    apply_friction(mp, dummy, std::abs(mp), 0.5 * dt * resistance<M>(h, u, w.zeta[k], w.kappa[k]));
     drag(mp, h, 0.5 * dt);
     w.mp[k] = mp;
   }
@@ -253,6 +274,7 @@ void Sh1dSolver::positivity(double lam) {
 }
 
 // Corrector (4.73, 4.74, 4.77, 4.80) on the staggered cell between k and k+1.
+template <MuForm M>
 void Sh1dSolver::corrector(double dt, double lam, Sh1dResult& r) {
   for (int k = 1; k < n + 2 * G - 2; ++k) {
     const double s0 = scale(k), s1 = scale(k + 1);
@@ -268,8 +290,8 @@ void Sh1dSolver::corrector(double dt, double lam, Sh1dResult& r) {
     }
     // Friction at the half step (midpoint rule, second order), bounded so it never reverses u.
     const double uq1 = vel(w.hp[k], w.mp[k]), uq3 = vel(w.hp[k + 1], w.mp[k + 1]);
-    const double R = 0.5 * (resistance(hq1, uq1, w.zeta[k], w.kappa[k]) +
-                            resistance(hq3, uq3, w.zeta[k + 1], w.kappa[k + 1]));
+    const double R = 0.5 * (resistance<M>(hq1, uq1, w.zeta[k], w.kappa[k]) +
+                            resistance<M>(hq3, uq3, w.zeta[k + 1], w.kappa[k + 1]));
     double dummy = 0;
     apply_friction(Sm, dummy, std::abs(Sm), dt * R);
     drag(Sm, Sh, dt);
@@ -310,10 +332,11 @@ Sh1dResult Sh1dSolver::run() {
     const double dt = next_dt(t);
     const double lam = dt / dx;
     const double mass_before = open ? mass() : 0.0;
-    predictor(dt, lam);
-    positivity(lam);
-    corrector(dt, lam, r);
-    average_back();
+    switch (fr.form()) {
+      case MuForm::constant: step<MuForm::constant>(dt, lam, r); break;
+      case MuForm::flow: step<MuForm::flow>(dt, lam, r); break;
+      case MuForm::hysteresis: step<MuForm::hysteresis>(dt, lam, r); break;
+    }
     t += dt;
     ++r.steps;
     if (open) r.boundary_exchange += mass() - mass_before;

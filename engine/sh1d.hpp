@@ -9,10 +9,12 @@
 //   beta = K g cos(zeta),
 //
 // zeta(xi) the local inclination (positive where the bed falls in +xi), kappa = -dzeta/dxi the
-// bed curvature (positive where the channel flattens: concave), mu = tan(delta) (Coulomb) or the
-// Voellmy mu, and 1/xi_V = 0 for pure Coulomb friction (Voellmy's drag is a stress, independent of
-// the depth; it is integrated implicitly, engine/rheology.hpp turbulent_factor). K = 1 or K_act/pass from phi and delta by
-// the sign of du/dxi.
+// bed curvature (positive where the channel flattens: concave), mu = tan(delta) (Coulomb), the
+// Voellmy mu, or mu(h, Fr) with Fr = |u| / sqrt(g_n h), g_n = (g cos(zeta) + kappa u^2)_+ the same
+// normal load (Pouliquen-Forterre, mu(I); engine/friction/law.hpp), and 1/xi_V = 0 but for Voellmy
+// (Voellmy's drag is a stress, independent of the depth; it is integrated implicitly,
+// engine/rheology.hpp turbulent_factor). K = 1 or K_act/pass from phi and delta by the sign of du/dxi
+// (delta = atan of the law's lowest mu).
 //
 // Scheme: the NOC (non-oscillatory central) predictor-corrector of Tai et al. (2002) and the
 // dissertation's section 4.2 with a TVD slope limiter (minmod by default): predictor (4.78) to
@@ -21,7 +23,8 @@
 // by the limited piecewise-linear reconstruction of Jiang, Levy, Lin, Osher & Tadmor (1998), so
 // that every step returns to the same grid (needed for hazard maps and boundary conditions).
 // Coulomb friction is applied as a bounded impulse (engine/rheology.hpp apply_friction): it stops
-// material and holds it at rest, but never reverses its velocity.
+// material and holds it at rest, but never reverses its velocity. Its mu comes from the state at t in
+// the predictor and from the half-step state in the corrector, as its load does.
 // Time step: dt = cfl * dx / max(|u| + sqrt(beta h)), cfl <= 0.5 (dissertation eq. 4.90).
 #include <functional>
 #include <vector>

@@ -6,13 +6,17 @@
 #include <string_view>
 
 #include "engine/friction/coulomb.hpp"
+#include "engine/friction/mu_i.hpp"
+#include "engine/friction/pouliquen_forterre.hpp"
 #include "engine/friction/voellmy.hpp"
 
 namespace runout::engine {
 
-inline constexpr std::array<const FrictionLaw*, 2> kFrictionLaws{
+inline constexpr std::array<const FrictionLaw*, 4> kFrictionLaws{
     &friction::coulomb,
     &friction::voellmy,
+    &friction::pouliquen_forterre,
+    &friction::mu_i,
 };
 
 /// The law called `name`; an unknown name throws std::invalid_argument listing the valid ones.

@@ -54,10 +54,17 @@ Solver::Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
       T_(cfg.tile), ntx_((nx_ + T_ - 1) / T_), nty_((ny_ + T_ - 1) / T_), ntiles_(ntx_ * nty_) {
   g_ = cfg.gravity;
   qcap_ = cfg.curvature_cap * cfg.gravity;
-  // The friction law, resolved once: its two coefficients enter the kernels (engine/friction).
-  const BasalFriction friction = cfg.material.friction();
-  mu_ = friction.mu;
-  ixi_ = friction.inv_xi;
+  // The friction law, resolved once: its coefficients enter the kernels (engine/friction), and its
+  // form picks them.
+  fr_ = cfg.material.friction();
+  mu_ = fr_.mu;
+  ixi_ = fr_.inv_xi;
+  switch (fr_.form()) {
+    case MuForm::constant: basal_ = ixi_ > 0 ? Basal::voellmy : Basal::coulomb; break;
+    case MuForm::flow: basal_ = Basal::flow; break;
+    case MuForm::hysteresis: basal_ = Basal::hysteresis; break;
+  }
+  if (fr_.flow && ixi_ > 0) throw std::logic_error("2D solver: the kernels of mu(h, Fr) have no turbulent drag (1/xi = 0)");
   kap_ = cfg.material.earth_pressure == EarthPressure::active_passive;
   if (kap_) {
     const double d = std::atan(mu_), phi = cfg.material.phi;

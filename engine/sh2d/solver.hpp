@@ -21,6 +21,11 @@
 
 namespace runout::engine::sh2d_detail {
 
+// std::max and std::min by value (the same selects): the kernels take them of locals, and a
+// reference to a local in an OpenMP simd loop keeps the compiler from vectorising it.
+inline double vmax(double a, double b) { return a < b ? b : a; }
+inline double vmin(double a, double b) { return b < a ? b : a; }
+
 // A box of cells [i0, i1) x [j0, j1).
 struct CellBox {
   int i0, i1, j0, j1;
@@ -29,6 +34,12 @@ struct CellBox {
 struct Face {
   double f0, f1, f2;
 };
+
+// The basal friction a kernel computes, a template parameter (no branch in the loops): a constant mu
+// with or without Voellmy's drag, or mu(h, Fr) with or without the start/stop term
+// (engine/friction/law.hpp).
+enum class Basal { coulomb, voellmy, flow, hysteresis };
+constexpr bool is_flow(Basal b) { return b == Basal::flow || b == Basal::hysteresis; }
 
 // A reconstructed state on one side of a face, in face coordinates: depth, normal and tangential
 // velocity, and the pressure coefficients Pi_nn, Pi_nt of that side's cell.
@@ -54,6 +65,8 @@ struct TileWork {
   // (else 0), CFL rate; written by the update's cell kernels, summed in cell order afterwards. And
   // the row kernel's normal depth and pressure of a flowing cell (else 0), for the hazard maps.
   std::vector<double> cell_ke, cell_speed, cell_rate, cell_h, cell_pressure;
+  // One row's friction coefficients without the start/stop term and that term's weights (start_terms).
+  std::vector<double> row_mu, row_w;
   Face fxf(std::size_t k) const { return Face{Fx0[k], Fx1[k], Fx2[k]}; }
   Face fyf(std::size_t k) const { return Face{Fy0[k], Fy1[k], Fy2[k]}; }
   void reserve(int T) {
@@ -63,6 +76,7 @@ struct TileWork {
     for (auto* v : {&Fx0, &Fx1, &Fx2}) v->assign(std::size_t(T + 5) * (T + 4), 0.0);
     for (auto* v : {&Fy0, &Fy1, &Fy2}) v->assign(std::size_t(T + 4) * (T + 5), 0.0);
     for (auto* v : {&cell_ke, &cell_speed, &cell_rate, &cell_h, &cell_pressure}) v->assign(std::size_t(T), 0.0);
+    for (auto* v : {&row_mu, &row_w}) v->assign(std::size_t(T + 4), 0.0);
   }
   std::size_t at(int i, int j) const { return std::size_t(j - bj0) * bw + (i - bi0); }
   std::size_t fx(int i, int j) const { return std::size_t(j - bj0) * (bw + 1) + (i - bi0); }
@@ -116,9 +130,21 @@ class Solver {
   }
   // Coulomb resistance per horizontal area (magnitude of the basal friction force, 3D):
   // mu N / cos(theta) with N / rho = h c (g + Q)_+ = H c^2 (g + Q)_+; gn = (g + Q)_+.
-  double resistance(std::size_t k, double H, double gn) const {
+  double resistance(std::size_t k, double H, double gn, double mu) const {
     const double load = cfg_.curvature ? gn : g_;
-    return H * mu_ * geo_.c[k] * load;
+    return H * mu * geo_.c[k] * load;
+  }
+  // The friction coefficient of cell k at depth H and velocity (U, V) with normal load gn: mu_, or
+  // mu(h, Fr) with h = H c, the 3D speed and g_n = c (g + Q)_+ (c g without curvature), the load of
+  // resistance(), so that Fr = |u| / sqrt(g_n h) uses the friction's own normal stress.
+  template <Basal B>
+  double basal_mu(std::size_t k, double H, double U, double V, double gn) const {
+    if constexpr (is_flow(B)) {
+      const double c = geo_.c[k], load = cfg_.curvature ? gn : g_;
+      return flow_mu<B == Basal::hysteresis>(fr_, H * c, m3(k, U, V), c * load);
+    } else {
+      return mu_;
+    }
   }
   // sqrt(Pxx)/dx + sqrt(Pyy)/dy: the gravity-wave part of the CFL rate, per sqrt(H).
   double wave_factor(double pxx, double pyy) const { return std::sqrt(pxx) / t_.dx + std::sqrt(pyy) / t_.dy; }
@@ -144,17 +170,23 @@ class Solver {
   void fill_whole(int tt);
   template <Limiter L>
   void predictor(TileWork& w, double dt) const;
+  template <Limiter L, Basal B>
+  void predictor_cells(TileWork& w, double dt) const;
   void earth_pressure(std::size_t k, int i, int j, double U, double V, double& Pxx, double& Pxy, double& Pyy,
                       double& Ps) const;
-  template <Limiter L, bool Voellmy>
+  template <Limiter L, Basal B>
   void predictor_row(TileWork& w, int j, int ia, int ib, double dt) const;
+  void start_terms(int n, std::size_t k0, const double* H, const double* U, const double* V, TileWork& w) const;
   void faces(TileWork& w, int ci0, int ci1, int cj0, int cj1) const;
   template <bool X>
   Face face(const TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi, Boundary2D blo, Boundary2D bhi) const;
   long positivity(TileWork& w, int i0, int i1, int j0, int j1, double dt) const;
   void update(int tt, TileWork& w, const CellBox& c, double t, double dt);
+  template <Basal B>
+  void update_cells(int tt, TileWork& w, const CellBox& c, double t, double dt);
+  template <Basal B>
   void update_cell(TileWork& w, int i, int j, int i0, double t, double dt, double& out);
-  template <bool Voellmy>
+  template <Basal B>
   void update_row(TileWork& w, int j, int ia, int ib, int i0, double dt);
 
   const Terrain2D& t_;
@@ -164,6 +196,8 @@ class Solver {
   std::size_t n_;
   int T_, ntx_, nty_, ntiles_;
   double g_ = 9.81, mu_ = 0, ixi_ = 0, qcap_ = 9.81;
+  BasalFriction fr_;             // the law's coefficients (engine/friction)
+  Basal basal_ = Basal::coulomb;  // the kernels it takes
   bool kap_ = false;
   double kx_[2] = {1, 1}, ky_[2][2] = {{1, 1}, {1, 1}};
   // State at t (index cur_) and t + dt (1 - cur_); U, V the velocity (zero where dry).

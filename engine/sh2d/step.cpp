@@ -79,8 +79,19 @@ void Solver::earth_pressure(std::size_t k, int i, int j, double U, double V, dou
   Ps = wave_factor(Pxx, Pyy);
 }
 
+// The predictor with the kernels of the material's friction (Basal).
 template <Limiter lim>
 void Solver::predictor(TileWork& w, double dt) const {
+  switch (basal_) {
+    case Basal::coulomb: predictor_cells<lim, Basal::coulomb>(w, dt); break;
+    case Basal::voellmy: predictor_cells<lim, Basal::voellmy>(w, dt); break;
+    case Basal::flow: predictor_cells<lim, Basal::flow>(w, dt); break;
+    case Basal::hysteresis: predictor_cells<lim, Basal::hysteresis>(w, dt); break;
+  }
+}
+
+template <Limiter lim, Basal B>
+void Solver::predictor_cells(TileWork& w, double dt) const {
   const auto &Hs = H_[cur_], &HUs = HU_[cur_], &HVs = HV_[cur_], &Us = U_[cur_], &Vs = V_[cur_];
   const double hx = 0.5 * dt / t_.dx, hy = 0.5 * dt / t_.dy, dry = cfg_.dry_depth;
   // Cells away from the domain's edges take the branch-free row kernel (K = 1, the default set-up);
@@ -93,8 +104,11 @@ void Solver::predictor(TileWork& w, double dt) const {
       if (fast && j > 0 && j < ny_ - 1 && i >= fa && i < fb && !near_outside(idx(i, j))) {
         int e = i + 1;  // a run of cells for the row kernel
         while (e < fb && !near_outside(idx(e, j))) ++e;
-        if (ixi_ > 0) predictor_row<lim, true>(w, j, i, e, dt);
-        else predictor_row<lim, false>(w, j, i, e, dt);
+        if constexpr (B == Basal::hysteresis) {
+          const std::size_t k0 = idx(i, j);
+          start_terms(e - i, k0, &Hs[k0], &Us[k0], &Vs[k0], w);
+        }
+        predictor_row<lim, B>(w, j, i, e, dt);
         i = e - 1;
         continue;
       }
@@ -138,7 +152,8 @@ void Solver::predictor(TileWork& w, double dt) const {
         Up = H > dry ? U + 0.5 * dt * acc * geo_.bx[k] : 0.0;
         Vp = H > dry ? V + 0.5 * dt * acc * geo_.by[k] : 0.0;
       }
-      const double M3 = m3(k, Up, Vp), imp = 0.5 * dt * resistance(k, 1.0, gn);
+      // Friction with the load and mu of the state at t.
+      const double M3 = m3(k, Up, Vp), imp = 0.5 * dt * resistance(k, 1.0, gn, basal_mu<B>(k, H, U, V, gn));
       const bool rest = apply_friction(Up, Vp, M3, imp);
       if (ixi_ > 0 && H > dry) {  // Voellmy drag over the half step, implicit
         const double f = turbulent_factor(std::max(M3 - imp, 0.0), H * geo_.c[k], 0.5 * dt * g_ * ixi_);
@@ -218,12 +233,12 @@ RUNOUT_SIMD_CLONES void face_row(int n, std::ptrdiff_t s, const double* __restri
 }
 
 // The predictor of the branch-free kind for cells (ia..ib-1, j), all away from the domain's edges,
-// K = 1. Same arithmetic as the general loop in Solver::predictor, written with 0/1
-// masks instead of branches so that the compiler can vectorise it. Voellmy: the turbulent drag is
-// on (1/xi > 0); without it its factor would be exactly 1, and its square root and division are
-// skipped.
-template <Limiter lim, bool Voellmy>
+// K = 1. Same arithmetic as the general loop in Solver::predictor_cells, written with 0/1
+// masks instead of branches so that the compiler can vectorise it. B: the friction's kernel; without
+// Voellmy's drag its factor would be exactly 1, and its square root and division are skipped.
+template <Limiter lim, Basal B>
 RUNOUT_SIMD_CLONES void Solver::predictor_row(TileWork& w, int j, int ia, int ib, double dt) const {
+  constexpr bool Voellmy = B == Basal::voellmy;
   const double* __restrict Hs = H_[cur_].data();
   const double* __restrict HUs = HU_[cur_].data();
   const double* __restrict HVs = HV_[cur_].data();
@@ -242,6 +257,8 @@ RUNOUT_SIMD_CLONES void Solver::predictor_row(TileWork& w, int j, int ia, int ib
   const double hx = 0.5 * dt / t_.dx, hy = 0.5 * dt / t_.dy, dry = cfg_.dry_depth, g = g_, mu = mu_, ixi = ixi_;
   const double qcap = qcap_;
   const double curv = cfg_.curvature ? 1.0 : 0.0;
+  const BasalFriction fr = fr_;
+  const double *__restrict rmu = w.row_mu.data(), *__restrict rwt = w.row_w.data();  // start_terms'
   const std::ptrdiff_t N = nx_;
   auto mm = [](double a, double b) { return limited_slope(lim, a, b); };
   const int n = ib - ia;
@@ -273,9 +290,16 @@ RUNOUT_SIMD_CLONES void Solver::predictor_row(TileWork& w, int j, int ia, int ib
     double Up = good * Up1 + bad * (wet * (U + 0.5 * dt * acc * bx[k]));
     double Vp = good * Vp1 + bad * (wet * (V + 0.5 * dt * acc * by[k]));
     // Friction over the half step, bounded: the same numbers as apply_friction, then Voellmy's
-    // drag implicitly (turbulent_factor; 1 without it).
+    // drag implicitly (turbulent_factor; 1 without it). Load and mu of the state at t.
     const double load = curv * gn + (1.0 - curv) * g;
-    const double imp = 0.5 * dt * (mu * c * load);
+    double mu_k = mu;
+    if constexpr (B == Basal::flow) {
+      const double w0 = bx[k] * U + by[k] * V;
+      mu_k = flow_mu<false>(fr, H * c, std::sqrt(U * U + V * V + w0 * w0), c * load);
+    } else if constexpr (B == Basal::hysteresis) {
+      mu_k = with_start(fr, rmu[t], rwt[t]);
+    }
+    const double imp = 0.5 * dt * (mu_k * c * load);
     const double wp = bx[k] * Up + by[k] * Vp;
     const double M3 = std::sqrt(Up * Up + Vp * Vp + wp * wp);
     const double f = std::max(0.0, 1.0 - imp / std::max(M3, 1e-300));
@@ -304,6 +328,29 @@ RUNOUT_SIMD_CLONES void Solver::predictor_row(TileWork& w, int j, int ia, int ib
     oPyy[t] = pyy;
     oPs[t] = Ps[k];
   }
+}
+
+// The start/stop kernel's friction of cells k0..k0+n-1 at depth H and velocity (U, V) (the row's
+// values): mu without the start/stop term into w.row_mu, the term's weights q^kappa into w.row_w.
+// The power only where a cell moves, slower than beta_s (start_weight), in a scalar loop of its own:
+// the row kernels that read them stay vectorised. The same arithmetic as basal_mu.
+RUNOUT_SIMD_CLONES void Solver::start_terms(int n, std::size_t k0, const double* __restrict H, const double* __restrict U,
+                                            const double* __restrict V, TileWork& w) const {
+  const double *__restrict cc = &geo_.c[k0], *__restrict bx = &geo_.bx[k0], *__restrict by = &geo_.by[k0];
+  const double *__restrict hxx = &geo_.hxx[k0], *__restrict hxy = &geo_.hxy[k0], *__restrict hyy = &geo_.hyy[k0];
+  double *__restrict mu = w.row_mu.data(), *__restrict wt = w.row_w.data();
+  const double g = g_, qcap = qcap_, curv = cfg_.curvature ? 1.0 : 0.0;
+  const BasalFriction fr = fr_;
+#pragma omp simd
+  for (int m = 0; m < n; ++m) {
+    const double u = U[m], v = V[m], c = cc[m];
+    const double gn = vmax(0.0, g + vmin(qcap, u * u * hxx[m] + 2 * u * v * hxy[m] + v * v * hyy[m]));
+    const double load = curv * gn + (1.0 - curv) * g, w3 = bx[m] * u + by[m] * v;
+    const MuParts p = flow_mu_parts(fr, H[m] * c, std::sqrt(u * u + v * v + w3 * w3), c * load);
+    mu[m] = p.mu;
+    wt[m] = p.q;
+  }
+  for (int m = 0; m < n; ++m) wt[m] = start_weight(wt[m]);
 }
 
 void Solver::faces(TileWork& w, int ci0, int ci1, int cj0, int cj1) const {

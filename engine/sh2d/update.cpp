@@ -13,10 +13,6 @@
 namespace runout::engine::sh2d_detail {
 namespace {
 
-// std::max and std::min by value (the same selects): the kernels take them of locals, and a
-// reference to a local in an OpenMP simd loop keeps the compiler from vectorising it.
-inline double vmax(double a, double b) { return a < b ? b : a; }
-inline double vmin(double a, double b) { return b < a ? b : a; }
 // The same number for the row kernel, as a sum of 0/1-weighted terms: exact because the factors lie
 // in [0, 1]. Written as selects, the compiler would load rl and rr only in their branch and could
 // not vectorise the loop (a conditional load might fault).
@@ -61,6 +57,7 @@ long Solver::positivity(TileWork& w, int i0, int i1, int j0, int j1, double dt) 
 // The update of one cell in the general form (domain edges, cells outside the domain next to it):
 // new state, hazard maps, the outflow through its edges into `out`, and its terms of the tile's sums
 // into the work space's row buffers (index i - i0).
+template <Basal B>
 void Solver::update_cell(TileWork& w, int i, int j, int i0, double t, double dt, double& out) {
   const auto &H0 = H_[cur_], &HU0 = HU_[cur_], &HV0 = HV_[cur_];
   auto &H1 = H_[1 - cur_], &HU1 = HU_[1 - cur_], &HV1 = HV_[1 - cur_], &U1 = U_[1 - cur_], &V1 = V_[1 - cur_];
@@ -93,8 +90,9 @@ void Solver::update_cell(TileWork& w, int i, int j, int i0, double t, double dt,
   double MV = HV0[k] - lx * (fe.f2 - fw.f2) - ly * (fn.f2 - fs.f2) + dt * drive * geo_.by[k];
   double U = 0, V = 0, sp = 0;
   if (H > dry) {
-    // Friction at the half step (midpoint rule), as a bounded impulse that never reverses u.
-    const double M3 = m3(k, MU, MV), impulse = dt * resistance(k, Hp, gn);
+    // Friction at the half step (midpoint rule), as a bounded impulse that never reverses u; its load
+    // and mu from the half-step state.
+    const double M3 = m3(k, MU, MV), impulse = dt * resistance(k, Hp, gn, basal_mu<B>(k, Hp, Up, Vp, gn));
     apply_friction(MU, MV, M3, impulse);
     const double inv = 1.0 / H;
     sp = std::max(M3 - impulse, 0.0) * inv;  // surface speed after Coulomb friction
@@ -129,10 +127,11 @@ void Solver::update_cell(TileWork& w, int i, int j, int i0, double t, double dt,
 }
 
 // The update of cells (ia..ib-1, j), all inside the domain and away from its edges: the same
-// arithmetic as update_cell, branch-free. Voellmy: the turbulent drag is on (1/xi > 0); without
-// it the factor would be exactly 1 and its square root is skipped.
-template <bool Voellmy>
+// arithmetic as update_cell, branch-free. B: the friction's kernel; without Voellmy's drag its
+// factor would be exactly 1 and its square root is skipped.
+template <Basal B>
 RUNOUT_SIMD_CLONES void Solver::update_row(TileWork& w, int j, int ia, int ib, int i0, double dt) {
+  constexpr bool Voellmy = B == Basal::voellmy;
   const std::size_t k0 = idx(ia, j), q0 = w.at(ia, j);
   const std::ptrdiff_t bw = w.bw;
   const double *__restrict H0 = &H_[cur_][k0], *__restrict HU0 = &HU_[cur_][k0], *__restrict HV0 = &HV_[cur_][k0];
@@ -153,6 +152,8 @@ RUNOUT_SIMD_CLONES void Solver::update_row(TileWork& w, int j, int ia, int ib, i
   const double lx = dt / t_.dx, ly = dt / t_.dy, dx = t_.dx, dy = t_.dy, dry = cfg_.dry_depth, g = g_, qcap = qcap_;
   const double mu = mu_, gxd = dt * g_ * ixi_, thr = cfg_.flow_threshold, rho = cfg_.material.density;
   const double curv = cfg_.curvature ? 1.0 : 0.0;  // a 0/1 weight: exact, as gn and g are finite
+  const BasalFriction fr = fr_;
+  const double *__restrict rmu = w.row_mu.data(), *__restrict rwt = w.row_w.data();  // start_terms'
   const int n = ib - ia;
 #pragma omp simd
   for (int m = 0; m < n; ++m) {
@@ -169,7 +170,15 @@ RUNOUT_SIMD_CLONES void Solver::update_row(TileWork& w, int j, int ia, int ib, i
     double MV = HV0[m] - lx * (Fx2[m + 1] * se - Fx2[m] * sw) - ly * (Fy2[m + bw] * sn - Fy2[m] * ss) + dt * drive * by[m];
     const double wz = bx[m] * MU + by[m] * MV;
     const double M3 = std::sqrt(MU * MU + MV * MV + wz * wz);
-    const double imp = dt * (hp * mu * c * (curv * gn + (1.0 - curv) * g));
+    const double load = curv * gn + (1.0 - curv) * g;
+    double mu_k = mu;  // mu of the half-step state
+    if constexpr (B == Basal::flow) {
+      const double wq = bx[m] * up + by[m] * vp;
+      mu_k = flow_mu<false>(fr, hp * c, std::sqrt(up * up + vp * vp + wq * wq), c * load);
+    } else if constexpr (B == Basal::hysteresis) {
+      mu_k = with_start(fr, rmu[m], rwt[m]);
+    }
+    const double imp = dt * (hp * mu_k * c * load);
     const bool rest = M3 <= imp;  // apply_friction: stopped, or slowed by the impulse
     const double f = 1.0 - imp / M3;
     MU = rest ? 0.0 : MU * f;
@@ -210,7 +219,18 @@ RUNOUT_SIMD_CLONES void Solver::update_row(TileWork& w, int j, int ia, int ib, i
   }
 }
 
+// The update with the kernels of the material's friction (Basal).
 void Solver::update(int tt, TileWork& w, const CellBox& c, double t, double dt) {
+  switch (basal_) {
+    case Basal::coulomb: update_cells<Basal::coulomb>(tt, w, c, t, dt); break;
+    case Basal::voellmy: update_cells<Basal::voellmy>(tt, w, c, t, dt); break;
+    case Basal::flow: update_cells<Basal::flow>(tt, w, c, t, dt); break;
+    case Basal::hysteresis: update_cells<Basal::hysteresis>(tt, w, c, t, dt); break;
+  }
+}
+
+template <Basal B>
+void Solver::update_cells(int tt, TileWork& w, const CellBox& c, double t, double dt) {
   const int i0 = c.i0, i1 = c.i1, j0 = c.j0, j1 = c.j1;
   const auto &H1 = H_[1 - cur_], &HU1 = HU_[1 - cur_], &HV1 = HV_[1 - cur_];
   double out = 0, travel = 0, mass = 0, ke = 0, vmax = 0, rate = 0;
@@ -224,13 +244,16 @@ void Solver::update(int tt, TileWork& w, const CellBox& c, double t, double dt) 
     }
     for (int i = i0; i < i1; ++i) {
       if (i == ia && ib > ia) {
-        if (ixi_ > 0) update_row<true>(w, j, ia, ib, i0, dt);
-        else update_row<false>(w, j, ia, ib, i0, dt);
+        if constexpr (B == Basal::hysteresis) {
+          const std::size_t q = w.at(ia, j);
+          start_terms(ib - ia, idx(ia, j), &w.Hp[q], &w.Up[q], &w.Vp[q], w);
+        }
+        update_row<B>(w, j, ia, ib, i0, dt);
         i = ib - 1;
         continue;
       }
       if (w.has_outside && outside(i, j)) continue;  // never holds material (both buffers stay 0)
-      update_cell(w, i, j, i0, t, dt, out);
+      update_cell<B>(w, i, j, i0, t, dt, out);
     }
     // The tile's sums, cell by cell in a fixed order.
     for (int i = i0; i < i1; ++i) {

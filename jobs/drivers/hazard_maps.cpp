@@ -102,6 +102,13 @@ std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain
   p.push_back(std::string("engine: ") + (s.terrain ? "3D VOF Navier–Stokes (Coulomb viscosity)" : "depth-averaged Savage–Hutter"));
   if (m.rheology() == "voellmy")
     p.push_back("friction: Voellmy, μ = " + num(m.voellmy_mu()) + ", ξ = " + num(m.voellmy_xi()) + " m/s²");
+  else if (m.rheology() == "pouliquen_forterre")
+    p.push_back("friction: Pouliquen–Forterre, δ₁ = " + num(m.bed_friction_1_deg()) + "°, δ₂ = " + num(m.bed_friction_2_deg()) +
+                "°, δ₃ = " + num(m.has_bed_friction_3_deg() ? m.bed_friction_3_deg() : m.bed_friction_1_deg()) + "°, β = " +
+                num(m.pf_beta()) + ", L = " + num(m.pf_length_m()) + " m, γ = " + num(m.pf_gamma()));
+  else if (m.rheology() == "mu_i")
+    p.push_back("friction: μ(I), μs = " + num(m.mu_s()) + ", μ₂ = " + num(m.mu_2()) + ", I₀ = " + num(m.mu_i0()) +
+                ", d = " + num(m.grain_diameter_m()) + " m, ρs = " + num(m.grain_density_kg_m3()) + " kg/m³");
   else
     p.push_back("friction: Coulomb, δ = " + num(m.bed_friction_deg()) + "°" +
                 (m.has_internal_friction_deg() ? ", φ = " + num(m.internal_friction_deg()) + "°" : ""));

@@ -43,6 +43,8 @@ constexpr double kMaxCell = 1e4;            // grid.resolution_m [m]
 constexpr double kMaxThickness = 500;       // a release [m]: rock avalanches start some hundred metres thick
 constexpr double kMaxDensity = 1e4;         // [kg/m3]: above any rock or ore
 constexpr double kMaxXi = 1e5;              // Voellmy xi [m/s2]
+constexpr double kMaxFlowRule = 10;         // pf_beta, pf_gamma, mu_i0 [-]: published values lie below 1
+constexpr double kMaxLength = 100;          // pf_length_m, grain_diameter_m [m]: boulders, h_stop of rock avalanches
 constexpr double kMaxEndTime = 1e5;         // numerics.end_time_s, outputs.timeseries_interval_s [s]
 constexpr double kMaxDepthThreshold = 100;  // outline and flow thresholds [m]
 constexpr double kMaxZonePressure = 1e5;    // outputs.pressure_zones_kpa[].from_kpa [kPa]: 100 MPa
@@ -239,7 +241,7 @@ const OptionTable& depth_averaged_options() {
        "the basal friction law (engine/friction; the section below)", "Material::rheology", "",
        [](const S& s, R& r) { r.config.material.rheology = &engine::friction_law(s.material().rheology()); }},
       {"material.density_kg_m3", T::number, U::fill, "300", Range{0, kMaxDensity, true}, {}, "kg/m3",
-       "bulk density, for the pressure outputs", "Material::density", "",
+       "bulk density, for the pressure outputs (and mu_i's solid fraction)", "Material::density", "",
        [](const S& s, R& r) { r.config.material.density = s.material().density_kg_m3(); }},
       {"material.bed_friction_deg", T::number, U::as_given, "", Range{0, 90, false, true}, {}, "deg",
        "delta, the bed friction angle (coulomb)", "Material::delta (radians)", "", [](const S& s, R& r) {
@@ -252,6 +254,58 @@ const OptionTable& depth_averaged_options() {
       {"material.voellmy_xi", T::number, U::as_given, "", Range{0, kMaxXi, true}, {}, "m/s^2",
        "xi, the turbulent-friction coefficient (voellmy)", "Material::xi", "", [](const S& s, R& r) {
          if (s.material().has_voellmy_xi()) r.config.material.xi = s.material().voellmy_xi();
+       }},
+      {"material.bed_friction_1_deg", T::number, U::as_given, "", Range{0, 90, false, true}, {}, "deg",
+       "delta_1, the lowest friction angle of steady flow (pouliquen_forterre; glass beads 20.9)", "Material::delta1 (radians)", "",
+       [](const S& s, R& r) {
+         if (s.material().has_bed_friction_1_deg()) r.config.material.delta1 = radians(s.material().bed_friction_1_deg());
+       }},
+      {"material.bed_friction_2_deg", T::number, U::as_given, "", Range{0, 90, false, true}, {}, "deg",
+       "delta_2 > delta_1, the friction angle of thin layers (pouliquen_forterre; glass beads 32.76)", "Material::delta2 (radians)", "",
+       [](const S& s, R& r) {
+         if (s.material().has_bed_friction_2_deg()) r.config.material.delta2 = radians(s.material().bed_friction_2_deg());
+       }},
+      {"material.bed_friction_3_deg", T::number, U::as_given, "", Range{0, 90, false, true}, {}, "deg",
+       "delta_3 >= delta_1, the friction angle of mu_start: a layer at rest starts above it (pouliquen_forterre; unset: delta_1)",
+       "Material::delta3 (radians)", "", [](const S& s, R& r) {
+         if (s.material().has_bed_friction_3_deg()) r.config.material.delta3 = radians(s.material().bed_friction_3_deg());
+       }},
+      {"material.pf_beta", T::number, U::as_given, "", Range{0, kMaxFlowRule, true}, {}, "",
+       "beta of the flow rule Fr = beta h / h_stop - gamma (pouliquen_forterre; glass beads 0.136)", "Material::pf_beta", "",
+       [](const S& s, R& r) {
+         if (s.material().has_pf_beta()) r.config.material.pf_beta = s.material().pf_beta();
+       }},
+      {"material.pf_length_m", T::number, U::as_given, "", Range{0, kMaxLength, true}, {}, "m",
+       "L of h_stop = L (tan d2 - tan theta) / (tan theta - tan d1) (pouliquen_forterre; glass beads 0.000825, 1.65 d)", "Material::pf_length",
+       "", [](const S& s, R& r) {
+         if (s.material().has_pf_length_m()) r.config.material.pf_length = s.material().pf_length_m();
+       }},
+      {"material.pf_gamma", T::number, U::as_given, "0", Range{0, kMaxFlowRule}, {}, "",
+       "gamma < beta, the flow rule's offset (pouliquen_forterre; glass beads 0)", "Material::pf_gamma", "", [](const S& s, R& r) {
+         if (s.material().has_pf_gamma()) r.config.material.pf_gamma = s.material().pf_gamma();
+       }},
+      {"material.mu_s", T::number, U::as_given, "", Range{0, 5, false, true}, {}, "",
+       "mu_s, the friction coefficient as I -> 0 (mu_i; glass beads 0.38)", "Material::mu_s", "", [](const S& s, R& r) {
+         if (s.material().has_mu_s()) r.config.material.mu_s = s.material().mu_s();
+       }},
+      {"material.mu_2", T::number, U::as_given, "", Range{0, 5, false, true}, {}, "",
+       "mu_2 >= mu_s, the friction coefficient as I -> infinity (mu_i; glass beads 0.64)", "Material::mu_2", "",
+       [](const S& s, R& r) {
+         if (s.material().has_mu_2()) r.config.material.mu_2 = s.material().mu_2();
+       }},
+      {"material.mu_i0", T::number, U::as_given, "", Range{0, kMaxFlowRule, true}, {}, "",
+       "I_0, the inertial number where mu is halfway from mu_s to mu_2 (mu_i; glass beads 0.279)", "Material::mu_i0", "",
+       [](const S& s, R& r) {
+         if (s.material().has_mu_i0()) r.config.material.mu_i0 = s.material().mu_i0();
+       }},
+      {"material.grain_diameter_m", T::number, U::as_given, "", Range{0, kMaxLength, true}, {}, "m",
+       "d, the grain diameter (mu_i; glass beads 0.0005)", "Material::grain_diameter", "", [](const S& s, R& r) {
+         if (s.material().has_grain_diameter_m()) r.config.material.grain_diameter = s.material().grain_diameter_m();
+       }},
+      {"material.grain_density_kg_m3", T::number, U::as_given, "", Range{0, kMaxDensity, true}, {}, "kg/m3",
+       "rho_s, the grains' density: phi = density_kg_m3 / rho_s <= 1 is the solid fraction (mu_i; glass beads 2450)",
+       "Material::grain_density", "", [](const S& s, R& r) {
+         if (s.material().has_grain_density_kg_m3()) r.config.material.grain_density = s.material().grain_density_kg_m3();
        }},
       {"material.internal_friction_deg", T::number, U::as_given, "", Range{0, 90, false, true}, {}, "deg",
        "phi, the internal friction angle (earth_pressure active-passive)", "Material::phi (radians)", "", [](const S& s, R& r) {

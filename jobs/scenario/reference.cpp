@@ -16,7 +16,9 @@ std::string friction_laws_markdown() {
   for (const auto* law : engine::kFrictionLaws) {
     std::string needs;
     for (const auto& p : law->parameters)
-      if (!p.field.empty()) needs += (needs.empty() ? "" : ", ") + ("`material." + std::string(p.field) + "` (" + std::string(p.symbol) + ", " + std::string(p.doc) + ")");
+      if (!p.field.empty())
+        needs += (needs.empty() ? "" : ", ") + ("`material." + std::string(p.field) + "` (" + std::string(p.symbol) + ", " +
+                                                std::string(p.doc) + (p.unset.empty() ? "" : "; unset: " + std::string(p.unset)) + ")");
     s += "| `" + std::string(law->name) + "` | " + std::string(law->equation) + " | " + needs + " |\n";
   }
   return s;
@@ -60,6 +62,9 @@ come after the table's.
 
 Each law gives the basal shear stress tau_b from the basal normal stress N (with its centrifugal
 part on curved terrain unless `numerics.curvature_off`); `engine/friction/` holds one file per law.
+Fr = \|u\| / sqrt(g_n h) is the Froude number with the friction's own normal load g_n (N = rho g_n h)
+and the normal depth h. docs/design/depth-averaged.md ("Flow-dependent friction") has the laws'
+derivations and reference values for glass beads.
 
 )" + friction_laws_markdown() +
          R"(

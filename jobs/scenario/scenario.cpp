@@ -224,12 +224,13 @@ void resolve_releases(const v1::Scenario& s, const std::string& base, ResolvedSc
     bad("releases", "every release is secondary: at least one must start the flow");
 }
 
-// The friction law's parameters (engine/friction: each law lists the material fields it needs),
-// then the material's physical limits.
+// The friction law's parameters (engine/friction: each law lists the material fields it reads; those
+// without a meaning for unset are required), then the material's physical limits.
 void check_material(const v1::Material& m, const engine::Material& mat) {
   const auto* refl = m.GetReflection();
   for (const auto& p : mat.rheology->parameters) {
     if (p.field.empty()) break;
+    if (!p.unset.empty()) continue;
     const auto* f = m.GetDescriptor()->FindFieldByName(std::string(p.field));
     if (!f || !refl->HasField(m, f))
       bad("material." + std::string(p.field), "needed by the " + std::string(mat.rheology->name) + " rheology");

@@ -4,9 +4,10 @@
 
 #include "engine/limiters.hpp"
 #include "engine/rheology.hpp"
+#include "tests/support/depth_averaged.hpp"
 
 using namespace runout::engine;
-constexpr double kDeg = M_PI / 180.0;
+using namespace runout::test_support::depth_averaged;
 
 TEST(Limiters, MinmodPicksTheSmallerSlopeAndZeroAtExtrema) {
   EXPECT_DOUBLE_EQ(limited_slope(Limiter::minmod, 1.0, 3.0), 1.0);
@@ -106,4 +107,100 @@ TEST(Material, ValidationNamesTheParameter) {
   m.mu = 0.2;
   m.xi = 0;
   EXPECT_THROW(m.validate(), std::invalid_argument);
+}
+
+namespace {
+
+// The law's value through the kernels' function.
+double mu_of(const BasalFriction& f, double h, double fr, double gn = 9.81) {
+  const double speed = fr * std::sqrt(gn * h);
+  return f.form() == MuForm::hysteresis ? flow_mu<true>(f, h, speed, gn) : flow_mu<false>(f, h, speed, gn);
+}
+
+}  // namespace
+
+TEST(FlowFriction, PouliquenForterreFollowsItsBranches) {
+  const auto m = glass_beads_pf(22.0, 0.05);
+  ASSERT_NO_THROW(m.validate());
+  const auto f = m.friction();
+  ASSERT_EQ(f.form(), MuForm::hysteresis);
+  const double t1 = std::tan(m.delta1), t2 = std::tan(m.delta2), t3 = std::tan(m.delta3), L = m.pf_length;
+  const double beta = m.pf_beta, gamma = m.pf_gamma;
+  for (double h : {0.2e-3, 1e-3, 3e-3, 1e-2}) {
+    const double mu_stop = t1 + (t2 - t1) / (h / L + 1), mu_start = t3 + (t2 - t1) / (h / L + 1);
+    EXPECT_NEAR(mu_of(f, h, 0.0), mu_start, 1e-14) << h;                 // at rest
+    EXPECT_NEAR(mu_of(f, h, beta - gamma), mu_stop, 1e-14) << h;         // the branches meet
+    for (double fr : {0.2, 0.5, 1.3, 4.0}) {                             // flowing
+      const double dyn = t1 + (t2 - t1) / (beta * h / (L * (fr + gamma)) + 1);
+      EXPECT_NEAR(mu_of(f, h, fr), dyn, 1e-14) << h << " " << fr;
+    }
+    const double fr = 0.5 * (beta - gamma);  // slower: (Fr / (beta - gamma))^kappa between the two
+    EXPECT_NEAR(mu_of(f, h, fr), std::pow(0.5, 1e-3) * (mu_stop - mu_start) + mu_start, 1e-14);
+  }
+  // The steady flow rule: on a slope theta, Fr = beta h / h_stop(theta) - gamma has mu = tan(theta).
+  const double th = 27 * kDeg, hstop = L * (t2 - std::tan(th)) / (std::tan(th) - t1);
+  for (double h : {1.5 * hstop, 4 * hstop}) EXPECT_NEAR(mu_of(f, h, beta * h / hstop - gamma), std::tan(th), 1e-14);
+}
+
+TEST(FlowFriction, MuIIsTheBagnoldProfilesBasalFriction) {
+  const auto m = glass_beads_mu_i();
+  ASSERT_NO_THROW(m.validate());
+  const auto f = m.friction();
+  ASSERT_EQ(f.form(), MuForm::flow);
+  for (double h : {1e-3, 5e-3, 0.02})
+    for (double fr : {0.0, 0.1, 0.7, 3.0}) {
+      // I = gamma_dot d / sqrt(p / rho_s) at the base of the Bagnold profile: depth-averaged
+      // u = (2/5) I sqrt(phi g cos) h^(3/2) / d, so I = 5 Fr d / (2 sqrt(phi) h).
+      const double I = 5 * fr * m.grain_diameter / (2 * std::sqrt(0.6) * h);
+      const double expect = fr == 0 ? m.mu_s : m.mu_s + (m.mu_2 - m.mu_s) / (m.mu_i0 / I + 1);
+      EXPECT_NEAR(mu_of(f, h, fr), expect, 1e-14) << h << " " << fr;
+    }
+}
+
+TEST(FlowFriction, ConstantLimitAndEdgesAreExact) {
+  // mu_2 = mu_s: mu(I) is the constant mu_s, bit for bit, for every state (the engines' Coulomb limit).
+  const auto f = mu_i_material(std::tan(0.4), std::tan(0.4), 0.3, 0.01, 2500, 1500).friction();
+  for (double h : {0.0, 1e-300, 1e-6, 2.0})
+    for (double speed : {0.0, 1e-300, 0.3, 80.0})
+      for (double gn : {0.0, 9.81, 30.0}) EXPECT_EQ(flow_mu<false>(f, h, speed, gn), std::tan(0.4));
+  // Every law's mu stays finite on a dry cell, at rest and without load.
+  const auto pf = glass_beads_pf(23.0, 0.02).friction();
+  for (double h : {0.0, 1e-3})
+    for (double speed : {0.0, 1.0})
+      for (double gn : {0.0, 9.81}) EXPECT_TRUE(std::isfinite(flow_mu<true>(pf, h, speed, gn)));
+}
+
+TEST(FlowFriction, BadParametersAreRejectedNamingTheField) {
+  auto expect = [](const Material& m, const std::string& field) {
+    try {
+      m.validate();
+      ADD_FAILURE() << "accepted, expected an error naming " << field;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  auto m = glass_beads_pf(22.0, 0.0);
+  m.delta2 = m.delta1;
+  expect(m, "bed_friction_2_deg");
+  m = glass_beads_pf(19.0, 0.0);
+  expect(m, "bed_friction_3_deg");
+  m = glass_beads_pf(22.0, 0.0);
+  m.pf_beta = 0;
+  expect(m, "pf_beta");
+  m = glass_beads_pf(22.0, 0.0);
+  m.pf_length = -1e-3;
+  expect(m, "pf_length_m");
+  expect(glass_beads_pf(22.0, -0.1), "pf_gamma");
+  expect(glass_beads_pf(22.0, 0.2), "pf_gamma");  // gamma >= beta: no static branch left
+  auto i = mu_i_material(0.4, 0.3, 0.3, 1e-3, 2500, 1500);
+  expect(i, "mu_2");
+  i.mu_2 = 0.6;
+  i.grain_diameter = 0;
+  expect(i, "grain_diameter_m");
+  i.grain_diameter = 1e-3;
+  i.density = 3000;  // phi > 1
+  expect(i, "grain_density_kg_m3");
+  i.density = 1500;
+  i.mu_i0 = 0;
+  expect(i, "mu_i0");
 }

@@ -198,7 +198,7 @@ TEST(ScenarioOptions, FrictionLawsAreOneTable) {
     engine::friction_law("bingham");
     FAIL();
   } catch (const std::invalid_argument& e) {
-    EXPECT_STREQ(e.what(), "unknown friction law 'bingham' (valid: coulomb, voellmy)");
+    EXPECT_STREQ(e.what(), "unknown friction law 'bingham' (valid: coulomb, voellmy, pouliquen_forterre, mu_i)");
   }
   // The coefficients are today's expressions, bit for bit.
   engine::FrictionParams p;
@@ -219,7 +219,61 @@ TEST(ScenarioOptions, FrictionLawsAreOneTable) {
   EXPECT_EQ(r.config.material.rheology, &engine::friction::voellmy);
   EXPECT_EQ(r.config.material.coulomb_coefficient(), 0.2);
   s.mutable_material()->set_rheology("bingham");
-  EXPECT_EQ(resolve_error(s, kDataDir), "material.rheology: unknown 'bingham' (valid: coulomb, voellmy)");
+  EXPECT_EQ(resolve_error(s, kDataDir), "material.rheology: unknown 'bingham' (valid: coulomb, voellmy, pouliquen_forterre, mu_i)");
+}
+
+// The flow-dependent laws: their fields in radians and SI, the optional ones unset, and every bad
+// value refused with the field.
+TEST(ScenarioOptions, FlowDependentLawsTakeTheirFields) {
+  v1::Scenario s = arelen();
+  auto* m = s.mutable_material();
+  m->set_rheology("pouliquen_forterre");
+  m->set_bed_friction_1_deg(20.9);
+  m->set_bed_friction_2_deg(32.76);
+  m->set_pf_beta(0.136);
+  EXPECT_EQ(resolve_error(s, kDataDir), "material.pf_length_m: needed by the pouliquen_forterre rheology");
+  m->set_pf_length_m(0.5);
+  auto r = jobs::resolve_scenario(s, kDataDir);
+  const auto& mat = r.config.material;
+  EXPECT_EQ(mat.rheology, &engine::friction::pouliquen_forterre);
+  EXPECT_DOUBLE_EQ(mat.delta1, 20.9 * M_PI / 180);
+  EXPECT_TRUE(std::isnan(mat.delta3));  // delta_1: no start/stop hysteresis
+  EXPECT_EQ(mat.pf_gamma, 0.0);
+  EXPECT_EQ(mat.friction().form(), engine::MuForm::flow);
+  m->set_bed_friction_3_deg(23);
+  m->set_pf_gamma(0.05);
+  r = jobs::resolve_scenario(s, kDataDir);
+  EXPECT_EQ(r.config.material.friction().form(), engine::MuForm::hysteresis);
+  EXPECT_EQ(r.config.material.pf_gamma, 0.05);
+  auto refused = [&](auto change, const std::string& field) {
+    v1::Scenario bad = s;
+    change(*bad.mutable_material());
+    const std::string e = resolve_error(bad, kDataDir);
+    EXPECT_NE(e.find(field), std::string::npos) << e;
+  };
+  refused([](v1::Material& x) { x.set_bed_friction_2_deg(20); }, "bed_friction_2_deg");
+  refused([](v1::Material& x) { x.set_bed_friction_3_deg(15); }, "bed_friction_3_deg");
+  refused([](v1::Material& x) { x.set_pf_gamma(0.2); }, "pf_gamma");
+  refused([](v1::Material& x) { x.set_pf_gamma(-1); }, "material.pf_gamma: must lie in [0, 10]");
+  refused([](v1::Material& x) { x.set_pf_beta(0); }, "material.pf_beta: must lie in (0, 10]");
+  refused([](v1::Material& x) { x.set_pf_length_m(0); }, "material.pf_length_m: must lie in (0, 100] m");
+  s = arelen();
+  m = s.mutable_material();
+  m->set_rheology("mu_i");
+  m->set_mu_s(0.38);
+  m->set_mu_2(0.64);
+  m->set_mu_i0(0.279);
+  m->set_grain_diameter_m(0.5e-3);
+  EXPECT_EQ(resolve_error(s, kDataDir), "material.grain_density_kg_m3: needed by the mu_i rheology");
+  m->set_grain_density_kg_m3(2450);
+  r = jobs::resolve_scenario(s, kDataDir);
+  EXPECT_EQ(r.config.material.rheology, &engine::friction::mu_i);
+  EXPECT_EQ(r.config.material.grain_diameter, 0.5e-3);
+  EXPECT_EQ(r.config.material.friction().form(), engine::MuForm::flow);
+  refused([](v1::Material& x) { x.set_mu_2(0.3); }, "mu_2");
+  refused([](v1::Material& x) { x.set_density_kg_m3(3000); }, "grain_density_kg_m3");
+  refused([](v1::Material& x) { x.set_mu_i0(0); }, "material.mu_i0: must lie in (0, 10]");
+  refused([](v1::Material& x) { x.set_grain_diameter_m(-1); }, "material.grain_diameter_m: must lie in (0, 100] m");
 }
 
 TEST(ScenarioOptions, NameTablesHaveNoFallback) {

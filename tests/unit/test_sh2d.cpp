@@ -5,38 +5,12 @@
 #include <limits>
 
 #include "engine/sh2d.hpp"
+#include "tests/support/depth_averaged.hpp"
 
 using namespace runout::engine;
-constexpr double kDeg = M_PI / 180.0;
+using namespace runout::test_support::depth_averaged;
 
 namespace {
-
-// Slope falling in direction `aspect` (radians from +x) at `slope_deg`, plus a run-out bowl.
-Terrain2D hillside(int nx, int ny, double dx, double slope_deg, double aspect) {
-  Terrain2D t;
-  t.nx = nx;
-  t.ny = ny;
-  t.dx = t.dy = dx;
-  t.z.resize(t.cells());
-  const double s = std::tan(slope_deg * kDeg);
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      const double x = i * dx, y = j * dx;
-      const double along = std::cos(aspect) * x + std::sin(aspect) * y;
-      t.z[std::size_t(j) * nx + i] = -s * along + 0.0005 * along * along + 0.3 * std::sin(0.05 * x) * std::cos(0.07 * y);
-    }
-  return t;
-}
-
-std::vector<double> blob(const Terrain2D& t, double ci, double cj, double r, double h) {
-  std::vector<double> v(t.cells(), 0.0);
-  for (int j = 0; j < t.ny; ++j)
-    for (int i = 0; i < t.nx; ++i) {
-      const double q = ((i - ci) * (i - ci) + (j - cj) * (j - cj)) / (r * r);
-      v[std::size_t(j) * t.nx + i] = q < 1 ? h * (1 - q) : 0.0;
-    }
-  return v;
-}
 
 Sh2dConfig coulomb(double delta_deg, double t_end) {
   Sh2dConfig c;
@@ -145,13 +119,8 @@ TEST(Sh2d, OutflowIsAccountedFor) {
 
 TEST(Sh2d, VoellmyLayerReachesItsTerminalSpeed) {
   // Uniform 2 m layer on an infinite 30 degree slope: g sin - mu g cos - g u^2 / (xi h) = 0.
-  Terrain2D t;
-  t.nx = t.ny = 12;
-  t.dx = t.dy = 5.0;
-  t.z.resize(t.cells());
+  const auto t = inclined_plane(12, 12, 5.0, 30);
   const double th = 30 * kDeg;
-  for (int j = 0; j < t.ny; ++j)
-    for (int i = 0; i < t.nx; ++i) t.z[std::size_t(j) * t.nx + i] = -std::tan(th) * i * t.dx;
   Sh2dConfig cfg;
   cfg.material.rheology = &friction::voellmy;
   cfg.material.mu = 0.2;
@@ -344,14 +313,9 @@ TEST(Sh2d, OutsideMaskIsChecked) {
 TEST(Sh2d, CurvatureBoundKeepsFlowsOnRoughTerrainWithinTheirEnergy) {
   // A 35 degree slope corrugated at the grid scale (wavelength 3 cells, amplitude 1.5 m). Without
   // friction a flow can never be faster than free fall from its highest point allows.
-  Terrain2D t;
-  t.nx = 160;
-  t.ny = 40;
-  t.dx = t.dy = 5.0;
-  t.z.resize(t.cells());
-  for (int j = 0; j < t.ny; ++j)
-    for (int i = 0; i < t.nx; ++i)
-      t.z[std::size_t(j) * t.nx + i] = -std::tan(35 * kDeg) * i * t.dx + 1.5 * std::sin(2 * M_PI * i / 3.0) * std::cos(2 * M_PI * j / 3.0);
+  const auto t = terrain_of(160, 40, 5.0, [](double x, double y) {
+    return -std::tan(35 * kDeg) * x + 1.5 * std::sin(2 * M_PI * x / 15.0) * std::cos(2 * M_PI * y / 15.0);
+  });
   const auto h0 = blob(t, 20, 20, 8, 2.0);
   double zmax = -1e9, zmin = 1e9;
   for (std::size_t k = 0; k < t.cells(); ++k) {
@@ -376,12 +340,7 @@ TEST(Sh2d, CurvatureBoundKeepsFlowsOnRoughTerrainWithinTheirEnergy) {
 }
 
 TEST(Sh2d, NormalDepthConventionOnASlope) {
-  Terrain2D t;
-  t.nx = t.ny = 5;
-  t.dx = t.dy = 1;
-  t.z.resize(25);
-  for (int j = 0; j < 5; ++j)
-    for (int i = 0; i < 5; ++i) t.z[std::size_t(j) * 5 + i] = -std::tan(30 * kDeg) * i;
+  const auto t = inclined_plane(5, 5, 1.0, 30);
   const auto s = state_from_normal_depth(t, std::vector<double>(25, 2.0));
   EXPECT_NEAR(s.H[12], 2.0 / std::cos(30 * kDeg), 1e-12);  // volume per horizontal area
   EXPECT_NEAR(normal_depth(t, s)[12], 2.0, 1e-12);
@@ -432,35 +391,6 @@ TEST(Sh2d, NonFiniteStateFailsTheRun) {
   EXPECT_THROW(run_sh2d(t, cfg, init), std::invalid_argument);
 }
 
-namespace {
-void expect_same(const Sh2dResult& a, const Sh2dResult& b) {
-  EXPECT_EQ(a.diag.steps, b.diag.steps);
-  EXPECT_EQ(a.diag.t, b.diag.t);
-  EXPECT_EQ(a.diag.stop, b.diag.stop);
-  EXPECT_EQ(a.state.H, b.state.H);
-  EXPECT_EQ(a.state.HU, b.state.HU);
-  EXPECT_EQ(a.state.HV, b.state.HV);
-  EXPECT_EQ(a.hazard.max_depth, b.hazard.max_depth);
-  EXPECT_EQ(a.hazard.max_speed, b.hazard.max_speed);
-  EXPECT_EQ(a.hazard.max_pressure, b.hazard.max_pressure);
-  EXPECT_EQ(a.hazard.final_depth, b.hazard.final_depth);
-  ASSERT_EQ(a.hazard.arrival_time.size(), b.hazard.arrival_time.size());
-  for (std::size_t k = 0; k < a.hazard.arrival_time.size(); ++k)
-    ASSERT_TRUE(a.hazard.arrival_time[k] == b.hazard.arrival_time[k] ||
-                (std::isnan(a.hazard.arrival_time[k]) && std::isnan(b.hazard.arrival_time[k])))
-        << k;
-  EXPECT_EQ(a.diag.volume_initial, b.diag.volume_initial);
-  EXPECT_EQ(a.diag.volume_final, b.diag.volume_final);
-  EXPECT_EQ(a.diag.volume_outflow, b.diag.volume_outflow);
-  EXPECT_EQ(a.diag.kinetic_energy_peak, b.diag.kinetic_energy_peak);
-  EXPECT_EQ(a.diag.max_speed, b.diag.max_speed);
-  EXPECT_EQ(a.diag.positivity_limited, b.diag.positivity_limited);
-  EXPECT_EQ(a.diag.cell_updates, b.diag.cell_updates);
-  EXPECT_EQ(a.diag.mean_active_fraction, b.diag.mean_active_fraction);
-  EXPECT_EQ(a.diag.max_active_fraction, b.diag.max_active_fraction);
-  EXPECT_EQ(a.diag.mean_travel, b.diag.mean_travel);
-}
-}  // namespace
 
 // Checkpoints change nothing, and a run continued from any of them (periodic, or taken when the run
 // was cancelled) computes the bits of the uninterrupted run, snapshots included.
