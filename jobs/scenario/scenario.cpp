@@ -3,6 +3,7 @@
 #include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
 
+#include "engine/vof/models/mu_i_law.hpp"
 #include "jobs/digest/sha256.hpp"
 #include "jobs/scenario/json_shape.hpp"
 #include "jobs/scenario/options.hpp"
@@ -121,6 +122,17 @@ v1::Scenario parse_scenario_json(const std::string& json) {
     throw ScenarioError("scenario JSON: " + std::string(e.what()));
   }
   return s;
+}
+
+void apply_material_rheology(const v1::Material& m, engine::vof::VofConfig& c) {
+  c.rho1 = m.density_kg_m3();
+  c.rheology = m.rheology() == "mu_i" ? "mu_i" : "coulomb";
+  c.phi_deg = m.internal_friction_deg();
+  if (m.has_mu_s()) c.mu_i.mu_s = m.mu_s();
+  if (m.has_mu_2()) c.mu_i.mu_2 = m.mu_2();
+  if (m.has_mu_i0()) c.mu_i.i0 = m.mu_i0();
+  if (m.has_grain_diameter_m()) c.mu_i.grain_diameter = m.grain_diameter_m();
+  if (m.has_grain_density_kg_m3()) c.mu_i.grain_density = m.grain_density_kg_m3();
 }
 
 ResolvedScenario load_scenario(const std::string& path) {
@@ -244,11 +256,25 @@ void check_material(const v1::Material& m, const engine::Material& mat) {
   }
 }
 
-// The 3D engine on the DEM: a Coulomb material with both friction angles.
+// The 3D engine on the DEM: the Coulomb viscosity (with the internal friction angle) or mu(I) (with
+// the parameters the depth-averaged mu_i law takes too, checked by check_material; here their
+// join), and the bed's friction angle.
 void check_terrain_vof(const v1::Scenario& s) {
   const auto& m = s.material();
-  if (m.rheology() != "coulomb") bad("material.rheology", "the 3D engine takes \"coulomb\" only (got \"" + m.rheology() + "\")");
-  if (!m.has_internal_friction_deg()) bad("material.internal_friction_deg", "needed by the 3D engine's Coulomb viscosity");
+  if (m.rheology() != "coulomb" && m.rheology() != "mu_i")
+    bad("material.rheology", "the 3D engine takes \"coulomb\" or \"mu_i\" (got \"" + m.rheology() + "\")");
+  if (m.rheology() == "coulomb" && !m.has_internal_friction_deg())
+    bad("material.internal_friction_deg", "needed by the 3D engine's Coulomb viscosity");
+  if (m.rheology() == "mu_i" && m.has_mu_s() && m.has_mu_2() && m.has_mu_i0() && m.has_grain_diameter_m() && m.has_grain_density_kg_m3()) {
+    engine::vof::VofConfig c;
+    apply_material_rheology(m, c);
+    try {
+      const engine::vof::MuILaw law(c.mu_i, c.rho1, true);  // it checks and joins when built
+      (void)law;
+    } catch (const engine::vof::VofError& e) {
+      bad("material.mu_2", e.what());
+    }
+  }
   if (!m.has_bed_friction_deg()) bad("material.bed_friction_deg", "needed by the 3D engine's bed condition");
   const auto& me = s.mesh();
   if (me.has_first_layer_m() && me.has_band_height_m() && !(me.band_height_m() > me.first_layer_m()))

@@ -112,5 +112,8 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base_dir);
 /// The laboratory block's granular rheology into the engine's configuration: lab.rheology and the
 /// mu(I) parameters that are set (the rest keep the engine's defaults, the glass beads).
 void apply_lab_rheology(const v1::Lab& lab, engine::vof::VofConfig& c);
+/// The material block into the 3D engine's configuration on the DEM: its density, the granular
+/// rheology ("coulomb" with internal_friction_deg, or "mu_i" with its parameters).
+void apply_material_rheology(const v1::Material& m, engine::vof::VofConfig& c);
 
 }  // namespace runout::jobs

@@ -297,6 +297,28 @@ TEST(TerrainVof, BadOptionsAreNamed) {
   };
   EXPECT_NE(message([](auto& s) { s.mutable_material()->set_rheology("voellmy"); }).find("material.rheology"), std::string::npos);
   EXPECT_NE(message([](auto& s) { s.mutable_material()->clear_internal_friction_deg(); }).find("material.internal_friction_deg"), std::string::npos);
+  // mu(I): its parameters are needed (as the depth-averaged mu_i law needs them) and must join.
+  auto mu_i = [](runout::v1::Scenario& s) {
+    auto* m = s.mutable_material();
+    m->set_rheology("mu_i");
+    m->set_density_kg_m3(1470);
+    m->set_mu_s(0.38);
+    m->set_mu_2(0.64);
+    m->set_mu_i0(0.279);
+    m->set_grain_diameter_m(5e-4);
+    m->set_grain_density_kg_m3(2450);
+  };
+  EXPECT_EQ(message(mu_i), "no error");
+  EXPECT_NE(message([&](auto& s) {
+              mu_i(s);
+              s.mutable_material()->clear_mu_i0();
+            }).find("material.mu_i0"),
+            std::string::npos);
+  EXPECT_NE(message([&](auto& s) {
+              mu_i(s);
+              s.mutable_material()->set_mu_2(0.381);
+            }).find("material.mu_2: mu(I): the regularisation cannot join"),
+            std::string::npos);
   EXPECT_NE(message([](auto& s) { s.mutable_mesh()->set_growth(5); }).find("mesh.growth"), std::string::npos);
   EXPECT_NE(message([](auto& s) {
               s.mutable_mesh()->set_first_layer_m(2);

@@ -11,8 +11,7 @@ vof::VofConfig terrain_config(const ResolvedScenario& r) {
   const auto& s = r.scenario;
   const auto& v = s.vof();
   vof::VofConfig c;
-  c.rho1 = s.material().density_kg_m3();
-  c.phi_deg = s.material().internal_friction_deg();
+  apply_material_rheology(s.material(), c);  // density, rheology (checked when the scenario was resolved)
   c.max_co = c.max_alpha_co = v.max_courant();
   c.dt_max = 1.0;  // the Courant numbers limit the step on a real grid's cells (metres, not centimetres)
   c.n_outer_correctors = v.outer_correctors();
