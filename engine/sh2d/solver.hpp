@@ -29,6 +29,7 @@ inline double vmin(double a, double b) { return b < a ? b : a; }
 // A box of cells [i0, i1) x [j0, j1).
 struct CellBox {
   int i0, i1, j0, j1;
+  bool empty() const { return i1 <= i0 || j1 <= j0; }
 };
 
 struct Face {

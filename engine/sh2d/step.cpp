@@ -435,9 +435,8 @@ void Solver::clear_outside(int tt, const CellBox& c) {
     const std::size_t k = idx(a, j), n = std::size_t(b - a);
     for (auto* v : {&H_[nb], &HU_[nb], &HV_[nb], &U_[nb], &V_[nb]}) std::fill_n(v->begin() + std::ptrdiff_t(k), n, 0.0);
   };
-  const bool none = c.i1 <= c.i0 || c.j1 <= c.j0;
   for (int j = o.j0; j < o.j1; ++j) {
-    if (none || j < c.j0 || j >= c.j1) {
+    if (c.empty() || j < c.j0 || j >= c.j1) {
       clear(j, o.i0, o.i1);
       continue;
     }
@@ -459,7 +458,7 @@ long Solver::step_tile(int tt, double t, double dt, TileWork& w) {
   tile_range(tt, i0, i1, j0, j1);
   const CellBox c = material_box(i0, i1, j0, j1);
   clear_outside(tt, c);
-  if (c.i1 <= c.i0 || c.j1 <= c.j0) {  // nothing within reach: the tile's sums are those of an empty tile
+  if (c.empty()) {  // nothing within reach: the tile's sums are those of an empty tile
     tile_mass_[tt] = tile_ke_[tt] = tile_speed_[tt] = tile_rate_[tt] = 0.0;
     tile_wet_[tt] = 0;
     return 0;

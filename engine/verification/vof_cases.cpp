@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <sstream>
 
 #include "engine/vof/mesh.hpp"
 #include "engine/vof/models/granular_viscosity.hpp"
@@ -370,7 +371,9 @@ std::vector<Row> bagnold_rows(const Options& o, const std::string& id, double ze
     const Err e = profile_error(s, exact, [&](const Vec& x) { return x.y < h && std::abs(x.x - L / 2) < L / 4; });
     Row row;
     row.case_id = id;
-    row.variant = "vof-" + rheology + "-" + (zeta_deg == 25 ? "25" : zeta_deg == 21.5 ? "21.5" : "20.95") + "deg";
+    std::ostringstream label;
+    label << "vof-" << rheology << "-" << zeta_deg << "deg";
+    row.variant = label.str();
     row.cells = mesh.cells();
     row.dx = H / ny;
     row.metrics.push_back({"inertial_number", I});

@@ -294,31 +294,44 @@ TEST(Scenarios, LabB10TallerColumnsRunOutFurther) {
 // B8 (validation.md B8, coarse: 5 cm cells, 4 s) runs beside its DEM-path counterpart in
 // test_b8_dem.cpp.
 
-// B1 (validation.md B1, coarse: 8 mm cells, 0.8 s): below phi the fine sand turns with the box as a
-// rigid body, so the free surface's angle to the horizontal (run.json's monitor) follows the rotation
-// angle; the closed box keeps its volume.
-TEST(Scenarios, LabB1SurfaceAngleFollowsTheRotationBelowPhi) {
+// B1 on coarse cells (8 mm) to end_time: the closed box keeps its volume; the monitors of the
+// surface angle, the share of sand moving and the rotation's angular speed.
+namespace {
+struct B1Run {
+  std::vector<double> t, angle, moving;
+  double omega_deg = 0;
+};
+B1Run b1_coarse(double end_time) {
   auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b1-rotating-box.json");
   auto* lab = r.scenario.mutable_lab();
   lab->set_nx(25);
   lab->set_ny(25);
-  lab->set_end_time_s(0.8);
+  lab->set_end_time_s(end_time);
   lab->set_write_interval_s(0);
   TempDir d;
   const auto sum = jobs::run_scenario(r, d.p.string());
-  ASSERT_EQ(sum.stop, "end-time");
+  EXPECT_EQ(sum.stop, "end-time");
   EXPECT_NEAR(sum.volume_final, sum.volume_initial, 1e-6 * sum.volume_initial);
   const auto j = run_record(d / "run.json");
-  const auto t = as_vector(j.monitors().t_s()), angle = as_vector(j.monitors().surface_angle_deg()),
-             moving = as_vector(j.monitors().moving_share());
-  ASSERT_EQ(angle.size(), t.size());
-  ASSERT_GT(t.size(), 10u);
-  const double omega_deg = 360.0 / lab->rotation_period_s();
-  for (std::size_t q = 0; q < t.size(); q += 5) {
-    EXPECT_NEAR(angle[q], omega_deg * t[q], 2.0) << "t = " << t[q];
-    EXPECT_LT(moving[q], 0.1) << "t = " << t[q];  // at most a few surface cells creep above 1 cm/s
+  B1Run b{as_vector(j.monitors().t_s()), as_vector(j.monitors().surface_angle_deg()), as_vector(j.monitors().moving_share()),
+          360.0 / lab->rotation_period_s()};
+  EXPECT_EQ(b.angle.size(), b.t.size());
+  EXPECT_EQ(b.moving.size(), b.t.size());
+  return b;
+}
+}  // namespace
+
+// B1 (validation.md B1, coarse: 8 mm cells, 0.8 s): below phi the fine sand turns with the box as a
+// rigid body, so the free surface's angle to the horizontal (run.json's monitor) follows the rotation
+// angle; the closed box keeps its volume.
+TEST(Scenarios, LabB1SurfaceAngleFollowsTheRotationBelowPhi) {
+  const auto b = b1_coarse(0.8);
+  ASSERT_GT(b.t.size(), 10u);
+  for (std::size_t q = 0; q < b.t.size(); q += 5) {
+    EXPECT_NEAR(b.angle[q], b.omega_deg * b.t[q], 2.0) << "t = " << b.t[q];
+    EXPECT_LT(b.moving[q], 0.1) << "t = " << b.t[q];  // at most a few surface cells creep above 1 cm/s
   }
-  EXPECT_GT(angle.back(), 35.0);  // 0.8 s: 41.6 deg
+  EXPECT_GT(b.angle.back(), 35.0);  // 0.8 s: 41.6 deg
 }
 
 // B1 with the Coulomb law at the fine sand's phi = 54.5 deg (tan phi > 1) against the dissertation's
@@ -329,29 +342,16 @@ TEST(Scenarios, LabB1SurfaceAngleFollowsTheRotationBelowPhi) {
 // more than 2 deg behind the rigid turn) between 84 and 97 deg. Measured: fails at 90.0 deg (on the
 // bundled 4 mm cells: 86.3 deg, with 40 % of the sand moving by 92 deg).
 TEST(Scenarios, LabB1TurnsRigidlyToNinetyDegreesThenFailsAsTheReferenceMethodDoes) {
-  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b1-rotating-box.json");
-  auto* lab = r.scenario.mutable_lab();
-  lab->set_nx(25);
-  lab->set_ny(25);
-  lab->set_end_time_s(2.1);
-  lab->set_write_interval_s(0);
-  TempDir d;
-  const auto sum = jobs::run_scenario(r, d.p.string());
-  ASSERT_EQ(sum.stop, "end-time");
-  EXPECT_NEAR(sum.volume_final, sum.volume_initial, 1e-6 * sum.volume_initial);
-  const auto j = run_record(d / "run.json");
-  const auto t = as_vector(j.monitors().t_s()), angle = as_vector(j.monitors().surface_angle_deg()),
-             moving = as_vector(j.monitors().moving_share());
-  ASSERT_EQ(angle.size(), t.size());
-  const double omega_deg = 360.0 / lab->rotation_period_s();
+  const auto b = b1_coarse(2.1);
+  ASSERT_GT(b.t.size(), 10u);
   double fails_at = -1;
-  for (std::size_t q = 0; q < t.size(); ++q) {
-    const double turn = omega_deg * t[q], rigid = turn <= 90 ? turn : 180 - turn;  // the angle is folded to 0-90
+  for (std::size_t q = 0; q < b.t.size(); ++q) {
+    const double turn = b.omega_deg * b.t[q], rigid = turn <= 90 ? turn : 180 - turn;  // the angle is folded to 0-90
     if (turn <= 83) {
-      EXPECT_NEAR(angle[q], rigid, 1.0) << "rotation " << turn << " deg";
-      EXPECT_LT(moving[q], 0.05) << "rotation " << turn << " deg";
+      EXPECT_NEAR(b.angle[q], rigid, 1.0) << "rotation " << turn << " deg";
+      EXPECT_LT(b.moving[q], 0.05) << "rotation " << turn << " deg";
     }
-    if (fails_at < 0 && std::abs(angle[q] - rigid) > 2.0) fails_at = turn;
+    if (fails_at < 0 && std::abs(b.angle[q] - rigid) > 2.0) fails_at = turn;
   }
   std::printf("B1 coarse, phi 54.5 deg: the fill fails at %.1f deg of rotation (reference method: 90-97 deg)\n", fails_at);
   EXPECT_GE(fails_at, 84.0);
