@@ -31,6 +31,7 @@ const CaseEntry kCases[] = {
     {"V4", "VOF engine: start-up of plane Couette flow from rest (series solution)", case_v4},
     {"V5", "VOF engine: steady Bagnold flow of the mu(I) rheology down an inclined plane, under air", case_v5},
     {"V6", "VOF engine: Bagnold flow at low inertial number, mu(I) regularised (converges) and not (does not)", case_v6},
+    {"V7", "VOF engine: mu(I) flow down an inclined plane between side walls with Coulomb friction (Jop et al. 2005)", case_v7},
 };
 
 }  // namespace

@@ -14,5 +14,6 @@ std::vector<Row> case_v3(const Options& o);  ///< still two-layer column in a cl
 std::vector<Row> case_v4(const Options& o);  ///< start-up of plane Couette flow (transient)
 std::vector<Row> case_v5(const Options& o);  ///< Bagnold flow of the mu(I) rheology down an inclined plane
 std::vector<Row> case_v6(const Options& o);  ///< the same at low I: regularised against unregularised
+std::vector<Row> case_v7(const Options& o);  ///< the same between side walls with Coulomb friction
 
 }  // namespace runout::engine::verification

@@ -66,7 +66,23 @@ void MomentumEqn::build(const Fields& F, double dt) {
   convection_diffusion(F);
   if (cfg_.momentum_convection == Convection::limited_linear) limited_linear_correction(F);
   boundary_terms(F);
+  if (cfg_.side_walls.width > 0) side_wall_friction(F);
   coefficients(F, dt);
+}
+
+// The friction of the side walls a plane set-up stands for (VofConfig::side_walls): two walls W
+// apart, each carrying tan(delta_w) p against the velocity, 2 tan(delta_w) p / W per unit volume of
+// material (p the confining pressure, as the granular viscosity takes it), on the material's share
+// alpha of the cell. Implicit as the Coulomb friction bed: a drag of the force over
+// max(|u|, creep speed) on the diagonal, so that the force's magnitude is the friction while the
+// material moves and material held by less comes to rest.
+void MomentumEqn::side_wall_friction(const Fields& F) {
+  const auto& sw = cfg_.side_walls;
+  const double k = 2 * sw.tan_delta / sw.width;
+  parallel_each(region_.halo, [&](int c) {
+    const double p = std::max(bc_ctx_.hydrostatics.confining_pressure(c), 0.0);
+    UEqn_.diag[c] += F.alpha[c] * k * p * m_.volume[c] / std::max(norm(F.U[c]), sw.creep_speed);
+  });
 }
 
 // ddt(rho, U), Euler implicit.

@@ -47,6 +47,7 @@ class MomentumEqn {
   void convection_diffusion(const Fields& F);
   void limited_linear_correction(const Fields& F);
   void boundary_terms(const Fields& F);
+  void side_wall_friction(const Fields& F);
   void coefficients(const Fields& F, double dt);
   void predictor_forces();
   void predictor_rows(const Fields& F);

@@ -115,9 +115,18 @@ struct VofConfig {
     double grain_diameter = 5e-4;  ///< d [m]
     double grain_density = 2450;   ///< rho_s [kg/m3]; rho1 / rho_s is the solid fraction
     /// Barker & Gray (2017)'s alpha of the regularised branch sqrt(alpha / ln(A / I)) below I_1.
-    double alpha = 1.9;
+    double alpha = 0;  ///< the regularisation's alpha; 0: MuILaw::scaled_alpha (1.9 for these beads)
   } mu_i;
   double nu_min = 1e-15, nu_max = 1e2;  ///< viscosity limits [m2/s]
+  /// The side walls a plane (one cell thick) set-up stands for: two walls `width` apart, each
+  /// carrying the Coulomb friction tan_delta p against the velocity (Jop, Forterre & Pouliquen
+  /// 2005), 2 tan_delta p / width per unit volume of material; width 0: none. Below creep_speed the
+  /// force falls linearly, as the Coulomb friction bed's.
+  struct SideWalls {
+    double width = 0;          ///< [m]
+    double tan_delta = 0;      ///< the walls' friction coefficient
+    double creep_speed = 1e-4;  ///< [m/s]
+  } side_walls;
   std::function<Vec(double)> gravity = [](double) { return Vec{0, -9.81, 0}; };
   double max_co = 0.2;         ///< target Courant number (velocity) in cells with material
   double max_alpha_co = 0.2;   ///< target Courant number in interface cells

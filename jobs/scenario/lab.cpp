@@ -94,7 +94,18 @@ void check_rheology(const v1::Lab& l) {
 }  // namespace
 
 void apply_lab_rheology(const v1::Lab& l, engine::vof::VofConfig& c) {
+  if (l.has_side_wall_width_m()) {
+    c.side_walls.width = l.side_wall_width_m();
+    c.side_walls.tan_delta = std::tan(l.side_wall_friction_deg() * 3.14159265358979323846 / 180);
+  }
   if (!l.rheology().empty()) c.rheology = l.rheology();
+  const LabMaterial& mat = lab_material(l.material());  // mu(I)'s defaults: the material's (options.hpp)
+  constexpr double kDeg = 3.14159265358979323846 / 180;
+  c.mu_i.mu_s = std::tan(mat.repose_deg * kDeg);
+  c.mu_i.mu_2 = std::tan((mat.repose_deg + LabMaterial::kMuIRise) * kDeg);
+  c.mu_i.i0 = LabMaterial::kMuII0;
+  c.mu_i.grain_diameter = mat.grain_diameter;
+  c.mu_i.grain_density = mat.grain_density;
   if (l.has_mu_s()) c.mu_i.mu_s = l.mu_s();
   if (l.has_mu_2()) c.mu_i.mu_2 = l.mu_2();
   if (l.has_mu_i0()) c.mu_i.i0 = l.mu_i0();
@@ -120,6 +131,10 @@ ResolvedScenario resolve_lab(v1::Scenario s) {
   check_fill(l, three_d);
   check_boundaries(l, three_d);
   check_rheology(l);
+  if (l.has_side_wall_width_m() != l.has_side_wall_friction_deg())
+    bad(l.has_side_wall_width_m() ? "lab.side_wall_friction_deg" : "lab.side_wall_width_m",
+        "the side walls need both their width and their friction angle");
+  if (l.has_side_wall_width_m() && three_d) bad("lab.side_wall_width_m", "only for plane set-ups (a 3D set-up has its own side walls)");
   const auto& ref = l.reference();
   if (ref.has_front_x_min() != ref.has_front_x_max() || (ref.has_front_x_min() && ref.front_x_max() < ref.front_x_min()))
     bad("lab.reference.front_x_max", "the front is a range: give front_x_min and front_x_max >= front_x_min");

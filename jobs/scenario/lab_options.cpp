@@ -39,9 +39,9 @@ Option length(std::string path, std::string doc, std::string zero = "") {
 const std::vector<LabMaterial>& lab_materials() {
   // validation.md part B; fine-sand: the rotating box, whose side walls raise the effective phi.
   static const std::vector<LabMaterial> m = {
-      {"pvc", 936.17, 32, 20, "PVC granulate of the laboratory chutes"},
-      {"sand", 1626.67, 37, 18, "quartz sand"},
-      {"fine-sand", 1855, 54.5, 54.5, "the rotating box's fine sand (its side walls raise the effective phi)"},
+      {"pvc", 936.17, 32, 20, "PVC granulate of the laboratory chutes", 32, 4e-3, 1550},
+      {"sand", 1626.67, 37, 18, "quartz sand", 37, 0.98e-3, 2650},
+      {"fine-sand", 1855, 54.5, 54.5, "the rotating box's fine sand (its side walls raise the effective phi)", 37, 0.175e-3, 2650},
   };
   return m;
 }
@@ -142,15 +142,20 @@ const OptionTable& lab_options() {
        "viscosity on walls and inflows: evaluated on the face (as OpenFOAM) or the cell's", "VofConfig::wall_viscosity"},
       {"lab.rheology", T::choice, U::keep, "coulomb", {}, std::vector<std::string>(engine::vof::kGranularViscosityNames.begin(), engine::vof::kGranularViscosityNames.end()), "",
        "the granular viscosity: Coulomb (tan(phi) p) or mu(I), regularised at low I or not", "VofConfig::rheology"},
-      {"lab.mu_s", T::number, U::as_given, "", Range{0, 5, true}, {}, "", "mu(I): static friction coefficient mu_s (default tan 20.9 deg)",
+      {"lab.mu_s", T::number, U::as_given, "", Range{0, 5, true}, {}, "", "mu(I): static friction coefficient mu_s (default: the material's, tan(angle of repose))",
        "VofConfig::mu_i.mu_s"},
       {"lab.mu_2", T::number, U::as_given, "", Range{0, 5, true}, {}, "",
-       "mu(I): limiting friction coefficient mu_2 >= mu_s (default tan 32.76 deg)", "VofConfig::mu_i.mu_2"},
+       "mu(I): limiting friction coefficient mu_2 >= mu_s (default: the material's, tan(angle of repose + 11.86 deg))", "VofConfig::mu_i.mu_2"},
       {"lab.mu_i0", T::number, U::as_given, "", Range{0, 10, true}, {}, "", "mu(I): I_0 (default 0.279)", "VofConfig::mu_i.i0"},
-      {"lab.grain_diameter_m", T::number, U::as_given, "", Range{0, 0.1, true}, {}, "m", "mu(I): grain diameter d (default 0.5 mm)",
+      {"lab.grain_diameter_m", T::number, U::as_given, "", Range{0, 0.1, true}, {}, "m", "mu(I): grain diameter d (default: the material's)",
        "VofConfig::mu_i.grain_diameter"},
       {"lab.grain_density_kg_m3", T::number, U::as_given, "", Range{100, 20000}, {}, "kg/m3",
-       "mu(I): grain density rho_s, at least the material's density (default 2450)", "VofConfig::mu_i.grain_density"},
+       "mu(I): grain density rho_s, at least the material's density (default: the material's)", "VofConfig::mu_i.grain_density"},
+      {"lab.side_wall_width_m", T::number, U::as_given, "", Range{0, 10, true}, {}, "m",
+       "plane set-ups: the width between the side walls they stand for (with side_wall_friction_deg)", "VofConfig::side_walls.width"},
+      {"lab.side_wall_friction_deg", T::number, U::as_given, "", Range{0, 80, false, true}, {}, "deg",
+       "plane set-ups: the side walls' friction angle; 2 tan(delta_w) p / width per unit volume against the velocity",
+       "VofConfig::side_walls.tan_delta"},
   };
   return t;
 }

@@ -81,6 +81,13 @@ struct LabMaterial {
   std::string name;
   double rho, phi_deg, delta_deg;  ///< density [kg/m^3], internal and bed friction angles [deg]
   std::string doc;
+  /// mu(I)'s parameters (lab.rheology "mu_i"): the measured angle of repose as mu_s = tan(repose),
+  /// mu_2 = tan(repose + kMuIRise) (the rise of the glass beads of Jop et al. 2006, 20.9 to 32.76
+  /// deg: not measured for these materials), I_0 0.279 (the beads'), the measured mean grain
+  /// diameter [m] and grain density [kg/m^3].
+  double repose_deg, grain_diameter, grain_density;
+  static constexpr double kMuIRise = 32.76 - 20.9;
+  static constexpr double kMuII0 = 0.279;
 };
 const std::vector<LabMaterial>& lab_materials();
 /// The material called `name` ("" is the default, pvc); an unknown name is a ScenarioError listing

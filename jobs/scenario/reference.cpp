@@ -25,9 +25,12 @@ std::string friction_laws_markdown() {
 }
 
 std::string lab_materials_markdown() {
-  std::string s = "| `lab.material` | Density [kg/m3] | phi [deg] | delta [deg] | |\n|---|---|---|---|---|\n";
+  std::string s =
+      "| `lab.material` | Density [kg/m3] | phi [deg] | delta [deg] | mu(I): repose [deg], d [mm], rho_s [kg/m3] | |\n"
+      "|---|---|---|---|---|---|\n";
   for (const auto& m : lab_materials())
-    s += "| `" + m.name + "` | " + num(m.rho) + " | " + num(m.phi_deg) + " | " + num(m.delta_deg) + " | " + m.doc + " |\n";
+    s += "| `" + m.name + "` | " + num(m.rho) + " | " + num(m.phi_deg) + " | " + num(m.delta_deg) + " | " + num(m.repose_deg) + ", " +
+         num(m.grain_diameter * 1e3) + ", " + num(m.grain_density) + " | " + m.doc + " |\n";
   return s;
 }
 

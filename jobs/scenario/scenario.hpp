@@ -109,8 +109,9 @@ ResolvedScenario load_scenario(const std::string& path);
 /// Resolve and validate a message; relative paths are taken from `base_dir`. Throws ScenarioError.
 ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base_dir);
 
-/// The laboratory block's granular rheology into the engine's configuration: lab.rheology and the
-/// mu(I) parameters that are set (the rest keep the engine's defaults, the glass beads).
+/// The laboratory block's granular rheology into the engine's configuration: lab.rheology, the
+/// mu(I) parameters (those not set are the material's, LabMaterial) and the side walls' friction of
+/// a plane set-up.
 void apply_lab_rheology(const v1::Lab& lab, engine::vof::VofConfig& c);
 /// The material block into the 3D engine's configuration on the DEM: its density, the granular
 /// rheology ("coulomb" with internal_friction_deg, or "mu_i" with its parameters).

@@ -353,8 +353,9 @@ TEST(LabOptions, BoundaryKindsAreTheEngineRegistrys) {
 }
 
 // lab.rheology: "coulomb" by default (left unset), "mu_i" accepted and reaching the run (coarse B2:
-// the mu(I) beads, with their lower static friction, run further than PVC's Coulomb phi); the mu(I)
-// parameters checked between each other and against the material, each error naming the field.
+// PVC's mu(I), whose friction rises above its Coulomb phi where it shears, stops at another front);
+// the mu(I) parameters default to the material's and are checked between each other and against
+// the material, each error naming the field.
 TEST(Scenarios, LabRheologyIsValidatedAndReachesTheRun) {
   expect_unset_default_option("rheology", "coulomb", "mu_i", "bingham", [](const v1::Lab& l) { return l.rheology(); });
   const std::string head = R"({"engine": "vof", "lab": {"x_max": 1, "y_max": 1, "nx": 10, "ny": 10,
@@ -363,7 +364,17 @@ TEST(Scenarios, LabRheologyIsValidatedAndReachesTheRun) {
   EXPECT_NO_THROW(jobs::resolve_scenario(with(R"(, "mu_s": 0.5, "mu_2": 0.9, "mu_i0": 0.3, "grain_diameter_m": 0.001)"), "."));
   expect_resolve_error(with(R"(, "mu_s": 0.6, "mu_2": 0.5)"), {"lab.mu_2", "at least lab.mu_s"});
   expect_resolve_error(with(R"(, "grain_density_kg_m3": 500)"), {"lab.grain_density_kg_m3", "material's density"});
-  expect_resolve_error(with(R"(, "mu_2": 0.382)"), {"lab.mu_2", "too small"});
+  expect_resolve_error(with(R"(, "mu_s": 0.381863, "mu_2": 0.382)"), {"lab.mu_2", "too small"});
+  for (const auto& m : jobs::lab_materials()) {  // the defaults: the material's (options.hpp LabMaterial)
+    runout::engine::vof::VofConfig c;
+    auto r = jobs::resolve_scenario(with(R"(, "material": ")" + m.name + "\""), ".");
+    jobs::apply_lab_rheology(r.scenario.lab(), c);
+    EXPECT_NEAR(c.mu_i.mu_s, std::tan(m.repose_deg * M_PI / 180), 1e-12) << m.name;
+    EXPECT_NEAR(c.mu_i.mu_2, std::tan((m.repose_deg + 11.86) * M_PI / 180), 1e-12) << m.name;
+    EXPECT_EQ(c.mu_i.grain_diameter, m.grain_diameter) << m.name;
+    EXPECT_EQ(c.mu_i.grain_density, m.grain_density) << m.name;
+    EXPECT_EQ(c.mu_i.i0, 0.279) << m.name;
+  }
   expect_resolve_error(with(R"(, "grain_diameter_m": 0)"), {"lab.grain_diameter_m"});
   double front[2] = {0, 0};
   for (int k = 0; k < 2; ++k) {
@@ -375,6 +386,24 @@ TEST(Scenarios, LabRheologyIsValidatedAndReachesTheRun) {
     ASSERT_EQ(jobs::run_scenario(r, d.p.string()).stop, "end-time");
     front[k] = record_figure(d / "run.json", "front_x_m");
   }
-  std::printf("coarse B2 to 0.4 s: front %.4f m (coulomb), %.4f m (mu_i, glass beads)\n", front[0], front[1]);
+  std::printf("coarse B2 to 0.4 s: front %.4f m (coulomb), %.4f m (mu_i, PVC)\n", front[0], front[1]);
   EXPECT_GT(std::abs(front[1] - front[0]), 0.005);  // at least half a cell apart
+}
+
+// lab.side_wall_width_m and lab.side_wall_friction_deg: both or neither, plane set-ups only; they
+// reach the engine's configuration (their effect: VofSolver.SideWallFrictionSlowsAPlugByItsDepthOverTheWidth).
+TEST(Scenarios, LabSideWallsAreValidatedAndReachTheConfiguration) {
+  const std::string head = R"({"engine": "vof", "lab": {"x_max": 1, "y_max": 1, "nx": 10, "ny": 10,
+      "fill": [{"x_max": 0.5, "y_max": 0.5}])";
+  auto with = [&](const std::string& more) { return jobs::parse_scenario_json(head + more + "}}"); };
+  const auto r = jobs::resolve_scenario(with(R"(, "side_wall_width_m": 0.005, "side_wall_friction_deg": 18)"), ".");
+  runout::engine::vof::VofConfig c;
+  jobs::apply_lab_rheology(r.scenario.lab(), c);
+  EXPECT_EQ(c.side_walls.width, 0.005);
+  EXPECT_NEAR(c.side_walls.tan_delta, std::tan(18 * M_PI / 180), 1e-15);
+  expect_resolve_error(with(R"(, "side_wall_width_m": 0.005)"), {"lab.side_wall_friction_deg", "both"});
+  expect_resolve_error(with(R"(, "side_wall_friction_deg": 18)"), {"lab.side_wall_width_m", "both"});
+  expect_resolve_error(with(R"(, "side_wall_width_m": 0, "side_wall_friction_deg": 18)"), {"lab.side_wall_width_m"});
+  expect_resolve_error(with(R"(, "nz": 2, "z_max": 0.1, "side_wall_width_m": 0.1, "side_wall_friction_deg": 18)"),
+                       {"lab.side_wall_width_m", "plane set-ups"});
 }

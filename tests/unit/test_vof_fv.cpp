@@ -9,6 +9,7 @@
 #include "engine/vof/fv/ops.hpp"
 #include "engine/vof/mixture.hpp"
 #include "engine/vof/models/granular_viscosity.hpp"
+#include "engine/vof/models/mu_i_law.hpp"
 #include "engine/vof/solver.hpp"
 
 using namespace runout::engine::vof;
@@ -194,6 +195,29 @@ TEST(VofFv, MuIParametersAreChecked) {
   bad([](VofConfig& c) { c.mu_i.grain_diameter = 0; }, "grain diameter");
   bad([](VofConfig& c) { c.mu_i.grain_density = 1000; }, "grain density must be at least the bulk density");
   bad([](VofConfig& c) { c.mu_i.mu_2 = c.mu_i.mu_s + 1e-3; }, "too small for alpha");
+  bad([](VofConfig& c) { c.mu_i.alpha = -1; }, "alpha must be > 0");
+  bad([](VofConfig& c) { c.mu_i.alpha = 1.9, c.mu_i.mu_s = 0.625, c.mu_i.mu_2 = 0.961; }, "too small for alpha");
+}
+
+// The regularisation's alpha when none is given (MuILaw::scaled_alpha): Barker & Gray's 1.9 for the
+// beads; for the steeper laws of the lab materials (PVC tan 32 deg, sand tan 37 deg, each with the
+// beads' rise of 11.86 deg), where 1.9 cannot join, in the same proportion to the smallest alpha
+// that joins, and the law is joined with the same value and slope.
+TEST(VofFv, MuIRegularisationScalesItsAlphaWithTheLaw) {
+  EXPECT_EQ(MuILaw::scaled_alpha(VofConfig::MuI{}), 1.9);
+  for (double repose : {32.0, 37.0}) {
+    VofConfig::MuI m;
+    m.mu_s = std::tan(repose * M_PI / 180), m.mu_2 = std::tan((repose + 11.86) * M_PI / 180);
+    const double a = MuILaw::scaled_alpha(m);
+    EXPECT_NEAR(a / MuILaw::smallest_alpha(m.mu_s, m.mu_2, m.i0), 1.9 / 0.8864, 0.01) << repose;
+    const MuILaw law(m, 1600, true);
+    EXPECT_EQ(law.alpha(), a);
+    const double i1 = law.i1(), e = 1e-7 * i1;
+    ASSERT_GT(i1, 0);
+    EXPECT_NEAR(law.friction(i1 - e), law.friction(i1 + e), 1e-6) << repose;
+    EXPECT_LT(law.friction(1e-6), m.mu_s) << repose;  // it creeps below mu_s
+    std::printf("repose %.0f deg: alpha %.3f, I_1 %.4g, mu(1e-6) %.3f (mu_s %.3f)\n", repose, a, i1, law.friction(1e-6), m.mu_s);
+  }
 }
 
 TEST(VofFv, UnknownRheologyListsTheValidNames) {

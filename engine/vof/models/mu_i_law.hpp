@@ -16,6 +16,7 @@
 // of 2 alpha I mu'(I) - mu(I)^3 and A = I_1 exp(alpha / mu(I_1)^2). It is partial: at high I the
 // law stays ill posed, as every mu(I) curve is there. "mu_i_unregularised" takes the law as it
 // stands, for comparison.
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -28,7 +29,7 @@ class MuILaw {
   /// Checks the parameters (VofError naming the one that is wrong) and, regularised, joins the
   /// branches (VofError when mu_2 - mu_s is too small for alpha).
   MuILaw(const VofConfig::MuI& m, double rho1, bool regularised)
-      : mu_s_(m.mu_s), dmu_(m.mu_2 - m.mu_s), i0_(m.i0), alpha_(m.alpha) {
+      : mu_s_(m.mu_s), dmu_(m.mu_2 - m.mu_s), i0_(m.i0), alpha_(m.alpha != 0 ? m.alpha : scaled_alpha(m)) {
     if (!(m.mu_s > 0 && std::isfinite(m.mu_s))) throw VofError("mu(I): mu_s must be > 0 (got " + std::to_string(m.mu_s) + ")");
     if (!(m.mu_2 >= m.mu_s && std::isfinite(m.mu_2)))
       throw VofError("mu(I): mu_2 must be at least mu_s (got mu_2 = " + std::to_string(m.mu_2) + ", mu_s = " + std::to_string(m.mu_s) + ")");
@@ -47,7 +48,28 @@ class MuILaw {
     return law(I);
   }
   bool constant() const { return dmu_ == 0; }  ///< mu_2 = mu_s: the Coulomb limit
+  /// The smallest alpha for which the regularisation joins the law of mu_s, mu_2 and I_0 (the join
+  /// needs 2 alpha I mu'(I) >= mu(I)^3 somewhere); infinite for mu_2 = mu_s.
+  static double smallest_alpha(double mu_s, double mu_2, double i0) {
+    if (!(mu_2 > mu_s)) return HUGE_VAL;
+    double most = 0;  // the largest 2 I mu'(I) / mu(I)^3 over a fine logarithmic scan
+    for (double I = 1e-12; I < 1e3; I *= 1.001) {
+      const double mu = mu_s + (mu_2 - mu_s) / (i0 / I + 1.0), slope = (mu_2 - mu_s) * i0 / ((i0 + I) * (i0 + I));
+      most = std::max(most, 2 * I * slope / (mu * mu * mu));
+    }
+    return most > 0 ? 1 / most : HUGE_VAL;
+  }
+  /// alpha when VofConfig::MuI::alpha is 0: Barker & Gray's 1.9 for the glass beads (MuI's
+  /// defaults), scaled with the smallest alpha that joins (0.886 for the beads; 2.7 for PVC's law and
+  /// 4.0 for the sands' of the lab materials, whose mu_s is higher), so that every law is joined as
+  /// far from its limit as the beads'.
+  static double scaled_alpha(const VofConfig::MuI& m) {
+    static const double beads = smallest_alpha(VofConfig::MuI{}.mu_s, VofConfig::MuI{}.mu_2, VofConfig::MuI{}.i0);
+    const double own = smallest_alpha(m.mu_s, m.mu_2, m.i0);
+    return std::isfinite(own) ? 1.9 * own / beads : 1.9;
+  }
   double mu_s() const { return mu_s_; }
+  double alpha() const { return alpha_; }
   double i1() const { return i1_; }  ///< below it the regularised branch (0: none)
 
  private:
@@ -76,6 +98,9 @@ class MuILaw {
     }
     i1_ = hi;
     a_ = i1_ * std::exp(alpha_ / (law(i1_) * law(i1_)));
+    if (!std::isfinite(a_))
+      throw VofError("mu(I): the regularisation cannot join the law (mu_2 - mu_s = " + std::to_string(dmu_) +
+                     " is too small for alpha = " + std::to_string(alpha_) + ": its branch would not creep); take mu_i_unregularised or a larger mu_2 - mu_s");
   }
 
   double mu_s_, dmu_, i0_, alpha_;

@@ -223,7 +223,7 @@ void ShockMonitor::write(v1::Monitors& rec, const std::vector<double>& t) const 
 
 SurfaceAngleMonitor::SurfaceAngleMonitor(const LabSetup& su, const v1::Lab& L, double every)
     : su_(su),
-      rotating_(L.rotation_period_s() > 0 && !su.g.three_d),
+      rotating_(L.rotation_period_s() > 0),
       centre_{0.5 * (L.x_min() + L.x_max()), 0.5 * (L.y_min() + L.y_max()), 0},
       period_(L.rotation_period_s()),
       every_(every) {}
@@ -245,16 +245,49 @@ void SurfaceAngleMonitor::sample(double t, const vof::VofSolver& s) {
   }
   if (n < 3) {
     angle.push_back(NAN);
+    layer.push_back(NAN);
     return;
   }
   mx /= n, my /= n;
   const double cxx = sxx / n - mx * mx, cxy = sxy / n - mx * my, cyy = syy / n - my * my;
   const double dir = 0.5 * std::atan2(2 * cxy, cxx - cyy);  // the principal axis
+  layer.push_back(flowing_layer(s, mx, my, dir));
   const vof::Vec gv = su_.config.gravity(t);
   const double horizontal = std::atan2(gv.y, gv.x) + 0.5 * kPi;
   double d = std::fmod(std::abs(dir - horizontal), kPi);
   if (d > 0.5 * kPi) d = kPi - d;
   angle.push_back(d * 180 / kPi);
+}
+
+// The flowing layer's thickness at the centre (the rigid bulk is at rest on the fixed mesh, the box
+// turning gravity): along the surface line's normal into the sand, the deepest sand cell within 2 cm
+// of the normal through the points' centroid that moves faster than 10 % of the fastest there and
+// 5 mm/s, plus half a cell (the reference method's measure, validation.md B1).
+double SurfaceAngleMonitor::flowing_layer(const vof::VofSolver& s, double mx, double my, double dir) const {
+  const auto& m = su_.m;
+  double nx = -std::sin(dir), ny = std::cos(dir), sgn = 0;
+  for (int c = 0; c < m.cells(); ++c) {
+    const vof::Vec& p = m.centre[std::size_t(c)];
+    sgn += (s.alpha()[std::size_t(c)] - 0.5) * ((p.x - mx) * nx + (p.y - my) * ny);
+  }
+  if (sgn > 0) nx = -nx, ny = -ny;  // the normal points into the air
+  double fastest = 0;
+  std::vector<std::pair<double, double>> col;  // (depth, speed)
+  for (int c = 0; c < m.cells(); ++c) {
+    if (s.alpha()[std::size_t(c)] <= 0.5) continue;
+    const vof::Vec& p = m.centre[std::size_t(c)];
+    const double depth = -((p.x - mx) * nx + (p.y - my) * ny), along = std::abs((p.x - mx) * ny - (p.y - my) * nx);
+    if (along >= 0.02 || depth <= -0.004) continue;
+    const vof::Vec& u = s.velocity()[std::size_t(c)];
+    const double speed = std::hypot(u.x, u.y);
+    col.emplace_back(depth, speed);
+    fastest = std::max(fastest, speed);
+  }
+  if (col.empty()) return NAN;
+  double deepest = -HUGE_VAL;
+  for (const auto& [depth, speed] : col)
+    if (speed > 0.1 * fastest && speed > 0.005) deepest = std::max(deepest, depth);
+  return std::isfinite(deepest) ? deepest + 0.5 * su_.g.dx : 0.0;
 }
 
 void SurfaceAngleMonitor::write(v1::Monitors& rec, const std::vector<double>& t) const {
@@ -272,11 +305,12 @@ void SurfaceAngleMonitor::write(v1::Monitors& rec, const std::vector<double>& t)
       break;
     }
   const double quarter = 0.25 * period_;
-  double sum_a = 0, sum_aa = 0, cnt = 0;
+  double sum_a = 0, sum_aa = 0, cnt = 0, sum_layer = 0, n_layer = 0;
   std::vector<double> qsum(64, 0.0), qn(64, 0.0);
   for (std::size_t q = 0; q < t.size(); ++q) {
     if (std::isnan(onset) || t[q] < onset + 0.25 * quarter || std::isnan(angle[q])) continue;
     sum_a += angle[q], sum_aa += angle[q] * angle[q], cnt += 1;
+    if (!std::isnan(layer[q])) sum_layer += layer[q], n_layer += 1;
     const auto k = std::min<std::size_t>(63, std::size_t(t[q] / quarter));
     qsum[k] += angle[q], qn[k] += 1;
   }
@@ -287,6 +321,8 @@ void SurfaceAngleMonitor::write(v1::Monitors& rec, const std::vector<double>& t)
   for (std::size_t k = 0; k < qsum.size(); ++k)
     if (qn[k] >= 0.5 * quarter / every_) rec.add_surface_angle_quarter_turn_means_deg(qsum[k] / qn[k]);  // sampled for half a quarter turn
   for (double v : angle) rec.add_surface_angle_deg(v);
+  rec.set_flowing_layer_mean_m(n_layer > 0 ? sum_layer / n_layer : NAN);
+  for (double v : layer) rec.add_flowing_layer_m(v);
 }
 
 // ---- the collection ----

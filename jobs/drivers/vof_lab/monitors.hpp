@@ -118,10 +118,13 @@ class SurfaceAngleMonitor : public Monitor {
   bool enabled() const { return rotating_; }
   void sample(double t, const engine::vof::VofSolver& s) override;
   void write(v1::Monitors& rec, const std::vector<double>& t) const override;
-  std::vector<std::pair<const char*, std::vector<double>*>> series() override { return {{"surface_angle", &angle}}; }
-  std::vector<double> angle;
+  std::vector<std::pair<const char*, std::vector<double>*>> series() override {
+    return {{"surface_angle", &angle}, {"flowing_layer", &layer}};
+  }
+  std::vector<double> angle, layer;
 
  private:
+  double flowing_layer(const engine::vof::VofSolver& s, double mx, double my, double dir) const;
   const LabSetup& su_;
   bool rotating_;
   engine::vof::Vec centre_;
