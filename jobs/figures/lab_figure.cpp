@@ -238,12 +238,17 @@ void draw_section(cairo_t* cr, const SectionFigure& f, const SectionLayout& L) {
 // axis, the moving share [0, 1] on the right, with ours and the reference's figures.
 // The captions under the monitors: what each line is, ours and the reference's figures.
 void series_captions(cairo_t* cr, const SectionFigure& f, double ox, double ty, bool shock) {
+  const bool box = !f.surface_angle.empty();
   text(cr, ox, ty,
-       shock ? "the shock's distance from the end wall (blue), share of the material moving > 1 cm/s (grey)"
-             : "gate flux (blue), outflow at the end (green), share of the material moving > 1 cm/s (grey)",
+       box     ? "surface angle (blue), a rigid turn (dashed), flowing layer at the centre [mm] (green), moving > 1 cm/s (grey)"
+       : shock ? "the shock's distance from the end wall (blue), share of the material moving > 1 cm/s (grey)"
+               : "gate flux (blue), outflow at the end (green), share of the material moving > 1 cm/s (grey)",
        11);
   std::string ours;
   auto add = [](std::string& to, const std::string& s) { to += (to.empty() ? " " : ", ") + s; };
+  if (!std::isnan(f.angle_mean))
+    add(ours, "surface " + fmt("%.1f", f.angle_mean) + " +- " + fmt("%.1f deg", f.angle_sd) + " once it flows, flowing layer " +
+                  fmt("%.1f mm", f.layer_mean * 1e3));
   if (!std::isnan(f.fluidised)) add(ours, "fluidised " + fmt("%.2f s", f.fluidised) + " (black tick)");
   if (!std::isnan(f.gate_flux_early)) add(ours, "gate flux " + fmt("%.2f l/s", f.gate_flux_early) + " (median 0.12-0.30 s)");
   if (!std::isnan(f.strain_early)) add(ours, "gate strain rate " + fmt("%.1f 1/s", f.strain_early) + " (median 0.10-0.20 s)");
@@ -252,6 +257,7 @@ void series_captions(cairo_t* cr, const SectionFigure& f, double ox, double ty, 
   if (!std::isnan(f.ref_fluidised)) add(ref, "fluidised " + fmt("%.2f s", f.ref_fluidised) + " (dashed)");
   if (!std::isnan(f.ref_outflow)) add(ref, "outflow " + fmt("%.2f l/s", f.ref_outflow) + " (dashed)");
   if (!std::isnan(f.ref_strain)) add(ref, "gate strain rate " + fmt("%.0f 1/s", f.ref_strain));
+  if (box && !std::isnan(f.ref_angle)) add(ref, "surface angle " + fmt("%.0f deg", f.ref_angle) + " (dashed)");
   if (!ref.empty()) text(cr, ox, ty + 34, source_name(f.ref_source) + ":" + ref, 11, kReference);
 }
 
@@ -259,13 +265,14 @@ void draw_series(cairo_t* cr, const SectionFigure& f, const SectionLayout& L) {
   const double ox = L.ox, top = L.top, sec_h = L.sec_h, sec_w = L.sec_w, gap = L.gap, ser_h = L.ser_h;
   const double py = top + sec_h + gap + 40, pw = std::max(sec_w, 500.0), ph = ser_h;
   const double t0 = f.t.front(), t1 = f.t.back();
-  const bool shock = !f.shock.empty();
+  const bool shock = !f.shock.empty(), box = !f.surface_angle.empty();
   double qmax = shock ? 0.1 : 1;
   for (const auto* v : shock ? std::vector<const std::vector<double>*>{&f.shock} : std::vector<const std::vector<double>*>{&f.gate_flux, &f.outflow})
     for (double q : *v)
       if (std::isfinite(q)) qmax = std::max(qmax, q);
   if (!std::isnan(f.ref_outflow)) qmax = std::max(qmax, f.ref_outflow);
   qmax *= 1.1;
+  if (box) qmax = 90;
   auto TX = [&](double t) { return ox + (t - t0) / std::max(1e-12, t1 - t0) * pw; };
   auto QY = [&](double q) { return py + ph - q / qmax * ph; };
   auto SY = [&](double s) { return py + ph - s * ph; };
@@ -292,7 +299,7 @@ void draw_series(cairo_t* cr, const SectionFigure& f, const SectionLayout& L) {
     text(cr, ox + pw + 8, SY(sh) + 4, fmt("%.1f", sh), 10);
   }
   text(cr, ox + pw - 25, py + ph + 32, "t [s]", 11);
-  text(cr, 8, py - 8, shock ? "shock from the end wall [m]" : "flux [l/s, 10 cm channel]", 11);
+  text(cr, 8, py - 8, box ? "angle [deg], layer [mm]" : shock ? "shock from the end wall [m]" : "flux [l/s, 10 cm channel]", 11);
   text(cr, ox + pw - 60, py - 8, "moving share", 11, {0.45, 0.45, 0.45});
   auto line = [&](const std::vector<double>& v, auto yf, const Rgb& c) {
     cairo_set_source_rgb(cr, c.r, c.g, c.b);
@@ -312,7 +319,15 @@ void draw_series(cairo_t* cr, const SectionFigure& f, const SectionLayout& L) {
   };
   const Rgb gate_c{0.1, 0.3, 0.9}, out_c{0.1, 0.6, 0.2}, mov_c{0.55, 0.55, 0.55};
   line(f.moving, SY, mov_c);
-  if (shock) {
+  if (box) {
+    std::vector<double> layer_mm(f.flowing_layer);
+    for (double& v : layer_mm) v *= 1e3;
+    line(layer_mm, QY, out_c);
+    line(f.surface_angle, QY, gate_c);
+    dashed(cr, true);
+    line(f.rigid_angle, QY, Rgb{0.2, 0.2, 0.2});
+    dashed(cr, false);
+  } else if (shock) {
     line(f.shock, QY, gate_c);
   } else {
     line(f.gate_flux, QY, gate_c);
@@ -321,11 +336,12 @@ void draw_series(cairo_t* cr, const SectionFigure& f, const SectionLayout& L) {
   cairo_set_source_rgb(cr, kReference.r, kReference.g, kReference.b);
   cairo_set_line_width(cr, 2);
   dashed(cr, true);
-  if (!std::isnan(f.ref_outflow)) {
-    cairo_move_to(cr, ox, QY(f.ref_outflow));
-    cairo_line_to(cr, ox + pw, QY(f.ref_outflow));
-    cairo_stroke(cr);
-  }
+  for (double level : {f.ref_outflow, box ? f.ref_angle : NAN})
+    if (!std::isnan(level)) {
+      cairo_move_to(cr, ox, QY(level));
+      cairo_line_to(cr, ox + pw, QY(level));
+      cairo_stroke(cr);
+    }
   if (!std::isnan(f.ref_fluidised) && f.ref_fluidised >= t0 && f.ref_fluidised <= t1) {
     cairo_move_to(cr, TX(f.ref_fluidised), py);
     cairo_line_to(cr, TX(f.ref_fluidised), py + ph);

@@ -23,6 +23,11 @@ struct SectionFigure {
   double anchor_x = NAN, height = NAN;  ///< where our surface is at 70 % of the deposit's height [m], and that height
   std::vector<double> t, gate_flux, outflow, moving;  ///< monitors [s], [l/s], [l/s], [-]
   std::vector<double> shock;  ///< B6: the shock's distance from the end wall [m] (drawn instead of the fluxes)
+  /// B1, the rotating box (drawn instead of the fluxes): the free surface's angle to the horizontal
+  /// and the rotation folded to 0-90 deg (a rigid turn) [deg], the flowing layer at the centre [m],
+  /// and their means once the material flows.
+  std::vector<double> surface_angle, rigid_angle, flowing_layer;
+  double angle_mean = NAN, angle_sd = NAN, layer_mean = NAN;
   double fluidised = NAN, gate_flux_early = NAN, strain_early = NAN;
   // The reference (lab.reference); NaN where not given.
   std::string ref_source;

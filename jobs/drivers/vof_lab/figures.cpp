@@ -131,6 +131,18 @@ void write_section_comparison(const std::string& path, const std::string& title,
   fig.fluidised = mon.moving.t_fluid >= 0 && !su.has_inflow ? mon.moving.t_fluid : NAN;
   if (mon.shock.enabled())
     for (double x : mon.shock.x) fig.shock.push_back(L.x_max() - x);
+  if (mon.surface.enabled()) {  // the rotating box: its angles and flowing layer instead of the fluxes
+    v1::Monitors summary;
+    mon.surface.write(summary, mon.t);
+    fig.surface_angle = mon.surface.angle;
+    fig.flowing_layer = mon.surface.layer;
+    for (double t : mon.t) {
+      const double turn = std::fmod(360.0 * t / L.rotation_period_s(), 180.0);
+      fig.rigid_angle.push_back(turn <= 90 ? turn : 180 - turn);
+    }
+    fig.angle_mean = summary.surface_angle_mean_deg(), fig.angle_sd = summary.surface_angle_std_deg();
+    fig.layer_mean = summary.flowing_layer_mean_m();
+  }
   if (mon.gate.has_gate()) {
     fig.gate_flux_early = median_between(mon.t, mon.gate.flux, 0.12, 0.30);
     fig.strain_early = median_between(mon.t, mon.gate.strain, 0.10, 0.20);
