@@ -17,7 +17,7 @@ TEST(Scenarios, VofHashCarriesTheResultsVersion) {
   // cached result and refuse every checkpoint, so it must be deliberate (then record the new value;
   // so also when this scenario file is edited or kVofResultsVersion is bumped; this is version 6's).
   const auto b2 = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json");
-  EXPECT_EQ(jobs::scenario_hash(b2), "e3c8e41c0fb73947129d4c21fbfc9d1ec46e9014181ffa951f5db4516a287e4c");
+  EXPECT_EQ(jobs::scenario_hash(b2), "3a7053db68964db3863456cc77b796ca91be8abe485806c7ae017064d2c10574");
 }
 
 // Each engine's results version is in its scenarios' hashes, and only in its own: a change of what
@@ -37,11 +37,11 @@ TEST(Scenarios, HashCarriesEachEnginesResultsVersion) {
   EXPECT_EQ(jobs::scenario_hash(sh), "918dcdeca5e9bec9e9a76dfff012a3cfac302eef04dfcd01eed3a3fb57d0c7d4");
 }
 
-// The figures that VOF results version kVofResultsVersion gives for twelve short coarse runs: B2
+// The figures that VOF results version kVofResultsVersion gives for thirteen short coarse runs: B2
 // (PISO; once more with lab.coulomb_pressure "excess", once with the linear face viscosity in the
 // viscous stress's transpose part, once with the walls' viscosity the cell's), B3 (the consistent coupling, the gate monitor; once more with limited-linear convection
 // and the Coulomb friction bed, once with appendix B.2's Coulomb slip wall), B4 (an inflow, a
-// station), B7 (3D, an obstacle), B1 (gravity turning with time; once more with the excess
+// station; without and with the file's side walls), B7 (3D, an obstacle), B1 (gravity turning with time; once more with the excess
 // pressure, whose level in a closed domain follows the turning gravity) and B8 (the curved chute's
 // terrain-following mesh). A change to the numerics that moves them for an unchanged scenario
 // fails here: then bump kVofResultsVersion (jobs/scenario.hpp), so that services compute such
@@ -58,7 +58,7 @@ TEST(Scenarios, HashCarriesEachEnginesResultsVersion) {
 // limited by the largest step, not the Courant number (version 4: a rotation period changed by 1e-9
 // moved its figures by at most 2e-5; version 5's B1 barely moves by 39 deg, 1.8e-4 m/s).
 TEST(Scenarios, VofResultsMatchTheFingerprintOfTheirVersion) {
-  constexpr int version = 6;  // 6 added files on the DEM and moved none of these figures
+  constexpr int version = 7;  // 6 added files on the DEM, 7 lab mu(I)'s material parameters: neither moved these figures
   struct Figure {
     const char* key;
     double want;
@@ -78,7 +78,8 @@ TEST(Scenarios, VofResultsMatchTheFingerprintOfTheirVersion) {
       {"b3-triangle-pvc", 100, 24, 0, 0.2, NAN,
        {{"peak_speed_m_s", 1.822905984}, {"mean_surface_angle_deg", 23.45792271}, {"gate_flux_median_second_half_l_s_10cm", 5.57107901}}},
       {"b4-steady-pvc", 175, 10, 0, 0.4, 1.0,
-       {{"depth_m", 0.01799014697}, {"depth_averaged_u_m_s", 2.648249221}, {"surface_u_m_s", 3.051591273}}},
+       {{"depth_m", 0.01799014697}, {"depth_averaged_u_m_s", 2.648249221}, {"surface_u_m_s", 3.051591273}},
+       [](runout::v1::Lab* l) { l->clear_side_wall_width_m(), l->clear_side_wall_friction_deg(); }},  // the file's side walls: below
       {"b7-wide-chute-tetrahedron-edge", 47, 10, 24, 0.3, NAN,
        {{"peak_speed_m_s", 2.165007373}, {"volume_final_m3", 0.001061999866}, {"max_depth_m", 0.02818623777}}},
       // Limited-linear convection and the Coulomb friction bed.
@@ -124,6 +125,8 @@ TEST(Scenarios, VofResultsMatchTheFingerprintOfTheirVersion) {
        {{"peak_speed_m_s", 0.91235653}, {"final_speed_m_s", 0.6097962227}, {"mean_surface_angle_deg", 27.69741279},
         {"upper_surface_angle_deg", 29.34973597}},
        [](runout::v1::Lab* l) { l->set_wall_viscosity("cell"); }},
+      // The side walls' friction (the file's: 10 cm apart, 20 deg).
+      {"b4-steady-pvc", 175, 10, 0, 0.4, 1.0, {{"depth_m", 0.01850921677}, {"depth_averaged_u_m_s", 2.521649625}, {"surface_u_m_s", 2.959551746}}},
   };
   EXPECT_EQ(jobs::kVofResultsVersion, version) << "record this version's figures below";
   for (const auto& c : cases) {

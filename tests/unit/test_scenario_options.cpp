@@ -301,7 +301,8 @@ TEST(ScenarioOptions, LabMaterialsByNameWithoutFallback) {
 }
 
 // The bundled scenarios' hashes, recorded before the option tables replaced the hand-written
-// resolver: the tables' defaults reproduce them.
+// resolver: the tables' defaults reproduce them. (A results version enters its engine's hashes: a
+// bump, or an edit of a file, records that file's hash anew.)
 TEST(ScenarioOptions, BundledScenarioHashesAreUnchanged) {
   const std::vector<std::pair<std::string, std::string>> pinned = {
 #include "tests/unit/scenario_hashes.inc"

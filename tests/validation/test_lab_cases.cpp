@@ -1,5 +1,7 @@
 // The VOF laboratory set-ups through the run driver: monitors, checkpoints and each case's behaviour at
 // coarse resolutions.
+#include <functional>
+
 #include "tests/support/run_helpers.hpp"
 
 using namespace runout::test_support::run;
@@ -298,23 +300,28 @@ TEST(Scenarios, LabB10TallerColumnsRunOutFurther) {
 // surface angle, the share of sand moving and the rotation's angular speed.
 namespace {
 struct B1Run {
-  std::vector<double> t, angle, moving;
-  double omega_deg = 0;
+  std::vector<double> t, angle, moving, layer;
+  double omega_deg = 0, mean = NAN, sd = NAN, onset = NAN;
 };
-B1Run b1_coarse(double end_time) {
-  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b1-rotating-box.json");
+B1Run b1_coarse(double end_time, const std::function<void(runout::v1::Lab&)>& change = {}, const std::string& file = "b1-rotating-box") {
+  auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/" + file + ".json");
   auto* lab = r.scenario.mutable_lab();
   lab->set_nx(25);
   lab->set_ny(25);
   lab->set_end_time_s(end_time);
   lab->set_write_interval_s(0);
+  if (change) {
+    change(*lab);
+    r = jobs::resolve_scenario(r.scenario, std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab");
+  }
   TempDir d;
   const auto sum = jobs::run_scenario(r, d.p.string());
   EXPECT_EQ(sum.stop, "end-time");
   EXPECT_NEAR(sum.volume_final, sum.volume_initial, 1e-6 * sum.volume_initial);
   const auto j = run_record(d / "run.json");
-  B1Run b{as_vector(j.monitors().t_s()), as_vector(j.monitors().surface_angle_deg()), as_vector(j.monitors().moving_share()),
-          360.0 / lab->rotation_period_s()};
+  const auto& m = j.monitors();
+  B1Run b{as_vector(m.t_s()), as_vector(m.surface_angle_deg()), as_vector(m.moving_share()), as_vector(m.flowing_layer_m()),
+          360.0 / r.scenario.lab().rotation_period_s(), m.surface_angle_mean_deg(), m.surface_angle_std_deg(), m.surface_angle_onset_s()};
   EXPECT_EQ(b.angle.size(), b.t.size());
   EXPECT_EQ(b.moving.size(), b.t.size());
   return b;
@@ -418,4 +425,62 @@ TEST(Scenarios, LabB7WideChuteFlowsAroundTheTetrahedron) {
   auto bad = jobs::parse_scenario_json(R"({"engine": "vof", "lab": {"x_max": 1, "y_max": 1, "nx": 10, "ny": 10,
       "fill": [{"x_max": 0.5, "y_max": 0.5}], "obstacles": [{"shape": "cylinder", "radius": 0.1, "height": 0.1}]}})");
   expect_resolve_error(bad, {"lab.obstacles[0].shape"});
+}
+
+// B1 with the fine sand's measured angle of repose, 37 deg (validation.md B1, coarse: 8 mm cells to
+// 3.5 s, 182 deg): with mu(I) (the material's parameters) the fill fails before 80 deg and then keeps
+// a flowing layer over the rigid bulk at a steady angle (measured 43.0 +- 3.6 deg, layer 3.7 cm; on
+// the bundled 4 mm cells 41.0 +- 1.2 deg, 3.3 cm); with the side walls' friction the 0.5 cm box
+// stands for (PMMA, 18 deg) the same law turns rigidly again after each avalanche: no steady layer
+// (at 8 mm, 4 mm and 2 mm cells).
+TEST(Scenarios, LabB1WithMuIKeepsAFlowingLayerAndWithSideWallsSlumps) {
+  const auto mu_i = [](runout::v1::Lab& l) { l.set_rheology("mu_i"); };
+  const auto b = b1_coarse(3.5, mu_i);
+  double fails_at = -1;
+  for (std::size_t q = 0; q < b.t.size() && fails_at < 0; ++q)
+    if (std::abs(b.angle[q] - b.omega_deg * b.t[q]) > 2.0) fails_at = b.omega_deg * b.t[q];
+  double still_late = 0, layer = 0, n = 0;  // after the first failure's quarter turn: samples with nothing moving
+  for (std::size_t q = 0; q < b.t.size(); ++q)
+    if (b.t[q] > b.onset + 0.4) still_late += b.moving[q] < 0.02, layer += b.layer[q], n += 1;
+  std::printf("B1 coarse, mu(I): fails at %.1f deg, then %.1f +- %.1f deg, layer %.1f mm, %g of %g samples at rest\n", fails_at, b.mean,
+              b.sd, 1e3 * layer / n, still_late, n);
+  EXPECT_GT(fails_at, 60.0);
+  EXPECT_LT(fails_at, 80.0);
+  EXPECT_NEAR(b.mean, 43.0, 4.0);
+  EXPECT_LT(b.sd, 5.0);
+  EXPECT_GT(layer / n, 0.015);
+  EXPECT_LT(still_late, 0.1 * n);
+  const auto w = b1_coarse(3.5, [&](runout::v1::Lab& l) {
+    mu_i(l);
+    l.set_side_wall_width_m(0.005);
+    l.set_side_wall_friction_deg(18);
+  });
+  double at_rest = 0, m = 0;
+  for (std::size_t q = 0; q < w.t.size(); ++q)
+    if (w.t[q] > w.onset + 0.4) at_rest += w.moving[q] < 0.02, m += 1;
+  std::printf("B1 coarse, mu(I) and side walls: %.1f +- %.1f deg, %g of %g samples at rest\n", w.mean, w.sd, at_rest, m);
+  EXPECT_GT(at_rest, 0.5 * m);  // locked again for most of the time
+  EXPECT_GT(w.sd, 10.0);        // no steady angle
+}
+
+// B1's validated configuration (validation.md B1; b1-rotating-box-measured.json: the fine sand's
+// measured 37 deg, limited-linear convection), coarse: 8 mm cells to 3.5 s. The fill fails before
+// 80 deg, then a flowing layer over the rigid bulk keeps the surface near a steady angle (measured
+// 49.9 +- 7.8 deg, layer 2.3 cm, 8 of 178 samples with nothing moving; on the bundled 4 mm cells
+// 48.3 +- 3.5 deg and 1.6 cm, as the reference method at 37 deg: 49.4 +- 3.5 deg, 1.6 cm).
+TEST(Scenarios, LabB1MeasuredKeepsASteadyLayer) {
+  const auto b = b1_coarse(3.5, {}, "b1-rotating-box-measured");
+  double fails_at = -1, at_rest = 0, layer = 0, n = 0;
+  for (std::size_t q = 0; q < b.t.size(); ++q) {
+    if (fails_at < 0 && std::abs(b.angle[q] - b.omega_deg * b.t[q]) > 2.0) fails_at = b.omega_deg * b.t[q];
+    if (b.t[q] > b.onset + 0.4) at_rest += b.moving[q] < 0.02, layer += b.layer[q], n += 1;
+  }
+  std::printf("B1 measured, coarse: fails at %.1f deg, then %.1f +- %.1f deg, layer %.1f mm, %g of %g samples at rest\n", fails_at,
+              b.mean, b.sd, 1e3 * layer / n, at_rest, n);
+  EXPECT_GT(fails_at, 60.0);
+  EXPECT_LT(fails_at, 80.0);
+  EXPECT_GT(b.mean, 44.0);
+  EXPECT_LT(b.mean, 56.0);
+  EXPECT_GT(layer / n, 0.01);
+  EXPECT_LT(at_rest, 0.2 * n);
 }
