@@ -48,7 +48,7 @@ struct Options {
   std::vector<double> resolutions;  ///< override the case's cell sizes [m] (or cells across, A2)
 };
 
-/// The case identifiers in order: A1 ... A7, STRESS, V1 ... V6 (the VOF engine, vof_cases.hpp).
+/// The case identifiers in order: A1 ... A7, STRESS, V1 ... V7 (the VOF engine, vof_cases.hpp).
 std::vector<std::string> case_ids();
 /// One-line description of a case.
 std::string describe(const std::string& id);

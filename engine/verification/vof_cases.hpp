@@ -1,7 +1,7 @@
 #pragma once
-// Verification cases V1-V6 of the VOF engine (engine/vof/, docs/validation/verification.md): Newtonian flows
+// Verification cases V1-V7 of the VOF engine (engine/vof/, docs/validation/verification.md): Newtonian flows
 // with exact solutions (plane Couette, plane Poiseuille, Couette's start-up), a two-layer column
-// at rest (hydrostatic pressure, no spurious currents) and the Bagnold flow of the mu(I) rheology, with and without its regularisation. Same rows and registry as A1-A7 (cases.cpp).
+// at rest (hydrostatic pressure, no spurious currents) and the Bagnold flow of the mu(I) rheology, with and without its regularisation and between side walls. Same rows and registry as A1-A7 (cases.cpp).
 #include <vector>
 
 #include "engine/verification/cases.hpp"

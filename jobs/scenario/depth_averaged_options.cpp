@@ -36,8 +36,6 @@ std::vector<std::string> friction_law_names() {
   return out;
 }
 
-double radians(double deg) { return deg * M_PI / 180.0; }
-
 // Bounds (the README's "Valid ranges").
 constexpr double kMaxCell = 1e4;            // grid.resolution_m [m]
 constexpr double kMaxThickness = 500;       // a release [m]: rock avalanches start some hundred metres thick

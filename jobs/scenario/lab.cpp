@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "engine/vof/models/mu_i_law.hpp"
+#include "jobs/scenario/mu_i_fields.hpp"
 #include "jobs/scenario/options.hpp"
 #include "jobs/scenario/scenario.hpp"
 #include "jobs/scenario/scenario_impl.hpp"
@@ -83,12 +83,7 @@ void check_rheology(const v1::Lab& l) {
   if (m.mu_2 < m.mu_s) bad("lab.mu_2", "must be at least lab.mu_s (" + num(m.mu_s) + "), got " + num(m.mu_2));
   if (m.grain_density < c.rho1)
     bad("lab.grain_density_kg_m3", "must be at least the material's density " + num(c.rho1) + " kg/m3, got " + num(m.grain_density));
-  try {
-    const engine::vof::MuILaw law(m, c.rho1, c.rheology == "mu_i");  // it checks and joins when built
-    (void)law;
-  } catch (const engine::vof::VofError& e) {
-    bad("lab.mu_2", e.what());
-  }
+  check_mu_i_law(c, c.rheology == "mu_i", "lab.mu_2");
 }
 
 }  // namespace
@@ -96,21 +91,16 @@ void check_rheology(const v1::Lab& l) {
 void apply_lab_rheology(const v1::Lab& l, engine::vof::VofConfig& c) {
   if (l.has_side_wall_width_m()) {
     c.side_walls.width = l.side_wall_width_m();
-    c.side_walls.tan_delta = std::tan(l.side_wall_friction_deg() * 3.14159265358979323846 / 180);
+    c.side_walls.tan_delta = std::tan(radians(l.side_wall_friction_deg()));
   }
   if (!l.rheology().empty()) c.rheology = l.rheology();
   const LabMaterial& mat = lab_material(l.material());  // mu(I)'s defaults: the material's (options.hpp)
-  constexpr double kDeg = 3.14159265358979323846 / 180;
-  c.mu_i.mu_s = std::tan(mat.repose_deg * kDeg);
-  c.mu_i.mu_2 = std::tan((mat.repose_deg + LabMaterial::kMuIRise) * kDeg);
+  c.mu_i.mu_s = std::tan(radians(mat.repose_deg));
+  c.mu_i.mu_2 = std::tan(radians(mat.repose_deg + LabMaterial::kMuIRise));
   c.mu_i.i0 = LabMaterial::kMuII0;
   c.mu_i.grain_diameter = mat.grain_diameter;
   c.mu_i.grain_density = mat.grain_density;
-  if (l.has_mu_s()) c.mu_i.mu_s = l.mu_s();
-  if (l.has_mu_2()) c.mu_i.mu_2 = l.mu_2();
-  if (l.has_mu_i0()) c.mu_i.i0 = l.mu_i0();
-  if (l.has_grain_diameter_m()) c.mu_i.grain_diameter = l.grain_diameter_m();
-  if (l.has_grain_density_kg_m3()) c.mu_i.grain_density = l.grain_density_kg_m3();
+  take_mu_i_fields(l, c.mu_i);
 }
 
 ResolvedScenario resolve_lab(v1::Scenario s) {

@@ -3,9 +3,9 @@
 #include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
 
-#include "engine/vof/models/mu_i_law.hpp"
 #include "jobs/digest/sha256.hpp"
 #include "jobs/scenario/json_shape.hpp"
+#include "jobs/scenario/mu_i_fields.hpp"
 #include "jobs/scenario/options.hpp"
 #include "jobs/scenario/scenario_impl.hpp"
 
@@ -128,11 +128,7 @@ void apply_material_rheology(const v1::Material& m, engine::vof::VofConfig& c) {
   c.rho1 = m.density_kg_m3();
   c.rheology = m.rheology() == "mu_i" ? "mu_i" : "coulomb";
   c.phi_deg = m.internal_friction_deg();
-  if (m.has_mu_s()) c.mu_i.mu_s = m.mu_s();
-  if (m.has_mu_2()) c.mu_i.mu_2 = m.mu_2();
-  if (m.has_mu_i0()) c.mu_i.i0 = m.mu_i0();
-  if (m.has_grain_diameter_m()) c.mu_i.grain_diameter = m.grain_diameter_m();
-  if (m.has_grain_density_kg_m3()) c.mu_i.grain_density = m.grain_density_kg_m3();
+  take_mu_i_fields(m, c.mu_i);
 }
 
 ResolvedScenario load_scenario(const std::string& path) {
@@ -268,12 +264,7 @@ void check_terrain_vof(const v1::Scenario& s) {
   if (m.rheology() == "mu_i" && m.has_mu_s() && m.has_mu_2() && m.has_mu_i0() && m.has_grain_diameter_m() && m.has_grain_density_kg_m3()) {
     engine::vof::VofConfig c;
     apply_material_rheology(m, c);
-    try {
-      const engine::vof::MuILaw law(c.mu_i, c.rho1, true);  // it checks and joins when built
-      (void)law;
-    } catch (const engine::vof::VofError& e) {
-      bad("material.mu_2", e.what());
-    }
+    check_mu_i_law(c, true, "material.mu_2");
   }
   if (!m.has_bed_friction_deg()) bad("material.bed_friction_deg", "needed by the 3D engine's bed condition");
   const auto& me = s.mesh();

@@ -16,6 +16,8 @@ inline std::string num(double v) {
   return o.str();
 }
 
+inline double radians(double deg) { return deg * 3.14159265358979323846 / 180.0; }
+
 [[noreturn]] inline void bad(const std::string& field, const std::string& problem) { throw ScenarioError(field + ": " + problem); }
 
 /// Safety net after the field checks: no number anywhere in `m` may be NaN or infinite.

@@ -54,8 +54,8 @@ class MuILaw {
     if (!(mu_2 > mu_s)) return HUGE_VAL;
     double most = 0;  // the largest 2 I mu'(I) / mu(I)^3 over a fine logarithmic scan
     for (double I = 1e-12; I < 1e3; I *= 1.001) {
-      const double mu = mu_s + (mu_2 - mu_s) / (i0 / I + 1.0), slope = (mu_2 - mu_s) * i0 / ((i0 + I) * (i0 + I));
-      most = std::max(most, 2 * I * slope / (mu * mu * mu));
+      const double mu = law(mu_s, mu_2 - mu_s, i0, I);
+      most = std::max(most, 2 * I * slope(mu_2 - mu_s, i0, I) / (mu * mu * mu));
     }
     return most > 0 ? 1 / most : HUGE_VAL;
   }
@@ -73,8 +73,14 @@ class MuILaw {
   double i1() const { return i1_; }  ///< below it the regularised branch (0: none)
 
  private:
-  double law(double I) const { return mu_s_ + dmu_ / (i0_ / I + 1.0); }
-  double slope(double I) const { return dmu_ * i0_ / ((i0_ + I) * (i0_ + I)); }
+  static double law(double mu_s, double dmu, double i0, double I) { return mu_s + dmu / (i0 / I + 1.0); }
+  static double slope(double dmu, double i0, double I) { return dmu * i0 / ((i0 + I) * (i0 + I)); }
+  double law(double I) const { return law(mu_s_, dmu_, i0_, I); }
+  double slope(double I) const { return slope(dmu_, i0_, I); }
+  VofError cannot_join(const std::string& why) const {
+    return VofError("mu(I): the regularisation cannot join the law (mu_2 - mu_s = " + std::to_string(dmu_) + " is too small for alpha = " +
+                    std::to_string(alpha_) + why + "); take the unregularised law (mu_i_unregularised) or a larger mu_2 - mu_s");
+  }
   double gap(double I) const { return 2 * alpha_ * I * slope(I) - std::pow(law(I), 3); }
 
   // I_1: the first sign change of gap() on a logarithmic scan, refined by bisection.
@@ -88,19 +94,14 @@ class MuILaw {
       }
       lo = I;
     }
-    if (hi < 0)
-      throw VofError("mu(I): the regularisation cannot join the law (mu_2 - mu_s = " + std::to_string(dmu_) +
-                     " is too small for alpha = " + std::to_string(alpha_) +
-                     "); take the unregularised law (mu_i_unregularised) or a larger mu_2 - mu_s");
+    if (hi < 0) throw cannot_join("");
     for (int k = 0; k < 200 && hi - lo > 1e-15 * hi; ++k) {
       const double mid = 0.5 * (lo + hi);
       (gap(mid) > 0 ? hi : lo) = mid;
     }
     i1_ = hi;
     a_ = i1_ * std::exp(alpha_ / (law(i1_) * law(i1_)));
-    if (!std::isfinite(a_))
-      throw VofError("mu(I): the regularisation cannot join the law (mu_2 - mu_s = " + std::to_string(dmu_) +
-                     " is too small for alpha = " + std::to_string(alpha_) + ": its branch would not creep); take mu_i_unregularised or a larger mu_2 - mu_s");
+    if (!std::isfinite(a_)) throw cannot_join(": its branch would not creep");
   }
 
   double mu_s_, dmu_, i0_, alpha_;
