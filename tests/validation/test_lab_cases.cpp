@@ -387,6 +387,27 @@ TEST(Scenarios, LabB1TurnsRigidlyToNinetyDegreesThenFailsAsTheReferenceMethodDoe
   EXPECT_LE(fails_at, 97.0);
 }
 
+// B1 in 3D (validation.md B1: the box's 0.5 cm depth resolved, its PMMA faces `coulomb-friction`):
+// the rotating box's monitors run on a 3D mesh too; below phi the surface follows the rotation and
+// nothing flows (coarse: 8 mm x 2.5 mm cells, to 0.6 s, 31 deg).
+TEST(Scenarios, LabB1In3dReportsTheSurfaceAngle) {
+  const auto b = b1_coarse(0.6, [](runout::v1::Lab& l) {
+    l.set_nz(2), l.set_z_min(0), l.set_z_max(0.005), l.set_bed_friction_deg(18);
+    for (const char* side : {"back", "front"}) {
+      auto* w = l.add_boundaries();
+      w->set_side(side);
+      w->set_kind("coulomb-friction");
+    }
+  });
+  ASSERT_GT(b.t.size(), 10u);
+  for (std::size_t q = 0; q < b.t.size(); q += 5) {
+    EXPECT_NEAR(b.angle[q], b.rigid(q), 1.0) << "t = " << b.t[q];
+    EXPECT_LT(b.moving[q], 0.05) << "t = " << b.t[q];
+  }
+  EXPECT_EQ(b.layer.size(), b.t.size());
+  EXPECT_GT(b.angle.back(), 25.0);  // 0.6 s: 31 deg
+}
+
 // B6 (validation.md B6, coarse: the 50 deg PVC set-up fed 10 cm deep, shortened to a 1 m chute with
 // 1 cm cells, 2 s): the flow runs into the closed end, a deposit forms in the corner and the bore
 // at its upstream edge (the shock) moves upstream; run.json carries its position over time and its speed.
