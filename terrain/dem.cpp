@@ -113,10 +113,9 @@ OGRSpatialReference computation_crs(const DemRequest& req, const OGRSpatialRefer
   return dst;
 }
 
-// gdalwarp's arguments for the grid. With an area of interest, the area is transformed into the
-// computation CRS here (bounding box here, mask later) and the extent is its box on whole cells.
-std::vector<std::string> warp_args(const DemRequest& req, GDALDataset& dem, const OGRSpatialReference& src,
-                                   const OGRSpatialReference& dst, double res, OGRGeometry* aoi, const OGRSpatialReference& aoi_srs) {
+// gdalwarp's arguments for the DEM in the computation CRS at `res` (without the extent).
+std::vector<std::string> resample_args(const DemRequest& req, GDALDataset& dem, const OGRSpatialReference& src,
+                                       const OGRSpatialReference& dst, double res) {
   std::vector<std::string> args = {"-of", "MEM", "-tr", fmt(res, 6), fmt(res, 6),
                                    "-r", req.resampling.empty() ? "cubic" : req.resampling, "-dstnodata", "-99999",
                                    "-ot", "Float64"};
@@ -131,6 +130,14 @@ std::vector<std::string> warp_args(const DemRequest& req, GDALDataset& dem, cons
     args.push_back("-s_srs");
     args.push_back(wkt(src));
   }
+  return args;
+}
+
+// gdalwarp's arguments for the grid. With an area of interest, the area is transformed into the
+// computation CRS here (bounding box here, mask later) and the extent is its box on whole cells.
+std::vector<std::string> warp_args(const DemRequest& req, GDALDataset& dem, const OGRSpatialReference& src,
+                                   const OGRSpatialReference& dst, double res, OGRGeometry* aoi, const OGRSpatialReference& aoi_srs) {
+  std::vector<std::string> args = resample_args(req, dem, src, dst, res);
   if (aoi) {
     auto ct = transform(aoi_srs, dst, "area of interest");
     if (ct && aoi->transform(ct.get()) != OGRERR_NONE)
@@ -370,6 +377,52 @@ Grid prepare_grid(const DemRequest& req, DemReport* report) {
   if (report) *report = rep;
   return g;
 }
+
+namespace detail {
+
+double dem_resolution_on(const DemRequest& req, const Grid& g) {
+  GDALDatasetUniquePtr dem(GDALDataset::Open(req.dem_path.c_str(), GDAL_OF_RASTER));
+  if (!dem) throw TerrainError("DEM '" + req.dem_path + "': cannot read it as a raster" + gdal_message());
+  const double r = source_resolution_m(dem.get(), dem_crs(*dem, req));
+  return r > 0 ? std::max(r, g.dx / 16) : g.dx;
+}
+
+Grid dem_surface(const DemRequest& req, const Grid& g, double res, double x0, double y0, double x1, double y1) {
+  init_gdal();
+  GDALDatasetUniquePtr dem(GDALDataset::Open(req.dem_path.c_str(), GDAL_OF_RASTER));
+  if (!dem) throw TerrainError("DEM '" + req.dem_path + "': cannot read it as a raster" + gdal_message());
+  const OGRSpatialReference src = dem_crs(*dem, req);
+  OGRSpatialReference dst;
+  dst.importFromWkt(g.crs_wkt.c_str());
+  dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  auto args = resample_args(req, *dem, src, dst, res);
+  const int nx = std::max(3, int(std::ceil((x1 - x0) / res))), ny = std::max(3, int(std::ceil((y1 - y0) / res)));
+  for (const std::string& a : {std::string("-te"), fmt(x0, 6), fmt(y0, 6), fmt(x0 + nx * res, 6), fmt(y0 + ny * res, 6)}) args.push_back(a);
+  const auto wopt = warp_options(args);
+  GDALDatasetH srch = GDALDataset::ToHandle(dem.get());
+  int usage_error = 0;
+  GDALDatasetUniquePtr warped(GDALDataset::FromHandle(GDALWarp("", nullptr, 1, &srch, wopt.get(), &usage_error)));
+  if (!warped) throw TerrainError("DEM '" + req.dem_path + "': resampling it at its own resolution failed" + gdal_message());
+  Grid s;
+  s.nx = warped->GetRasterXSize();
+  s.ny = warped->GetRasterYSize();
+  double wgt[6];
+  warped->GetGeoTransform(wgt);
+  s.dx = wgt[1];
+  s.x_min = wgt[0];
+  s.y_min = wgt[3] + wgt[5] * s.ny;
+  s.crs_wkt = g.crs_wkt;
+  s.crs_name = g.crs_name;
+  std::vector<double> rows(s.cells());
+  if (warped->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, s.nx, s.ny, rows.data(), s.nx, s.ny, GDT_Float64, 0, 0) != CE_None)
+    throw TerrainError("DEM '" + req.dem_path + "': reading the resampled raster failed" + gdal_message());
+  DemReport unused;
+  take_rows(s, rows, unused);
+  fill_without_data(s);
+  return s;
+}
+
+}  // namespace detail
 
 std::vector<double> slope_deg(const Grid& g) {
   std::vector<double> s(g.cells());

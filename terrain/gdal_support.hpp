@@ -35,6 +35,14 @@ std::unique_ptr<OGRCoordinateTransformation> transform(const OGRSpatialReference
                                                        const std::string& what);
 /// GDAL's warper options from gdalwarp's command-line arguments.
 std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> warp_options(std::vector<std::string> args);
+/// The DEM's own resolution in metres (its pixel size, in metres on the ground for a geographic
+/// DEM), no finer than a sixteenth of the grid's cells: the resolution at which the release's slope
+/// window is evaluated (dem_surface).
+double dem_resolution_on(const DemRequest& req, const Grid& g);
+/// The DEM of `req` in the grid's CRS at resolution `res` (dem_resolution_on), resampled as the
+/// grid is (req.resampling), over [x0, x1] x [y0, y1] of the grid's CRS (widened to whole cells and
+/// to at least 3 x 3); cells without data take the elevation of the nearest data.
+Grid dem_surface(const DemRequest& req, const Grid& g, double res, double x0, double y0, double x1, double y1);
 /// A one-band in-memory raster on the grid (north-up, the grid's CRS).
 GDALDatasetUniquePtr mem_raster(const Grid& g, GDALDataType type);
 /// The rows of a raster, north first (GDAL's order), from `value(k)` of cell k (row 0 south).

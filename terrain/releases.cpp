@@ -2,17 +2,20 @@
 // thickness raster (alone or inside the polygons), the slope window, and the released volume.
 #include <gdal_alg.h>
 #include <gdal_priv.h>
+#include <ogr_api.h>
 #include <ogr_geometry.h>
 #include <ogr_spatialref.h>
 #include <ogrsf_frmts.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <functional>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "terrain/gdal_support.hpp"
@@ -45,36 +48,208 @@ double field_value(OGRFeature& f, const std::string& attr, const std::string& wh
   return f.GetFieldAsDouble(idx);
 }
 
-// The cells one release fills: those where `in` holds and the domain has terrain, with a positive
-// thickness `thick` and a slope within [smin, smax]; the normal thickness times `factor` (the
-// release's thickness_factor) goes into h (the maximum of what is there). Errors name `what`.
-struct CellFill {
+// The release is evaluated on a lattice of samples finer than the grid: each cell divided into
+// n x n squares. A square counts with the fraction of it that the polygon covers (the exact area of
+// their intersection, OGR), the thickness there (the release's, or the thickness raster resampled
+// at the square's centre) and the slope at its centre, taken from the DEM at the DEM's own
+// resolution (dem_surface on cells at multiples of that resolution, the same for every grid:
+// slopes by centred differences there, resampled bilinearly). A square
+// inside the slope window releases fraction x area x thickness (vertical thickness) or
+// fraction x area x thickness / cos(slope) (normal thickness); the cell's normal depth is the one
+// that carries exactly the sum of its squares: volume x cos(the grid's slope) / dx^2, since the
+// engines hold h dx^2 / cos(the grid's slope). n is the number that puts at least 8 samples along
+// each of the DEM's cells (at most 16). docs/user/scenarios.md, Releases.
+struct Lattice {
   const Grid& g;
-  const std::vector<double>& slope;
-  const std::string& extent;
-  std::vector<double>& h;
-  void operator()(const std::string& what, bool vertical, double smin, double smax, const std::function<bool(std::size_t)>& in,
-                  const std::function<double(std::size_t)>& thick, double factor) const {
-    long inside = 0, kept = 0;
-    double smin_seen = 90, smax_seen = 0;
-    for (std::size_t k = 0; k < g.cells(); ++k) {
-      if (!in(k) || (!g.outside.empty() && g.outside[k])) continue;  // no release where the domain has no terrain
-      const double t = thick(k);
-      if (!(t > 0)) continue;
-      ++inside;
-      smin_seen = std::min(smin_seen, slope[k]);
-      smax_seen = std::max(smax_seen, slope[k]);
-      if (slope[k] < smin || slope[k] > smax) continue;
-      ++kept;
-      h[k] = std::max(h[k], factor * (vertical ? t * std::cos(slope[k] * M_PI / 180) : t));
-    }
-    if (inside == 0)
-      throw TerrainError(what + " lies outside the grid, outside the area of interest or where the DEM has no data, or is thinner than a cell (" + extent + ")");
-    if (kept == 0)
-      throw TerrainError(what + ": no cell has a slope within [" + fmt(smin) + ", " + fmt(smax) + "] deg (slopes inside: " + fmt(smin_seen) +
-                         " to " + fmt(smax_seen) + " deg)");
+  const DemRequest& dem;
+  double res = 0;  // the DEM's own resolution [m] (dem_resolution_on)
+  int n = 1;       // samples per cell side
+  Lattice(const Grid& grid, const DemRequest& d) : g(grid), dem(d), res(dem_resolution_on(d, grid)) {
+    n = std::clamp(int(std::ceil(8 * g.dx / res - 1e-9)), 1, 16);
+  }
+  // The samples of the cells [i0, i1) x [j0, j1) as a grid (row 0 south).
+  Grid of(int i0, int j0, int i1, int j1) const {
+    Grid l;
+    l.nx = (i1 - i0) * n;
+    l.ny = (j1 - j0) * n;
+    l.dx = g.dx / n;
+    l.x_min = g.x_min + i0 * g.dx;
+    l.y_min = g.y_min + j0 * g.dx;
+    l.crs_wkt = g.crs_wkt;
+    l.crs_name = g.crs_name;
+    return l;
   }
 };
+
+// Reads band 1 of `ds` on the grid `l`, row 0 south.
+std::vector<double> south_first(const Grid& l, GDALDataset& ds, const std::string& what) {
+  std::vector<double> rows(l.cells()), v(l.cells());
+  if (ds.GetRasterBand(1)->RasterIO(GF_Read, 0, 0, l.nx, l.ny, rows.data(), l.nx, l.ny, GDT_Float64, 0, 0) != CE_None)
+    throw TerrainError(what + gdal_message());
+  for (int r = 0; r < l.ny; ++r) std::copy_n(rows.begin() + std::ptrdiff_t(r) * l.nx, l.nx, v.begin() + std::ptrdiff_t(l.ny - 1 - r) * l.nx);
+  return v;
+}
+
+// The slope [deg] at the samples of `l`: the DEM at its own resolution around them (two of its
+// cells beyond), its slopes by centred differences, resampled bilinearly by GDAL's warper.
+std::vector<double> sample_slopes(const Lattice& lat, const Grid& l) {
+  // Its cells on multiples of its resolution in the grid's CRS, whatever the grid: every grid samples
+  // the same surface.
+  const double r = lat.res, x0 = std::floor(l.x_min / r - 2) * r, y0 = std::floor(l.y_min / r - 2) * r;
+  const Grid s = dem_surface(lat.dem, lat.g, r, x0, y0, std::ceil((l.x_min + l.nx * l.dx) / r + 2) * r, std::ceil((l.y_min + l.ny * l.dx) / r + 2) * r);
+  const auto slope = slope_deg(s);
+  auto src = mem_raster(s, GDT_Float64);
+  auto rows = north_first<double>(s, [&](std::size_t k) { return slope[k]; });
+  if (src->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, s.nx, s.ny, rows.data(), s.nx, s.ny, GDT_Float64, 0, 0) != CE_None)
+    throw TerrainError("the DEM's slopes: writing them failed" + gdal_message());
+  auto out = mem_raster(l, GDT_Float64);
+  const auto wopt = warp_options({"-r", "bilinear", "-to", "SRC_METHOD=GEOTRANSFORM", "-to", "DST_METHOD=GEOTRANSFORM"});
+  GDALDatasetH srch = GDALDataset::ToHandle(src.get());
+  int usage_error = 0;
+  if (!GDALWarp(nullptr, GDALDataset::ToHandle(out.get()), 1, &srch, wopt.get(), &usage_error))
+    throw TerrainError("the DEM's slopes: resampling them onto the release's samples failed" + gdal_message());
+  return south_first(l, *out, "the DEM's slopes: reading them failed");
+}
+
+// The fraction of each sample square of `l` that the polygon covers (row 0 south): the squares it
+// touches (GDAL's rasteriser, ALL_TOUCHED), 1 for those inside it, else the area of the
+// intersection (OGR) over the square's.
+std::vector<double> coverage(const Grid& l, const OGRGeometry& geom, const std::string& what) {
+  auto mask_ds = mem_raster(l, GDT_Byte);
+  int band = 1;
+  double burn = 1;
+  OGRGeometryH gh = OGRGeometry::ToHandle(const_cast<OGRGeometry*>(&geom));
+  char* opts[] = {const_cast<char*>("ALL_TOUCHED=TRUE"), nullptr};
+  if (GDALRasterizeGeometries(GDALDataset::ToHandle(mask_ds.get()), 1, &band, 1, &gh, nullptr, nullptr, &burn, opts, nullptr, nullptr) !=
+      CE_None)
+    throw TerrainError(what + ": rasterisation failed" + gdal_message());
+  std::vector<unsigned char> rows(l.cells());
+  if (mask_ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, l.nx, l.ny, rows.data(), l.nx, l.ny, GDT_Byte, 0, 0) != CE_None)
+    throw TerrainError(what + ": reading the rasterised polygon failed" + gdal_message());
+  std::unique_ptr<std::remove_pointer_t<OGRPreparedGeometryH>, decltype(&OGRDestroyPreparedGeometry)> prepared(
+      OGRCreatePreparedGeometry(gh), &OGRDestroyPreparedGeometry);
+  std::vector<double> f(l.cells(), 0.0);
+  const double a = l.dx * l.dx;
+  for (int r = 0; r < l.ny; ++r)
+    for (int i = 0; i < l.nx; ++i) {
+      if (!rows[std::size_t(r) * l.nx + i]) continue;
+      const int j = l.ny - 1 - r;
+      const double x0 = l.x_min + i * l.dx, y0 = l.y_min + j * l.dx;
+      OGRLinearRing ring;
+      ring.addPoint(x0, y0);
+      ring.addPoint(x0 + l.dx, y0);
+      ring.addPoint(x0 + l.dx, y0 + l.dx);
+      ring.addPoint(x0, y0 + l.dx);
+      ring.addPoint(x0, y0);
+      OGRPolygon sq;
+      sq.addRing(&ring);
+      double frac = 0;
+      if (prepared && OGRPreparedGeometryContains(prepared.get(), OGRGeometry::ToHandle(&sq))) {
+        frac = 1;
+      } else {
+        const std::unique_ptr<OGRGeometry> x(geom.Intersection(&sq));
+        if (x) frac = std::min(1.0, OGR_G_Area(OGRGeometry::ToHandle(x.get())) / a);
+      }
+      f[std::size_t(j) * l.nx + i] = frac;
+    }
+  return f;
+}
+
+// The cells one release fills, from its samples (Lattice): those where the domain has terrain,
+// with a positive thickness and a slope within [smin, smax]; the depth carrying the volume times
+// `factor` (the release's thickness_factor) goes into h where it exceeds what is there (area: the
+// plan area released in the cell). Errors name `what`.
+struct CellFill {
+  const Lattice& lat;
+  const std::vector<double>& slope;  // the grid's
+  const std::string& extent;
+  std::vector<double>& h;
+  std::vector<double>& area;
+  // `geom` (null: all of each cell) and the thickness per sample: `raster` (a thickness raster's
+  // request, resampled at the samples) or `t`, over the cells [i0, i1) x [j0, j1).
+  void operator()(const std::string& what, bool vertical, double smin, double smax, const OGRGeometry* geom, const ReleaseRequest* raster,
+                  const OGRSpatialReference& dst, double t, double factor, int i0, int j0, int i1, int j1) const;
+};
+
+std::vector<double> raster_thickness(const Grid& g, const ReleaseRequest& rq, const OGRSpatialReference& dst);
+
+void CellFill::operator()(const std::string& what, bool vertical, double smin, double smax, const OGRGeometry* geom,
+                          const ReleaseRequest* raster, const OGRSpatialReference& dst, double t, double factor, int i0, int j0, int i1,
+                          int j1) const {
+  const Grid& g = lat.g;
+  const int n = lat.n;
+  i0 = std::max(i0, 0);
+  j0 = std::max(j0, 0);
+  i1 = std::min(i1, g.nx);
+  j1 = std::min(j1, g.ny);
+  long inside = 0, kept = 0;
+  double smin_seen = 90, smax_seen = 0;
+  std::vector<double> vol(g.cells(), 0.0), plan(g.cells(), 0.0);
+  std::vector<std::size_t> touched;
+  // Bands of rows of at most about 4 million samples.
+  const int band_rows = i1 > i0 ? std::max(1, int((1 << 22) / (std::size_t(i1 - i0) * n * n))) : 1;
+  for (int b0 = j0; b0 < j1 && i0 < i1; b0 += band_rows) {
+    const int b1 = std::min(j1, b0 + band_rows);
+    const Grid l = lat.of(i0, b0, i1, b1);
+    const auto cov = geom ? coverage(l, *geom, what) : std::vector<double>(l.cells(), 1.0);
+    const auto thick = raster ? raster_thickness(l, *raster, dst) : std::vector<double>(l.cells(), t);
+    bool any = false;
+    for (std::size_t q = 0; q < l.cells() && !any; ++q) any = cov[q] > 0 && thick[q] > 0;
+    if (!any) continue;
+    const auto sl = sample_slopes(lat, l);
+    const double a = l.dx * l.dx;
+    for (int v = 0; v < l.ny; ++v)
+      for (int u = 0; u < l.nx; ++u) {
+        const std::size_t q = std::size_t(v) * l.nx + u;
+        const std::size_t k = std::size_t(b0 + v / n) * g.nx + std::size_t(i0 + u / n);
+        if (!(cov[q] > 0) || !(thick[q] > 0) || (!g.outside.empty() && g.outside[k])) continue;  // no release where the domain has no terrain
+        ++inside;
+        smin_seen = std::min(smin_seen, sl[q]);
+        smax_seen = std::max(smax_seen, sl[q]);
+        if (sl[q] < smin || sl[q] > smax) continue;
+        ++kept;
+        if (vol[k] == 0) touched.push_back(k);
+        vol[k] += cov[q] * a * factor * (vertical ? thick[q] : thick[q] / std::cos(sl[q] * M_PI / 180));
+        plan[k] += cov[q] * a;
+      }
+  }
+  if (inside == 0)
+    throw TerrainError(what + " lies outside the grid, outside the area of interest or where the DEM has no data, or is thinner than a cell (" + extent + ")");
+  if (kept == 0)
+    throw TerrainError(what + ": no cell has a slope within [" + fmt(smin) + ", " + fmt(smax) + "] deg (slopes inside: " + fmt(smin_seen) +
+                       " to " + fmt(smax_seen) + " deg)");
+  for (std::size_t k : touched) {
+    const double d = vol[k] * std::cos(slope[k] * M_PI / 180) / (g.dx * g.dx);
+    if (d > h[k]) {
+      h[k] = d;
+      area[k] = plan[k];
+    }
+  }
+}
+
+// The cells [i0, i1) x [j0, j1) that the envelope of `geom` meets.
+std::array<int, 4> cells_of(const Grid& g, const OGRGeometry& geom) {
+  OGREnvelope e;
+  geom.getEnvelope(&e);
+  const auto clampi = [](double v, int hi) { return int(std::clamp(v, 0.0, double(hi))); };
+  return {clampi(std::floor((e.MinX - g.x_min) / g.dx), g.nx), clampi(std::floor((e.MinY - g.y_min) / g.dx), g.ny),
+          clampi(std::ceil((e.MaxX - g.x_min) / g.dx), g.nx), clampi(std::ceil((e.MaxY - g.y_min) / g.dx), g.ny)};
+}
+
+// The cells of a thickness raster alone: those where it is positive at their centres and one cell
+// around them, as [i0, i1) x [j0, j1).
+std::array<int, 4> cells_of(const Grid& g, const std::vector<double>& t) {
+  int i0 = g.nx, j0 = g.ny, i1 = 0, j1 = 0;
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i)
+      if (t[std::size_t(j) * g.nx + i] > 0) {
+        i0 = std::min(i0, i - 1);
+        j0 = std::min(j0, j - 1);
+        i1 = std::max(i1, i + 2);
+        j1 = std::max(j1, j + 2);
+      }
+  return {i0, j0, i1, j1};
+}
 
 // The polygon rasterised onto the grid: 1 for the cells whose centre it covers, row 0 south.
 std::vector<unsigned char> polygon_cells(const Grid& g, OGRGeometry& geom, const std::string& what) {
@@ -160,11 +335,13 @@ std::vector<double> raster_thickness(const Grid& g, const ReleaseRequest& rq, co
 }
 
 // One polygon file's releases, each polygon with its thickness (the release's, its attribute's or
-// the raster's `raster_t`) and its slope window.
-void release_polygons(const ReleaseRequest& rq, const OGRSpatialReference& dst, const std::vector<double>* raster_t, const CellFill& fill,
-                      ReleaseReport& rep, std::vector<ReleaseArea>* areas = nullptr) {
+// the thickness raster's) and its slope window.
+void release_polygons(const ReleaseRequest& rq, const OGRSpatialReference& dst, const CellFill& fill, ReleaseReport& rep,
+                      std::vector<ReleaseArea>* areas = nullptr) {
   GDALDatasetUniquePtr ds(GDALDataset::Open(rq.path.c_str(), GDAL_OF_VECTOR));
   if (!ds) throw TerrainError("release '" + rq.path + "': cannot read it as a vector file" + gdal_message());
+  const bool raster = !rq.thickness_raster.empty();
+  const Grid& g = fill.lat.g;
   int n = 0;
   for (auto* layer : ds->GetLayers()) {
     const std::string file = "release '" + rq.path + "'";
@@ -174,34 +351,48 @@ void release_polygons(const ReleaseRequest& rq, const OGRSpatialReference& dst, 
       ++n;
       const std::string what = "release polygon " + std::to_string(n) + " of '" + rq.path + "'";
       bool repaired = false;
-      const auto geom = polygon_on_grid(f->GetGeometryRef(), ct.get(), fill.g, what, repaired);
+      const auto geom = polygon_on_grid(f->GetGeometryRef(), ct.get(), g, what, repaired);
       if (repaired) rep.notes.push_back(what + ": invalid geometry (e.g. self-intersecting) repaired with GEOS MakeValid");
       double t = rq.has_thickness ? rq.thickness : 0.0;
-      if (!rq.has_thickness && !raster_t) {
+      if (!rq.has_thickness && !raster) {
         if (rq.thickness_attribute.empty()) throw TerrainError(what + ": no thickness (set thickness_m or thickness_attribute)");
         t = field_value(*f, rq.thickness_attribute, what);
       }
       // The same bound as the scenario's releases[].thickness_m (docs/user/scenarios.md, Valid ranges).
-      if (!raster_t && !(t > 0 && t <= 500)) throw TerrainError(what + ": thickness must be > 0 m and at most 500 m, got " + fmt(t, 3));
+      if (!raster && !(t > 0 && t <= 500)) throw TerrainError(what + ": thickness must be > 0 m and at most 500 m, got " + fmt(t, 3));
       double smin = rq.has_min_slope ? rq.min_slope : 0.0, smax = rq.has_max_slope ? rq.max_slope : 90.0;
       if (!rq.has_min_slope && !rq.min_slope_attribute.empty()) smin = field_value(*f, rq.min_slope_attribute, what);
       if (!rq.has_max_slope && !rq.max_slope_attribute.empty()) smax = field_value(*f, rq.max_slope_attribute, what);
       if (!(smin >= 0 && smax <= 90 && smin < smax))
         throw TerrainError(what + ": slope window [" + fmt(smin) + ", " + fmt(smax) + "] deg must satisfy 0 <= min < max <= 90");
-      const auto m = polygon_cells(fill.g, *geom, what);
-      const std::string named = what + (raster_t ? " with the thickness raster '" + rq.thickness_raster + "'" : "");
-      auto in = [&](std::size_t k) { return m[k] != 0; };
-      auto thick = [&](std::size_t k) { return raster_t ? (*raster_t)[k] : t; };
+      const std::string named = what + (raster ? " with the thickness raster '" + rq.thickness_raster + "'" : "");
+      const auto c = cells_of(g, *geom);
       if (areas) {  // a secondary release: each polygon an area of its own
-        areas->push_back({what, std::vector<double>(fill.g.cells(), 0.0), 0});
-        CellFill{fill.g, fill.slope, fill.extent, areas->back().h}(named, rq.vertical, smin, smax, in, thick, rq.thickness_factor);
+        areas->push_back({what, std::vector<double>(g.cells(), 0.0), 0});
+        std::vector<double> area(g.cells(), 0.0);
+        CellFill{fill.lat, fill.slope, fill.extent, areas->back().h, area}(named, rq.vertical, smin, smax, geom.get(), raster ? &rq : nullptr,
+                                                                           dst, t, rq.thickness_factor, c[0], c[1], c[2], c[3]);
       } else {
-        fill(named, rq.vertical, smin, smax, in, thick, rq.thickness_factor);
+        fill(named, rq.vertical, smin, smax, geom.get(), raster ? &rq : nullptr, dst, t, rq.thickness_factor, c[0], c[1], c[2], c[3]);
       }
       ++rep.polygons;
     }
   }
   if (n == 0) throw TerrainError("release '" + rq.path + "': no polygon in the file");
+}
+
+// A release given by its thickness raster alone (no polygons).
+void release_raster(const ReleaseRequest& rq, const OGRSpatialReference& dst, const CellFill& fill, const std::string& what) {
+  const auto c = cells_of(fill.lat.g, raster_thickness(fill.lat.g, rq, dst));
+  const double smin = rq.has_min_slope ? rq.min_slope : 0.0, smax = rq.has_max_slope ? rq.max_slope : 90.0;
+  fill(what, rq.vertical, smin, smax, nullptr, &rq, dst, 0, rq.thickness_factor, c[0], c[1], c[2], c[3]);
+}
+
+OGRSpatialReference grid_crs(const Grid& g) {
+  OGRSpatialReference dst;
+  dst.importFromWkt(g.crs_wkt.c_str());
+  dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  return dst;
 }
 
 }  // namespace
@@ -210,9 +401,7 @@ std::vector<std::uint8_t> rasterize_polygons(const Grid& g, const std::string& p
   init_gdal();
   GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR));
   if (!ds) throw TerrainError(what + ": cannot read '" + path + "' as a vector file" + gdal_message());
-  OGRSpatialReference dst;
-  dst.importFromWkt(g.crs_wkt.c_str());
-  dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  const OGRSpatialReference dst = grid_crs(g);
   std::vector<std::uint8_t> in(g.cells(), 0);
   int n = 0;
   for (auto* layer : ds->GetLayers()) {
@@ -232,29 +421,26 @@ std::vector<std::uint8_t> rasterize_polygons(const Grid& g, const std::string& p
   return in;
 }
 
-std::vector<ReleaseArea> secondary_release_areas(const Grid& g, const std::vector<ReleaseRequest>& releases) {
+std::vector<ReleaseArea> secondary_release_areas(const Grid& g, const DemRequest& dem, const std::vector<ReleaseRequest>& releases) {
   init_gdal();
   std::vector<ReleaseArea> areas;
+  if (std::none_of(releases.begin(), releases.end(), [](const ReleaseRequest& r) { return r.secondary; })) return areas;
   const auto slope = slope_deg(g);
-  OGRSpatialReference dst;
-  dst.importFromWkt(g.crs_wkt.c_str());
-  dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  const OGRSpatialReference dst = grid_crs(g);
   const std::string extent = grid_extent(g);
-  std::vector<double> unused(g.cells(), 0.0);
+  const Lattice lat(g, dem);
+  std::vector<double> unused(g.cells(), 0.0), unused_area(g.cells(), 0.0);
   ReleaseReport rep;
   for (const auto& rq : releases) {
     if (!rq.secondary) continue;
-    std::vector<double> raster_t;
-    if (!rq.thickness_raster.empty()) raster_t = raster_thickness(g, rq, dst);
     if (!rq.path.empty()) {
-      release_polygons(rq, dst, rq.thickness_raster.empty() ? nullptr : &raster_t, CellFill{g, slope, extent, unused}, rep, &areas);
+      release_polygons(rq, dst, CellFill{lat, slope, extent, unused, unused_area}, rep, &areas);
       continue;
     }
     const std::string what = "secondary release thickness raster '" + rq.thickness_raster + "'";
     areas.push_back({what, std::vector<double>(g.cells(), 0.0), 0});
-    const double smin = rq.has_min_slope ? rq.min_slope : 0.0, smax = rq.has_max_slope ? rq.max_slope : 90.0;
-    CellFill{g, slope, extent, areas.back().h}(what, rq.vertical, smin, smax, [](std::size_t) { return true; },
-                                               [&](std::size_t k) { return raster_t[k]; }, rq.thickness_factor);
+    std::vector<double> area(g.cells(), 0.0);
+    release_raster(rq, dst, CellFill{lat, slope, extent, areas.back().h, area}, what);
   }
   for (auto& a : areas)
     for (std::size_t k = 0; k < a.h.size(); ++k)
@@ -262,32 +448,25 @@ std::vector<ReleaseArea> secondary_release_areas(const Grid& g, const std::vecto
   return areas;
 }
 
-std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseRequest>& releases, ReleaseReport* report) {
+std::vector<double> rasterize_releases(const Grid& g, const DemRequest& dem, const std::vector<ReleaseRequest>& releases,
+                                       ReleaseReport* report) {
   init_gdal();
   ReleaseReport rep;
-  std::vector<double> h(g.cells(), 0.0);
+  std::vector<double> h(g.cells(), 0.0), area(g.cells(), 0.0);
   const auto slope = slope_deg(g);
-  OGRSpatialReference dst;
-  dst.importFromWkt(g.crs_wkt.c_str());
-  dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  const OGRSpatialReference dst = grid_crs(g);
   const std::string extent = grid_extent(g);
-  const CellFill fill{g, slope, extent, h};
+  const Lattice lat(g, dem);
+  const CellFill fill{lat, slope, extent, h, area};
   for (const auto& rq : releases) {
     if (rq.secondary) continue;
-    std::vector<double> raster_t;
-    if (!rq.thickness_raster.empty()) raster_t = raster_thickness(g, rq, dst);
-    if (!rq.path.empty()) {
-      release_polygons(rq, dst, rq.thickness_raster.empty() ? nullptr : &raster_t, fill, rep);
-      continue;
-    }
-    const double smin = rq.has_min_slope ? rq.min_slope : 0.0, smax = rq.has_max_slope ? rq.max_slope : 90.0;
-    fill("release thickness raster '" + rq.thickness_raster + "'", rq.vertical, smin, smax, [](std::size_t) { return true; },
-         [&](std::size_t k) { return raster_t[k]; }, rq.thickness_factor);
+    if (!rq.path.empty()) release_polygons(rq, dst, fill, rep);
+    else release_raster(rq, dst, fill, "release thickness raster '" + rq.thickness_raster + "'");
   }
   for (std::size_t k = 0; k < h.size(); ++k)
     if (h[k] > 0) {
       ++rep.cells;
-      rep.area_m2 += g.dx * g.dx;
+      rep.area_m2 += area[k];
       rep.volume_m3 += h[k] * g.dx * g.dx / std::cos(slope[k] * M_PI / 180);
     }
   if (report) *report = rep;

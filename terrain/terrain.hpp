@@ -87,8 +87,8 @@ struct ReleaseRequest {
 struct ReleaseReport {
   int polygons = 0;
   long cells = 0;
-  double area_m2 = 0;   ///< plan area of the released cells
-  double volume_m3 = 0; ///< sum of normal thickness x surface area
+  double area_m2 = 0;   ///< plan area released: inside the polygons and the slope window
+  double volume_m3 = 0; ///< the volume the engines hold: sum of h dx^2 / cos(the grid's slope)
   std::vector<std::string> notes;  ///< e.g. repaired geometries
 };
 
@@ -100,11 +100,14 @@ struct ReleaseArea {
 };
 /// The areas of the secondary releases (ReleaseRequest::secondary), each polygon its own, with the
 /// same thickness, slope-window and domain rules as the primary releases. Throws TerrainError.
-std::vector<ReleaseArea> secondary_release_areas(const Grid& g, const std::vector<ReleaseRequest>& releases);
+std::vector<ReleaseArea> secondary_release_areas(const Grid& g, const DemRequest& dem, const std::vector<ReleaseRequest>& releases);
 
 /// Normal release thickness per cell (row 0 south), maximum over overlapping polygons and the
-/// primary releases (secondary ones are left out: secondary_release_areas).
-std::vector<double> rasterize_releases(const Grid& g, const std::vector<ReleaseRequest>& releases,
+/// primary releases (secondary ones are left out: secondary_release_areas). Each cell carries the
+/// volume of the part of it inside the polygon and inside the slope window, the slope taken from
+/// `dem` (the grid's DEM request) at the DEM's own resolution on samples finer than the cell
+/// (releases.cpp, Lattice), so that the released volume does not depend on the grid.
+std::vector<double> rasterize_releases(const Grid& g, const DemRequest& dem, const std::vector<ReleaseRequest>& releases,
                                        ReleaseReport* report = nullptr);
 
 /// What a raster band says about itself (GDAL's band description, unit type and metadata): QGIS

@@ -214,7 +214,7 @@ v1::EnsembleRecord aggregate_ensemble(const ResolvedScenario& e, const std::vect
   auto& files = *rec.mutable_outputs();
   // Probabilities of exceedance.
   figures::HazardMap base;
-  base.release = terrain::rasterize_releases(g, e.releases);
+  base.release = terrain::rasterize_releases(g, e.dem, e.releases);
   base.parameters = map_block(e, members, g);
   // The members' percentiles of max depth (written below), and the median's outline on the maps.
   const auto depth_pct = ensemble::percentiles(stack[0], settings.percentiles, g.outside);

@@ -143,7 +143,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   terrain::DemReport dem_rep;
   const terrain::Grid grid = cached_grid(s.dem, opt.terrain_cache_dir, dem_rep);
   terrain::ReleaseReport rel_rep;
-  const auto h0 = terrain::rasterize_releases(grid, s.releases, &rel_rep);
+  const auto h0 = terrain::rasterize_releases(grid, s.dem, s.releases, &rel_rep);
   const auto output_inputs = read_output_inputs(s, grid, h0);  // a bad point, line or outline: refused before the run
   sum.nx = grid.nx;
   sum.ny = grid.ny;
@@ -154,7 +154,7 @@ RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, c
   sum.notes = rel_rep.notes;
   const engine::Terrain2D t = engine_terrain(grid);
   auto cfg = s.config;
-  const auto secondary = terrain::secondary_release_areas(grid, s.releases);
+  const auto secondary = terrain::secondary_release_areas(grid, s.dem, s.releases);
   cfg.secondary = engine_secondary(secondary);
   cfg.time.progress = opt.progress;
   cfg.time.progress_every = opt.progress_every;

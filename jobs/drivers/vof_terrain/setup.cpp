@@ -23,7 +23,7 @@ terrain::ColumnMeshSpec mesh_spec(const v1::TerrainMesh& m, double max_vertical)
 
 void build_terrain_setup(const ResolvedScenario& r, TerrainSetup& out) {
   out.grid = terrain::prepare_grid(r.dem, &out.dem);
-  out.h0 = terrain::rasterize_releases(out.grid, r.releases, &out.release);
+  out.h0 = terrain::rasterize_releases(out.grid, r.dem, r.releases, &out.release);
   out.output_inputs = read_output_inputs(r, out.grid, out.h0);  // a bad point, line or outline: refused before the run
   // Vertical thickness and the slope's cosine exactly as the depth-averaged engine takes them.
   const engine::Terrain2D t = engine_terrain(out.grid);
