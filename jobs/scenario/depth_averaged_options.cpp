@@ -213,8 +213,8 @@ const OptionTable& depth_averaged_options() {
       {"releases[].thickness_m", T::number, U::as_given, "", Range{0, kMaxThickness, true}, {}, "m",
        "release thickness of every polygon (or thickness_attribute, or thickness_raster)", "ReleaseRequest::thickness"},
       {"releases[].thickness_raster", T::path, U::as_given, "", {}, {}, "",
-       "the release thickness from a raster (any GDAL format and CRS, resampled bilinearly onto the grid; cells of 0 or no data do not "
-       "release), inside the polygons of path when given",
+       "the release thickness from a raster (any GDAL format and CRS, resampled bilinearly at the release's samples, finer than the grid; 0 or no data "
+       "does not release), inside the polygons of path when given",
        "ReleaseRequest::thickness_raster"},
       {"releases[].thickness_factor", T::number, U::keep, "1", Range{0, 100, true}, {}, "",
        "every thickness of the release (given, attribute or raster) times this; ensembles vary it (variations)",
@@ -224,9 +224,9 @@ const OptionTable& depth_averaged_options() {
       {"releases[].thickness_measured", T::choice, U::as_given, "normal", {}, {"normal", "vertical"}, "",
        "the thickness is measured normal to the slope or vertically", "ReleaseRequest::vertical"},
       {"releases[].min_slope_deg", T::number, U::as_given, "", Range{0, 90, false, true}, {}, "deg",
-       "slope window: only cells at least this steep release", "ReleaseRequest::min_slope"},
+       "slope window: only ground at least this steep releases (on the DEM's own resolution)", "ReleaseRequest::min_slope"},
       {"releases[].max_slope_deg", T::number, U::as_given, "", Range{0, 90, true}, {}, "deg",
-       "slope window: only cells at most this steep release", "ReleaseRequest::max_slope"},
+       "slope window: only ground at most this steep releases (on the DEM's own resolution)", "ReleaseRequest::max_slope"},
       {"releases[].min_slope_attribute", T::text, U::as_given, "", {}, {}, "", "the slope window's lower bound per polygon",
        "ReleaseRequest::min_slope_attribute"},
       {"releases[].max_slope_attribute", T::text, U::as_given, "", {}, {}, "", "the slope window's upper bound per polygon",
