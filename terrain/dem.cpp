@@ -380,11 +380,13 @@ Grid prepare_grid(const DemRequest& req, DemReport* report) {
 
 namespace detail {
 
-double dem_resolution_on(const DemRequest& req, const Grid& g) {
+double slope_spacing(const DemRequest& req, const Grid& g) {
+  init_gdal();
   GDALDatasetUniquePtr dem(GDALDataset::Open(req.dem_path.c_str(), GDAL_OF_RASTER));
   if (!dem) throw TerrainError("DEM '" + req.dem_path + "': cannot read it as a raster" + gdal_message());
   const double r = source_resolution_m(dem.get(), dem_crs(*dem, req));
-  return r > 0 ? std::max(r, g.dx / 16) : g.dx;
+  if (!(r > 0)) return g.dx;  // no georeferenced pixel size: the grid's own
+  return std::min(r, std::max(r / 8, 1.0));
 }
 
 Grid dem_surface(const DemRequest& req, const Grid& g, double res, double x0, double y0, double x1, double y1) {
@@ -402,7 +404,7 @@ Grid dem_surface(const DemRequest& req, const Grid& g, double res, double x0, do
   GDALDatasetH srch = GDALDataset::ToHandle(dem.get());
   int usage_error = 0;
   GDALDatasetUniquePtr warped(GDALDataset::FromHandle(GDALWarp("", nullptr, 1, &srch, wopt.get(), &usage_error)));
-  if (!warped) throw TerrainError("DEM '" + req.dem_path + "': resampling it at its own resolution failed" + gdal_message());
+  if (!warped) throw TerrainError("DEM '" + req.dem_path + "': resampling it at the slope window's spacing failed" + gdal_message());
   Grid s;
   s.nx = warped->GetRasterXSize();
   s.ny = warped->GetRasterYSize();

@@ -35,13 +35,15 @@ std::unique_ptr<OGRCoordinateTransformation> transform(const OGRSpatialReference
                                                        const std::string& what);
 /// GDAL's warper options from gdalwarp's command-line arguments.
 std::unique_ptr<GDALWarpAppOptions, decltype(&GDALWarpAppOptionsFree)> warp_options(std::vector<std::string> args);
-/// The DEM's own resolution in metres (its pixel size, in metres on the ground for a geographic
-/// DEM), no finer than a sixteenth of the grid's cells: the resolution at which the release's slope
-/// window is evaluated (dem_surface).
-double dem_resolution_on(const DemRequest& req, const Grid& g);
-/// The DEM of `req` in the grid's CRS at resolution `res` (dem_resolution_on), resampled as the
-/// grid is (req.resampling), over [x0, x1] x [y0, y1] of the grid's CRS (widened to whole cells and
-/// to at least 3 x 3); cells without data take the elevation of the nearest data.
+/// The fixed spacing [m] of the surface on which the release's slope window is evaluated: the DEM's
+/// pixel size (in metres on the ground for a geographic DEM) / 8, not below 1 m (a DEM finer than
+/// 1 m: its own pixel size). It depends on the DEM alone, never on the grid (the grid's cell size
+/// only for a DEM without a georeferenced pixel size).
+double slope_spacing(const DemRequest& req, const Grid& g);
+/// The DEM of `req` in the grid's CRS at spacing `res` (slope_spacing), resampled as the grid is
+/// (req.resampling: its continuous surface, e.g. cubic), over [x0, x1] x [y0, y1] of the grid's CRS
+/// (widened to whole cells and to at least 3 x 3); cells without data take the elevation of the
+/// nearest data.
 Grid dem_surface(const DemRequest& req, const Grid& g, double res, double x0, double y0, double x1, double y1);
 /// A one-band in-memory raster on the grid (north-up, the grid's CRS).
 GDALDatasetUniquePtr mem_raster(const Grid& g, GDALDataType type);

@@ -51,21 +51,24 @@ double field_value(OGRFeature& f, const std::string& attr, const std::string& wh
 // The release is evaluated on a lattice of samples finer than the grid: each cell divided into
 // n x n squares. A square counts with the fraction of it that the polygon covers (the exact area of
 // their intersection, OGR), the thickness there (the release's, or the thickness raster resampled
-// at the square's centre) and the slope at its centre, taken from the DEM at the DEM's own
-// resolution (dem_surface on cells at multiples of that resolution, the same for every grid:
-// slopes by centred differences there, resampled bilinearly). A square
+// at the square's centre) and the slope at its centre. The slope window is decided on the DEM's
+// continuous surface as the scenario's resampling reconstructs it (grid.resampling, the interpolant
+// the grids are made with), sampled at a fixed spacing s that depends on the DEM alone
+// (slope_spacing: its pixel size / 8, not below 1 m) on cells at multiples of s in the grid's CRS,
+// so that every grid sees the same surface; slopes by centred differences there (what a grid of
+// spacing s made from this DEM sees), interpolated bilinearly at each square's centre. A square
 // inside the slope window releases fraction x area x thickness (vertical thickness) or
 // fraction x area x thickness / cos(slope) (normal thickness); the cell's normal depth is the one
 // that carries exactly the sum of its squares: volume x cos(the grid's slope) / dx^2, since the
-// engines hold h dx^2 / cos(the grid's slope). n is the number that puts at least 8 samples along
-// each of the DEM's cells (at most 16). docs/user/scenarios.md, Releases.
+// engines hold h dx^2 / cos(the grid's slope). n is the smallest number that makes the squares no
+// larger than s (at most 16). docs/user/scenarios.md, Releases on the grid.
 struct Lattice {
   const Grid& g;
   const DemRequest& dem;
-  double res = 0;  // the DEM's own resolution [m] (dem_resolution_on)
+  double res = 0;  // the slope surface's spacing s [m] (slope_spacing)
   int n = 1;       // samples per cell side
-  Lattice(const Grid& grid, const DemRequest& d) : g(grid), dem(d), res(dem_resolution_on(d, grid)) {
-    n = std::clamp(int(std::ceil(8 * g.dx / res - 1e-9)), 1, 16);
+  Lattice(const Grid& grid, const DemRequest& d) : g(grid), dem(d), res(slope_spacing(d, grid)) {
+    n = std::clamp(int(std::ceil(g.dx / res - 1e-9)), 1, 16);
   }
   // The samples of the cells [i0, i1) x [j0, j1) as a grid (row 0 south).
   Grid of(int i0, int j0, int i1, int j1) const {
@@ -81,34 +84,29 @@ struct Lattice {
   }
 };
 
-// Reads band 1 of `ds` on the grid `l`, row 0 south.
-std::vector<double> south_first(const Grid& l, GDALDataset& ds, const std::string& what) {
-  std::vector<double> rows(l.cells()), v(l.cells());
-  if (ds.GetRasterBand(1)->RasterIO(GF_Read, 0, 0, l.nx, l.ny, rows.data(), l.nx, l.ny, GDT_Float64, 0, 0) != CE_None)
-    throw TerrainError(what + gdal_message());
-  for (int r = 0; r < l.ny; ++r) std::copy_n(rows.begin() + std::ptrdiff_t(r) * l.nx, l.nx, v.begin() + std::ptrdiff_t(l.ny - 1 - r) * l.nx);
-  return v;
-}
-
-// The slope [deg] at the samples of `l`: the DEM at its own resolution around them (two of its
-// cells beyond), its slopes by centred differences, resampled bilinearly by GDAL's warper.
+// The slope [deg] at the samples' centres of `l`: the DEM's surface at the spacing s around them
+// (two of its cells beyond, so it covers only the release's cells), its slopes by centred
+// differences, interpolated bilinearly.
 std::vector<double> sample_slopes(const Lattice& lat, const Grid& l) {
-  // Its cells on multiples of its resolution in the grid's CRS, whatever the grid: every grid samples
-  // the same surface.
+  // Its cells on multiples of s in the grid's CRS, whatever the grid: every grid samples the same
+  // surface.
   const double r = lat.res, x0 = std::floor(l.x_min / r - 2) * r, y0 = std::floor(l.y_min / r - 2) * r;
   const Grid s = dem_surface(lat.dem, lat.g, r, x0, y0, std::ceil((l.x_min + l.nx * l.dx) / r + 2) * r, std::ceil((l.y_min + l.ny * l.dx) / r + 2) * r);
   const auto slope = slope_deg(s);
-  auto src = mem_raster(s, GDT_Float64);
-  auto rows = north_first<double>(s, [&](std::size_t k) { return slope[k]; });
-  if (src->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, s.nx, s.ny, rows.data(), s.nx, s.ny, GDT_Float64, 0, 0) != CE_None)
-    throw TerrainError("the DEM's slopes: writing them failed" + gdal_message());
-  auto out = mem_raster(l, GDT_Float64);
-  const auto wopt = warp_options({"-r", "bilinear", "-to", "SRC_METHOD=GEOTRANSFORM", "-to", "DST_METHOD=GEOTRANSFORM"});
-  GDALDatasetH srch = GDALDataset::ToHandle(src.get());
-  int usage_error = 0;
-  if (!GDALWarp(nullptr, GDALDataset::ToHandle(out.get()), 1, &srch, wopt.get(), &usage_error))
-    throw TerrainError("the DEM's slopes: resampling them onto the release's samples failed" + gdal_message());
-  return south_first(l, *out, "the DEM's slopes: reading them failed");
+  std::vector<double> out(l.cells());
+  for (int v = 0; v < l.ny; ++v) {
+    const double fy = (l.y_min + (v + 0.5) * l.dx - s.y_min) / s.dx - 0.5;
+    const int j = std::clamp(int(std::floor(fy)), 0, s.ny - 2);
+    const double ty = std::clamp(fy - j, 0.0, 1.0);
+    for (int u = 0; u < l.nx; ++u) {
+      const double fx = (l.x_min + (u + 0.5) * l.dx - s.x_min) / s.dx - 0.5;
+      const int i = std::clamp(int(std::floor(fx)), 0, s.nx - 2);
+      const double tx = std::clamp(fx - i, 0.0, 1.0);
+      const auto at = [&](int di, int dj) { return slope[std::size_t(j + dj) * s.nx + std::size_t(i + di)]; };
+      out[std::size_t(v) * l.nx + u] = (1 - ty) * ((1 - tx) * at(0, 0) + tx * at(1, 0)) + ty * ((1 - tx) * at(0, 1) + tx * at(1, 1));
+    }
+  }
+  return out;
 }
 
 // The fraction of each sample square of `l` that the polygon covers (row 0 south): the squares it
@@ -186,8 +184,9 @@ void CellFill::operator()(const std::string& what, bool vertical, double smin, d
   double smin_seen = 90, smax_seen = 0;
   std::vector<double> vol(g.cells(), 0.0), plan(g.cells(), 0.0);
   std::vector<std::size_t> touched;
-  // Bands of rows of at most about 4 million samples.
-  const int band_rows = i1 > i0 ? std::max(1, int((1 << 22) / (std::size_t(i1 - i0) * n * n))) : 1;
+  // Bands of rows of at most about 4 million samples and 4 million cells of the slope surface.
+  const double per_cell = std::max(double(n) * n, (g.dx / lat.res) * (g.dx / lat.res));
+  const int band_rows = i1 > i0 ? std::max(1, int(double(1 << 22) / ((i1 - i0) * per_cell))) : 1;
   for (int b0 = j0; b0 < j1 && i0 < i1; b0 += band_rows) {
     const int b1 = std::min(j1, b0 + band_rows);
     const Grid l = lat.of(i0, b0, i1, b1);

@@ -68,7 +68,8 @@ TEST(Scenarios, InDenArelenReachesTheValleyFloor) {
   const auto sum = jobs::run_scenario(r, d.p.string());
   EXPECT_EQ(sum.crs, "EPSG:32632");
   EXPECT_LT(sum.volume_error, 1e-12);
-  EXPECT_NEAR(sum.release_volume_m3, 68314, 0.01 * 68314);  // 39,905 m2 of the polygon within 28-50 deg on the DEM's 76 m
+  // 164,365 m2 of the polygon within 28-50 deg on the DEM's cubic surface at 9.56 m (its 76 m pixel / 8).
+  EXPECT_NEAR(sum.release_volume_m3, 287904, 0.01 * 287904);
   check_outputs(d, sum, "WGS 84 / UTM zone 32N");
   EXPECT_TRUE(fs::exists(d / "outline.geojson"));
   // (Pure Coulomb friction with delta = 15 deg lets thin layers slide on over the long slopes above
