@@ -70,7 +70,7 @@ Row run(int nx, int ny, double t_end, const std::string& pc) {
   r.scenario.mutable_material()->set_bed_friction_deg(20);
   r.scenario.mutable_vof()->set_pressure_preconditioner(pc);
   runout::jobs::apply_option_rules(runout::jobs::terrain_vof_options(), r.scenario);
-  vof::VofSolver s(m, vt::terrain_config(r));
+  vof::VofSolver s(m, vt::terrain_config(r, vt::bed_columns(vt::columns_of(cm), m, g)));
   s.initialise(vt::release_alpha(cm, vertical));
   Row row;
   row.nx = nx;

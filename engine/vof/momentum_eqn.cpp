@@ -67,6 +67,8 @@ void MomentumEqn::build(const Fields& F, double dt) {
   if (cfg_.momentum_convection == Convection::limited_linear) limited_linear_correction(F);
   boundary_terms(F);
   if (cfg_.side_walls.width > 0) side_wall_friction(F);
+  if (cfg_.column_friction.columns.columns() > 0)
+    bed_load = add_column_friction(m_, cfg_.column_friction, cfg_.rho1, F, bc_ctx_.hydrostatics, region_, UEqn_);
   coefficients(F, dt);
 }
 

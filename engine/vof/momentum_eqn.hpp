@@ -8,6 +8,7 @@
 // Also the velocity gradient and the viscosities it takes.
 #include "engine/vof/active_region.hpp"
 #include "engine/vof/bc/boundary.hpp"
+#include "engine/vof/column_friction.hpp"
 #include "engine/vof/fields.hpp"
 #include "engine/vof/fv/fv_matrix.hpp"
 #include "engine/vof/linear/petsc.hpp"
@@ -40,6 +41,7 @@ class MomentumEqn {
   CellField<double> rAU, rAtU;   ///< 1/A per unit volume [m3 s/kg]; the consistent coupling's 1/(A - H1)
   FaceField<double> rAUf, rAtUf; ///< the same on the faces
   CellField<Vec> HbyA;
+  BedLoad bed_load;  ///< the column friction's loads at the last build (VofConfig::column_friction)
 
  private:
   void transient(const Fields& F, double dt);

@@ -25,6 +25,8 @@ void check_config(const VofConfig& c) {
   if (!(c.phi_deg > 0 && c.phi_deg < 90)) throw VofError("phi_deg must lie in (0, 90)");
   if (!(c.side_walls.width >= 0 && c.side_walls.tan_delta >= 0 && c.side_walls.creep_speed > 0))
     throw VofError("side_walls: the width and the friction must be >= 0, the creep speed > 0");
+  if (!(c.column_friction.tan_delta >= 0 && c.column_friction.creep_speed > 0))
+    throw VofError("column_friction: the friction must be >= 0, the creep speed > 0");
   if (!(c.momentum_rtol > 0 && c.momentum_rtol < 1)) throw VofError("momentum_rtol must lie in (0, 1)");
   if (!(c.consistent_alpha > 0 && c.consistent_alpha <= 1)) throw VofError("consistent_alpha must lie in (0, 1]");
 }
@@ -53,6 +55,7 @@ struct VofSolver::Impl {
         UEqn(mesh, config, bc_ctx, bcs, region, reconstruct, dims),
         pEqn(mesh, config, bc_ctx, bcs, region, reconstruct, pressure_solver) {
     check_config(cfg);
+    if (cfg.column_friction.columns.columns() > 0) check_columns(m, cfg.column_friction.columns);
     cell_faces.build(m);
     reconstruct.build(m, cell_faces, dims);
     petsc_init();
@@ -201,6 +204,7 @@ const std::vector<double>& VofSolver::pressure() const { return impl_->F.p; }
 const std::vector<double>& VofSolver::viscosity() const { return impl_->F.nu1; }
 const std::vector<double>& VofSolver::face_flux() const { return impl_->F.phi; }
 const std::vector<double>& VofSolver::granular_flux() const { return impl_->F.alpha_phi; }
+const BedLoad& VofSolver::bed_load() const { return impl_->UEqn.bed_load; }
 
 void VofSolver::initialise(const std::vector<double>& alpha, const std::vector<Vec>& U) {
   auto& I = *impl_;

@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "engine/names.hpp"
+#include "engine/vof/column_friction.hpp"
 #include "engine/vof/mesh.hpp"
 
 namespace runout::engine::vof {
@@ -212,6 +213,10 @@ struct VofConfig {
   int active_layers = 4;
   double active_alpha = 1e-6;
   std::map<std::string, PatchBc> bc;  ///< by patch name; every patch needs one
+  /// The bed friction of a column mesh, on the column's weight (column_friction.hpp); no columns:
+  /// none (the bed patch's condition carries any friction). The bed patch then takes a condition
+  /// without shear (symmetry), so that the friction is counted once.
+  ColumnFrictionConfig column_friction;
 };
 
 struct VofError : std::runtime_error {
@@ -277,6 +282,8 @@ class VofSolver {
   const std::vector<double>& face_flux() const;
   /// Granular volume flux per face [m3/s] over the last step (alpha times the face flux, limited).
   const std::vector<double>& granular_flux() const;
+  /// What the bed carried at the last momentum build (VofConfig::column_friction; zero without it).
+  const BedLoad& bed_load() const;
 
  private:
   struct Impl;  // the fields, the equations and their solvers (engine/vof/solver.cpp)

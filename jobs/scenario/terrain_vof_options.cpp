@@ -42,9 +42,11 @@ const OptionTable& terrain_vof_options() {
       {"vof.non_orthogonal_limiter", T::number, U::fill, "1", Range{0, 1}, {}, "",
        "limits each face's non-orthogonal correction to psi / (1 - psi) times its orthogonal part (1: unlimited)",
        "VofConfig::non_orthogonal_limiter"},
-      {"vof.bed_normal_stress", T::choice, U::fill, "pressure", {}, {"pressure", "total"}, "",
-       "the bed friction's normal load: the pressure, or the total normal stress (less the viscous normal stress)",
-       "PatchBc::friction_total_normal_stress"},
+      {"vof.bed_normal_stress", T::choice, U::fill, "pressure", {}, {"pressure", "total", "column"}, "",
+       "the bed friction's normal load: the ground cell's pressure, its total normal stress (less the viscous normal stress), or "
+       "the column's weight (its bed-normal part and the curved bed's centripetal load, at least the bed's pressure) acting on the "
+       "column's material; \"column\" is experimental: unstable at a release's tapered edges (docs/design/vof.md)",
+       "PatchBc::friction_total_normal_stress, VofConfig::column_friction"},
       {"vof.max_viscosity_m2_s", T::number, U::as_given, "", Range{1, 1e8}, {}, "m2/s",
        "the Coulomb viscosity's clip nu_max, default 1e2: material at rest creeps at about g sin(theta) h^2 / (3 nu_max) "
        "(a 2 m layer on 15 deg: 2.7 cm/s at 1e2, 0.3 mm/s at 1e4)",

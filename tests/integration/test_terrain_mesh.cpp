@@ -192,3 +192,49 @@ TEST(TerrainRelease, VolumeIsTheDepthAveragedEnginesAndAlphaIsBounded) {
   const auto low = runout::terrain::column_mesh(g, {0.2, 1.2, 1.0});
   EXPECT_NE(message(low, H).find("mesh.band_height_m"), std::string::npos);
 }
+
+// The columns the bed friction on the column's weight takes (vt::bed_columns): every kept column
+// once, from its "ground" face up through its layers, and the bed's curvature such that u.K.u is the
+// bed-normal acceleration of material moving along it: zero on a plane; on a trough
+// z = y^2 / (2 R) running east, 1 / R for material moving north across its floor and 0 for
+// material moving east along it.
+TEST(ColumnMesh, BedColumnsCarryTheirCellsAndTheBedsCurvature) {
+  Grid g = plane(12, 10, 10, 30, 20, [](int i, int j) { return i == 0 && j == 0; });
+  const auto spec = vt::default_column_mesh(2.0);
+  auto cm = runout::terrain::column_mesh(g, spec);
+  auto m = vt::terrain_mesh(cm, vt::frame_of(cm));
+  auto cols = vt::columns_of(cm);
+  auto bc = vt::bed_columns(cols, m, g);
+  ASSERT_EQ(bc.columns(), cm.kept_columns());
+  EXPECT_EQ(int(bc.cells.size()), m.cells());
+  const auto& ground = m.patch("ground");
+  for (int k = 0; k < bc.columns(); ++k) {
+    const int f = bc.bed_face[std::size_t(k)];
+    EXPECT_GE(f, ground.start);
+    EXPECT_LT(f, ground.start + ground.size);
+    EXPECT_EQ(m.owner[std::size_t(f)], bc.cells[std::size_t(bc.start[std::size_t(k)])]);
+    EXPECT_EQ(bc.start[std::size_t(k) + 1] - bc.start[std::size_t(k)], cols.layers);
+    for (const auto& row : bc.curvature[std::size_t(k)].g)
+      for (double v : row) EXPECT_NEAR(v, 0.0, 1e-12);
+  }
+  const double R = 500;
+  g = plane(12, 10, 10, 0, 0, [](int, int) { return false; });
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      const double y = (j + 0.5 - 0.5 * g.ny) * g.dx;
+      g.z[std::size_t(j) * g.nx + i] = 2000 + y * y / (2 * R);
+    }
+  cm = runout::terrain::column_mesh(g, spec);
+  m = vt::terrain_mesh(cm, vt::frame_of(cm));
+  bc = vt::bed_columns(vt::columns_of(cm), m, g);
+  const auto& K = bc.curvature[std::size_t(5 * g.nx + 6)];  // next to the trough's floor (y = 5 m)
+  const runout::engine::vof::Vec north{0, 0, -1}, east{1, 0, 0};
+  auto uKu = [&](const runout::engine::vof::Vec& u) {
+    double s = 0;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) s += runout::engine::vof::comp(u, i) * K.g[i][j] * runout::engine::vof::comp(u, j);
+    return s;
+  };
+  EXPECT_NEAR(uKu(north), 1 / R, 1e-3 / R);  // cos(theta) = 0.99995 there
+  EXPECT_NEAR(uKu(east), 0.0, 1e-12);
+}

@@ -258,13 +258,13 @@ TEST(VofSolver, LimitedLinearConvectionKeepsAConvectedBandSharperAndBounded) {
 
 namespace {
 // Every field a run reports, to compare two runs bit for bit.
-struct Fields {
+struct RunFields {
   double t = 0;
   std::vector<double> alpha, p, nu, phi, granular_flux;
   std::vector<Vec> U;
 };
-Fields fields_of(const VofSolver& s) { return {s.time(), s.alpha(), s.pressure(), s.viscosity(), s.face_flux(), s.granular_flux(), s.velocity()}; }
-bool same_bits(const Fields& a, const Fields& b) {
+RunFields fields_of(const VofSolver& s) { return {s.time(), s.alpha(), s.pressure(), s.viscosity(), s.face_flux(), s.granular_flux(), s.velocity()}; }
+bool same_bits(const RunFields& a, const RunFields& b) {
   auto eq = [](const auto& x, const auto& y) {
     return x.size() == y.size() && (x.empty() || std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) == 0);
   };
@@ -323,7 +323,7 @@ TEST(VofSolver, CheckpointOfAnyStepContinuesBitForBit) {
   for (auto& k : cases) {
     k.alpha.resize(std::size_t(k.m.cells()));
     for (int q = 0; q < k.m.cells(); ++q) k.alpha[std::size_t(q)] = k.m.centre[std::size_t(q)].y < 0.06 - 1.0 * k.m.centre[std::size_t(q)].x ? 1 : 0;
-    std::vector<Fields> whole;
+    std::vector<RunFields> whole;
     {
       VofSolver s(k.m, k.c);
       s.initialise(k.alpha);

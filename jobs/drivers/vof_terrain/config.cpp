@@ -7,7 +7,7 @@ namespace runout::jobs::vof_terrain {
 
 namespace vof = engine::vof;
 
-vof::VofConfig terrain_config(const ResolvedScenario& r) {
+vof::VofConfig terrain_config(const ResolvedScenario& r, vof::MeshColumns columns) {
   const auto& s = r.scenario;
   const auto& v = s.vof();
   vof::VofConfig c;
@@ -32,6 +32,14 @@ vof::VofConfig terrain_config(const ResolvedScenario& r) {
   ground.friction_min_alpha = 0.01;
   ground.friction_total_normal_stress = v.bed_normal_stress() == "total";
   ground.tan_delta = std::tan(s.material().bed_friction_deg() * 3.14159265358979323846 / 180);
+  if (ground.type == "coulomb_friction" && v.bed_normal_stress() == "column") {
+    if (columns.columns() == 0) throw ScenarioError("vof.bed_normal_stress \"column\": the mesh has no columns");
+    // The friction acts on the column's material (engine/vof/column_friction.hpp); the ground
+    // itself takes no shear, so that the friction is counted once.
+    c.column_friction.columns = std::move(columns);
+    c.column_friction.tan_delta = ground.tan_delta;
+    ground.type = "symmetry";
+  }
   c.bc["ground"] = ground;
   c.bc["atmosphere"].kind = vof::Bc::atmosphere;
   c.bc["sides"].kind = vof::Bc::atmosphere;

@@ -13,7 +13,9 @@ namespace runout::jobs::vof_terrain {
 /// by vof.bed with the material's bed friction angle; the top and the sides open to the
 /// atmosphere (air at rest outside, anything out). The Coulomb viscosity keeps the engine's clip
 /// (a clip grown with the flow's depth let the viscous stress carry part of the weight, and the bed
-/// friction fell with the pressure; docs/design/vof.md).
-engine::vof::VofConfig terrain_config(const ResolvedScenario& r);
+/// friction fell with the pressure; docs/design/vof.md). With vof.bed "coulomb-friction" and
+/// vof.bed_normal_stress "column" (the default) the friction acts on the columns `columns`
+/// (bed_columns()) and the ground takes no shear of its own; ScenarioError when they are missing.
+engine::vof::VofConfig terrain_config(const ResolvedScenario& r, engine::vof::MeshColumns columns = {});
 
 }  // namespace runout::jobs::vof_terrain

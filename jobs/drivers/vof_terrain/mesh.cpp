@@ -1,6 +1,10 @@
 #include "jobs/drivers/vof_terrain/mesh.hpp"
 
 #include <algorithm>
+#include <string>
+
+#include "engine/sh2d.hpp"
+#include "jobs/drivers/hazard_outputs.hpp"
 
 namespace runout::jobs::vof_terrain {
 
@@ -38,6 +42,29 @@ Columns columns_of(const terrain::ColumnMesh& c) {
         const std::size_t col = std::size_t(k) * std::size_t(c.ni) + std::size_t(i);
         if (c.kept[col]) out.cells[col * std::size_t(out.layers) + std::size_t(j)] = next++;
       }
+  return out;
+}
+
+engine::vof::MeshColumns bed_columns(const Columns& cols, const engine::vof::Mesh& m, const terrain::Grid& g) {
+  engine::vof::MeshColumns out;
+  std::vector<int> face_of(std::size_t(m.cells()), -1);
+  const auto& ground = m.patch("ground");
+  for (int f = ground.start; f < ground.start + ground.size; ++f) face_of[std::size_t(m.owner[std::size_t(f)])] = f;
+  const auto geo = engine::SurfaceGeometry::from(engine_terrain(g));
+  out.start.push_back(0);
+  for (std::size_t col = 0; col < cols.columns(); ++col) {
+    if (cols.cell(col, 0) < 0) continue;
+    out.bed_face.push_back(face_of[std::size_t(cols.cell(col, 0))]);
+    for (int j = 0; j < cols.layers; ++j) out.cells.push_back(cols.cell(col, j));
+    out.start.push_back(int(out.cells.size()));
+    // x east, z south: the horizontal velocity (east, north) is (u.x, -u.z).
+    const double c = geo.c[col];
+    engine::vof::Tensor K;
+    K.g[0][0] = c * geo.hxx[col];
+    K.g[0][2] = K.g[2][0] = -c * geo.hxy[col];
+    K.g[2][2] = c * geo.hyy[col];
+    out.curvature.push_back(K);
+  }
   return out;
 }
 

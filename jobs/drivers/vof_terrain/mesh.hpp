@@ -6,6 +6,7 @@
 // grid's edges and the faces towards columns outside the domain).
 #include <vector>
 
+#include "engine/vof/column_friction.hpp"
 #include "engine/vof/mesh.hpp"
 #include "terrain/column_mesh.hpp"
 
@@ -37,5 +38,11 @@ struct Columns {
   std::size_t columns() const { return std::size_t(ni) * std::size_t(nk); }
 };
 Columns columns_of(const terrain::ColumnMesh& c);
+
+/// The engine's columns (the bed friction on the column's weight, VofConfig::column_friction): per
+/// kept column its "ground" face, its cells bottom up, and the bed's curvature from the grid's
+/// elevations (the depth-averaged engine's Hessian, as u.K.u = cos(theta) u_h.Hess(b).u_h for the
+/// horizontal part u_h of a velocity along the bed, in the engine's frame).
+engine::vof::MeshColumns bed_columns(const Columns& cols, const engine::vof::Mesh& m, const terrain::Grid& g);
 
 }  // namespace runout::jobs::vof_terrain

@@ -143,7 +143,7 @@ RunSummary run_terrain_vof(const ResolvedScenario& r, const std::string& out_dir
   const auto t0 = clk::now();
   TerrainSetup su;
   build_terrain_setup(r, su);
-  vof::VofSolver s(su.mesh, terrain_config(r));
+  vof::VofSolver s(su.mesh, terrain_config(r, bed_columns(su.columns, su.mesh, su.grid)));
   const bool continued = !opt.restart_path.empty();
   const std::string state_hash = continued || !opt.checkpoint_path.empty() ? terrain_state_hash(r) : std::string();
   LabCheckpoint restart;
@@ -180,6 +180,8 @@ RunSummary run_terrain_vof(const ResolvedScenario& r, const std::string& out_dir
   sum.notes = su.release.notes;
   sum.notes.push_back("mesh: " + std::to_string(su.columns_mesh.kept_columns()) + " columns x " + std::to_string(su.columns.layers) +
                       " layers = " + std::to_string(su.mesh.cells()) + " cells");
+  if (r.scenario.vof().bed_normal_stress() == "column")
+    sum.notes.push_back("vof.bed_normal_stress \"column\" is experimental: it is unstable at a release's tapered edges (docs/design/vof.md)");
   sum.seconds_prepare = since(t0);
 
   const double write_every = r.scenario.vof().write_interval_s();

@@ -1,0 +1,95 @@
+#include "engine/vof/column_friction.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "engine/vof/active_region.hpp"
+#include "engine/vof/fields.hpp"
+#include "engine/vof/hydrostatics.hpp"
+#include "engine/vof/solver.hpp"
+
+namespace runout::engine::vof {
+
+namespace {
+
+double quadratic(const Tensor& K, const Vec& u) {
+  double s = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) s += comp(u, i) * K.g[i][j] * comp(u, j);
+  return s;
+}
+
+}  // namespace
+
+void check_columns(const Mesh& m, const MeshColumns& c) {
+  const int n = c.columns();
+  if (int(c.start.size()) != n + 1 || c.start.front() != 0 || c.start.back() != int(c.cells.size()))
+    throw VofError("column friction: the columns' offsets do not match their cells");
+  if (!c.curvature.empty() && int(c.curvature.size()) != n) throw VofError("column friction: one curvature per column, or none");
+  std::vector<char> seen(std::size_t(m.faces()), 0);
+  for (int k = 0; k < n; ++k) {
+    const int f = c.bed_face[std::size_t(k)];
+    if (f < m.n_internal || f >= m.faces() || seen[std::size_t(f)]++)
+      throw VofError("column friction: column " + std::to_string(k) + "'s bed face is not a boundary face of its own");
+    if (c.start[std::size_t(k) + 1] <= c.start[std::size_t(k)] || c.cells[std::size_t(c.start[std::size_t(k)])] != m.owner[std::size_t(f)])
+      throw VofError("column friction: column " + std::to_string(k) + " does not start at its bed face's cell");
+    for (int i = c.start[std::size_t(k)]; i < c.start[std::size_t(k) + 1]; ++i)
+      if (c.cells[std::size_t(i)] < 0 || c.cells[std::size_t(i)] >= m.cells())
+        throw VofError("column friction: column " + std::to_string(k) + " names a cell outside the mesh");
+  }
+}
+
+BedLoad add_column_friction(const Mesh& m, const ColumnFrictionConfig& cf, double rho1, const Fields& F, const Hydrostatics& hs,
+                            const ActiveRegion& region, FvMatrix<Vec>& UEqn) {
+  const MeshColumns& cols = cf.columns;
+  const Vec g = hs.gravity();
+  BedLoad load;
+  for (int k = 0; k < cols.columns(); ++k) {
+    const int b = cols.start[std::size_t(k)], e = cols.start[std::size_t(k) + 1];
+    const int bed_cell = cols.cells[std::size_t(b)];
+    if (!region.active(bed_cell)) continue;  // material lies within the region's layers of its cells
+    const int f = cols.bed_face[std::size_t(k)];
+    const Vec n = (1.0 / m.magSf[f]) * m.Sf[f];  // out of the domain, into the ground
+    // The column's material and its velocity (volume-weighted).
+    double material = 0;
+    Vec um;
+    for (int i = b; i < e; ++i) {
+      const int c = cols.cells[std::size_t(i)];
+      const double v = F.alpha[c] * m.volume[c];
+      material += v;
+      um = um + v * F.U[c];
+    }
+    if (!(material > 0)) continue;
+    um = (1.0 / material) * um;
+    const Vec ut = um - dot(um, n) * n;
+    const double mass = rho1 * material;
+    const double weight_n = mass * std::max(dot(g, n), 0.0);
+    const double centripetal = cols.curvature.empty() ? 0.0 : mass * quadratic(cols.curvature[std::size_t(k)], ut);
+    // The bed face's pressure counts with the material's share of the bed cell: the air's share of a
+    // partly filled cell (whose pressure the material next to it sets) carries nothing.
+    const double face = std::max(hs.wall_pressure(f, bed_cell), 0.0) * m.magSf[f] * F.alpha[bed_cell];
+    // The friction's load: the weight's normal part and the centripetal load. The bed face's pressure
+    // is reported beside it but not taken as a floor: as max(weight, face pressure) the friction and
+    // the pressure it raises at the block's edges fed each other, and the 35 deg block ran away
+    // (docs/design/vof.md).
+    const double N = std::max(weight_n + centripetal, 0.0);
+    load.weight_normal += weight_n;
+    load.centripetal += centripetal;
+    load.face_pressure += face;
+    load.friction_load += N;
+    ++load.columns;
+    // Each cell's share of the force by its material; the drag per unit of material volume.
+    const double per_volume = cf.tan_delta * N / (material * std::max(norm(ut), cf.creep_speed));
+    for (int i = b; i < e; ++i) {
+      const int c = cols.cells[std::size_t(i)];
+      const double v = F.alpha[c] * m.volume[c];
+      if (!(v > 0) || !region.active(c)) continue;
+      const double drag = per_volume * v;
+      UEqn.diag[c] += drag;  // the part on the bed-normal velocity given back: the force acts along the bed
+      UEqn.source[c] = UEqn.source[c] + (drag * dot(F.U[c], n)) * n;
+    }
+  }
+  return load;
+}
+
+}  // namespace runout::engine::vof

@@ -1,0 +1,60 @@
+#pragma once
+// The bed friction of a column mesh (terrain-following meshes: a vertical column of cells above
+// each bed face; docs/design/vof.md, "The bed carries the column's weight"). The Coulomb friction
+// takes its normal load from the whole column: the bed-normal part of the weight of the material
+// above the bed face, plus the centripetal load of a curved bed, and never less than the bed face's
+// pressure (impacts and other dynamic loads). It acts against the velocity of the column's
+// material (its volume-weighted mean), on every cell of the column in proportion to the material
+// the cell holds: material in a mixed cell above a nearly empty ground cell feels the bed as the
+// rest of the column does. Implicit as the Coulomb friction condition: each cell takes the drag
+// tan(delta) N (its share of the column's material) / max(|u_t|, creep speed) on its diagonal, u_t
+// the column's material velocity along the bed, with the part on the bed-normal velocity given back
+// explicitly, so that the force on the column is tan(delta) N against u_t, and a column held by less
+// comes to rest cell by cell, without the creep of the Coulomb viscosity's clip.
+#include <vector>
+
+#include "engine/vof/fv/fv_matrix.hpp"
+#include "engine/vof/fv/ops.hpp"
+
+namespace runout::engine::vof {
+
+class ActiveRegion;
+class Hydrostatics;
+struct Fields;
+
+/// The columns of a terrain-following mesh: per column its bed face (a boundary face), its cells
+/// from the bed up, and the bed's curvature K in the engine's frame, such that material moving along
+/// the bed at u needs the bed-normal acceleration u.K.u to follow it (positive where the bed is
+/// concave: the load grows).
+struct MeshColumns {
+  std::vector<int> bed_face;     ///< per column
+  std::vector<int> start;        ///< per column, the first of its cells in `cells`; one more at the end
+  std::vector<int> cells;        ///< bottom up
+  std::vector<Tensor> curvature; ///< per column; empty: a plane bed
+  int columns() const { return int(bed_face.size()); }
+};
+
+/// What the bed carried at the last momentum build, summed over the columns with material [N]:
+/// the weight's bed-normal part, the centripetal load, the bed faces' pressure times their area,
+/// and the load the friction took (per column the largest of the first two summed and the third).
+struct BedLoad {
+  double weight_normal = 0, centripetal = 0, face_pressure = 0, friction_load = 0;
+  int columns = 0;  ///< columns with material
+};
+
+struct ColumnFrictionConfig {
+  MeshColumns columns;  ///< none: the bed conditions alone carry the friction
+  double tan_delta = 0;
+  double creep_speed = 1e-4;  ///< [m/s]; below it the force falls linearly
+};
+
+/// Adds the columns' bed friction to the momentum matrix's diagonal and source (cells of the active
+/// region only) and returns the loads; rho1 the material's density.
+BedLoad add_column_friction(const Mesh& m, const ColumnFrictionConfig& cf, double rho1, const Fields& F, const Hydrostatics& hs,
+                            const ActiveRegion& region, FvMatrix<Vec>& UEqn);
+
+/// Checks a MeshColumns against the mesh (offsets, cell and face indices, one column per bed face);
+/// throws VofError naming what is wrong.
+void check_columns(const Mesh& m, const MeshColumns& c);
+
+}  // namespace runout::engine::vof
