@@ -1,6 +1,8 @@
 #include "terrain/column_mesh.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 namespace runout::terrain {
@@ -53,7 +55,35 @@ int ColumnMesh::kept_columns() const {
   return n;
 }
 
-ColumnMesh column_mesh(const Grid& g, const ColumnMeshSpec& s) {
+std::vector<std::uint8_t> dilate_cells(const Grid& g, const std::vector<std::uint8_t>& cells, double margin_m) {
+  if (cells.size() != g.cells()) throw TerrainError("dilate_cells: one flag per grid cell expected");
+  if (!(margin_m >= 0) || !std::isfinite(margin_m)) throw TerrainError("dilate_cells: the margin must be >= 0, got " + num(margin_m));
+  const int r = int(std::floor(margin_m / g.dx + 1e-9));
+  std::vector<std::uint8_t> out(cells.size(), 0);
+  // The disc's half-width per row offset; only cells on the set's edge stamp it (an interior
+  // cell's disc lies within its neighbours' and the set itself).
+  std::vector<int> half(std::size_t(r) + 1);
+  for (int dj = 0; dj <= r; ++dj) half[std::size_t(dj)] = int(std::floor(std::sqrt(std::max(0.0, (margin_m / g.dx) * (margin_m / g.dx) - double(dj) * dj)) + 1e-9));
+  auto at = [&](int i, int j) { return std::size_t(j) * std::size_t(g.nx) + std::size_t(i); };
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      if (!cells[at(i, j)]) continue;
+      out[at(i, j)] = 1;
+      const bool edge = i == 0 || j == 0 || i == g.nx - 1 || j == g.ny - 1 || !cells[at(i - 1, j)] || !cells[at(i + 1, j)] ||
+                        !cells[at(i, j - 1)] || !cells[at(i, j + 1)];
+      if (!edge || r == 0) continue;
+      for (int dj = -r; dj <= r; ++dj) {
+        const int jj = j + dj;
+        if (jj < 0 || jj >= g.ny) continue;
+        const int h = half[std::size_t(std::abs(dj))];
+        for (int ii = std::max(0, i - h); ii <= std::min(g.nx - 1, i + h); ++ii) out[at(ii, jj)] = 1;
+      }
+    }
+  return out;
+}
+
+ColumnMesh column_mesh(const Grid& g, const ColumnMeshSpec& s, const std::vector<std::uint8_t>& corridor) {
+  if (!corridor.empty() && corridor.size() != g.cells()) throw TerrainError("mesh: the corridor needs one flag per grid cell");
   if (g.nx < 2 || g.ny < 2) throw TerrainError("mesh: the grid needs at least 2 x 2 cells");
   ColumnMesh m;
   m.ni = g.nx;
@@ -73,8 +103,8 @@ ColumnMesh column_mesh(const Grid& g, const ColumnMeshSpec& s) {
     }
   }
   m.kept.resize(g.cells());
-  for (std::size_t c = 0; c < g.cells(); ++c) m.kept[c] = g.outside.empty() || g.outside[c] == 0;
-  if (m.kept_columns() == 0) throw TerrainError("mesh: no column lies inside the domain");
+  for (std::size_t c = 0; c < g.cells(); ++c) m.kept[c] = (g.outside.empty() || g.outside[c] == 0) && (corridor.empty() || corridor[c] != 0);
+  if (m.kept_columns() == 0) throw TerrainError(corridor.empty() ? "mesh: no column lies inside the domain" : "mesh: no column of the corridor lies inside the domain");
   return m;
 }
 

@@ -45,8 +45,13 @@ struct ColumnMesh {
   int kept_columns() const;
 };
 
-/// The column mesh over `g` (at least 2 x 2 cells). Throws TerrainError when the spec is out of
-/// range or no column is kept.
-ColumnMesh column_mesh(const Grid& g, const ColumnMeshSpec& s);
+/// The column mesh over `g` (at least 2 x 2 cells): the columns inside the domain, and when
+/// `corridor` is given (one flag per grid cell, row 0 south) only those of the corridor too. Throws
+/// TerrainError when the spec is out of range or no column is kept.
+ColumnMesh column_mesh(const Grid& g, const ColumnMeshSpec& s, const std::vector<std::uint8_t>& corridor = {});
+
+/// The cells of `cells` (one flag per grid cell) dilated by `margin_m`: every cell whose centre lies
+/// within margin_m (Euclidean, centre to centre) of a flagged cell's centre. margin_m >= 0.
+std::vector<std::uint8_t> dilate_cells(const Grid& g, const std::vector<std::uint8_t>& cells, double margin_m);
 
 }  // namespace runout::terrain

@@ -189,6 +189,10 @@ void resolve_inputs(const v1::Scenario& s, const std::string& base, ResolvedScen
     r.observed_outline = path_in(base, s.observations().outline_path(), "observations.outline_path");
     add_vector(r.observed_outline, "observations.outline_path", r);
   }
+  if (!s.mesh().corridor_path().empty()) {
+    r.corridor_path = path_in(base, s.mesh().corridor_path(), "mesh.corridor_path");
+    add_vector(r.corridor_path, "mesh.corridor_path", r);
+  }
 }
 
 void resolve_releases(const v1::Scenario& s, const std::string& base, ResolvedScenario& r) {
@@ -270,6 +274,13 @@ void check_terrain_vof(const v1::Scenario& s) {
   const auto& me = s.mesh();
   if (me.has_first_layer_m() && me.has_band_height_m() && !(me.band_height_m() > me.first_layer_m()))
     bad("mesh.band_height_m", "must exceed mesh.first_layer_m");
+  if (me.corridor() == "polygon" && me.corridor_path().empty()) bad("mesh.corridor_path", "missing (mesh.corridor \"polygon\")");
+  if (me.corridor() != "polygon" && !me.corridor_path().empty())
+    bad("mesh.corridor_path", "only with mesh.corridor \"polygon\" (got \"" + me.corridor() + "\")");
+  if (me.corridor() != "polygon" && !me.corridor_crs().empty())
+    bad("mesh.corridor_crs", "only with mesh.corridor \"polygon\" (got \"" + me.corridor() + "\")");
+  if (me.corridor() != "footprint" && me.has_corridor_margin_m())
+    bad("mesh.corridor_margin_m", "only with mesh.corridor \"footprint\" (got \"" + me.corridor() + "\")");
   for (int k = 0; k < s.releases_size(); ++k)
     if (s.releases(k).secondary())
       bad("releases[" + std::to_string(k) + "].secondary", "the 3D engine takes no secondary releases (the depth-averaged engine does)");
@@ -334,6 +345,7 @@ std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version,
   }
   if (s.has_observations()) s.mutable_observations()->clear_outline_path();
   if (s.has_path()) s.mutable_path()->clear_line_path();
+  if (s.has_mesh()) s.mutable_mesh()->clear_corridor_path();
   // A block left empty (its kept defaults cleared) is the block not given.
   if (s.has_path() && s.path().ByteSizeLong() == 0) s.clear_path();
   if (s.has_observations() && s.observations().ByteSizeLong() == 0) s.clear_observations();

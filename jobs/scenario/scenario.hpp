@@ -46,6 +46,7 @@ struct ResolvedScenario {
   std::vector<ZoneThreshold> pressure_zones = {{"blue", 3}, {"red", 30}};
   std::string observed_outline, observed_crs;  ///< observations: polygons of the observed runout, their CRS
   PathSettings path;
+  std::string corridor_path;  ///< mesh.corridor_path (3D engine on the DEM), resolved; empty: none
   bool maps = true;  ///< outputs.maps: the report maps (PNG, PDF)
   std::vector<std::string> input_files;  ///< for hashing
   bool vof = false;  ///< engine "vof": a laboratory set-up (`lab`) or, with `terrain`, on the DEM

@@ -10,6 +10,7 @@
 
 #include "engine/sh2d.hpp"
 #include "engine/vof/mesh_quality.hpp"
+#include "jobs/drivers/vof_terrain/corridor.hpp"
 #include "jobs/drivers/vof_terrain/mesh.hpp"
 #include "jobs/drivers/vof_terrain/release.hpp"
 #include "terrain/column_mesh.hpp"
@@ -237,4 +238,68 @@ TEST(ColumnMesh, BedColumnsCarryTheirCellsAndTheBedsCurvature) {
   };
   EXPECT_NEAR(uKu(north), 1 / R, 1e-3 / R);  // cos(theta) = 0.99995 there
   EXPECT_NEAR(uKu(east), 0.0, 1e-12);
+}
+
+// The footprint corridor (mesh.corridor "footprint"): the cells above the flow threshold and the
+// release's, dilated by the margin (centre to centre), intersected with the domain; the faces towards
+// a domain column left out are the corridor's edge, those at the grid's or the domain's edge are not.
+TEST(ColumnMesh, CorridorFromAFootprintKeepsTheMarginsColumns) {
+  // 24 x 20 cells of 10 m; the domain leaves out the columns i >= 20 (the east edge).
+  const Grid g = plane(24, 20, 10, 20, 0, [](int i, int) { return i >= 20; });
+  std::vector<double> max_depth(g.cells(), 0.0), h0(g.cells(), 0.0);
+  auto at = [&](int i, int j) { return std::size_t(j) * g.nx + i; };
+  for (int i = 8; i <= 17; ++i) max_depth[at(i, 10)] = 0.5;  // a path along row 10
+  max_depth[at(12, 11)] = 0.005;                            // below the threshold
+  h0[at(3, 3)] = 1.5;                                       // the release, off the path
+  const double margin = 25;                                 // 2.5 cells
+  int footprint = 0;
+  const auto corridor = vt::footprint_corridor(g, max_depth, 0.01, h0, margin, &footprint);
+  EXPECT_EQ(footprint, 11);
+  // Every cell whose centre lies within 25 m of a footprint cell's centre, and no other.
+  int expected = 0;
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      bool near = false;
+      for (int jj = 0; jj < g.ny; ++jj)
+        for (int ii = 0; ii < g.nx; ++ii)
+          if ((max_depth[at(ii, jj)] > 0.01 || h0[at(ii, jj)] > 0) && std::hypot(ii - i, jj - j) * g.dx <= margin + 1e-9) near = true;
+      EXPECT_EQ(corridor[at(i, j)] != 0, near) << i << ", " << j;
+      expected += near && i < 20;
+    }
+  // The path's disc around (17, 10) reaches i = 19; the release's disc is 21 cells (radius 2.5).
+  EXPECT_TRUE(corridor[at(19, 10)]);
+  EXPECT_FALSE(corridor[at(20, 10)]);
+  EXPECT_TRUE(corridor[at(5, 4)]);   // 22.4 m from the release
+  EXPECT_FALSE(corridor[at(5, 5)]);  // 28.3 m
+  const auto c = runout::terrain::column_mesh(g, {0.4, 1.25, 6}, corridor);
+  EXPECT_EQ(c.kept_columns(), expected);
+  // The corridor's edge: faces of kept columns towards domain columns that are not kept.
+  const auto m = vt::terrain_mesh(c, vt::frame_of(c));
+  const auto cols = vt::columns_of(c);
+  const auto edge = vt::corridor_edge_faces(cols, m, g);
+  int edge_faces = 0, expected_faces = 0;
+  for (auto e : edge) edge_faces += e;
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) {
+      if (!c.kept[at(i, j)]) continue;
+      const int nb[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
+      for (const auto& n : nb)
+        if (n[0] >= 0 && n[1] >= 0 && n[0] < g.nx && n[1] < g.ny && !g.outside[at(n[0], n[1])] && !c.kept[at(n[0], n[1])])
+          expected_faces += c.layers();
+    }
+  EXPECT_EQ(edge_faces, expected_faces);
+  EXPECT_GT(edge_faces, 0);
+  // Every flagged face is a side face; the path's column at i = 19 faces the domain's edge (i = 20), unflagged.
+  const auto& sides = m.patch("sides");
+  for (int f = 0; f < m.faces(); ++f)
+    if (edge[std::size_t(f)]) EXPECT_TRUE(f >= sides.start && f < sides.start + sides.size);
+  // The default margin: 150 m, or two cells on a coarser grid; a given one as given.
+  runout::v1::TerrainMesh tm;
+  EXPECT_EQ(vt::corridor_margin(tm, 30), 150);
+  EXPECT_EQ(vt::corridor_margin(tm, 90), 180);
+  tm.set_corridor_margin_m(40);
+  EXPECT_EQ(vt::corridor_margin(tm, 90), 40);
+  // No margin: the footprint itself.
+  const auto bare = runout::terrain::dilate_cells(g, corridor, 0);
+  EXPECT_EQ(bare, corridor);
 }

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <string>
 #include <vector>
@@ -23,6 +24,7 @@
 #include "jobs/drivers/vof_terrain/config.hpp"
 #include "jobs/drivers/vof_terrain/mesh.hpp"
 #include "jobs/drivers/vof_terrain/release.hpp"
+#include "jobs/drivers/vof_terrain/setup.hpp"
 #include "jobs/scenario/options.hpp"
 #include "terrain/column_mesh.hpp"
 #include "tests/support/temp_dir.hpp"
@@ -313,6 +315,14 @@ TEST(TerrainVof, ArelenCoarseRunWritesTheHazardMapsFramesAndRecord) {
   EXPECT_GT(tm.aspect_ratio_max(), 1);
   EXPECT_NEAR(rec.release().volume_on_mesh_m3() / rec.release().volume_m3(), 1.0, 0.01);
   EXPECT_LT(rec.mass_balance().relative_error(), 1e-6);
+  // The mesh follows the depth-averaged engine's footprint with the default margin (two cells of 90 m).
+  EXPECT_EQ(tm.corridor(), "footprint");
+  EXPECT_EQ(tm.corridor_margin_m(), 180);
+  EXPECT_EQ(tm.domain_columns(), 1371);
+  EXPECT_LT(tm.columns(), tm.domain_columns());
+  EXPECT_GT(tm.columns(), tm.footprint_columns());
+  EXPECT_GT(tm.footprint_columns(), 0);
+  EXPECT_LE(tm.corridor_outflow_m3() + tm.domain_edge_outflow_m3(), rec.mass_balance().volume_outflow_m3() + 1e-9);
   EXPECT_GE(rec.solver().alpha_min(), -1e-6);
   EXPECT_LE(rec.solver().alpha_max(), 1 + 1e-6);
   EXPECT_EQ(rec.results().frames(), 3);
@@ -322,8 +332,104 @@ TEST(TerrainVof, ArelenCoarseRunWritesTheHazardMapsFramesAndRecord) {
   EXPECT_EQ(rec.profiles(0).profile_height_alpha_speed_size() == 0 || rec.profiles(0).profile_height_alpha_speed_size() == tm.layers(), true);
   // The frames lie in the grid's CRS (Float64 centres): east and north inside the grid.
   EXPECT_NE(runout::test_support::read_text(d.p / "fields.xmf").find("Precision=\"8\" Format=\"HDF\">fields.h5:/centres"), std::string::npos);
-  std::printf("Arelen at 90 m, 5 s: %d cells, %ld steps, %.1f s run; volume error %.1e, outflow %.0f m3, runout %.0f m\n", tm.cells(), sum.steps,
-              sum.seconds_run, sum.volume_error, sum.volume_outflow, sum.runout_m);
+  std::printf("Arelen at 90 m, 5 s: %d of %d columns, %d cells, %ld steps, %.1f s run; volume error %.1e, outflow %.0f m3, runout %.0f m\n",
+              tm.columns(), tm.domain_columns(), tm.cells(), sum.steps, sum.seconds_run, sum.volume_error, sum.volume_outflow, sum.runout_m);
+}
+
+// A corridor polygon (mesh.corridor "polygon") must hold the release: one around the farmhouse,
+// below the release, is refused naming the field and the file; the area of interest as the corridor
+// keeps every column of the domain and the release's volume.
+TEST(TerrainVof, CorridorPolygonMustHoldTheRelease) {
+  namespace fs = std::filesystem;
+  runout::test_support::TempDir d;
+  const auto square = d.p / "farmhouse.geojson";
+  {
+    std::ofstream f(square);
+    f << R"({"type":"FeatureCollection","features":[{"type":"Feature","properties":{},"geometry":{"type":"Polygon",)"
+         R"("coordinates":[[[9.850,46.834],[9.858,46.834],[9.858,46.839],[9.850,46.839],[9.850,46.834]]]}}]})";
+  }
+  auto sc = runout::jobs::parse_scenario_json(runout::test_support::read_text(kArelen3d));
+  sc.mutable_grid()->set_resolution_m(90);
+  sc.mutable_mesh()->set_corridor("polygon");
+  sc.mutable_mesh()->set_corridor_path(square.string());
+  const auto r = runout::jobs::resolve_scenario(sc, kArelen3d.parent_path().string());
+  try {
+    vt::TerrainSetup su;
+    vt::build_terrain_setup(r, su);
+    ADD_FAILURE() << "a corridor without the release was accepted";
+  } catch (const std::exception& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("mesh.corridor_path"), std::string::npos) << m;
+    EXPECT_NE(m.find("farmhouse.geojson"), std::string::npos) << m;
+    EXPECT_NE(m.find("release cell(s) out"), std::string::npos) << m;
+  }
+  sc.mutable_mesh()->set_corridor_path((kArelen3d.parent_path() / "data" / "arelen" / "aoi.geojson").string());
+  vt::TerrainSetup su;
+  vt::build_terrain_setup(runout::jobs::resolve_scenario(sc, kArelen3d.parent_path().string()), su);
+  EXPECT_EQ(su.corridor.kind, "polygon");
+  EXPECT_EQ(su.columns_mesh.kept_columns(), su.domain_columns);
+  EXPECT_NEAR(su.volume_on_mesh / su.release.volume_m3, 1.0, 0.01);
+  // The footprint corridor on the same grid: fewer columns, the same volume on the mesh.
+  sc.mutable_mesh()->set_corridor("footprint");
+  sc.mutable_mesh()->clear_corridor_path();
+  vt::TerrainSetup fp;
+  vt::build_terrain_setup(runout::jobs::resolve_scenario(sc, kArelen3d.parent_path().string()), fp);
+  EXPECT_LT(fp.columns_mesh.kept_columns(), su.columns_mesh.kept_columns());
+  EXPECT_DOUBLE_EQ(fp.volume_on_mesh, su.volume_on_mesh);
+  int corridor_edge = 0;
+  for (auto e : fp.corridor_edge) corridor_edge += e;
+  EXPECT_GT(corridor_edge, 0);
+}
+
+// Material that leaves through the corridor's edge is counted apart from the domain's edge and, above
+// 2 % of the released volume, run.json's notes say that the map is not complete: the release's own
+// cells as the corridor polygon (in the grid's CRS; 90 m, 5 s).
+TEST(TerrainVof, MaterialLeavingTheCorridorIsReported) {
+  auto sc = runout::jobs::parse_scenario_json(runout::test_support::read_text(kArelen3d));
+  sc.mutable_grid()->set_resolution_m(90);
+  sc.mutable_numerics()->set_end_time_s(5);
+  sc.mutable_vof()->set_write_interval_s(0);
+  sc.mutable_vof()->clear_profiles();
+  runout::test_support::TempDir d;
+  const auto cells = d.p / "release-cells.geojson";
+  {
+    auto none = sc;
+    none.mutable_mesh()->set_corridor("none");
+    vt::TerrainSetup su;
+    vt::build_terrain_setup(runout::jobs::resolve_scenario(none, kArelen3d.parent_path().string()), su);
+    const auto& g = su.grid;
+    std::ofstream f(cells);
+    f << R"({"type":"FeatureCollection","crs":{"type":"name","properties":{"name":")" << g.crs_name << R"("}},"features":[)";
+    bool first = true;
+    for (int j = 0; j < g.ny; ++j)
+      for (int i = 0; i < g.nx; ++i) {
+        if (!(su.h0[std::size_t(j) * std::size_t(g.nx) + std::size_t(i)] > 0)) continue;
+        const double x0 = g.x_min + i * g.dx + 1, x1 = x0 + g.dx - 2, y0 = g.y_min + j * g.dx + 1, y1 = y0 + g.dx - 2;
+        f << (first ? "" : ",") << R"({"type":"Feature","properties":{},"geometry":{"type":"Polygon","coordinates":[[)";
+        f.precision(12);
+        f << "[" << x0 << "," << y0 << "],[" << x1 << "," << y0 << "],[" << x1 << "," << y1 << "],[" << x0 << "," << y1 << "],[" << x0 << "," << y0
+          << "]]]}}";
+        first = false;
+      }
+    f << "]}";
+  }
+  sc.mutable_mesh()->set_corridor("polygon");
+  sc.mutable_mesh()->set_corridor_path(cells.string());
+  const auto r = runout::jobs::resolve_scenario(sc, kArelen3d.parent_path().string());
+  runout::jobs::run_scenario(r, d.p.string());
+  const auto rec = runout::jobs::read_run_record((d.p / "run.json").string());
+  const auto& tm = rec.terrain_mesh();
+  EXPECT_EQ(tm.corridor(), "polygon");
+  EXPECT_NE(tm.corridor_path().find("release-cells.geojson"), std::string::npos);
+  const double released = rec.release().volume_on_mesh_m3();
+  std::printf("the release's cells as the corridor: %d of %d columns; through the corridor's edge %.0f m3 (%.1f %%), the domain's %.0f m3, all %.0f m3\n",
+              tm.columns(), tm.domain_columns(), tm.corridor_outflow_m3(), 100 * tm.corridor_outflow_m3() / released,
+              tm.domain_edge_outflow_m3(), rec.mass_balance().volume_outflow_m3());
+  EXPECT_GT(tm.corridor_outflow_m3(), 0.02 * released);
+  EXPECT_LE(tm.corridor_outflow_m3() + tm.domain_edge_outflow_m3(), rec.mass_balance().volume_outflow_m3() + 1e-9);
+  ASSERT_EQ(rec.notes_size(), 1);
+  EXPECT_NE(rec.notes(0).find("the map is not complete"), std::string::npos) << rec.notes(0);
+  EXPECT_NE(rec.notes(0).find("corridor's edge"), std::string::npos) << rec.notes(0);
 }
 
 // The 3D engine's options on the DEM are checked before anything runs, each error naming its field.
@@ -370,6 +476,21 @@ TEST(TerrainVof, BadOptionsAreNamed) {
             }).find("mesh.band_height_m"),
             std::string::npos);
   EXPECT_NE(message([](auto& s) { s.mutable_vof()->set_bed("ice"); }).find("vof.bed"), std::string::npos);
+  EXPECT_NE(message([](auto& s) { s.mutable_mesh()->set_corridor("road"); }).find("mesh.corridor"), std::string::npos);
+  EXPECT_NE(message([](auto& s) { s.mutable_mesh()->set_corridor("polygon"); }).find("mesh.corridor_path: missing"), std::string::npos);
+  EXPECT_NE(message([](auto& s) { s.mutable_mesh()->set_corridor_path("data/arelen/aoi.geojson"); }).find("mesh.corridor_path: only with"),
+            std::string::npos);
+  EXPECT_NE(message([](auto& s) {
+              s.mutable_mesh()->set_corridor("none");
+              s.mutable_mesh()->set_corridor_margin_m(100);
+            }).find("mesh.corridor_margin_m: only with"),
+            std::string::npos);
+  EXPECT_NE(message([](auto& s) { s.mutable_mesh()->set_corridor_margin_m(-1); }).find("mesh.corridor_margin_m"), std::string::npos);
+  EXPECT_NE(message([](auto& s) {
+              s.mutable_mesh()->set_corridor("polygon");
+              s.mutable_mesh()->set_corridor_path("data/arelen/no-such-corridor.geojson");
+            }).find("mesh.corridor_path"),
+            std::string::npos);
   EXPECT_NE(message([](auto& s) { s.mutable_vof()->mutable_profiles(0)->clear_name(); }).find("vof.profiles[0].name"), std::string::npos);
   EXPECT_NE(message([](auto& s) { s.set_engine("depth-averaged"); }).find("vof: only for engine \"vof\""), std::string::npos);
   // A point outside the domain is refused when the run prepares its grid.

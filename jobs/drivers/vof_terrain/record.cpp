@@ -31,6 +31,15 @@ void write_grid(const TerrainSetup& su, v1::RunRecord& rec) {
   tm->set_skewness_mean(q.skewness_mean);
   tm->set_aspect_ratio_max(q.aspect_ratio_max);
   tm->set_aspect_ratio_mean(q.aspect_ratio_mean);
+  const auto& c = su.corridor;
+  tm->set_corridor(c.kind);
+  tm->set_domain_columns(su.domain_columns);
+  if (c.kind == "footprint") {
+    tm->set_corridor_margin_m(c.margin_m);
+    tm->set_footprint_columns(c.footprint_cells);
+    tm->set_footprint_seconds(c.footprint_seconds);
+  }
+  if (c.kind == "polygon") tm->set_corridor_path(c.path);
 }
 
 void write_profiles(const TerrainRunFacts& f, v1::RunRecord& rec) {
@@ -59,6 +68,9 @@ void write_terrain_record(const std::string& path, const ResolvedScenario& r, co
   const auto& sum = f.sum;
   v1::RunRecord rec = run_record_head(r, "vof");
   write_grid(su, rec);
+  rec.mutable_terrain_mesh()->set_corridor_outflow_m3(f.corridor_outflow);
+  rec.mutable_terrain_mesh()->set_domain_edge_outflow_m3(f.domain_edge_outflow);
+  for (const auto& n : f.notes) rec.add_notes(n);
   auto* rel = rec.mutable_release();
   rel->set_volume_on_mesh_m3(su.volume_on_mesh);
   auto* mb = rec.mutable_mass_balance();

@@ -3,6 +3,7 @@
 // sections, the terrain mesh and its quality, the mass balance (outflow through the sides counted),
 // the solver's figures (alpha bounds, active cells), the profiles at the named points and timings.
 #include <string>
+#include <vector>
 
 #include "jobs/drivers/hazard_outputs.hpp"
 #include "jobs/drivers/run.hpp"
@@ -20,6 +21,9 @@ struct TerrainRunFacts {
   double continued_from = 0;  ///< NaN: not continued
   const HazardOutputs& outputs;
   int frames = 0;
+  double corridor_outflow = 0;     ///< [m3] through the corridor's edge
+  double domain_edge_outflow = 0;  ///< [m3] through the domain's edge
+  std::vector<std::string> notes;  ///< run.json's notes
 };
 
 void write_terrain_record(const std::string& path, const ResolvedScenario& r, const TerrainRunFacts& f);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "jobs/drivers/hazard_outputs.hpp"
@@ -22,6 +23,9 @@ namespace {
 namespace vof = engine::vof;
 using namespace vof_terrain;
 using clk = std::chrono::steady_clock;
+
+// More of the released volume than this through the corridor's edge: run.json says the map is not complete.
+constexpr double kCorridorLossNote = 0.02;
 
 double since(clk::time_point t0) { return std::chrono::duration<double>(clk::now() - t0).count(); }
 
@@ -66,6 +70,7 @@ struct Stepper {
   std::string state_hash;
   double write_every = 0, next_write = 1e300, cp_every = 1e300, next_cp = 1e300;
   double outflow = 0, ke_peak = 0;
+  double outflow_corridor = 0, outflow_edge = 0;  ///< through the corridor's edge, through the domain's edge
   bool cancelled = false, settled = false;
 
   void save(LabCheckpoint& cp) const {
@@ -74,14 +79,18 @@ struct Stepper {
     hazard.save(cp);
     cp.figures["outflow_m3"] = outflow;
     cp.figures["ke_peak"] = ke_peak;
+    cp.figures["corridor_outflow_m3"] = outflow_corridor;
+    cp.figures["domain_edge_outflow_m3"] = outflow_edge;
   }
   void restore(const LabCheckpoint& cp, const std::string& path) {
     fig.restore(cp, path);
     hazard.restore(cp, path);
-    for (const char* k : {"outflow_m3", "ke_peak"})
+    for (const char* k : {"outflow_m3", "ke_peak", "corridor_outflow_m3", "domain_edge_outflow_m3"})
       if (!cp.figures.count(k)) throw ScenarioError("checkpoint " + path + ": damaged (no figure '" + k + "')");
     outflow = cp.figures.at("outflow_m3");
     ke_peak = cp.figures.at("ke_peak");
+    outflow_corridor = cp.figures.at("corridor_outflow_m3");
+    outflow_edge = cp.figures.at("domain_edge_outflow_m3");
   }
   void write_checkpoint_now() {
     LabCheckpoint cp;
@@ -89,10 +98,18 @@ struct Stepper {
     cp.state = s.state();
     write_checkpoint(opt.checkpoint_path, cp);
   }
-  // The granular kinetic energy and the volume through the sides in this step.
+  // The granular kinetic energy and the volume through the boundary in this step (the sides': the
+  // corridor's edge apart from the domain's).
   void balance(double dt) {
     const auto& m = s.mesh();
-    for (int f = m.n_internal; f < m.faces(); ++f) outflow += s.granular_flux()[std::size_t(f)] * dt;
+    const int sp = m.patch_index("sides");
+    const int s0 = sp < 0 ? 0 : m.patches[std::size_t(sp)].start, s1 = sp < 0 ? 0 : s0 + m.patches[std::size_t(sp)].size;
+    for (int f = m.n_internal; f < m.faces(); ++f) {
+      const double q = s.granular_flux()[std::size_t(f)] * dt;
+      outflow += q;
+      if (su.corridor_edge[std::size_t(f)]) outflow_corridor += q;
+      else if (f >= s0 && f < s1) outflow_edge += q;
+    }
     double ke = 0;
     for (int c = 0; c < m.cells(); ++c) {
       const double a = s.alpha()[std::size_t(c)];
@@ -179,7 +196,8 @@ RunSummary run_terrain_vof(const ResolvedScenario& r, const std::string& out_dir
   sum.volume_initial = su.volume_on_mesh;
   sum.notes = su.release.notes;
   sum.notes.push_back("mesh: " + std::to_string(su.columns_mesh.kept_columns()) + " columns x " + std::to_string(su.columns.layers) +
-                      " layers = " + std::to_string(su.mesh.cells()) + " cells");
+                      " layers = " + std::to_string(su.mesh.cells()) + " cells (corridor \"" + su.corridor.kind + "\": " +
+                      std::to_string(su.columns_mesh.kept_columns()) + " of the domain's " + std::to_string(su.domain_columns) + " columns)");
   if (r.scenario.vof().bed_normal_stress() == "column")
     sum.notes.push_back("vof.bed_normal_stress \"column\" is experimental: it is unstable at a release's tapered edges (docs/design/vof.md)");
   sum.seconds_prepare = since(t0);
@@ -233,8 +251,17 @@ RunSummary run_terrain_vof(const ResolvedScenario& r, const std::string& out_dir
     sum.files.push_back("fields.xmf");
   }
   sum.seconds_write = since(t2);
+  std::vector<std::string> record_notes;
+  if (su.corridor.kind != "none" && step.outflow_corridor > kCorridorLossNote * su.volume_on_mesh) {
+    char pct[32];
+    std::snprintf(pct, sizeof pct, "%.1f", 100 * step.outflow_corridor / su.volume_on_mesh);
+    record_notes.push_back(std::string("the map is not complete: ") + pct +
+                           " % of the released volume left the mesh through the corridor's edge (mesh.corridor \"" + su.corridor.kind +
+                           "\"): widen mesh.corridor_margin_m, give a wider mesh.corridor_path, or mesh.corridor \"none\"");
+    sum.notes.push_back(record_notes.back());
+  }
   TerrainRunFacts facts{su, hazard, fig, sum, continued ? restart.state.t : std::numeric_limits<double>::quiet_NaN(),
-                        outputs, n_frames};
+                        outputs, n_frames, step.outflow_corridor, step.outflow_edge, record_notes};
   write_terrain_record(out_dir + "/run.json", r, facts);
   sum.files.push_back("run.json");
   return sum;

@@ -30,11 +30,15 @@ void build_terrain_setup(const ResolvedScenario& r, TerrainSetup& out) {
   out.vertical = engine::state_from_normal_depth(t, out.h0).H;
   out.cos_slope = engine::SurfaceGeometry::from(t).c;
   out.spec = mesh_spec(r.scenario.mesh(), *std::max_element(out.vertical.begin(), out.vertical.end()));
-  out.columns_mesh = terrain::column_mesh(out.grid, out.spec);
+  out.corridor = build_corridor(r, out.grid, out.h0);
+  out.domain_columns = 0;
+  for (std::size_t c = 0; c < out.grid.cells(); ++c) out.domain_columns += out.grid.outside.empty() || out.grid.outside[c] == 0;
+  out.columns_mesh = terrain::column_mesh(out.grid, out.spec, out.corridor.cells);
   out.frame = frame_of(out.columns_mesh);
   out.columns = columns_of(out.columns_mesh);
   out.mesh = terrain_mesh(out.columns_mesh, out.frame);
   out.quality = engine::vof::mesh_quality(out.mesh);
+  out.corridor_edge = corridor_edge_faces(out.columns, out.mesh, out.grid);
   out.alpha = release_alpha(out.columns_mesh, out.vertical);
   out.volume_on_mesh = 0;
   for (std::size_t c = 0; c < out.alpha.size(); ++c) out.volume_on_mesh += out.alpha[c] * out.mesh.volume[c];

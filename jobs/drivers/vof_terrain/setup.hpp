@@ -1,12 +1,14 @@
 #pragma once
 // The set-up of a 3D run on the DEM: the scenario's grid and release (as the depth-averaged engine
-// prepares them), the terrain-following mesh over the domain's columns, the release's phase
+// prepares them), the corridor (corridor.hpp), the terrain-following mesh over the corridor's
+// columns inside the domain, the release's phase
 // fraction on it, and the named points placed on the grid.
 #include <string>
 #include <vector>
 
 #include "engine/vof/mesh_quality.hpp"
 #include "jobs/drivers/hazard_maps.hpp"
+#include "jobs/drivers/vof_terrain/corridor.hpp"
 #include "jobs/drivers/vof_terrain/hazard.hpp"
 #include "jobs/drivers/vof_terrain/mesh.hpp"
 #include "jobs/scenario/scenario.hpp"
@@ -30,11 +32,14 @@ struct TerrainSetup {
   std::vector<double> vertical;   ///< the same vertically (the depth-averaged engine's H)
   std::vector<double> cos_slope;  ///< per grid cell
   terrain::ColumnMeshSpec spec;
+  Corridor corridor;               ///< the columns meshed (mesh.corridor)
+  int domain_columns = 0;          ///< the columns inside the domain
   terrain::ColumnMesh columns_mesh;
   Frame frame;
   Columns columns;
   engine::vof::Mesh mesh;
   engine::vof::MeshQuality quality;
+  std::vector<std::uint8_t> corridor_edge;  ///< per face: 1 on the corridor's edge (corridor_edge_faces)
   std::vector<double> alpha;  ///< the release's phase fraction per cell
   double volume_on_mesh = 0;  ///< sum alpha V [m3]
   std::vector<NamedPoint> points;
