@@ -215,12 +215,15 @@ std::vector<double> read_native(const DemRequest& req, GDALDataset& dem, const d
 }
 
 // The DEM warped onto the grid by gdalwarp; rows from the north, nodata as -99999.
-std::vector<double> read_warped(const DemRequest& req, GDALDataset& dem, std::vector<std::string>& args, double res, Grid& g) {
+// The DEM warped by gdalwarp's `args`: the warped raster's geometry into g (nx, ny, dx, x_min, y_min)
+// and its rows (row 0 north). Errors name the DEM and the step (`warp_failed`, `read_failed`).
+std::vector<double> warp_rows(const std::string& dem_path, GDALDataset& dem, std::vector<std::string>& args, Grid& g,
+                              const std::string& warp_failed, const std::string& read_failed) {
   const auto wopt = warp_options(args);
   GDALDatasetH srch = GDALDataset::ToHandle(&dem);
   int usage_error = 0;
   GDALDatasetUniquePtr warped(GDALDataset::FromHandle(GDALWarp("", nullptr, 1, &srch, wopt.get(), &usage_error)));
-  if (!warped) throw TerrainError("DEM '" + req.dem_path + "': reprojection failed" + gdal_message());
+  if (!warped) throw TerrainError("DEM '" + dem_path + "': " + warp_failed + gdal_message());
   g.nx = warped->GetRasterXSize();
   g.ny = warped->GetRasterYSize();
   double wgt[6];
@@ -228,10 +231,15 @@ std::vector<double> read_warped(const DemRequest& req, GDALDataset& dem, std::ve
   g.dx = wgt[1];
   g.x_min = wgt[0];
   g.y_min = wgt[3] + wgt[5] * g.ny;
-  if (g.nx < 3 || g.ny < 3) throw TerrainError("the area of interest covers fewer than 3 x 3 cells at " + fmt(res, 2) + " m");
   std::vector<double> rows(g.cells());
   if (warped->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, g.nx, g.ny, rows.data(), g.nx, g.ny, GDT_Float64, 0, 0) != CE_None)
-    throw TerrainError("DEM '" + req.dem_path + "': reading the reprojected raster failed" + gdal_message());
+    throw TerrainError("DEM '" + dem_path + "': " + read_failed + gdal_message());
+  return rows;
+}
+
+std::vector<double> read_warped(const DemRequest& req, GDALDataset& dem, std::vector<std::string>& args, double res, Grid& g) {
+  auto rows = warp_rows(req.dem_path, dem, args, g, "reprojection failed", "reading the reprojected raster failed");
+  if (g.nx < 3 || g.ny < 3) throw TerrainError("the area of interest covers fewer than 3 x 3 cells at " + fmt(res, 2) + " m");
   return rows;
 }
 
@@ -400,24 +408,11 @@ Grid dem_surface(const DemRequest& req, const Grid& g, double res, double x0, do
   auto args = resample_args(req, *dem, src, dst, res);
   const int nx = std::max(3, int(std::ceil((x1 - x0) / res))), ny = std::max(3, int(std::ceil((y1 - y0) / res)));
   for (const std::string& a : {std::string("-te"), fmt(x0, 6), fmt(y0, 6), fmt(x0 + nx * res, 6), fmt(y0 + ny * res, 6)}) args.push_back(a);
-  const auto wopt = warp_options(args);
-  GDALDatasetH srch = GDALDataset::ToHandle(dem.get());
-  int usage_error = 0;
-  GDALDatasetUniquePtr warped(GDALDataset::FromHandle(GDALWarp("", nullptr, 1, &srch, wopt.get(), &usage_error)));
-  if (!warped) throw TerrainError("DEM '" + req.dem_path + "': resampling it at the slope window's spacing failed" + gdal_message());
   Grid s;
-  s.nx = warped->GetRasterXSize();
-  s.ny = warped->GetRasterYSize();
-  double wgt[6];
-  warped->GetGeoTransform(wgt);
-  s.dx = wgt[1];
-  s.x_min = wgt[0];
-  s.y_min = wgt[3] + wgt[5] * s.ny;
   s.crs_wkt = g.crs_wkt;
   s.crs_name = g.crs_name;
-  std::vector<double> rows(s.cells());
-  if (warped->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, s.nx, s.ny, rows.data(), s.nx, s.ny, GDT_Float64, 0, 0) != CE_None)
-    throw TerrainError("DEM '" + req.dem_path + "': reading the resampled raster failed" + gdal_message());
+  const auto rows = warp_rows(req.dem_path, *dem, args, s, "resampling it at the slope window's spacing failed",
+                              "reading the resampled raster failed");
   DemReport unused;
   take_rows(s, rows, unused);
   fill_without_data(s);
