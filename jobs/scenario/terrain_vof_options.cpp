@@ -58,7 +58,7 @@ const OptionTable& terrain_vof_options() {
       {"vof.bed_normal_stress", T::choice, U::fill, "pressure", {}, {"pressure", "total", "column"}, "",
        "the bed friction's normal load: the ground cell's pressure, its total normal stress (less the viscous normal stress), or "
        "the column's weight (its bed-normal part and the curved bed's centripetal load, at least the bed's pressure) acting on the "
-       "column's material; \"column\" is experimental: unstable at a release's tapered edges (docs/design/vof.md)",
+       "column's material; \"column\" is experimental: it runs away on real terrain (docs/design/vof.md)",
        "PatchBc::friction_total_normal_stress, VofConfig::column_friction"},
       {"vof.max_viscosity_m2_s", T::number, U::as_given, "", Range{1, 1e8}, {}, "m2/s",
        "the Coulomb viscosity's clip nu_max, default 1e2: material at rest creeps at about g sin(theta) h^2 / (3 nu_max) "

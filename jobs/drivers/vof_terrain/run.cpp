@@ -153,6 +153,25 @@ void write_3d_rasters(const TerrainSetup& su, const ColumnHazard& hz, const std:
   sum.files.push_back("max_ground_stress.tif");
 }
 
+// The run summary's figures of the set-up: the grid, the release, the mesh and its corridor.
+RunSummary summary_of_setup(const ResolvedScenario& r, const TerrainSetup& su) {
+  RunSummary sum;
+  sum.nx = su.grid.nx;
+  sum.ny = su.grid.ny;
+  sum.dx = su.grid.dx;
+  sum.crs = su.grid.crs_name;
+  sum.release_area_m2 = su.release.area_m2;
+  sum.release_volume_m3 = su.release.volume_m3;
+  sum.volume_initial = su.volume_on_mesh;
+  sum.notes = su.release.notes;
+  sum.notes.push_back("mesh: " + std::to_string(su.columns_mesh.kept_columns()) + " columns x " + std::to_string(su.columns.layers) +
+                      " layers = " + std::to_string(su.mesh.cells()) + " cells (corridor \"" + su.corridor.kind + "\": " +
+                      std::to_string(su.columns_mesh.kept_columns()) + " of the domain's " + std::to_string(su.domain_columns) + " columns)");
+  if (r.scenario.vof().bed_normal_stress() == "column")
+    sum.notes.push_back("vof.bed_normal_stress \"column\" is experimental: it runs away on real terrain (docs/design/vof.md)");
+  return sum;
+}
+
 }  // namespace
 
 RunSummary run_terrain_vof(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt) {
@@ -186,20 +205,7 @@ RunSummary run_terrain_vof(const ResolvedScenario& r, const std::string& out_dir
   hs.flow_threshold = r.config.flow_threshold;
   ColumnHazard hazard(su.columns, s.mesh(), su.cos_slope, hs, tracked);
 
-  RunSummary sum;
-  sum.nx = su.grid.nx;
-  sum.ny = su.grid.ny;
-  sum.dx = su.grid.dx;
-  sum.crs = su.grid.crs_name;
-  sum.release_area_m2 = su.release.area_m2;
-  sum.release_volume_m3 = su.release.volume_m3;
-  sum.volume_initial = su.volume_on_mesh;
-  sum.notes = su.release.notes;
-  sum.notes.push_back("mesh: " + std::to_string(su.columns_mesh.kept_columns()) + " columns x " + std::to_string(su.columns.layers) +
-                      " layers = " + std::to_string(su.mesh.cells()) + " cells (corridor \"" + su.corridor.kind + "\": " +
-                      std::to_string(su.columns_mesh.kept_columns()) + " of the domain's " + std::to_string(su.domain_columns) + " columns)");
-  if (r.scenario.vof().bed_normal_stress() == "column")
-    sum.notes.push_back("vof.bed_normal_stress \"column\" is experimental: it is unstable at a release's tapered edges (docs/design/vof.md)");
+  RunSummary sum = summary_of_setup(r, su);
   sum.seconds_prepare = since(t0);
 
   const double write_every = r.scenario.vof().write_interval_s();
