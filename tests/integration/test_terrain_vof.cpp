@@ -528,3 +528,22 @@ TEST(TerrainVof, ResultsDoNotDependOnTheThreadCount) {
     EXPECT_EQ(differ, 0u) << k + 1 << " threads against 1";
   }
 }
+
+// A run on the column load (experimental; it runs away on real terrain) says so in run.json's notes,
+// and a run on the default load does not.
+TEST(TerrainVof, ColumnLoadRunSaysItIsExperimental) {
+  auto sc = runout::jobs::parse_scenario_json(runout::test_support::read_text(kArelen3d));
+  sc.mutable_grid()->set_resolution_m(90);
+  sc.mutable_numerics()->set_end_time_s(0.3);
+  sc.mutable_vof()->set_write_interval_s(0);
+  sc.mutable_vof()->clear_profiles();
+  for (const std::string load : {"column", "pressure"}) {
+    sc.mutable_vof()->set_bed_normal_stress(load);
+    runout::test_support::TempDir d;
+    runout::jobs::run_scenario(runout::jobs::resolve_scenario(sc, kArelen3d.parent_path().string()), d.p.string());
+    const auto rec = runout::jobs::read_run_record((d.p / "run.json").string());
+    bool said = false;
+    for (const auto& n : rec.notes()) said = said || n.find("\"column\" is experimental") != std::string::npos;
+    EXPECT_EQ(said, load == "column") << load;
+  }
+}

@@ -167,8 +167,6 @@ RunSummary summary_of_setup(const ResolvedScenario& r, const TerrainSetup& su) {
   sum.notes.push_back("mesh: " + std::to_string(su.columns_mesh.kept_columns()) + " columns x " + std::to_string(su.columns.layers) +
                       " layers = " + std::to_string(su.mesh.cells()) + " cells (corridor \"" + su.corridor.kind + "\": " +
                       std::to_string(su.columns_mesh.kept_columns()) + " of the domain's " + std::to_string(su.domain_columns) + " columns)");
-  if (r.scenario.vof().bed_normal_stress() == "column")
-    sum.notes.push_back("vof.bed_normal_stress \"column\" is experimental: it runs away on real terrain (docs/design/vof.md)");
   return sum;
 }
 
@@ -257,15 +255,17 @@ RunSummary run_terrain_vof(const ResolvedScenario& r, const std::string& out_dir
     sum.files.push_back("fields.xmf");
   }
   sum.seconds_write = since(t2);
-  std::vector<std::string> record_notes;
+  std::vector<std::string> record_notes;  // what the reader of the maps must know: run.json's notes and the summary's
+  if (r.scenario.vof().bed_normal_stress() == "column")
+    record_notes.push_back("vof.bed_normal_stress \"column\" is experimental: it runs away on real terrain (docs/design/vof.md)");
   if (su.corridor.kind != "none" && step.outflow_corridor > kCorridorLossNote * su.volume_on_mesh) {
     char pct[32];
     std::snprintf(pct, sizeof pct, "%.1f", 100 * step.outflow_corridor / su.volume_on_mesh);
     record_notes.push_back(std::string("the map is not complete: ") + pct +
                            " % of the released volume left the mesh through the corridor's edge (mesh.corridor \"" + su.corridor.kind +
                            "\"): widen mesh.corridor_margin_m, give a wider mesh.corridor_path, or mesh.corridor \"none\"");
-    sum.notes.push_back(record_notes.back());
   }
+  sum.notes.insert(sum.notes.end(), record_notes.begin(), record_notes.end());
   TerrainRunFacts facts{su, hazard, fig, sum, continued ? restart.state.t : std::numeric_limits<double>::quiet_NaN(),
                         outputs, n_frames, step.outflow_corridor, step.outflow_edge, record_notes};
   write_terrain_record(out_dir + "/run.json", r, facts);
