@@ -1,6 +1,7 @@
 // The 3D engine on terrain: cost per step against the material, on two domain sizes.
 //
 //   runout_bench_terrain [--end T] [--pc ilu|gamg]
+//   runout_bench_terrain --arelen [--resolution R] [--end T]
 //
 // The same block (60 m square, 2 m thick, phi 40, delta 20) released on a 35 deg plane (10 m
 // columns) through the terrain driver's mesh, release and configuration (the scenario defaults of
@@ -9,7 +10,14 @@
 // cell-step and per active cell-step, the share of the pressure correctors and of the pressure
 // solves in the step, wall time and threads. With the active region the cost per step follows the
 // active cells, not the mesh (docs/design/performance.md, "3D engine on terrain"). Threads: OMP_NUM_THREADS.
+//
+// --arelen: scenarios/in-den-arelen-3d.json as bundled (30 m, the kinetic-energy stop rule; R and T
+// change the grid and the end time) through the run driver, as `runout run` runs it: wall time,
+// steps, simulated time, the mesh's and the active region's cells, what set each step's length
+// (the Courant number in the material, at the interface or in the air, the growth limit) and the
+// mean step (docs/design/performance.md, "In den Arelen at 30 m").
 #include <omp.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cmath>
@@ -21,11 +29,17 @@
 #include "engine/sh2d.hpp"
 #include "engine/vof/solver.hpp"
 #include "jobs/drivers/hazard_outputs.hpp"
+#include "jobs/drivers/run.hpp"
 #include "jobs/drivers/vof_terrain/config.hpp"
 #include "jobs/drivers/vof_terrain/mesh.hpp"
 #include "jobs/drivers/vof_terrain/release.hpp"
 #include "jobs/scenario/options.hpp"
+#include "jobs/formats/run_record.hpp"
+#include "jobs/scenario/scenario.hpp"
 #include "terrain/column_mesh.hpp"
+
+#include <filesystem>
+#include <map>
 
 namespace {
 
@@ -89,21 +103,65 @@ Row run(int nx, int ny, double t_end, const std::string& pc) {
   return row;
 }
 
+// In den Arelen through the run driver (--arelen); t_end, res_m: the scenario's when 0.
+int run_arelen(double res_m, double t_end) {
+  namespace fs = std::filesystem;
+  const fs::path file = fs::path(RUNOUT_SOURCE_DIR) / "scenarios" / "in-den-arelen-3d.json";
+  auto r = runout::jobs::load_scenario(file.string());
+  if (res_m > 0 || t_end > 0) {
+    if (res_m > 0) r.scenario.mutable_grid()->set_resolution_m(res_m);
+    if (t_end > 0) r.scenario.mutable_numerics()->set_end_time_s(t_end);
+    r = runout::jobs::resolve_scenario(r.scenario, file.parent_path().string());
+  }
+  const fs::path out = fs::temp_directory_path() / ("runout_bench_arelen_" + std::to_string(::getpid()));
+  fs::create_directories(out);
+  std::map<std::string, long> limits;
+  double dt_sum = 0;
+  runout::jobs::RunOptions opt;
+  opt.progress_every = 1;
+  opt.progress = [&](const runout::engine::Progress& p) {
+    ++limits[p.dt_limit];
+    dt_sum += p.dt;
+    return true;
+  };
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto sum = runout::jobs::run_scenario(r, out.string(), opt);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const auto rec = runout::jobs::read_run_record((out / "run.json").string());
+  fs::remove_all(out);
+  std::printf("In den Arelen 3D at %.0f m, %d threads: %ld steps to %.1f s of flow (stop: %s) in %.0f s wall (%.0f s CPU)\n", sum.dx,
+              omp_get_max_threads(), sum.steps, sum.t, sum.stop.c_str(), wall, sum.cpu_seconds);
+  std::printf("mesh: %d columns, %d cells; active cells %.0f on average, %d at most; mean step %.4f s\n", rec.terrain_mesh().columns(),
+              rec.terrain_mesh().cells(), rec.solver().active_cells_mean(), rec.solver().active_cells_max(), dt_sum / std::max(1L, sum.steps));
+  std::printf("what set the step's length:");
+  for (const auto& [what, n] : limits) std::printf(" %s %.1f %%;", what.c_str(), 100.0 * n / std::max(1L, sum.steps));
+  std::printf("\nout of the mesh: %.2f %% of the released volume; affected area %.3f km2, runout %.0f m\n",
+              100 * sum.volume_outflow / sum.volume_initial, sum.affected_area_m2 / 1e6, sum.runout_m);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  double t_end = 1.0;
+  double t_end = 1.0, res_m = 0;
+  bool arelen = false, t_given = false;
   std::string pc = "ilu";
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--end") && i + 1 < argc) {
       t_end = std::atof(argv[++i]);
+      t_given = true;
     } else if (!std::strcmp(argv[i], "--pc") && i + 1 < argc) {
       pc = argv[++i];
+    } else if (!std::strcmp(argv[i], "--arelen")) {
+      arelen = true;
+    } else if (!std::strcmp(argv[i], "--resolution") && i + 1 < argc) {
+      res_m = std::atof(argv[++i]);
     } else {
-      std::fprintf(stderr, "usage: runout_bench_terrain [--end T] [--pc ilu|gamg]\n");
+      std::fprintf(stderr, "usage: runout_bench_terrain [--end T] [--pc ilu|gamg]\n       runout_bench_terrain --arelen [--resolution R] [--end T]\n");
       return 2;
     }
   }
+  if (arelen) return run_arelen(res_m, t_given ? t_end : 0);
   const int threads = omp_get_max_threads();  // OMP_NUM_THREADS (loops under 4,096 elements stay serial)
   std::printf("block 60 m x 2 m on a 35 deg plane, 10 m columns, to %.2f s, pressure preconditioner %s, %d threads\n\n", t_end, pc.c_str(),
               threads);

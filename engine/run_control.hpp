@@ -23,6 +23,7 @@ inline std::string_view to_string(StopReason r) {
 struct Progress {
   double t = 0, dt = 0, mass = 0, max_speed = 0, kinetic_energy = 0, active_fraction = 0;
   long step = 0;
+  const char* dt_limit = "";  ///< what set dt (the VOF engine: engine::vof::StepStats::dt_limit)
 };
 /// Returns false to cancel the run (it then stops cleanly at the end of the step).
 using ProgressHook = std::function<bool(const Progress&)>;

@@ -3,7 +3,9 @@
 // last face fluxes, upwind plus a correction toward the central value with interface compression
 // (c_alpha), limited by Zalesak's flux-corrected transport so that every cell stays within its
 // neighbours' bounds and [0, 1] (interFoam's MULES), in sub-cycles. Leaves the step's granular flux
-// alpha_phi and the mass flux rho_phi.
+// alpha_phi and the mass flux rho_phi. With VofConfig::settling_speed the granular phase also falls
+// through the air along gravity (a monotone settling flux in the low-order part), with as many more
+// sub-cycles as keep its Courant number at most 0.5.
 #include "engine/vof/active_region.hpp"
 #include "engine/vof/bc/boundary.hpp"
 #include "engine/vof/fields.hpp"
@@ -14,11 +16,15 @@ class AlphaEqn {
  public:
   AlphaEqn(const Mesh& m, const VofConfig& cfg, const BcContext& bc_ctx, const Boundaries& bcs, const ActiveRegion& region,
            double mean_cell_size);
-  void solve(Fields& F, double dt);
+  void solve(Fields& F, double dt, const Vec& gravity);
+  /// The sub-cycles of the last solve (at least VofConfig::alpha_subcycles).
+  int subcycles() const { return subcycles_; }
 
  private:
   void interface_normal(const Fields& F);
   void fluxes_and_bounds(const Fields& F);
+  void settling_fluxes(const Fields& F);
+  int settling_subcycles(const Vec& gravity, double dt);
   void limit_and_update(Fields& F, double dts, int subcycles);
 
   const Mesh& m_;
@@ -30,6 +36,8 @@ class AlphaEqn {
   FaceField<double> FL_, AF_;  // low-order flux; antidiffusive flux (high-order less low-order), then its limited share of the step
   CellField<double> amax_, amin_, Rp_, Rm_, aL_;  // local bounds; Zalesak's ratios; alpha V
   CellField<Vec> grad_alpha_;
+  FaceField<double> settle_;  // w (g/|g|).Sf per face (settling on)
+  int subcycles_ = 1;
 };
 
 }  // namespace runout::engine::vof

@@ -40,8 +40,9 @@ void check_columns(const Mesh& m, const MeshColumns& c) {
 }
 
 BedLoad add_column_friction(const Mesh& m, const ColumnFrictionConfig& cf, double rho1, const Fields& F, const Hydrostatics& hs,
-                            const ActiveRegion& region, FvMatrix<Vec>& UEqn) {
+                            const ActiveRegion& region, FvMatrix<Vec>& UEqn, ColumnDrag& out) {
   const MeshColumns& cols = cf.columns;
+  for (int c : region.halo) out.drag[c] = 0;
   const Vec g = hs.gravity();
   BedLoad load;
   for (int k = 0; k < cols.columns(); ++k) {
@@ -51,15 +52,17 @@ BedLoad add_column_friction(const Mesh& m, const ColumnFrictionConfig& cf, doubl
     const int f = cols.bed_face[std::size_t(k)];
     const Vec n = (1.0 / m.magSf[f]) * m.Sf[f];  // out of the domain, into the ground
     // The column's material and its velocity (volume-weighted).
-    double material = 0;
+    double material = 0, column_volume = 0;
     Vec um;
     for (int i = b; i < e; ++i) {
       const int c = cols.cells[std::size_t(i)];
       const double v = F.alpha[c] * m.volume[c];
       material += v;
+      column_volume += m.volume[c];
       um = um + v * F.U[c];
     }
-    if (!(material > 0)) continue;
+    // Round-off traces (down to denormal numbers, whose mean velocity overflows) carry no load.
+    if (!(material > 1e-12 * column_volume)) continue;
     um = (1.0 / material) * um;
     const Vec ut = um - dot(um, n) * n;
     const double mass = rho1 * material;
@@ -86,7 +89,11 @@ BedLoad add_column_friction(const Mesh& m, const ColumnFrictionConfig& cf, doubl
       if (!(v > 0) || !region.active(c)) continue;
       const double drag = per_volume * v;
       UEqn.diag[c] += drag;  // the part on the bed-normal velocity given back: the force acts along the bed
-      UEqn.source[c] = UEqn.source[c] + (drag * dot(F.U[c], n)) * n;
+      const Vec back = (drag * dot(F.U[c], n)) * n;
+      UEqn.source[c] = UEqn.source[c] + back;
+      out.drag[c] = drag;
+      out.given_back[c] = back;
+      out.normal[c] = n;
     }
   }
   return load;

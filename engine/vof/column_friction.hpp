@@ -48,10 +48,19 @@ struct ColumnFrictionConfig {
   double creep_speed = 1e-4;  ///< [m/s]; below it the force falls linearly
 };
 
+/// The friction's drag per cell (its diagonal coefficient [kg/s]; 0 where none) and its column's bed
+/// normal: the pressure coupling takes the drag along the bed only (MomentumEqn).
+struct ColumnDrag {
+  CellField<double> drag;
+  CellField<Vec> normal;
+  CellField<Vec> given_back;  ///< the source's explicit part on the bed-normal velocity, drag (U.n) n
+};
+
 /// Adds the columns' bed friction to the momentum matrix's diagonal and source (cells of the active
-/// region only) and returns the loads; rho1 the material's density.
+/// region only), fills `drag` (sized to the mesh; cells of the active region set) and returns the
+/// loads; rho1 the material's density.
 BedLoad add_column_friction(const Mesh& m, const ColumnFrictionConfig& cf, double rho1, const Fields& F, const Hydrostatics& hs,
-                            const ActiveRegion& region, FvMatrix<Vec>& UEqn);
+                            const ActiveRegion& region, FvMatrix<Vec>& UEqn, ColumnDrag& drag);
 
 /// Checks a MeshColumns against the mesh (offsets, cell and face indices, one column per bed face);
 /// throws VofError naming what is wrong.

@@ -23,6 +23,41 @@ MomentumEqn::MomentumEqn(const Mesh& m, const VofConfig& cfg, const BcContext& b
   diag_o_.assign(nf, 0);
   diag_n_ = diag_o_;
   face_vec_.assign(nf, Vec{});
+  drA.assign(nc, 0);
+  drAt = drA;
+  column_ = cfg.column_friction.columns.columns() > 0;
+  if (column_) {
+    drag_.drag.assign(nc, 0);
+    drag_.normal.assign(nc, Vec{});
+    drag_.given_back.assign(nc, Vec{});
+    diag_no_drag_.assign(nc, 0);
+  }
+}
+
+namespace {
+double sq_along(const Vec& n, const Vec& s) {
+  const double c = dot(n, s) / norm(s);
+  return c * c;
+}
+}  // namespace
+
+double MomentumEqn::rA_along(bool consistent, int c, const Vec& s) const {
+  const double r = consistent ? rAtU[c] : rAU[c], dr = consistent ? drAt[c] : drA[c];
+  return dr != 0 ? r + dr * sq_along(drag_.normal[c], s) : r;
+}
+
+Vec MomentumEqn::rA_apply(bool consistent, int c, const Vec& v) const {
+  const double r = consistent ? rAtU[c] : rAU[c], dr = consistent ? drAt[c] : drA[c];
+  if (dr == 0) return r * v;
+  const Vec& n = drag_.normal[c];
+  return r * v + (dr * dot(n, v)) * n;
+}
+
+Vec MomentumEqn::rA_difference_apply(int c, const Vec& v) const {
+  const double dr = drA[c] - drAt[c];
+  if (drA[c] == 0 && drAt[c] == 0) return (rAU[c] - rAtU[c]) * v;
+  const Vec& n = drag_.normal[c];
+  return (rAU[c] - rAtU[c]) * v + (dr * dot(n, v)) * n;
 }
 
 void MomentumEqn::setup_predictor() { solver_.setup(cfg_.momentum_rtol); }
@@ -67,8 +102,11 @@ void MomentumEqn::build(const Fields& F, double dt) {
   if (cfg_.momentum_convection == Convection::limited_linear) limited_linear_correction(F);
   boundary_terms(F);
   if (cfg_.side_walls.width > 0) side_wall_friction(F);
-  if (cfg_.column_friction.columns.columns() > 0)
-    bed_load = add_column_friction(m_, cfg_.column_friction, cfg_.rho1, F, bc_ctx_.hydrostatics, region_, UEqn_);
+  if (column_) {
+    // The diagonal without the drag (A - D loses its digits where the drag outweighs it).
+    parallel_each(region_.halo, [&](int c) { diag_no_drag_[c] = UEqn_.diag[c]; });
+    bed_load = add_column_friction(m_, cfg_.column_friction, cfg_.rho1, F, bc_ctx_.hydrostatics, region_, UEqn_, drag_);
+  }
   coefficients(F, dt);
 }
 
@@ -227,11 +265,54 @@ void MomentumEqn::coefficients(const Fields& F, double dt) {
     rAtU[c] = F.alpha[c] < cfg_.consistent_alpha ? rAU[c] : V / std::max(A[c] - H1_[c], 0.5 * F.rho[c] * V / dt);
   });
   parallel_each(region_.faces, [&](int f) { rAtUf[f] = interpolate_or_owner(m_, f, rAtU); });
+  if (column_) normal_coefficients(F, dt);
+}
+
+// Where the column friction's drag D acts, the coefficients along the bed normal leave it out:
+// 1/(A - D) and 1/(A - D - H1) (the drag acts along the bed only); the faces take each cell's
+// coefficient along their normal, interpolated as the scalar ones are.
+void MomentumEqn::normal_coefficients(const Fields& F, double dt) {
+  parallel_each(region_.halo, [&](int c) {
+    const double D = drag_.drag[c], V = m_.volume[c];
+    if (!(D > 0)) {
+      drA[c] = drAt[c] = 0;
+      return;
+    }
+    const double A0 = diag_no_drag_[c];
+    drA[c] = V / A0 - rAU[c];
+    if (cfg_.consistent)
+      drAt[c] = F.alpha[c] < cfg_.consistent_alpha ? drA[c] : V / std::max(A0 - H1_[c], 0.5 * F.rho[c] * V / dt) - rAtU[c];
+  });
+  parallel_each(region_.faces, [&](int f) {
+    const int o = m_.owner[f];
+    const Vec& S = m_.Sf[f];
+    auto along = [&](const CellField<double>& dr, int c) { return dr[c] != 0 ? dr[c] * sq_along(drag_.normal[c], S) : 0.0; };
+    if (!internal(m_, f)) {
+      rAUf[f] += along(drA, o);
+      if (cfg_.consistent) rAtUf[f] += along(drAt, o);
+      return;
+    }
+    const int nb = m_.neighbour[f];
+    const double w = m_.weight[f];
+    rAUf[f] += w * along(drA, o) + (1 - w) * along(drA, nb);
+    if (cfg_.consistent) rAtUf[f] += w * along(drAt, o) + (1 - w) * along(drAt, nb);
+  });
 }
 
 void MomentumEqn::update_HbyA(const Fields& F) {
   UEqn_.H(m_, region_.cell_faces(), region_.face_in, F.U, region_.halo, H_);
   parallel_each(region_.halo, [&](int c) { HbyA[c] = (1.0 / UEqn_.diag[c]) * H_[c]; });
+  if (!column_) return;
+  // Where the column friction acts: (A along the bed, A - D along n)^-1 (H less the drag's explicit
+  // part on the normal velocity), the momentum equation with the drag along the bed only.
+  parallel_each(region_.halo, [&](int c) {
+    const double D = drag_.drag[c];
+    if (!(D > 0)) return;
+    const double A = UEqn_.diag[c];
+    const Vec h = H_[c] - drag_.given_back[c];
+    const Vec& n = drag_.normal[c];
+    HbyA[c] = (1.0 / A) * h + ((1.0 / diag_no_drag_[c] - 1.0 / A) * dot(n, h)) * n;
+  });
 }
 
 void MomentumEqn::unit_coefficients() {

@@ -41,6 +41,18 @@ class MomentumEqn {
   CellField<double> rAU, rAtU;   ///< 1/A per unit volume [m3 s/kg]; the consistent coupling's 1/(A - H1)
   FaceField<double> rAUf, rAtUf; ///< the same on the faces
   CellField<Vec> HbyA;
+  /// Where the column friction acts (VofConfig::column_friction) its drag holds the velocity along
+  /// the bed only, so the coefficients along the bed normal n are those without it: larger by drA
+  /// (1/A) and drAt (1/(A - H1)) per unit volume; zero elsewhere. A face or a vector takes the
+  /// coefficient r + dr (s.n)^2 along its unit normal s, r v + dr (n.v) n (docs/design/vof.md).
+  CellField<double> drA, drAt;
+  const CellField<Vec>& bed_normal() const { return drag_.normal; }
+  /// 1/A (consistent: 1/(A - H1)) of cell c along the direction of s.
+  double rA_along(bool consistent, int c, const Vec& s) const;
+  /// 1/A (consistent: 1/(A - H1)) of cell c applied to v.
+  Vec rA_apply(bool consistent, int c, const Vec& v) const;
+  /// (1/A - 1/(A - H1)) of cell c applied to v.
+  Vec rA_difference_apply(int c, const Vec& v) const;
   BedLoad bed_load;  ///< the column friction's loads at the last build (VofConfig::column_friction)
 
  private:
@@ -51,6 +63,7 @@ class MomentumEqn {
   void boundary_terms(const Fields& F);
   void side_wall_friction(const Fields& F);
   void coefficients(const Fields& F, double dt);
+  void normal_coefficients(const Fields& F, double dt);
   void predictor_forces();
   void predictor_rows(const Fields& F);
 
@@ -65,6 +78,9 @@ class MomentumEqn {
   CellField<Vec> H_;
   CellField<double> H1_;
   CellField<Vec> force_;          // the predictor's force
+  ColumnDrag drag_;               // the column friction's drag per cell (sized when it acts)
+  CellField<double> diag_no_drag_;  // the diagonal before the drag was added
+  bool column_ = false;
   FaceField<double> diag_o_, diag_n_;  // per face: what it adds to its owner's and neighbour's diagonal
   FaceField<Vec> face_vec_;       // per face: the transpose stress it gives its cells
   std::vector<int> rows_, row_of_;  // the predicted cells (ascending); per cell its row or -1

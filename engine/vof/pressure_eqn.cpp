@@ -32,7 +32,7 @@ int PressureEqn::correct(Fields& F, const MomentumEqn& UEqn, bool initial, bool 
   // 1/(A - H1); the part of the last pressure's force that 1/A would have carried, (1/A -
   // 1/(A - H1)) F_old, stays in the predicted flux and velocity (SIMPLEC).
   const bool cons = cfg_.consistent && !initial;
-  const Coupling k{cons, cons ? UEqn.rAtU : UEqn.rAU, cons ? UEqn.rAtUf : UEqn.rAUf};
+  const Coupling k{cons, cons ? UEqn.rAtU : UEqn.rAU, cons ? UEqn.rAtUf : UEqn.rAUf, UEqn};
   // Within a step 1/A, the density and the active region do not change (reuse), and with them
   // neither which faces are openings, the Laplacian coefficients, the buoyancy fluxes nor the
   // outside pressures: those are set by the step's first call. Every call forms the predicted flux
@@ -75,7 +75,7 @@ void PressureEqn::laplacian_coefficients(const Fields& F, const Coupling& k) {
       } else if (ao || an) {
         const int a = ao ? o : nb;
         open_[f] = ao ? 1 : -1;
-        coef[f] = k.rA[a] * m_.magSf[f] * m_.delta_coeff[f];
+        coef[f] = k.U.rA_along(k.consistent, a, m_.Sf[f]) * m_.magSf[f] * m_.delta_coeff[f];
         pout_[f] = hs.outside_p_rgh(f, a);
       }
     } else if (ao && bcs_[f].opening()) {
@@ -91,7 +91,6 @@ void PressureEqn::laplacian_coefficients(const Fields& F, const Coupling& k) {
 void PressureEqn::predicted_flux(const MomentumEqn& UEqn, bool initial, const Coupling& k) {
   const Hydrostatics& hs = bc_ctx_.hydrostatics;
   const auto& HbyA = UEqn.HbyA;
-  const auto &rAU = UEqn.rAU, &rAtU = UEqn.rAtU;
   const auto &rAUf = UEqn.rAUf, &rAtUf = UEqn.rAtUf;
   const bool non_orth = cfg_.n_non_orthogonal_correctors > 0;
   // Per face: the predicted flux, and (consistent coupling) the face force that its active cells'
@@ -115,7 +114,7 @@ void PressureEqn::predicted_flux(const MomentumEqn& UEqn, bool initial, const Co
         if (k.consistent) {
           const double sg = op;
           const double Fout = hs.opening_force(f, a, pout_[f]);  // out of a
-          ph += sg * (rAU[a] - rAtU[a]) * Fout * m_.magSf[f];
+          ph += sg * (UEqn.rA_along(false, a, m_.Sf[f]) - UEqn.rA_along(true, a, m_.Sf[f])) * Fout * m_.magSf[f];
           w = sg * Fout;
         }
       }
@@ -123,7 +122,7 @@ void PressureEqn::predicted_flux(const MomentumEqn& UEqn, bool initial, const Co
       ph = bcs_[f].predicted_flux(bc_ctx_, f, HbyA[o], initial);
       if (bcs_[f].opening() && k.consistent) {
         const double Fout = hs.opening_force(f, o, pout_[f]);
-        ph += (rAU[o] - rAtU[o]) * Fout * m_.magSf[f];
+        ph += (UEqn.rA_along(false, o, m_.Sf[f]) - UEqn.rA_along(true, o, m_.Sf[f])) * Fout * m_.magSf[f];
         w = Fout;
       }
     }
@@ -204,7 +203,8 @@ void PressureEqn::correct_flux_and_velocity(Fields& F, const MomentumEqn& UEqn, 
       const double sg = op;
       const double pflux_out = pEqn_.flux_out(f, F.p_rgh[a], pout_[f]);
       F.phi[f] = phiHbyA_[f] + sg * pflux_out;
-      if (k.rA[a] > 0) w = pflux_out / k.rA[a] / m_.magSf[f] * sg;
+      const double ra = k.U.rA_along(k.consistent, a, m_.Sf[f]);
+      if (ra > 0) w = pflux_out / ra / m_.magSf[f] * sg;
     } else {
       const double pflux = internal(m_, f) ? pEqn_.flux(m_, f, F.p_rgh) : 0.0;
       F.phi[f] = phiHbyA_[f] + pflux;
@@ -219,8 +219,8 @@ void PressureEqn::correct_flux_and_velocity(Fields& F, const MomentumEqn& UEqn, 
   gather_face_forces(rec_);
   parallel_each(region_.cells, [&](int c) {
     const Vec R = reconstruct_(c, rec_[c]);
-    F.U[c] = UEqn.HbyA[c] + k.rA[c] * R;
-    if (k.consistent) F.U[c] = F.U[c] + (UEqn.rAU[c] - UEqn.rAtU[c]) * reconstruct_(c, rec_old_[c]);
+    F.U[c] = UEqn.HbyA[c] + UEqn.rA_apply(k.consistent, c, R);
+    if (k.consistent) F.U[c] = F.U[c] + UEqn.rA_difference_apply(c, reconstruct_(c, rec_old_[c]));
   });
 }
 

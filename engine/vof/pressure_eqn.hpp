@@ -32,6 +32,7 @@ class PressureEqn {
     bool consistent;
     const CellField<double>& rA;
     const FaceField<double>& rAf;
+    const MomentumEqn& U;  // the cells' coefficients along a direction (the column friction's drag acts along the bed only)
   };
   void laplacian_coefficients(const Fields& F, const Coupling& k);
   void predicted_flux(const MomentumEqn& UEqn, bool initial, const Coupling& k);

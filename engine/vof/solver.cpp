@@ -101,7 +101,7 @@ struct VofSolver::Impl {
     }
   }
   Courant courant(double dt) const;
-  double next_dt(const Courant& co, double dt, double time_left) const;
+  double next_dt(const Courant& co, double dt, double time_left, const char*& limit) const;
   void initial_pressure(double t);
   void diagnostics(StepStats& st, double t);
 };
@@ -126,12 +126,16 @@ VofSolver::Impl::Courant VofSolver::Impl::courant(double dt) const {
 }
 
 // The next step's length: the Courant numbers' targets, growing by at most 20 % a step, at most
-// dt_max, and not beyond the end of run().
-double VofSolver::Impl::next_dt(const Courant& co, double dt, double time_left) const {
-  const double fac = std::min({cfg.max_co / std::max(co.co, 1e-30), cfg.max_alpha_co / std::max(co.alpha_co, 1e-30),
-                               cfg.max_air_co / std::max(co.air_co, 1e-30)});
+// dt_max, and not beyond the end of run(); `limit` names what set it.
+double VofSolver::Impl::next_dt(const Courant& co, double dt, double time_left, const char*& limit) const {
+  const double f_mat = cfg.max_co / std::max(co.co, 1e-30), f_int = cfg.max_alpha_co / std::max(co.alpha_co, 1e-30),
+               f_air = cfg.max_air_co / std::max(co.air_co, 1e-30);
+  const double fac = std::min({f_mat, f_int, f_air});
   const double grow = std::min(std::min(fac, 1.0 + 0.1 * fac), 1.2);
+  limit = grow == 1.2 ? "growth" : fac == f_mat ? "material" : fac == f_int ? "interface" : "air";
+  if (grow * dt >= cfg.dt_max) limit = "largest step";
   dt = std::min(grow * dt, cfg.dt_max);
+  if (time_left < dt) limit = "end time";
   return std::min(dt, std::max(1e-12, time_left));
 }
 
@@ -286,12 +290,13 @@ StepStats VofSolver::step() {
   auto& F = I.F;
   StepStats st;
   const auto co = I.courant(dt_);  // of the last step's fluxes
-  dt_ = I.next_dt(co, dt_, t_limit_ - t_);
+  const char* limit = "";
+  dt_ = I.next_dt(co, dt_, t_limit_ - t_, limit);
   t_ += dt_;
   I.update_gravity(t_);
   I.keep_old_time();
 
-  I.alpha_eqn.solve(F, dt_);  // alpha, alpha_phi, rho_phi
+  I.alpha_eqn.solve(F, dt_, cfg_.gravity(t_));  // alpha, alpha_phi, rho_phi
   I.update_rho();             // rho(alpha)
   if (I.region.update(false)) I.pEqn.make_system();
 
@@ -322,6 +327,7 @@ StepStats VofSolver::step() {
   st.co = co.co;
   st.alpha_co = co.alpha_co;
   st.air_co = co.air_co;
+  st.dt_limit = limit;
   st.active_cells = I.region.n_active;
   I.diagnostics(st, t_);
   st.seconds_pressure = t_p;

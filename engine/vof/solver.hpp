@@ -136,6 +136,12 @@ struct VofConfig {
   double material_alpha = 1e-3;  ///< cells with more material than this count as material
   double dt_initial = 1e-4, dt_max = 1e-2;
   double c_alpha = 1.0;        ///< interface compression coefficient
+  /// The granular phase falls through the air along gravity at this speed [m/s] (a settling flux
+  /// w alpha_upper (1 - alpha_lower) across each face with a component along gravity, in the
+  /// phase-fraction equation; the mixture's volume flux is unchanged). 0 (default): none. On
+  /// terrain meshes it gathers the thin mixed cells of a spreading edge onto the bed
+  /// (docs/design/vof.md, "Thin mixed cells fall onto the bed").
+  double settling_speed = 0;
   int n_correctors = 3;        ///< PISO correctors per step
   /// Outer correctors per step (PIMPLE's nOuterCorrectors): the viscosity, the momentum matrix, the
   /// momentum predictor and the correctors are repeated with the latest velocity and pressure, the
@@ -226,6 +232,9 @@ struct VofError : std::runtime_error {
 /// Per-step solver statistics.
 struct StepStats {
   double t = 0, dt = 0, co = 0, alpha_co = 0, air_co = 0;  ///< Courant numbers: material, interface, air
+  /// What set dt: the Courant number in the "material", at the "interface" or in the "air", the
+  /// step's "growth" limit (20 % a step), the "largest step" or the "end time".
+  const char* dt_limit = "";
   int pressure_iterations = 0;  ///< summed over the correctors (and outer correctors)
   int momentum_iterations = 0;  ///< of the predictor, both components (summed over outer correctors)
   double seconds_pressure = 0, seconds_total = 0;  ///< the pressure correctors (assembly, solve, flux update); the step

@@ -34,6 +34,7 @@ bool report_step(const RunOptions& opt, const engine::vof::StepStats& st, long s
   p.max_speed = st.max_speed;
   p.active_fraction = double(st.active_cells) / cells;
   p.step = steps;
+  p.dt_limit = st.dt_limit;
   return opt.progress(p);
 }
 

@@ -65,12 +65,13 @@ struct ResolvedScenario {
 /// granular viscosity evaluated on the face, lab.wall_viscosity "face"; 6: runs on the DEM write
 /// max_pressure.tif in kPa, the pressure zones, maps, QGIS styles and the path analysis; 7: lab
 /// mu(I) takes the material's parameters, the rotating box reports its flowing layer and draws its
-/// angles in comparison.png). Adding a
+/// angles in comparison.png; 8: runs on the DEM take the column's weight as the bed friction's
+/// load and let the material of partly filled cells settle onto the bed, by default). Adding a
 /// file or a figure counts too: a cached result lacks it. The test
 /// Scenarios.VofResultsMatchTheFingerprintOfTheirVersion holds this version's figures for thirteen
 /// short runs and fails when a change to the numerics moves them (options those runs do not take
 /// are not covered); Scenarios.VofHashCarriesTheResultsVersion pins a hash that a bump changes.
-inline constexpr int kVofResultsVersion = 7;
+inline constexpr int kVofResultsVersion = 8;
 
 /// The version of what a depth-averaged run's results contain (rasters, outline, run.json, time
 /// series) for an unchanged scenario; the same rule as kVofResultsVersion (1: run.json's and the

@@ -55,15 +55,19 @@ const OptionTable& terrain_vof_options() {
       {"vof.non_orthogonal_limiter", T::number, U::fill, "1", Range{0, 1}, {}, "",
        "limits each face's non-orthogonal correction to psi / (1 - psi) times its orthogonal part (1: unlimited)",
        "VofConfig::non_orthogonal_limiter"},
-      {"vof.bed_normal_stress", T::choice, U::fill, "pressure", {}, {"pressure", "total", "column"}, "",
-       "the bed friction's normal load: the ground cell's pressure, its total normal stress (less the viscous normal stress), or "
-       "the column's weight (its bed-normal part and the curved bed's centripetal load, at least the bed's pressure) acting on the "
-       "column's material; \"column\" is experimental: it runs away on real terrain (docs/design/vof.md)",
-       "PatchBc::friction_total_normal_stress, VofConfig::column_friction"},
+      {"vof.bed_normal_stress", T::choice, U::fill, "column", {}, {"column", "pressure", "total"}, "",
+       "the bed friction's normal load: the column's weight (its bed-normal part and the curved bed's centripetal load) acting on "
+       "the column's material, the ground cell's pressure, or its total normal stress (less the viscous normal stress) "
+       "(docs/design/vof.md)",
+       "VofConfig::column_friction, PatchBc::friction_total_normal_stress"},
       {"vof.max_viscosity_m2_s", T::number, U::as_given, "", Range{1, 1e8}, {}, "m2/s",
        "the Coulomb viscosity's clip nu_max, default 1e2: material at rest creeps at about g sin(theta) h^2 / (3 nu_max) "
        "(a 2 m layer on 15 deg: 2.7 cm/s at 1e2, 0.3 mm/s at 1e4)",
        "VofConfig::nu_max"},
+      {"vof.settling_speed_m_s", T::number, U::fill, "10", Range{0, 100}, {}, "m/s",
+       "the granular phase falls through the air along gravity at this speed, so that the thin mixed cells of a spreading flow "
+       "gather on the bed instead of running off as a sheet; 0: none (docs/design/vof.md)",
+       "VofConfig::settling_speed"},
       {"vof.pressure_preconditioner", T::choice, U::fill, "ilu", {}, {"ilu", "gamg", "hypre"}, "",
        "the pressure solve's preconditioner: ILU(0) (suits the thin layers), PETSc's GAMG or hypre's BoomerAMG",
        "VofConfig::pressure_pc"},

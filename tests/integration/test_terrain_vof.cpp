@@ -46,7 +46,6 @@ struct PlaneCase {
   std::string normal_stress;  ///< vof.bed_normal_stress; empty: the default
   int active_layers = 4;      ///< vof.active_layers (-1: every cell)
   int threads = 0;            ///< OpenMP threads; 0: as they are
-  double nu_max = 0;          ///< vof.max_viscosity_m2_s; 0: the default
 };
 
 // A plane falling at slope_deg towards the azimuth turn_deg (0: east, counter-clockwise).
@@ -78,6 +77,8 @@ struct PlaneRun {
   double outflow = 0;       ///< relative
   std::vector<double> end_fields;  ///< alpha, the velocity's components and p per cell at the end
   vof::BedLoad load;               ///< what the bed carried at the last step (column friction)
+  int footprint_growth = 0;        ///< columns deeper than 1 cm at the end that were not at the start
+  int footprint_reach = 0;         ///< of those, the farthest from the start's footprint, in columns
 };
 
 // A square block of normal thickness `thickness_m` whose centre lies a quarter of the plane above its
@@ -108,7 +109,6 @@ PlaneRun run_plane(const PlaneCase& pc, double t_end) {
   r.scenario.mutable_material()->set_bed_friction_deg(pc.delta_deg);
   if (!pc.normal_stress.empty()) r.scenario.mutable_vof()->set_bed_normal_stress(pc.normal_stress);
   r.scenario.mutable_vof()->set_active_layers(pc.active_layers);
-  if (pc.nu_max > 0) r.scenario.mutable_vof()->set_max_viscosity_m2_s(pc.nu_max);
   const int threads_before = omp_get_max_threads();
   if (pc.threads > 0) omp_set_num_threads(pc.threads);
   runout::jobs::apply_option_rules(runout::jobs::terrain_vof_options(), r.scenario);
@@ -154,6 +154,27 @@ PlaneRun run_plane(const PlaneCase& pc, double t_end) {
     out.end_fields.insert(out.end_fields.end(), {s.alpha()[std::size_t(c)], U.x, U.y, U.z, s.pressure()[std::size_t(c)]});
   }
   out.load = s.bed_load();
+  // The footprint: columns holding more than 1 cm of material, at the start and at the end.
+  const vof::MeshColumns cols = vt::bed_columns(vt::columns_of(cm), m, g);
+  auto footprint = [&](const std::vector<double>& a) {
+    std::vector<vof::Vec> at;
+    for (int k = 0; k < cols.columns(); ++k) {
+      double v = 0;
+      for (int i = cols.start[std::size_t(k)]; i < cols.start[std::size_t(k) + 1]; ++i)
+        v += a[std::size_t(cols.cells[std::size_t(i)])] * m.volume[std::size_t(cols.cells[std::size_t(i)])];
+      if (v > 0.01 * pc.dx * pc.dx) at.push_back(m.Cf[std::size_t(cols.bed_face[std::size_t(k)])]);
+    }
+    return at;
+  };
+  const auto before = footprint(alpha), after = footprint(s.alpha());
+  for (const vof::Vec& x : after) {
+    double nearest = 1e30;
+    for (const vof::Vec& y : before) nearest = std::min(nearest, std::hypot(x.x - y.x, x.z - y.z));
+    if (nearest > 0.5 * pc.dx) {
+      ++out.footprint_growth;
+      out.footprint_reach = std::max(out.footprint_reach, int(std::lround(nearest / pc.dx)));
+    }
+  }
   omp_set_num_threads(threads_before);
   out.outflow = outflow / v0;
   return out;
@@ -161,25 +182,22 @@ PlaneRun run_plane(const PlaneCase& pc, double t_end) {
 
 }  // namespace
 
-// The material's momentum grows at the Coulomb rate whatever the plane's orientation to the grid.
-// Frictionless it is g sin(theta) within 5 % (0.986 along the grid, 0.975 turned 45 deg); with a bed
-// friction of 20 deg the bed takes about 80 % of tan(delta) times the weight's normal part, and the
-// rate lies 10-23 % above the exact one (spread over orientations and solver settings)
-// (docs/design/vof.md, "Meshes over terrain": the bed friction's shortfall; the issue's "few per
-// cent" is not yet met). The bounds hold the shortfall where it is and fail when the friction or
-// the non-orthogonal correction goes missing (1.6-2.1 x).
+// The material's momentum grows at the Coulomb rate whatever the plane's orientation to the grid:
+// the friction takes the column's weight (vof.bed_normal_stress "column", the default), whose
+// bed-normal part it carries whole. Measured: 1.020 / 1.008 / 0.966 of g (sin(theta) - tan(delta)
+// cos(theta)) turned 0 / 30 / 45 deg; frictionless 0.98 / 0.97 of g sin(theta) (validation.md D1).
+// The bounds fail when the friction or the non-orthogonal correction goes missing (1.6-2.1 x) or the
+// load falls back to the ground cell's pressure (1.16-1.23 x).
 TEST(TerrainVof, BlockOnAnInclinedPlaneAcceleratesAtTheCoulombRate) {
-  double unturned = 0;
   for (double turn : {0.0, 30.0, 45.0}) {
     PlaneCase pc;
     pc.turn_deg = turn;
     const PlaneRun r = run_plane(pc, 1.0);
-    std::printf("35 deg plane turned %.0f deg, delta 20: acceleration %.3f m/s2 = %.3f x exact; volume error %.1e, outflow %.1e\n", turn, r.acceleration,
-                r.acceleration / r.exact, r.volume_error, r.outflow);
-    EXPECT_GT(r.acceleration / r.exact, 0.95);
-    EXPECT_LT(r.acceleration / r.exact, 1.3);
-    if (turn == 0) unturned = r.acceleration;
-    EXPECT_NEAR(r.acceleration / unturned, 1.0, 0.05) << "turned " << turn << " deg";
+    std::printf("35 deg plane turned %.0f deg, delta 20: acceleration %.3f m/s2 = %.3f x exact; friction load / weight's normal part %.3f; "
+                "volume error %.1e, outflow %.1e\n",
+                turn, r.acceleration, r.acceleration / r.exact, r.load.friction_load / r.load.weight_normal, r.volume_error, r.outflow);
+    EXPECT_NEAR(r.acceleration / r.exact, 1.0, 0.05);
+    EXPECT_NEAR(r.load.friction_load / r.load.weight_normal, 1.0, 1e-9);
     EXPECT_LT(r.volume_error, 1e-6);
   }
   for (double turn : {0.0, 45.0}) {
@@ -188,107 +206,75 @@ TEST(TerrainVof, BlockOnAnInclinedPlaneAcceleratesAtTheCoulombRate) {
     pc.delta_deg = 0;
     const PlaneRun r = run_plane(pc, 1.0);
     std::printf("35 deg plane turned %.0f deg, frictionless: acceleration %.3f x g sin(theta)\n", turn, r.acceleration / r.exact);
-    EXPECT_NEAR(r.acceleration / r.exact, 1.0, 0.05);
+    EXPECT_NEAR(r.acceleration / r.exact, 1.0, 0.04);
   }
 }
 
-// vof.bed_normal_stress "total": the friction takes p less the viscous normal stress, which carries
-// part of the weight in the spreading block. Closer to the exact rate on average, but more
-// dependent on the orientation and on the solver's settings (along the grid 0.93-0.96; turned 45 deg
-// 0.82-1.05 with ILU or GAMG and intermediate tolerances 0.1-0.001: the spreading edges' thin cells
-// answer to round-off) and not the default: a rate below the exact one shortens the runout.
-TEST(TerrainVof, FrictionOnTheTotalNormalStressIsNearTheCoulombRate) {
-  for (double turn : {0.0, 45.0}) {
+// The other loads the friction can take: the ground cell's pressure ("pressure") carries 0.85-0.87
+// of the weight's normal part in the sliding block (the rest in viscous normal stress) and the
+// block runs 1.16-1.23 x the exact rate; the total normal stress ("total", p less the viscous normal
+// stress) is near it (docs/design/vof.md, "The bed friction's load").
+TEST(TerrainVof, FrictionOnTheGroundCellsPressureOrTotalNormalStress) {
+  for (const char* load : {"pressure", "total"}) {
     PlaneCase pc;
-    pc.turn_deg = turn;
-    pc.normal_stress = "total";
+    pc.normal_stress = load;
     const PlaneRun r = run_plane(pc, 1.0);
-    std::printf("35 deg plane turned %.0f deg, delta 20, total normal stress: %.3f x exact\n", turn, r.acceleration / r.exact);
-    EXPECT_NEAR(r.acceleration / r.exact, 1.0, 0.2);  // 0.82-1.05 turned 45 deg across the pressure solver's settings
+    std::printf("35 deg plane, delta 20, load \"%s\": %.3f x exact\n", load, r.acceleration / r.exact);
+    if (std::string(load) == "pressure") {
+      EXPECT_GT(r.acceleration / r.exact, 1.08);
+      EXPECT_LT(r.acceleration / r.exact, 1.3);
+    } else {
+      EXPECT_NEAR(r.acceleration / r.exact, 1.0, 0.2);
+    }
   }
 }
 
-// A block flatter than its bed friction (15 deg, delta 20, phi 30; its edges tapered over two cells)
-// is held by the bed: its mean speed after 2 s is a few per cent of the 5 m/s it would reach
-// without friction. The issue's 1 mm/s is not yet met: the steps between the columns' flat tops
-// slump into thin mixed cells at the edges that run off at metres per second (docs/design/vof.md).
+// Blocks flatter than their bed friction (15 deg, delta 20, phi 30, 10 m columns): the body rests
+// but the edges, vertical steps one column wide, slump into the next columns, and the material's
+// mean speed after 2 s is 0.10-0.11 m/s (5 m/s without friction), its footprint grown by up to three
+// columns: the issue's 1 mm/s and one column are not met (docs/design/vof.md, "Thin mixed cells
+// settle onto the bed"). Tapering the edges over two columns changes nothing.
 TEST(TerrainVof, BlockFlatterThanItsBedFrictionIsHeld) {
-  PlaneCase pc;
-  pc.slope_deg = 15;
-  pc.phi_deg = 30;
-  pc.taper_m = 20;
-  const PlaneRun r = run_plane(pc, 2.0);
-  std::printf("15 deg plane, delta 20: mean speed %.2e m/s after 2 s (%.2e m/s without friction)\n", r.speed_end, 2 * 9.81 * std::sin(15 * kPi / 180));
-  EXPECT_LT(r.speed_end, 0.5);
-}
-
-// A layer over the whole plane (no edges, 2 m on 15 deg, delta 20): the bed holds it, and what moves
-// is the creep of the Coulomb viscosity's clip, a film sheared at nu_max over a stuck bed, whose
-// mean speed is g sin(theta) h^2 / (3 nu_max) (3.4 cm/s at the default 1e2: 2.7 cm/s measured, the
-// same on a plane turned 30 deg and 10 columns from the sides). With vof.max_viscosity_m2_s 1e4 it
-// rests: below 1 mm/s after 2 s (0.36 and 0.67 mm/s).
-TEST(TerrainVof, LayerFlatterThanItsBedFrictionStaysAtRest) {
-  const double creep = 9.81 * std::sin(15 * kPi / 180) * 2 * 2 / 3;  // times 1 / nu_max
-  PlaneCase pc;
-  pc.slope_deg = 15;
-  pc.phi_deg = 30;
-  pc.block_m = 5000;
-  const PlaneRun soft = run_plane(pc, 2.0);
-  std::printf("15 deg plane, layer, delta 20, nu_max 1e2: mean speed %.2e m/s after 2 s (%.2e m/s 10 cells from the sides; creep %.2e m/s)\n",
-              soft.speed_end, soft.speed_core, creep / 1e2);
-  EXPECT_GT(soft.speed_core, 0.5 * creep / 1e2);
-  EXPECT_LT(soft.speed_core, 1.0 * creep / 1e2);
-  for (double turn : {0.0, 30.0}) {
-    pc.turn_deg = turn;
-    pc.nu_max = 1e4;
-    const PlaneRun r = run_plane(pc, 2.0);
-    std::printf("15 deg plane turned %.0f deg, layer, delta 20, nu_max 1e4: mean speed %.2e m/s after 2 s (%.2e m/s 10 cells from the sides)\n", turn,
-                r.speed_end, r.speed_core);
-    EXPECT_LT(r.speed_end, 1e-3);
-    EXPECT_LT(r.speed_core, 1e-3);
-  }
-}
-
-// vof.bed_normal_stress "column" (experimental): the friction takes the column's weight (its
-// bed-normal part; the centripetal load is zero on a plane) and acts on the column's material
-// (engine/vof/column_friction.hpp). The bed then carries the weight's whole normal part, where the
-// ground cells' pressure carries 0.78-0.88 of it. Along the grid the block's rate is the exact one
-// (0.998); turned 30 deg 1.04, turned 45 deg 1.30 (the spreading edges' thin cells, whose motion
-// changes with round-off: 0.93-1.30 turned 45 deg over small changes of the load). A layer
-// flatter than its bed friction rests without the Coulomb viscosity's creep at the default clip
-// (7e-5 m/s 10 columns from the sides, against 2.7e-2 m/s on the ground cell's pressure). The
-// tapered block on 15 deg still moves at 0.1 m/s after 2 s. Not the default
-// (docs/design/vof.md, "The bed carries the column's weight").
-TEST(TerrainVof, FrictionOnTheColumnsWeightTakesTheWholeLoad) {
-  for (double turn : {0.0, 30.0, 45.0}) {
+  for (double taper : {0.0, 20.0}) {
     PlaneCase pc;
-    pc.turn_deg = turn;
-    pc.normal_stress = "column";
-    const PlaneRun r = run_plane(pc, 1.0);
-    std::printf("35 deg plane turned %.0f deg, delta 20, column load: %.3f x exact; friction load / weight's normal part %.3f, bed face "
-                "pressure / it %.3f\n",
-                turn, r.acceleration / r.exact, r.load.friction_load / r.load.weight_normal, r.load.face_pressure / r.load.weight_normal);
-    if (turn == 0) EXPECT_NEAR(r.acceleration / r.exact, 1.0, 0.03);
-    EXPECT_GT(r.acceleration / r.exact, 0.9);
-    EXPECT_LT(r.acceleration / r.exact, 1.35);
-    EXPECT_NEAR(r.load.friction_load / r.load.weight_normal, 1.0, 1e-9);
-    EXPECT_LT(r.load.face_pressure / r.load.weight_normal, 0.95);  // what the pressure alone would have given the friction
+    pc.slope_deg = 15;
+    pc.phi_deg = 30;
+    pc.taper_m = taper;
+    const PlaneRun r = run_plane(pc, 2.0);
+    std::printf("15 deg plane, block with edges tapered over %.0f m, delta 20: mean speed %.2e m/s after 2 s (%.2e m/s without friction); "
+                "footprint grown by %d columns, the farthest %d columns out\n",
+                taper, r.speed_end, 2 * 9.81 * std::sin(15 * kPi / 180), r.footprint_growth, r.footprint_reach);
+    EXPECT_LT(r.speed_end, 0.15);
+    EXPECT_LE(r.footprint_reach, 3);
     EXPECT_LT(r.volume_error, 1e-6);
   }
+}
+
+// A layer over the whole plane (no edges, 2 m on 15 deg, delta 20): on the column's weight (the
+// default) the bed holds it at rest, 10 columns from the sides below 1 mm/s after 2 s, on the plane
+// turned 30 deg too. On the ground cell's pressure what moves is the creep of the Coulomb
+// viscosity's clip, a film sheared at nu_max over a stuck bed, whose mean speed is
+// g sin(theta) h^2 / (3 nu_max) (3.4 cm/s at the default 1e2: 2.7 cm/s measured).
+TEST(TerrainVof, LayerFlatterThanItsBedFrictionStaysAtRest) {
   PlaneCase pc;
   pc.slope_deg = 15;
   pc.phi_deg = 30;
   pc.block_m = 5000;
-  pc.normal_stress = "column";
-  const PlaneRun r = run_plane(pc, 2.0);
-  std::printf("15 deg plane, layer, delta 20, column load: mean speed %.2e m/s after 2 s (%.2e m/s 10 cells from the sides)\n", r.speed_end,
-              r.speed_core);
-  EXPECT_LT(r.speed_core, 1e-3);
-  pc.block_m = 60;
-  pc.taper_m = 20;
-  const PlaneRun b = run_plane(pc, 2.0);
-  std::printf("15 deg plane, tapered block, delta 20, column load: mean speed %.2e m/s after 2 s\n", b.speed_end);
-  EXPECT_LT(b.speed_end, 0.2);  // 0.1 m/s measured; 0.23 m/s on the ground cell's pressure
+  for (double turn : {0.0, 30.0}) {
+    pc.turn_deg = turn;
+    const PlaneRun r = run_plane(pc, 2.0);
+    std::printf("15 deg plane turned %.0f deg, layer, delta 20: mean speed %.2e m/s after 2 s (%.2e m/s 10 cells from the sides)\n", turn,
+                r.speed_end, r.speed_core);
+    EXPECT_LT(r.speed_core, 1e-3);
+  }
+  const double creep = 9.81 * std::sin(15 * kPi / 180) * 2 * 2 / 3;  // times 1 / nu_max
+  pc.turn_deg = 0;
+  pc.normal_stress = "pressure";
+  const PlaneRun soft = run_plane(pc, 2.0);
+  std::printf("15 deg plane, layer, delta 20, ground cell's pressure: %.2e m/s 10 cells from the sides (creep %.2e m/s)\n", soft.speed_core,
+              creep / 1e2);
+  EXPECT_GT(soft.speed_core, 0.5 * creep / 1e2);
+  EXPECT_LT(soft.speed_core, 1.0 * creep / 1e2);
 }
 
 // In den Arelen through the whole terrain path on a coarse grid (90 m, 5 s): every raster of the
@@ -526,24 +512,5 @@ TEST(TerrainVof, ResultsDoNotDependOnTheThreadCount) {
     for (std::size_t i = 0; i < fields[0].size(); ++i)
       if (std::memcmp(&fields[k][i], &fields[0][i], sizeof(double)) != 0) ++differ;
     EXPECT_EQ(differ, 0u) << k + 1 << " threads against 1";
-  }
-}
-
-// A run on the column load (experimental; it runs away on real terrain) says so in run.json's notes,
-// and a run on the default load does not.
-TEST(TerrainVof, ColumnLoadRunSaysItIsExperimental) {
-  auto sc = runout::jobs::parse_scenario_json(runout::test_support::read_text(kArelen3d));
-  sc.mutable_grid()->set_resolution_m(90);
-  sc.mutable_numerics()->set_end_time_s(0.3);
-  sc.mutable_vof()->set_write_interval_s(0);
-  sc.mutable_vof()->clear_profiles();
-  for (const std::string load : {"column", "pressure"}) {
-    sc.mutable_vof()->set_bed_normal_stress(load);
-    runout::test_support::TempDir d;
-    runout::jobs::run_scenario(runout::jobs::resolve_scenario(sc, kArelen3d.parent_path().string()), d.p.string());
-    const auto rec = runout::jobs::read_run_record((d.p / "run.json").string());
-    bool said = false;
-    for (const auto& n : rec.notes()) said = said || n.find("\"column\" is experimental") != std::string::npos;
-    EXPECT_EQ(said, load == "column") << load;
   }
 }

@@ -26,6 +26,8 @@ vof::VofConfig terrain_config(const ResolvedScenario& r, vof::MeshColumns column
   c.pressure_pc = v.pressure_preconditioner();
   if (v.has_max_viscosity_m2_s()) c.nu_max = v.max_viscosity_m2_s();
   c.gravity = [](double) { return vof::Vec{0, -9.81, 0}; };
+  // Material in a partly filled cell falls onto the bed (docs/design/vof.md, "Thin mixed cells fall onto the bed").
+  c.settling_speed = v.settling_speed_m_s();
   vof::PatchBc ground;
   ground.type = v.bed();
   std::replace(ground.type.begin(), ground.type.end(), '-', '_');  // the registry's spelling

@@ -14,8 +14,9 @@ namespace runout::jobs::vof_terrain {
 /// atmosphere (air at rest outside, anything out). The Coulomb viscosity keeps the engine's clip
 /// (a clip grown with the flow's depth let the viscous stress carry part of the weight, and the bed
 /// friction fell with the pressure; docs/design/vof.md). With vof.bed "coulomb-friction" and
-/// vof.bed_normal_stress "column" (experimental) the friction acts on the columns `columns`
+/// vof.bed_normal_stress "column" (the default) the friction acts on the columns `columns`
 /// (bed_columns()) and the ground takes no shear of its own; ScenarioError when they are missing.
+/// The material in partly filled cells falls onto the bed at vof.settling_speed_m_s.
 engine::vof::VofConfig terrain_config(const ResolvedScenario& r, engine::vof::MeshColumns columns = {});
 
 }  // namespace runout::jobs::vof_terrain

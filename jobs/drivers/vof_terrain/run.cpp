@@ -256,8 +256,6 @@ RunSummary run_terrain_vof(const ResolvedScenario& r, const std::string& out_dir
   }
   sum.seconds_write = since(t2);
   std::vector<std::string> record_notes;  // what the reader of the maps must know: run.json's notes and the summary's
-  if (r.scenario.vof().bed_normal_stress() == "column")
-    record_notes.push_back("vof.bed_normal_stress \"column\" is experimental: it runs away on real terrain (docs/design/vof.md)");
   if (su.corridor.kind != "none" && step.outflow_corridor > kCorridorLossNote * su.volume_on_mesh) {
     char pct[32];
     std::snprintf(pct, sizeof pct, "%.1f", 100 * step.outflow_corridor / su.volume_on_mesh);
