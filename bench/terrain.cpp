@@ -129,8 +129,8 @@ int run_arelen(double res_m, double t_end) {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const auto rec = runout::jobs::read_run_record((out / "run.json").string());
   fs::remove_all(out);
-  std::printf("In den Arelen 3D at %.0f m, %d threads: %ld steps to %.1f s of flow (stop: %s) in %.0f s wall (%.0f s CPU)\n", sum.dx,
-              omp_get_max_threads(), sum.steps, sum.t, sum.stop.c_str(), wall, sum.cpu_seconds);
+  std::printf("In den Arelen 3D at %.0f m, %d threads: %ld steps to %.1f s of flow (stop: %s) in %.0f s wall\n", sum.dx,
+              omp_get_max_threads(), sum.steps, sum.t, sum.stop.c_str(), wall);
   std::printf("mesh: %d columns, %d cells; active cells %.0f on average, %d at most; mean step %.4f s\n", rec.terrain_mesh().columns(),
               rec.terrain_mesh().cells(), rec.solver().active_cells_mean(), rec.solver().active_cells_max(), dt_sum / std::max(1L, sum.steps));
   std::printf("what set the step's length:");

@@ -474,3 +474,39 @@ TEST(Sh2d, CheckpointOfAnotherGridIsRefused) {
   tiles.tile = 16;
   EXPECT_THROW(run_sh2d(t, tiles, cp), std::invalid_argument);
 }
+
+// The 3D engine's rest case (validation.md D1) in the depth-averaged engine: a block 2 m deep (normal
+// to the slope), 60 m square on a 15 deg plane of 10 m cells, Coulomb delta 20 (earth pressure 1).
+// On these cells the bed holds the whole block, its vertical edges included: it does not move at all
+// (0 m/s at 2, 4 and 10 s, no cell added to its footprint), where the 3D engine's edges slump over
+// three columns (TerrainVof.BlockFlatterThanItsBedFrictionIsHeld).
+TEST(Sh2d, BlockFlatterThanItsBedFrictionSpreadsAtItsEdges) {
+  const auto t = inclined_plane(40, 32, 10.0, 15);
+  std::vector<double> h(t.cells(), 0.0);
+  for (int j = 13; j < 19; ++j)
+    for (int i = 7; i < 13; ++i) h[std::size_t(j) * t.nx + i] = 2.0;
+  const auto init = state_from_normal_depth(t, h);
+  for (double t_end : {2.0, 4.0, 10.0}) {
+    auto cfg = coulomb(20, t_end);
+    cfg.time.stop_fraction = 0;
+    const auto r = run_sh2d(t, cfg, init);
+    double H = 0, HU = 0, HV = 0;
+    int grown = 0, reach = 0;
+    for (int j = 0; j < t.ny; ++j)
+      for (int i = 0; i < t.nx; ++i) {
+        const std::size_t k = std::size_t(j) * t.nx + i;
+        H += r.state.H[k];
+        HU += r.state.HU[k];
+        HV += r.state.HV[k];
+        if (r.state.H[k] > 0.01 && h[k] == 0) {
+          ++grown;
+          reach = std::max(reach, std::max(std::max(7 - i, i - 12), std::max(13 - j, j - 18)));
+        }
+      }
+    std::printf("depth-averaged, 15 deg, delta 20, block with vertical edges: mean speed %.2e m/s at %.0f s; footprint grown by %d cells, "
+                "the farthest %d cells out\n",
+                std::hypot(HU, HV) / H, t_end, grown, reach);
+    EXPECT_LT(std::hypot(HU, HV) / H, 1e-3);
+    EXPECT_LE(reach, 1);
+  }
+}
