@@ -21,7 +21,6 @@ AlphaEqn::AlphaEqn(const Mesh& m, const VofConfig& cfg, const BcContext& bc_ctx,
 // neighbours (the halo).
 void AlphaEqn::solve(Fields& F, double dt, const Vec& gravity) {
   const int n = std::max(std::max(1, cfg_.alpha_subcycles), settling_subcycles(gravity, dt));
-  subcycles_ = n;
   const double dts = dt / n;
   parallel_each(region_.faces, [&](int f) { F.alpha_phi[f] = 0; });
   for (int sub = 0; sub < n; ++sub) {
@@ -33,20 +32,18 @@ void AlphaEqn::solve(Fields& F, double dt, const Vec& gravity) {
   parallel_each(region_.faces, [&](int f) { F.rho_phi[f] = bc_ctx_.mixture.rho_flux(F.alpha_phi[f], F.phi[f]); });
 }
 
-// The settling flux per face, w (g/|g|).Sf, and the sub-cycles that keep its Courant number
+// Gravity's direction for this solve, and the settling flux's sub-cycles that keep its Courant number
 // w |g.Sf| dts / V of the smaller cell at most 0.5 (the flux alone keeps alpha in [0, 1] up to 1).
 int AlphaEqn::settling_subcycles(const Vec& gravity, double dt) {
-  if (cfg_.settling_speed <= 0) return 1;
+  down_ = Vec{};
   const double gn = norm(gravity);
-  if (gn <= 0) return 1;
-  const Vec gh = (1.0 / gn) * gravity;
-  settle_.assign(std::size_t(m_.faces()), 0);
+  if (cfg_.settling_speed <= 0 || gn <= 0) return 1;
+  down_ = (1.0 / gn) * gravity;
   double co = 0;
   for (int f : region_.faces) {
     if (!internal(m_, f)) continue;
-    settle_[f] = cfg_.settling_speed * dot(gh, m_.Sf[f]);
     const double v = std::min(m_.volume[m_.owner[f]], m_.volume[m_.neighbour[f]]);
-    co = std::max(co, std::abs(settle_[f]) * dt / v);
+    co = std::max(co, std::abs(cfg_.settling_speed * dot(down_, m_.Sf[f])) * dt / v);
   }
   return int(std::ceil(co / 0.5));
 }
@@ -59,7 +56,7 @@ void AlphaEqn::settling_fluxes(const Fields& F) {
   const auto& a = F.alpha;
   parallel_each(region_.faces, [&](int f) {
     if (!internal(m_, f)) return;
-    const double s = settle_[f];
+    const double s = cfg_.settling_speed * dot(down_, m_.Sf[f]);
     const double ao = std::clamp(a[m_.owner[f]], 0.0, 1.0), an = std::clamp(a[m_.neighbour[f]], 0.0, 1.0);
     // s > 0: gravity points from the owner to the neighbour, the owner is the upper cell.
     FL_[f] += s > 0 ? s * ao * (1 - an) : s * an * (1 - ao);

@@ -17,8 +17,6 @@ class AlphaEqn {
   AlphaEqn(const Mesh& m, const VofConfig& cfg, const BcContext& bc_ctx, const Boundaries& bcs, const ActiveRegion& region,
            double mean_cell_size);
   void solve(Fields& F, double dt, const Vec& gravity);
-  /// The sub-cycles of the last solve (at least VofConfig::alpha_subcycles).
-  int subcycles() const { return subcycles_; }
 
  private:
   void interface_normal(const Fields& F);
@@ -36,8 +34,7 @@ class AlphaEqn {
   FaceField<double> FL_, AF_;  // low-order flux; antidiffusive flux (high-order less low-order), then its limited share of the step
   CellField<double> amax_, amin_, Rp_, Rm_, aL_;  // local bounds; Zalesak's ratios; alpha V
   CellField<Vec> grad_alpha_;
-  FaceField<double> settle_;  // w (g/|g|).Sf per face (settling on)
-  int subcycles_ = 1;
+  Vec down_;  // g/|g| of this solve (settling on): the flux w down_.Sf per face
 };
 
 }  // namespace runout::engine::vof

@@ -46,7 +46,6 @@ class MomentumEqn {
   /// (1/A) and drAt (1/(A - H1)) per unit volume; zero elsewhere. A face or a vector takes the
   /// coefficient r + dr (s.n)^2 along its unit normal s, r v + dr (n.v) n (docs/design/vof.md).
   CellField<double> drA, drAt;
-  const CellField<Vec>& bed_normal() const { return drag_.normal; }
   /// 1/A (consistent: 1/(A - H1)) of cell c along the direction of s.
   double rA_along(bool consistent, int c, const Vec& s) const;
   /// 1/A (consistent: 1/(A - H1)) of cell c applied to v.

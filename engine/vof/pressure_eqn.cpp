@@ -32,7 +32,7 @@ int PressureEqn::correct(Fields& F, const MomentumEqn& UEqn, bool initial, bool 
   // 1/(A - H1); the part of the last pressure's force that 1/A would have carried, (1/A -
   // 1/(A - H1)) F_old, stays in the predicted flux and velocity (SIMPLEC).
   const bool cons = cfg_.consistent && !initial;
-  const Coupling k{cons, cons ? UEqn.rAtU : UEqn.rAU, cons ? UEqn.rAtUf : UEqn.rAUf, UEqn};
+  const Coupling k{cons, cons ? UEqn.rAtUf : UEqn.rAUf, UEqn};
   // Within a step 1/A, the density and the active region do not change (reuse), and with them
   // neither which faces are openings, the Laplacian coefficients, the buoyancy fluxes nor the
   // outside pressures: those are set by the step's first call. Every call forms the predicted flux

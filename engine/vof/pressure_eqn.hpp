@@ -30,9 +30,8 @@ class PressureEqn {
  private:
   struct Coupling {  // the coefficients of this corrector: 1/A (PISO) or 1/(A - H1) (SIMPLEC)
     bool consistent;
-    const CellField<double>& rA;
     const FaceField<double>& rAf;
-    const MomentumEqn& U;  // the cells' coefficients along a direction (the column friction's drag acts along the bed only)
+    const MomentumEqn& U;  // the cells' coefficients along a direction (rA_along, rA_apply; the column friction's drag acts along the bed only)
   };
   void laplacian_coefficients(const Fields& F, const Coupling& k);
   void predicted_flux(const MomentumEqn& UEqn, bool initial, const Coupling& k);

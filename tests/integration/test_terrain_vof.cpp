@@ -112,7 +112,8 @@ PlaneRun run_plane(const PlaneCase& pc, double t_end) {
   const int threads_before = omp_get_max_threads();
   if (pc.threads > 0) omp_set_num_threads(pc.threads);
   runout::jobs::apply_option_rules(runout::jobs::terrain_vof_options(), r.scenario);
-  vof::VofSolver s(m, vt::terrain_config(r, vt::bed_columns(vt::columns_of(cm), m, g)));
+  const vof::MeshColumns cols = vt::bed_columns(vt::columns_of(cm), m, g);
+  vof::VofSolver s(m, vt::terrain_config(r, cols));
   s.initialise(alpha);
   // Downslope in the engine's frame (x east, y up, z south).
   const vof::Vec down{std::cos(th) * std::cos(a), -std::sin(th), -std::cos(th) * std::sin(a)};
@@ -155,7 +156,6 @@ PlaneRun run_plane(const PlaneCase& pc, double t_end) {
   }
   out.load = s.bed_load();
   // The footprint: columns holding more than 1 cm of material, at the start and at the end.
-  const vof::MeshColumns cols = vt::bed_columns(vt::columns_of(cm), m, g);
   auto footprint = [&](const std::vector<double>& a) {
     std::vector<vof::Vec> at;
     for (int k = 0; k < cols.columns(); ++k) {

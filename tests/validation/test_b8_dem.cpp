@@ -4,7 +4,6 @@
 // symmetry), the spherical cap as a release-thickness raster, run by the 3D engine on terrain
 // (vertical columns, layers graded from the ground, Coulomb friction bed) and compared with the
 // analytic chute mesh's run (bed-normal columns, half the chute) at the same cell size.
-#include <gdal_priv.h>
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -163,21 +162,15 @@ ChuteFigures dem_run(double c, const fs::path& out) {
   fs::create_directories(run_dir);
   jobs::run_scenario(r, run_dir.string());
 
-  GDALDatasetUniquePtr ds(GDALDataset::Open((run_dir / "deposit.tif").c_str(), GDAL_OF_RASTER));
-  EXPECT_TRUE(ds);
+  const auto d = test_support::read_raster_band((run_dir / "deposit.tif").string());
   ChuteFigures f;
-  if (!ds) return f;
-  double gt[6];
-  ds->GetGeoTransform(gt);
-  const int gx = ds->GetRasterXSize(), gy = ds->GetRasterYSize();
-  std::vector<double> d(std::size_t(gx) * std::size_t(gy));
-  EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, gx, gy, d.data(), gx, gy, GDT_Float64, 0, 0), CE_None);
+  if (d.values.empty()) return f;
   double vol[3] = {0, 0, 0}, vs = 0;
-  for (int r = 0; r < gy; ++r)
-    for (int i = 0; i < gx; ++i) {
-      const double h = d[std::size_t(r) * std::size_t(gx) + std::size_t(i)];
+  for (int r = 0; r < d.ny; ++r)
+    for (int i = 0; i < d.nx; ++i) {
+      const double h = d.at(r, i);
       if (!(h > 1e-3)) continue;  // nodata (NaN, -9999) and the film below 1 mm
-      const double x = gt[0] + (i + 0.5) * gt[1], y = gt[3] + (r + 0.5) * gt[5], s = w.arc(x, y);
+      const double x = d.x_centre(i), y = d.y_centre(r), s = w.arc(x, y);
       const double a = w.arc(x + 0.5 * c, y) - w.arc(x - 0.5 * c, y);  // the cell's length along the bed
       const double v = h * a * c;
       vol[s < s1 ? 0 : s <= s2 ? 1 : 2] += v;
