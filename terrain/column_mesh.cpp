@@ -33,6 +33,7 @@ std::vector<double> layer_levels(const ColumnMeshSpec& s) {
   if (!(s.first_layer_m > 0) || !std::isfinite(s.first_layer_m))
     throw TerrainError("mesh.first_layer_m: must be > 0, got " + num(s.first_layer_m));
   if (!(s.growth >= 1 && s.growth <= 3)) throw TerrainError("mesh.growth: must lie in [1, 3], got " + num(s.growth));
+  if (s.refinement < 1 || s.refinement > 8) throw TerrainError("mesh.refinement: must lie in [1, 8], got " + std::to_string(s.refinement));
   if (!(s.band_height_m > s.first_layer_m) || !std::isfinite(s.band_height_m))
     throw TerrainError("mesh.band_height_m: must be finite and above mesh.first_layer_m (" + num(s.first_layer_m) + " m), got " +
                        num(s.band_height_m));
@@ -86,24 +87,43 @@ ColumnMesh column_mesh(const Grid& g, const ColumnMeshSpec& s, const std::vector
   if (!corridor.empty() && corridor.size() != g.cells()) throw TerrainError("mesh: the corridor needs one flag per grid cell");
   if (g.nx < 2 || g.ny < 2) throw TerrainError("mesh: the grid needs at least 2 x 2 cells");
   ColumnMesh m;
-  m.ni = g.nx;
-  m.nk = g.ny;
+  m.levels = layer_levels(s);
+  const int r = s.refinement;
+  m.refinement = r;
+  m.grid_nx = g.nx;
+  m.ni = g.nx * r;
+  m.nk = g.ny * r;
   m.x_min = g.x_min;
   m.y_min = g.y_min;
-  m.dx = g.dx;
-  m.levels = layer_levels(s);
-  m.ground.resize(std::size_t(g.nx + 1) * std::size_t(g.ny + 1));
+  m.dx = g.dx / r;
+  // The grid cells' corners, then the refined nodes bilinear between them.
+  std::vector<double> corner(std::size_t(g.nx + 1) * std::size_t(g.ny + 1));
   auto z = [&](int i, int j) { return g.z[std::size_t(j) * std::size_t(g.nx) + std::size_t(i)]; };
   for (int k = 0; k <= g.ny; ++k) {
     const Pair pj = node_weights(k, g.ny);
     for (int i = 0; i <= g.nx; ++i) {
       const Pair pi = node_weights(i, g.nx);
-      m.ground[std::size_t(k) * std::size_t(g.nx + 1) + std::size_t(i)] =
+      corner[std::size_t(k) * std::size_t(g.nx + 1) + std::size_t(i)] =
           pj.wa * (pi.wa * z(pi.a, pj.a) + pi.wb * z(pi.b, pj.a)) + pj.wb * (pi.wa * z(pi.a, pj.b) + pi.wb * z(pi.b, pj.b));
     }
   }
-  m.kept.resize(g.cells());
-  for (std::size_t c = 0; c < g.cells(); ++c) m.kept[c] = (g.outside.empty() || g.outside[c] == 0) && (corridor.empty() || corridor[c] != 0);
+  auto at = [&](int i, int k) { return corner[std::size_t(k) * std::size_t(g.nx + 1) + std::size_t(i)]; };
+  m.ground.resize(std::size_t(m.ni + 1) * std::size_t(m.nk + 1));
+  for (int k = 0; k <= m.nk; ++k) {
+    const int k0 = std::min(k / r, g.ny - 1);
+    const double fk = double(k - k0 * r) / r;
+    for (int i = 0; i <= m.ni; ++i) {
+      const int i0 = std::min(i / r, g.nx - 1);
+      const double fi = double(i - i0 * r) / r;
+      m.ground[std::size_t(k) * std::size_t(m.ni + 1) + std::size_t(i)] =
+          (1 - fk) * ((1 - fi) * at(i0, k0) + fi * at(i0 + 1, k0)) + fk * ((1 - fi) * at(i0, k0 + 1) + fi * at(i0 + 1, k0 + 1));
+    }
+  }
+  m.kept.resize(std::size_t(m.ni) * std::size_t(m.nk));
+  for (std::size_t col = 0; col < m.kept.size(); ++col) {
+    const std::size_t c = m.grid_cell(col);
+    m.kept[col] = (g.outside.empty() || g.outside[c] == 0) && (corridor.empty() || corridor[c] != 0);
+  }
   if (m.kept_columns() == 0) throw TerrainError(corridor.empty() ? "mesh: no column lies inside the domain" : "mesh: no column of the corridor lies inside the domain");
   return m;
 }

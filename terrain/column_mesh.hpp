@@ -5,8 +5,9 @@
 // towards the ground. Columns are vertical; each layer interface follows the ground at a constant
 // height above it, so that the cells' bottoms and tops are the ground surface lifted.
 //
-// The ground at the mesh's nodes (the grid cells' corners) is the bilinear interpolant of the cell
-// centres' elevations, extrapolated linearly at the grid's edges: a plane DEM gives a plane ground.
+// The ground at the grid cells' corners is the bilinear interpolant of the cell centres' elevations,
+// extrapolated linearly at the grid's edges: a plane DEM gives a plane ground. Refined columns
+// (mesh.refinement) split each grid cell into R x R columns on the same ground.
 // The area of interest is followed cell by cell (columns kept by their centre, as the depth-averaged
 // engine keeps cells); the faces towards a left-out column are the mesh's sides.
 //
@@ -23,6 +24,7 @@ struct ColumnMeshSpec {
   double first_layer_m = 0;  ///< the layer on the ground, vertical thickness [m]; > 0
   double growth = 1.2;       ///< each layer this many times the one below it; 1-3
   double band_height_m = 0;  ///< from the ground to the mesh's top [m]; > first_layer_m
+  int refinement = 1;        ///< columns per grid cell along each axis; 1-8
 };
 
 /// The heights above the ground of the layer interfaces, 0 first and band_height_m last: layers of
@@ -31,11 +33,13 @@ struct ColumnMeshSpec {
 std::vector<double> layer_levels(const ColumnMeshSpec& s);
 
 struct ColumnMesh {
-  int ni = 0, nk = 0;        ///< columns along x (east) and y (north): the grid's cells
-  double x_min = 0, y_min = 0, dx = 0;  ///< the grid's
+  int ni = 0, nk = 0;        ///< columns along x (east) and y (north): the grid's cells times the refinement
+  int refinement = 1;        ///< columns per grid cell along each axis
+  int grid_nx = 0;           ///< the grid's cells along x
+  double x_min = 0, y_min = 0, dx = 0;  ///< the grid's corner; the columns' width (the grid's cell / refinement)
   std::vector<double> levels;           ///< layer interfaces above the ground (layer_levels)
   std::vector<double> ground;           ///< (ni + 1) (nk + 1) node elevations, node (i, k) at k (ni + 1) + i
-  std::vector<std::uint8_t> kept;       ///< per column (grid cell, row k = grid row j): 1 inside the domain
+  std::vector<std::uint8_t> kept;       ///< per column (row k south to north, k * ni + i): 1 inside the domain
   int layers() const { return int(levels.size()) - 1; }
   double ground_at(int i, int k) const { return ground[std::size_t(k) * std::size_t(ni + 1) + std::size_t(i)]; }
   /// Node (i, k) of interface j in the grid's CRS: x east, y north, z up.
@@ -43,11 +47,19 @@ struct ColumnMesh {
   double node_y(int k) const { return y_min + k * dx; }
   double node_z(int i, int k, int j) const { return ground_at(i, k) + levels[std::size_t(j)]; }
   int kept_columns() const;
+  /// The grid cell (j * grid_nx + i) that column col = k * ni + i lies in.
+  std::size_t grid_cell(std::size_t col) const {
+    const std::size_t i = col % std::size_t(ni), k = col / std::size_t(ni), r = std::size_t(refinement);
+    return (k / r) * std::size_t(grid_nx) + i / r;
+  }
 };
 
 /// The column mesh over `g` (at least 2 x 2 cells): the columns inside the domain, and when
-/// `corridor` is given (one flag per grid cell, row 0 south) only those of the corridor too. Throws
-/// TerrainError when the spec is out of range or no column is kept.
+/// `corridor` is given (one flag per grid cell, row 0 south) only those of the corridor too. With a
+/// refinement R each grid cell holds R x R columns whose ground nodes lie on the unrefined mesh's
+/// ground (bilinear within each grid cell): the same surface, so that the refinement changes the
+/// flow's resolution and not the terrain. Throws TerrainError when the spec is out of range or no
+/// column is kept.
 ColumnMesh column_mesh(const Grid& g, const ColumnMeshSpec& s, const std::vector<std::uint8_t>& corridor = {});
 
 /// The cells of `cells` (one flag per grid cell) dilated by `margin_m`: every cell whose centre lies

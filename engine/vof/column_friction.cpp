@@ -1,6 +1,7 @@
 #include "engine/vof/column_friction.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "engine/vof/active_region.hpp"
@@ -37,6 +38,44 @@ void check_columns(const Mesh& m, const MeshColumns& c) {
       if (c.cells[std::size_t(i)] < 0 || c.cells[std::size_t(i)] >= m.cells())
         throw VofError("column friction: column " + std::to_string(k) + " names a cell outside the mesh");
   }
+}
+
+MeshColumns columns_above(const Mesh& m, const std::vector<int>& bed_faces) {
+  std::vector<std::vector<int>> faces_of(std::size_t(m.cells()));
+  for (int f = 0; f < m.faces(); ++f) {
+    faces_of[std::size_t(m.owner[std::size_t(f)])].push_back(f);
+    if (f < m.n_internal) faces_of[std::size_t(m.neighbour[std::size_t(f)])].push_back(f);
+  }
+  MeshColumns out;
+  out.start.push_back(0);
+  std::vector<char> taken(std::size_t(m.cells()), 0);
+  for (int f : bed_faces) {
+    if (f < m.n_internal || f >= m.faces()) throw VofError("column friction: face " + std::to_string(f) + " is not a boundary face");
+    const Vec up = (-1.0 / m.magSf[std::size_t(f)]) * m.Sf[std::size_t(f)];  // into the domain
+    out.bed_face.push_back(f);
+    int c = m.owner[std::size_t(f)], entry = f;
+    while (true) {
+      if (taken[std::size_t(c)]++) throw VofError("column friction: cell " + std::to_string(c) + " lies in two columns");
+      out.cells.push_back(c);
+      int best = -1;
+      double best_cos = std::cos(25 * 3.14159265358979323846 / 180);
+      for (int g : faces_of[std::size_t(c)]) {
+        if (g == entry) continue;
+        const double sign = m.owner[std::size_t(g)] == c ? 1.0 : -1.0;  // the face's normal out of c
+        const double cosine = sign * dot(m.Sf[std::size_t(g)], up) / m.magSf[std::size_t(g)];
+        if (cosine > best_cos) {
+          best_cos = cosine;
+          best = g;
+        }
+      }
+      if (best < 0) throw VofError("column friction: no face of cell " + std::to_string(c) + " faces away from bed face " + std::to_string(f));
+      if (best >= m.n_internal) break;  // the top of the column
+      entry = best;
+      c = m.owner[std::size_t(best)] == c ? m.neighbour[std::size_t(best)] : m.owner[std::size_t(best)];
+    }
+    out.start.push_back(int(out.cells.size()));
+  }
+  return out;
 }
 
 BedLoad add_column_friction(const Mesh& m, const ColumnFrictionConfig& cf, double rho1, const Fields& F, const Hydrostatics& hs,

@@ -62,6 +62,13 @@ struct ColumnDrag {
 BedLoad add_column_friction(const Mesh& m, const ColumnFrictionConfig& cf, double rho1, const Fields& F, const Hydrostatics& hs,
                             const ActiveRegion& region, FvMatrix<Vec>& UEqn, ColumnDrag& drag);
 
+/// The columns above `bed_faces` (boundary faces) of a mesh whose cells stack away from them, as
+/// the laboratory's blocks over their bottom: from each face's cell through the face opposite the
+/// one it entered by (the face whose outward normal is closest to the bed's inward normal, within
+/// 25 deg) to the next cell, until the walk reaches the boundary. Throws VofError when a cell has no
+/// such face. No curvature (plane beds).
+MeshColumns columns_above(const Mesh& m, const std::vector<int>& bed_faces);
+
 /// Checks a MeshColumns against the mesh (offsets, cell and face indices, one column per bed face);
 /// throws VofError naming what is wrong.
 void check_columns(const Mesh& m, const MeshColumns& c);

@@ -28,6 +28,11 @@ const OptionTable& terrain_vof_options() {
        "ColumnMeshSpec::growth"},
       {"mesh.band_height_m", T::number, U::as_given, "", Range{0, kHeight, true}, {}, "m",
        "from the ground to the mesh's top; default eight times the thickest release column", "ColumnMeshSpec::band_height_m"},
+      {"mesh.refinement", T::integer, U::fill, "1", Range{0, 8}, {}, "",
+       "columns per grid cell along each axis, so that cells are not far longer than the flow is deep (the maps stay on "
+       "the grid: each cell integrates its columns); 0: the rule, the smallest of 1, 2, 4 whose columns are within ten times "
+       "the thickest release column, as far as 250,000 cells allow (docs/design/vof.md)",
+       "ColumnMeshSpec::refinement"},
       {"mesh.corridor", T::choice, U::fill, "footprint", {}, {"footprint", "polygon", "none"}, "",
        "which columns are meshed: the depth-averaged engine's footprint on the same inputs (max depth above "
        "outputs.flow_threshold_m) dilated by mesh.corridor_margin_m, the polygons of mesh.corridor_path, or every column of the "

@@ -4,6 +4,7 @@
 
 #include "engine/vof/solver.hpp"
 #include "jobs/drivers/vof_lab/config.hpp"
+#include "jobs/drivers/vof_lab/setup.hpp"
 #include "jobs/scenario/options.hpp"
 #include "tests/support/run_helpers.hpp"
 
@@ -406,4 +407,28 @@ TEST(Scenarios, LabSideWallsAreValidatedAndReachTheConfiguration) {
   expect_resolve_error(with(R"(, "side_wall_width_m": 0, "side_wall_friction_deg": 18)"), {"lab.side_wall_width_m"});
   expect_resolve_error(with(R"(, "nz": 2, "z_max": 0.1, "side_wall_width_m": 0.1, "side_wall_friction_deg": 18)"),
                        {"lab.side_wall_width_m", "plane set-ups"});
+}
+
+// lab.bed_normal_stress: "pressure" by default (left unset, older scenarios keep their hash),
+// "column" takes the coulomb-friction sides' friction on the weight of the material above each of
+// their faces (the sides themselves then free of shear), and refuses a set-up without such a side.
+TEST(Scenarios, LabBedNormalStressIsValidatedAndReachesTheConfiguration) {
+  expect_unset_default_option("bed_normal_stress", "pressure", "column", "weight", [](const v1::Lab& l) { return l.bed_normal_stress(); });
+  const std::string head = R"({"engine": "vof", "lab": {"x_max": 1, "y_max": 0.1, "nx": 20, "ny": 4, "bed_normal_stress": "column",
+      "fill": [{"x_max": 0.5, "y_max": 0.05}])";
+  const auto r = jobs::resolve_scenario(
+      jobs::parse_scenario_json(head + R"(, "boundaries": [{"side": "bottom", "to": 0.6, "kind": "coulomb-friction"}, {"side": "top", "kind": "atmosphere"}]}})"), ".");
+  runout::jobs::vof_lab::LabSetup su;
+  runout::jobs::vof_lab::build_setup(r.scenario.lab(), su);
+  EXPECT_EQ(su.config.column_friction.columns.columns(), 12);  // the bottom's faces up to x = 0.6
+  EXPECT_EQ(su.config.column_friction.columns.cells.size(), 12u * 4u);
+  EXPECT_NEAR(su.config.column_friction.tan_delta, std::tan(su.mat.delta_deg * M_PI / 180), 1e-15);
+  EXPECT_EQ(su.config.bc.at("bottom-0").type, "symmetry");
+  try {
+    runout::jobs::vof_lab::LabSetup none;
+    runout::jobs::vof_lab::build_setup(jobs::resolve_scenario(jobs::parse_scenario_json(head + "}}"), ".").scenario.lab(), none);
+    ADD_FAILURE() << "no coulomb-friction side accepted";
+  } catch (const jobs::ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("lab.bed_normal_stress"), std::string::npos) << e.what();
+  }
 }

@@ -13,6 +13,7 @@
 #include "jobs/drivers/vof_terrain/corridor.hpp"
 #include "jobs/drivers/vof_terrain/mesh.hpp"
 #include "jobs/drivers/vof_terrain/release.hpp"
+#include "jobs/drivers/vof_terrain/setup.hpp"
 #include "terrain/column_mesh.hpp"
 
 namespace {
@@ -134,6 +135,89 @@ TEST(ColumnMesh, EngineMeshOfTheKeptColumnsOnASlope) {
   EXPECT_GT(q.non_orthogonality_mean_deg, 5.0);
   EXPECT_LT(q.skewness_max, 0.5);
   EXPECT_GT(q.aspect_ratio_max, 5 / 0.4 * 0.5);  // the thin first layer
+}
+
+// Refined columns (mesh.refinement R): R x R columns per grid cell on the unrefined mesh's ground
+// (the refined nodes that are grid corners carry the same elevation, the others lie on the bilinear
+// patches between them), the same kept cells, mesh volume, ground area and release volume; the
+// release's alpha the same in every column of a cell; the grid cell and sub-column numbering
+// inverse to each other.
+TEST(ColumnMesh, RefinedColumnsLieOnTheSameGround) {
+  // A curved ground (a bowl) with a corner outside the domain, so that the bilinear patches matter.
+  Grid g = plane(10, 8, 5, 20, 30, [](int i, int j) { return i >= 7 && j >= 6; });
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) g.z[std::size_t(j) * g.nx + i] += 0.02 * ((i - 4.5) * (i - 4.5) + (j - 3.5) * (j - 3.5)) * 25;
+  std::vector<double> H(g.cells(), 0.0);
+  for (int j = 2; j < 5; ++j)
+    for (int i = 2; i < 6; ++i) H[std::size_t(j) * g.nx + i] = 1.0 + 0.1 * i;
+  const ColumnMeshSpec one{0.3, 1.2, 6};
+  const auto c1 = runout::terrain::column_mesh(g, one);
+  const auto m1 = vt::terrain_mesh(c1, vt::frame_of(c1));
+  const auto a1 = vt::release_alpha(c1, H);
+  auto sums = [](const runout::engine::vof::Mesh& m, const std::vector<double>& a) {
+    double v = 0, va = 0, ground = 0;
+    for (int k = 0; k < m.cells(); ++k) {
+      v += m.volume[std::size_t(k)];
+      va += a[std::size_t(k)] * m.volume[std::size_t(k)];
+    }
+    const auto& p = m.patch("ground");
+    for (int f = p.start; f < p.start + p.size; ++f) ground += m.magSf[std::size_t(f)];
+    return std::vector<double>{v, va, ground};
+  };
+  const auto s1 = sums(m1, a1);
+  for (int r : {2, 4}) {
+    ColumnMeshSpec spec = one;
+    spec.refinement = r;
+    const auto c = runout::terrain::column_mesh(g, spec);
+    EXPECT_EQ(c.ni, g.nx * r);
+    EXPECT_EQ(c.nk, g.ny * r);
+    EXPECT_DOUBLE_EQ(c.dx, g.dx / r);
+    EXPECT_EQ(c.kept_columns(), r * r * c1.kept_columns());
+    for (int k = 0; k <= g.ny; ++k)
+      for (int i = 0; i <= g.nx; ++i) EXPECT_NEAR(c.ground_at(i * r, k * r), c1.ground_at(i, k), 1e-9);
+    const auto m = vt::terrain_mesh(c, vt::frame_of(c));
+    const auto a = vt::release_alpha(c, H);
+    const auto s = sums(m, a);
+    EXPECT_NEAR(s[0], s1[0], 1e-9 * s1[0]) << "mesh volume, refinement " << r;
+    EXPECT_NEAR(s[1], s1[1], 1e-9 * s1[1]) << "release volume, refinement " << r;
+    EXPECT_NEAR(s[2], s1[2], 2e-3 * s1[2]) << "ground area, refinement " << r;  // the bilinear patches' area, finer sums
+    const auto cols = vt::columns_of(c);
+    EXPECT_EQ(cols.grid_cells(), g.cells());
+    for (std::size_t gc = 0; gc < g.cells(); ++gc)
+      for (int q = 0; q < r * r; ++q) {
+        const std::size_t col = cols.sub_column(gc, q);
+        ASSERT_EQ(cols.grid_cell(col), gc);
+        ASSERT_EQ(c.grid_cell(col), gc);
+        ASSERT_EQ(c.kept[col], c1.kept[gc]);
+        if (c.kept[col])
+          for (int j = 0; j < c.layers(); ++j) ASSERT_EQ(a[std::size_t(cols.cell(col, j))], a1[std::size_t(vt::columns_of(c1).cell(gc, j))]);
+      }
+  }
+  ColumnMeshSpec bad = one;
+  bad.refinement = 9;
+  try {
+    runout::terrain::column_mesh(g, bad);
+    ADD_FAILURE() << "refinement 9 accepted";
+  } catch (const runout::terrain::TerrainError& e) {
+    EXPECT_NE(std::string(e.what()).find("mesh.refinement"), std::string::npos) << e.what();
+  }
+}
+
+// The rule of mesh.refinement 0: the smallest of 1, 2, 4 whose columns lie within ten times the
+// thickest release column, halved while the mesh would exceed 250,000 cells; an asked refinement
+// is taken as it is. The reason names the figures.
+TEST(ColumnMesh, RefinementRule) {
+  std::string why;
+  EXPECT_EQ(vt::choose_refinement(3, 30, 1.8, 5314, 13, why), 3);
+  EXPECT_NE(why.find("as given"), std::string::npos) << why;
+  EXPECT_EQ(vt::choose_refinement(0, 10, 2.0, 1000, 13, why), 1);   // 10 m within 20 m
+  EXPECT_EQ(vt::choose_refinement(0, 30, 1.8, 1000, 13, why), 2);   // 15 m within 18 m
+  EXPECT_EQ(vt::choose_refinement(0, 50, 1.9, 1000, 13, why), 4);   // 12.5 m within 19 m
+  EXPECT_EQ(vt::choose_refinement(0, 90, 1.8, 1000, 13, why), 4);   // at most 4
+  EXPECT_EQ(vt::choose_refinement(0, 30, 1.8, 5314, 13, why), 1);   // 276,328 cells at 2
+  EXPECT_NE(why.find("need 2"), std::string::npos) << why;
+  EXPECT_NE(why.find("exceed 250000 cells, so 1"), std::string::npos) << why;
+  EXPECT_EQ(vt::choose_refinement(0, 50, 1.9, 1357, 13, why), 2);   // 282,256 cells at 4, 70,564 at 2
 }
 
 // The release on the terrain mesh holds the depth-averaged engine's volume (its H, the vertical

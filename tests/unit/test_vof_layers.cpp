@@ -98,7 +98,7 @@ TEST(VofSolver, B9HeapSteeperThanPhiFails) {
 // coupling and the momentum predictor it does (0.19 m/s at 0.2 s); the PISO default reaches
 // 0.085 m/s there (0.015 m/s in the middle of a 2 m layer): each corrector is one Jacobi sweep of a viscous coupling that dominates the
 // momentum matrix, and the yielded layer is held as if it were stiff (docs/design/vof.md).
-double layer_speed_on_a_slope(bool consistent, Bc bed = Bc::wall, double delta_deg = 0) {
+double layer_speed_on_a_slope(bool consistent, Bc bed = Bc::wall, double delta_deg = 0, bool column_load = false) {
   BlockSpec b;
   b.x1 = 1.0, b.y1 = 0.06, b.nx = 200, b.ny = 12, b.thickness = 0.005;
   Mesh m = block_mesh(b);
@@ -113,6 +113,15 @@ double layer_speed_on_a_slope(bool consistent, Bc bed = Bc::wall, double delta_d
   c.bc["left"].kind = Bc::wall;
   c.bc["right"].kind = Bc::atmosphere;
   c.bc["top"].kind = Bc::atmosphere;
+  if (column_load) {  // the friction on the column's weight, the bed itself free of shear
+    const auto& bottom = m.patch("bottom");
+    std::vector<int> faces;
+    for (int f = bottom.start; f < bottom.start + bottom.size; ++f) faces.push_back(f);
+    c.column_friction.columns = columns_above(m, faces);
+    c.column_friction.tan_delta = c.bc["bottom"].tan_delta;
+    c.bc["bottom"].kind = Bc::symmetry;
+    c.n_outer_correctors = 3;
+  }
   VofSolver s(m, c);
   std::vector<double> a(std::size_t(m.cells()));
   for (int k = 0; k < m.cells(); ++k) a[std::size_t(k)] = m.centre[std::size_t(k)].x > 0.1 && m.centre[std::size_t(k)].x < 0.9 && m.centre[std::size_t(k)].y < 0.03;
@@ -164,10 +173,41 @@ TEST(VofSolver, LayerSteeperThanPhiAcceleratesWithTheConsistentCoupling) {
 // (0.37 m/s here; 0.27 m/s in the middle of a 2 m layer, about what the stick bed gives).
 TEST(VofSolver, CoulombFrictionBedLetsTheLayerSlideAtDelta) {
   const double fr = layer_speed_on_a_slope(true, Bc::coulomb_friction, 10), slip = layer_speed_on_a_slope(true, Bc::coulomb_slip, 10);
-  std::printf("layer on 40 deg, bed friction 10 deg: %.3f m/s at 0.2 s (Coulomb friction), %.3f m/s (appendix B.2's slip); "
-              "a block: 0.996 m/s\n", fr, slip);
+  const double column = layer_speed_on_a_slope(true, Bc::coulomb_friction, 10, true);
+  std::printf("layer on 40 deg, bed friction 10 deg: %.3f m/s at 0.2 s (Coulomb friction), %.3f m/s (on the column's weight), "
+              "%.3f m/s (appendix B.2's slip); a block: 0.996 m/s\n", fr, column, slip);
   EXPECT_NEAR(fr, 0.996, 0.1);
+  EXPECT_NEAR(column, 0.996, 0.1);
   EXPECT_LT(slip, 0.6);  // B.2's degeneracy, kept visible
+}
+
+// The columns above a block mesh's bottom (columns_above, the laboratory's lab.bed_normal_stress
+// "column"): one per bottom face, its cells from the bottom up; over a cut-out obstacle the columns
+// stop below it; a face whose cell has no face opposite it is refused.
+TEST(VofSolver, ColumnsAboveTheBottomOfABlockMesh) {
+  BlockSpec b;
+  b.x1 = 0.1, b.y1 = 0.05, b.nx = 10, b.ny = 5, b.thickness = 0.01, b.y_grading = 2;
+  b.blocked = {{0.052, 0.025}, {0.072, 0.025}, {0.072, 0.048}, {0.052, 0.048}};  // cells 5-6 of rows 3-4 (x 0.05-0.07)
+  const Mesh m = block_mesh(b);
+  const auto& bottom = m.patch("bottom");
+  std::vector<int> faces;
+  for (int f = bottom.start; f < bottom.start + bottom.size; ++f) faces.push_back(f);
+  const MeshColumns c = columns_above(m, faces);
+  check_columns(m, c);
+  ASSERT_EQ(c.columns(), 10);
+  int short_columns = 0;
+  for (int k = 0; k < c.columns(); ++k) {
+    const int n = c.start[std::size_t(k) + 1] - c.start[std::size_t(k)];
+    const double x = m.Cf[std::size_t(c.bed_face[std::size_t(k)])].x;
+    EXPECT_EQ(n, x > 0.05 && x < 0.07 ? 3 : 5) << "column at x = " << x;
+    short_columns += n == 3;
+    for (int i = c.start[std::size_t(k)] + 1; i < c.start[std::size_t(k) + 1]; ++i) {
+      EXPECT_NEAR(m.centre[std::size_t(c.cells[std::size_t(i)])].x, x, 1e-12);
+      EXPECT_GT(m.centre[std::size_t(c.cells[std::size_t(i)])].y, m.centre[std::size_t(c.cells[std::size_t(i) - 1])].y);
+    }
+  }
+  EXPECT_EQ(short_columns, 2);
+  EXPECT_THROW(columns_above(m, {0}), VofError);  // an internal face
 }
 
 // A layer 2 cm deep moving at 0.5 m/s over a horizontal stick bed, phi 33 deg. With the viscosity

@@ -28,6 +28,28 @@ E choose(const std::string& value, const char* field, const engine::NameTable<E,
   }
 }
 
+// lab.bed_normal_stress "column": the coulomb-friction sides' friction on the weight of the
+// material in the cells above each of their faces (engine/vof/column_friction.hpp), as the terrain
+// runs take it; the sides themselves then take no shear (symmetry), so that it is counted once.
+void take_column_load(const Material& mat, const vof::Mesh& m, vof::VofConfig& c) {
+  std::vector<int> faces;
+  for (auto& [name, pb] : c.bc) {
+    if (pb.type != "coulomb_friction") continue;
+    const auto& p = m.patch(name);
+    for (int f = p.start; f < p.start + p.size; ++f) faces.push_back(f);
+    pb.type = "symmetry";
+  }
+  if (faces.empty()) throw ScenarioError("lab.bed_normal_stress \"column\": no side of lab.boundaries is coulomb-friction");
+  try {
+    c.column_friction.columns = vof::columns_above(m, faces);
+  } catch (const vof::VofError& e) {
+    throw ScenarioError(std::string("lab.bed_normal_stress \"column\": ") + e.what() +
+                        " (the cells must stack away from every coulomb-friction face: a stair-stepped obstacle's do not, so give it "
+                        "another kind)");
+  }
+  c.column_friction.tan_delta = std::tan(mat.delta_deg * kPi / 180);
+}
+
 }  // namespace
 
 Material lab_material(const v1::Lab& L) {
@@ -96,6 +118,7 @@ void apply_boundaries(const v1::Lab& L, const Material& mat, vof::Mesh& m, vof::
   }
   for (auto it = c.bc.begin(); it != c.bc.end();)  // sides wholly taken by listed parts
     it = m.patch_index(it->first) < 0 ? c.bc.erase(it) : std::next(it);
+  if (L.bed_normal_stress() == "column") take_column_load(mat, m, c);
 }
 
 }  // namespace runout::jobs::vof_lab

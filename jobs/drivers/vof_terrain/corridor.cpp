@@ -79,8 +79,8 @@ std::vector<std::uint8_t> corridor_edge_faces(const Columns& cols, const engine:
     const auto& s = m.Sf[std::size_t(f)];  // horizontal: x east, z south
     if (std::abs(s.x) >= std::abs(s.z)) i += s.x > 0 ? 1 : -1;
     else k += s.z > 0 ? -1 : 1;
-    if (i < 0 || k < 0 || i >= g.nx || k >= g.ny) continue;  // the grid's edge
-    const std::size_t nb = std::size_t(k) * std::size_t(g.nx) + std::size_t(i);
+    if (i < 0 || k < 0 || i >= cols.ni || k >= cols.nk) continue;  // the grid's edge
+    const std::size_t nb = cols.grid_cell(std::size_t(k) * std::size_t(cols.ni) + std::size_t(i));
     if (g.outside.empty() || g.outside[nb] == 0) out[std::size_t(f)] = 1;
   }
   return out;

@@ -11,9 +11,9 @@ namespace runout::jobs::vof_terrain {
 namespace vof = engine::vof;
 
 ColumnHazard::ColumnHazard(const Columns& cols, const vof::Mesh& m, std::vector<double> cos_slope, HazardSettings s,
-                           std::vector<std::size_t> tracked)
+                           std::vector<Tracked> tracked)
     : cols_(cols), m_(m), cos_(std::move(cos_slope)), set_(s), tracked_(std::move(tracked)) {
-  const std::size_t n = cols.columns();
+  const std::size_t n = cols.grid_cells();
   hz_.max_depth.assign(n, 0);
   hz_.max_speed.assign(n, 0);
   hz_.max_pressure.assign(n, 0);
@@ -25,29 +25,37 @@ ColumnHazard::ColumnHazard(const Columns& cols, const vof::Mesh& m, std::vector<
   deepest_.resize(tracked_.size());
 }
 
-ColumnHazard::Column ColumnHazard::column(std::size_t col, const vof::VofSolver& s) const {
+ColumnHazard::Column ColumnHazard::column(std::size_t gc, const vof::VofSolver& s) const {
   Column out;
-  if (cols_.cell(col, 0) < 0) return out;
   const auto& a = s.alpha();
   const auto& u = s.velocity();
-  double vol = 0;
-  vof::Vec mom;
-  int top = -1;
-  for (int j = 0; j < cols_.layers; ++j) {
-    const int c = cols_.cell(col, j);
-    const double w = a[std::size_t(c)] * m_.volume[std::size_t(c)];
-    vol += w;
-    mom = mom + w * u[std::size_t(c)];
-    if (a[std::size_t(c)] >= 0.5) top = c;
-  }
-  out.depth = vol / cols_.plan_area * cos_[col];
-  if (vol > 0) out.speed = norm(mom) / vol;
-  if (top >= 0) out.surface_speed = norm(u[std::size_t(top)]);
-  // The ground cell's pressure less the air column's weight above it (the top cell's pressure and
-  // the air between the two centres).
-  const int c0 = cols_.cell(col, 0), cn = cols_.cell(col, cols_.layers - 1);
   const auto& p = s.pressure();
-  out.ground_stress = p[std::size_t(c0)] - p[std::size_t(cn)] - set_.rho_air * 9.81 * (m_.centre[std::size_t(cn)].y - m_.centre[std::size_t(c0)].y);
+  double vol = 0, stress = 0;
+  vof::Vec mom;
+  int kept = 0;
+  const int n = cols_.refinement * cols_.refinement;
+  for (int q = 0; q < n; ++q) {
+    const std::size_t col = cols_.sub_column(gc, q);
+    if (cols_.cell(col, 0) < 0) continue;
+    ++kept;
+    int top = -1;
+    for (int j = 0; j < cols_.layers; ++j) {
+      const int c = cols_.cell(col, j);
+      const double w = a[std::size_t(c)] * m_.volume[std::size_t(c)];
+      vol += w;
+      mom = mom + w * u[std::size_t(c)];
+      if (a[std::size_t(c)] >= 0.5) top = c;
+    }
+    if (top >= 0) out.surface_speed = std::max(out.surface_speed, norm(u[std::size_t(top)]));
+    // The ground cell's pressure less the air column's weight above it (the top cell's pressure and
+    // the air between the two centres).
+    const int c0 = cols_.cell(col, 0), cn = cols_.cell(col, cols_.layers - 1);
+    stress += p[std::size_t(c0)] - p[std::size_t(cn)] - set_.rho_air * 9.81 * (m_.centre[std::size_t(cn)].y - m_.centre[std::size_t(c0)].y);
+  }
+  if (kept == 0) return out;
+  out.depth = vol / (n * cols_.plan_area) * cos_[gc];
+  if (vol > 0) out.speed = norm(mom) / vol;
+  out.ground_stress = stress / kept;
   return out;
 }
 
@@ -63,10 +71,9 @@ Profile ColumnHazard::profile(std::size_t col, const vof::VofSolver& s) const {
 }
 
 void ColumnHazard::update(double t, const vof::VofSolver& s) {
-  const std::size_t n = cols_.columns();
+  const std::size_t n = cols_.grid_cells();
   for (std::size_t col = 0; col < n; ++col) {
-    if (cols_.cell(col, 0) < 0) continue;
-    const Column c = column(col, s);
+    const Column c = column(col, s);  // zero where no column of the cell is meshed
     hz_.max_depth[col] = std::max(hz_.max_depth[col], c.depth);
     if (c.depth > set_.flow_threshold) {
       hz_.max_speed[col] = std::max(hz_.max_speed[col], c.speed);
@@ -77,17 +84,17 @@ void ColumnHazard::update(double t, const vof::VofSolver& s) {
     }
   }
   for (std::size_t q = 0; q < tracked_.size(); ++q) {
-    const std::size_t col = tracked_[q];
-    const double d = column(col, s).depth;
-    if (d > set_.flow_threshold && !(hz_.max_depth[col] > d)) {
+    const Tracked& tr = tracked_[q];
+    const double d = column(tr.grid_cell, s).depth;
+    if (d > set_.flow_threshold && !(hz_.max_depth[tr.grid_cell] > d)) {
       deepest_t_[q] = t;
-      deepest_[q] = profile(col, s);
+      deepest_[q] = profile(tr.column, s);
     }
   }
 }
 
 std::vector<double> ColumnHazard::depth(const vof::VofSolver& s) const {
-  std::vector<double> d(cols_.columns(), 0.0);
+  std::vector<double> d(cols_.grid_cells(), 0.0);
   for (std::size_t col = 0; col < d.size(); ++col) d[col] = column(col, s).depth;
   return d;
 }
@@ -116,7 +123,7 @@ void ColumnHazard::restore(const LabCheckpoint& cp, const std::string& path) {
       throw ScenarioError("checkpoint " + path + ": its hazard map " + name + " is missing or of another grid");
     into = it->second;
   };
-  const std::size_t n = cols_.columns();
+  const std::size_t n = cols_.grid_cells();
   take("max_depth", hz_.max_depth, n);
   take("max_speed", hz_.max_speed, n);
   take("max_pressure", hz_.max_pressure, n);

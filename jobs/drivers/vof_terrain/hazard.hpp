@@ -1,10 +1,11 @@
 #pragma once
-// The hazard maps of a 3D run on the scenario's grid: each grid column's cells integrated through
-// the depth after every step. The flow depth normal to the ground is the column's material volume
-// over its plan area (the vertical thickness) times the cosine of the ground's slope, as the
-// depth-averaged engine measures it; the depth-averaged velocity is the material's momentum over its
-// volume; the surface speed the speed of the highest cell at least half full; the ground's normal
-// stress the ground cell's pressure less the column's air above it. The same files as the
+// The hazard maps of a 3D run on the scenario's grid: the cells of each grid cell's columns (one, or
+// R x R with mesh.refinement R) integrated through the depth after every step. The flow depth normal
+// to the ground is the material volume over the grid cell's plan area (the vertical thickness) times
+// the cosine of the ground's slope, as the depth-averaged engine measures it; the depth-averaged
+// velocity is the material's momentum over its volume; the surface speed the fastest of the columns'
+// highest cells at least half full; the ground's normal stress the columns' mean of the ground cell's
+// pressure less the column's air above it. The same files as the
 // depth-averaged engine come from these maps (jobs/drivers/hazard_outputs.hpp), plus the surface
 // speed and the ground stress.
 #include <string>
@@ -31,14 +32,18 @@ struct HazardSettings {
 
 class ColumnHazard {
  public:
-  /// cos_slope: per grid column, the cosine of the ground's slope (normal depth = vertical x cos).
+  /// A point whose profile through the depth is kept: its grid cell and the column it lies in.
+  struct Tracked {
+    std::size_t grid_cell = 0, column = 0;
+  };
+  /// cos_slope: per grid cell, the cosine of the ground's slope (normal depth = vertical x cos).
   ColumnHazard(const Columns& cols, const engine::vof::Mesh& m, std::vector<double> cos_slope, HazardSettings s,
-               std::vector<std::size_t> tracked = {});
+               std::vector<Tracked> tracked = {});
 
   /// After each step (and at t = 0): the running maxima, arrival times and the tracked columns'
   /// profiles at their deepest.
   void update(double t, const engine::vof::VofSolver& s);
-  /// The normal depth per column now.
+  /// The normal depth per grid cell now.
   std::vector<double> depth(const engine::vof::VofSolver& s) const;
   /// The final depth (the deposit) from the solver's state at the end.
   void finish(const engine::vof::VofSolver& s);
@@ -58,14 +63,14 @@ class ColumnHazard {
   struct Column {
     double depth = 0, speed = 0, surface_speed = 0, ground_stress = 0;
   };
-  Column column(std::size_t col, const engine::vof::VofSolver& s) const;
+  Column column(std::size_t gc, const engine::vof::VofSolver& s) const;
   Profile profile(std::size_t col, const engine::vof::VofSolver& s) const;
 
   const Columns& cols_;
   const engine::vof::Mesh& m_;
   std::vector<double> cos_;
   HazardSettings set_;
-  std::vector<std::size_t> tracked_;
+  std::vector<Tracked> tracked_;
   engine::HazardMaps hz_;
   std::vector<double> max_surface_, max_stress_;
   std::vector<double> deepest_t_;

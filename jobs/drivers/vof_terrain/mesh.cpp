@@ -32,6 +32,7 @@ Columns columns_of(const terrain::ColumnMesh& c) {
   out.ni = c.ni;
   out.nk = c.nk;
   out.layers = c.layers();
+  out.refinement = c.refinement;
   out.plan_area = c.dx * c.dx;
   out.levels = c.levels;
   out.cells.assign(out.columns() * std::size_t(out.layers), -1);
@@ -58,11 +59,12 @@ engine::vof::MeshColumns bed_columns(const Columns& cols, const engine::vof::Mes
     for (int j = 0; j < cols.layers; ++j) out.cells.push_back(cols.cell(col, j));
     out.start.push_back(int(out.cells.size()));
     // x east, z south: the horizontal velocity (east, north) is (u.x, -u.z).
-    const double c = geo.c[col];
+    const std::size_t gc = cols.grid_cell(col);
+    const double c = geo.c[gc];
     engine::vof::Tensor K;
-    K.g[0][0] = c * geo.hxx[col];
-    K.g[0][2] = K.g[2][0] = -c * geo.hxy[col];
-    K.g[2][2] = c * geo.hyy[col];
+    K.g[0][0] = c * geo.hxx[gc];
+    K.g[0][2] = K.g[2][0] = -c * geo.hxy[gc];
+    K.g[2][2] = c * geo.hyy[gc];
     out.curvature.push_back(K);
   }
   return out;

@@ -27,21 +27,35 @@ Frame frame_of(const terrain::ColumnMesh& c);
 engine::vof::Mesh terrain_mesh(const terrain::ColumnMesh& c, const Frame& frame);
 
 /// The engine's cells of each column, bottom up: cell(col, layer), -1 for columns outside the
-/// domain; col = k * ni + i as the grid's rows (row 0 south). Cells numbered as terrain_mesh()
-/// numbers them (the one place that numbering is spelt out besides structured_hex_mesh).
+/// domain; col = k * ni + i (row 0 south). Cells numbered as terrain_mesh() numbers them (the one
+/// place that numbering is spelt out besides structured_hex_mesh). With a refinement R each grid
+/// cell holds R x R columns (sub_column).
 struct Columns {
   int ni = 0, nk = 0, layers = 0;
+  int refinement = 1;          ///< columns per grid cell along each axis
   double plan_area = 0;        ///< of one column [m2]
   std::vector<double> levels;  ///< the layer interfaces' heights above the ground (ColumnMesh::levels)
   std::vector<int> cells;      ///< (col * layers + layer)
   int cell(std::size_t col, int layer) const { return cells[col * std::size_t(layers) + std::size_t(layer)]; }
   std::size_t columns() const { return std::size_t(ni) * std::size_t(nk); }
+  int grid_nx() const { return ni / refinement; }
+  std::size_t grid_cells() const { return columns() / std::size_t(refinement * refinement); }
+  /// The grid cell (j * grid_nx + i) of column col.
+  std::size_t grid_cell(std::size_t col) const {
+    const std::size_t i = col % std::size_t(ni), k = col / std::size_t(ni), r = std::size_t(refinement);
+    return (k / r) * std::size_t(grid_nx()) + i / r;
+  }
+  /// Column n (0 to R^2 - 1) of grid cell gc.
+  std::size_t sub_column(std::size_t gc, int n) const {
+    const std::size_t r = std::size_t(refinement), gi = gc % std::size_t(grid_nx()), gj = gc / std::size_t(grid_nx());
+    return (gj * r + std::size_t(n) / r) * std::size_t(ni) + gi * r + std::size_t(n) % r;
+  }
 };
 Columns columns_of(const terrain::ColumnMesh& c);
 
 /// The engine's columns (the bed friction on the column's weight, VofConfig::column_friction): per
 /// kept column its "ground" face, its cells bottom up, and the bed's curvature from the grid's
-/// elevations (the depth-averaged engine's Hessian, as u.K.u = cos(theta) u_h.Hess(b).u_h for the
+/// elevations (its grid cell's) (the depth-averaged engine's Hessian, as u.K.u = cos(theta) u_h.Hess(b).u_h for the
 /// horizontal part u_h of a velocity along the bed, in the engine's frame).
 engine::vof::MeshColumns bed_columns(const Columns& cols, const engine::vof::Mesh& m, const terrain::Grid& g);
 

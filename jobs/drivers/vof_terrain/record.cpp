@@ -24,6 +24,9 @@ void write_grid(const TerrainSetup& su, v1::RunRecord& rec) {
   tm->set_first_layer_m(su.columns.levels[1]);
   tm->set_growth(su.spec.growth);
   tm->set_band_height_m(su.columns.levels.back());
+  tm->set_refinement(su.columns.refinement);
+  tm->set_column_width_m(su.columns_mesh.dx);
+  tm->set_refinement_reason(su.refinement_reason);
   const auto& q = su.quality;
   tm->set_non_orthogonality_max_deg(q.non_orthogonality_max_deg);
   tm->set_non_orthogonality_mean_deg(q.non_orthogonality_mean_deg);

@@ -15,13 +15,13 @@ terrain::ColumnMeshSpec default_column_mesh(double max_vertical_m) {
 }
 
 std::vector<double> release_alpha(const terrain::ColumnMesh& c, const std::vector<double>& vertical_m) {
-  if (vertical_m.size() != std::size_t(c.ni) * std::size_t(c.nk))
+  if (vertical_m.size() != std::size_t(c.ni) * std::size_t(c.nk) / std::size_t(c.refinement * c.refinement))
     throw terrain::TerrainError("release: the thickness raster is not of the mesh's grid");
   const double band = c.levels.back();
   const Columns cols = columns_of(c);
   std::vector<double> alpha(std::size_t(c.kept_columns()) * std::size_t(c.layers()), 0.0);
   for (std::size_t col = 0; col < cols.columns(); ++col) {
-    const double h = vertical_m[col];
+    const double h = vertical_m[c.grid_cell(col)];  // every column of a grid cell takes the cell's thickness
     const int i = int(col % std::size_t(c.ni)), k = int(col / std::size_t(c.ni));
     if (!c.kept[col]) {
       if (h > 0)

@@ -17,7 +17,8 @@ terrain::ColumnMeshSpec default_column_mesh(double max_vertical_m);
 
 /// The phase fraction per cell of the engine's mesh of `c` (cells numbered as terrain_mesh numbers
 /// them: i east fastest, then the layer, then k north; columns outside the domain skipped) from
-/// the vertical thickness per grid cell, row-major as the grid (`vertical_m[k * ni + i]`).
+/// the vertical thickness per grid cell, row-major as the grid (`vertical_m[j * grid_nx + i]`); the
+/// refined columns of a grid cell all take its thickness, so that the volume does not change.
 /// Throws TerrainError naming mesh.band_height_m when a column's release does not fit in the band,
 /// and when material lies in a column outside the domain.
 std::vector<double> release_alpha(const terrain::ColumnMesh& c, const std::vector<double>& vertical_m);

@@ -167,6 +167,9 @@ RunSummary summary_of_setup(const ResolvedScenario& r, const TerrainSetup& su) {
   sum.notes.push_back("mesh: " + std::to_string(su.columns_mesh.kept_columns()) + " columns x " + std::to_string(su.columns.layers) +
                       " layers = " + std::to_string(su.mesh.cells()) + " cells (corridor \"" + su.corridor.kind + "\": " +
                       std::to_string(su.columns_mesh.kept_columns()) + " of the domain's " + std::to_string(su.domain_columns) + " columns)");
+  if (su.columns.refinement > 1 || r.scenario.mesh().refinement() == 0)
+    sum.notes.push_back("mesh: columns of " + json_number(su.columns_mesh.dx) + " m, " + std::to_string(su.columns.refinement) + " x " +
+                        std::to_string(su.columns.refinement) + " per grid cell (" + su.refinement_reason + "); the maps integrate them per grid cell");
   return sum;
 }
 
@@ -196,8 +199,8 @@ RunSummary run_terrain_vof(const ResolvedScenario& r, const std::string& out_dir
   } else {
     s.initialise(su.alpha);
   }
-  std::vector<std::size_t> tracked;
-  for (const auto& p : su.points) tracked.push_back(p.column);
+  std::vector<ColumnHazard::Tracked> tracked;
+  for (const auto& p : su.points) tracked.push_back({p.column, p.mesh_column});
   HazardSettings hs;
   hs.rho = r.scenario.material().density_kg_m3();
   hs.flow_threshold = r.config.flow_threshold;

@@ -1,6 +1,8 @@
 #include "jobs/drivers/vof_terrain/setup.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 
 #include "engine/sh2d.hpp"
 #include "jobs/drivers/hazard_outputs.hpp"
@@ -19,7 +21,30 @@ terrain::ColumnMeshSpec mesh_spec(const v1::TerrainMesh& m, double max_vertical)
   return s;  // terrain::layer_levels checks them
 }
 
+std::string fixed(double v, int digits) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.*f", digits, v);
+  return b;
+}
+
 }  // namespace
+
+int choose_refinement(int asked, double dx, double max_vertical_m, long columns, int layers, std::string& reason) {
+  if (asked > 0) {
+    reason = "mesh.refinement " + std::to_string(asked) + " as given";
+    return asked;
+  }
+  int want = 1;
+  while (want < 4 && dx / want > kRefinementDepths * max_vertical_m) want *= 2;
+  int r = want;
+  while (r > 1 && double(columns) * r * r * layers > kRefinementCellBudget) r /= 2;
+  reason = "the rule (mesh.refinement 0): columns of " + fixed(dx, 1) + " m within " + fixed(kRefinementDepths, 0) +
+           " times the thickest release column (" + fixed(max_vertical_m, 2) + " m) need " + std::to_string(want);
+  if (r < want)
+    reason += "; " + std::to_string(columns) + " columns x " + std::to_string(layers) + " layers x " + std::to_string(want * want) +
+              " would exceed " + fixed(kRefinementCellBudget, 0) + " cells, so " + std::to_string(r);
+  return r;
+}
 
 void build_terrain_setup(const ResolvedScenario& r, TerrainSetup& out) {
   out.grid = terrain::prepare_grid(r.dem, &out.dem);
@@ -33,6 +58,14 @@ void build_terrain_setup(const ResolvedScenario& r, TerrainSetup& out) {
   out.corridor = build_corridor(r, out.grid, out.h0);
   out.domain_columns = 0;
   for (std::size_t c = 0; c < out.grid.cells(); ++c) out.domain_columns += out.grid.outside.empty() || out.grid.outside[c] == 0;
+  long unrefined = 0;
+  for (std::size_t c = 0; c < out.grid.cells(); ++c)
+    unrefined += (out.grid.outside.empty() || out.grid.outside[c] == 0) && (out.corridor.cells.empty() || out.corridor.cells[c] != 0);
+  const int asked = r.scenario.mesh().refinement();
+  if (asked < 0 || asked > 8) throw terrain::TerrainError("mesh.refinement: must lie in [0, 8], got " + std::to_string(asked));
+  out.spec.refinement = choose_refinement(asked, out.grid.dx, *std::max_element(out.vertical.begin(), out.vertical.end()), unrefined,
+                                          int(terrain::layer_levels(out.spec).size()) - 1, out.refinement_reason);
+  out.domain_columns *= out.spec.refinement * out.spec.refinement;
   out.columns_mesh = terrain::column_mesh(out.grid, out.spec, out.corridor.cells);
   out.frame = frame_of(out.columns_mesh);
   out.columns = columns_of(out.columns_mesh);
@@ -49,6 +82,12 @@ void build_terrain_setup(const ResolvedScenario& r, TerrainSetup& out) {
     np.name = p.name();
     np.at = terrain::place_point(out.grid, p.x(), p.y(), p.crs(), "vof.profiles[" + std::to_string(k) + "]");
     np.column = std::size_t(np.at.j) * std::size_t(out.grid.nx) + std::size_t(np.at.i);
+    // The refined column holding the point, within its grid cell.
+    const int R = out.columns.refinement;
+    const double cw = out.columns_mesh.dx;
+    const int fi = std::clamp(int(std::floor((np.at.x - out.grid.x_min) / cw)), np.at.i * R, np.at.i * R + R - 1);
+    const int fk = std::clamp(int(std::floor((np.at.y - out.grid.y_min) / cw)), np.at.j * R, np.at.j * R + R - 1);
+    np.mesh_column = std::size_t(fk) * std::size_t(out.columns.ni) + std::size_t(fi);
     out.points.push_back(np);
   }
 }

@@ -21,8 +21,20 @@ namespace runout::jobs::vof_terrain {
 struct NamedPoint {
   std::string name;
   terrain::GridPoint at;
-  std::size_t column = 0;  ///< j * nx + i
+  std::size_t column = 0;       ///< its grid cell, j * nx + i
+  std::size_t mesh_column = 0;  ///< the mesh's column it lies in (Columns numbering)
 };
+
+/// The rule of mesh.refinement 0: the smallest of 1, 2, 4 whose columns are at most
+/// kRefinementDepths times the thickest release column wide, halved while the mesh would exceed
+/// kRefinementCellBudget cells.
+constexpr double kRefinementDepths = 10;
+constexpr double kRefinementCellBudget = 250000;
+
+/// The refinement for a grid of cells `dx` wide whose mesh has `columns` columns of `layers`
+/// layers unrefined: mesh.refinement when given (> 0), else the rule. `reason` says which, with the
+/// rule's figures.
+int choose_refinement(int asked, double dx, double max_vertical_m, long columns, int layers, std::string& reason);
 
 struct TerrainSetup {
   terrain::Grid grid;
@@ -31,9 +43,10 @@ struct TerrainSetup {
   std::vector<double> h0;         ///< the release's thickness normal to the ground per grid cell
   std::vector<double> vertical;   ///< the same vertically (the depth-averaged engine's H)
   std::vector<double> cos_slope;  ///< per grid cell
-  terrain::ColumnMeshSpec spec;
+  terrain::ColumnMeshSpec spec;    ///< its refinement chosen by choose_refinement
+  std::string refinement_reason;
   Corridor corridor;               ///< the columns meshed (mesh.corridor)
-  int domain_columns = 0;          ///< the columns inside the domain
+  int domain_columns = 0;          ///< the columns inside the domain (refined)
   terrain::ColumnMesh columns_mesh;
   Frame frame;
   Columns columns;
