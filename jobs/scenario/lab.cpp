@@ -41,6 +41,8 @@ void check_chute(const v1::Lab& l, bool three_d) {
     bad("lab.y_max", "the mesh (" + std::to_string(l.y_max() + bed_max) + " m above the reference surface) must stay well below the bend's radius of curvature (" +
                          std::to_string(radius) + " m)");
   if (!l.obstacles().empty()) bad("lab.obstacles", "obstacles are not supported on a curved chute");
+  if (l.bed_normal_stress() == "column")
+    bad("lab.bed_normal_stress", "\"column\" needs a plane bed: the curved chute's centripetal load is not in the laboratory's columns");
 }
 
 void check_fill(const v1::Lab& l, bool three_d) {

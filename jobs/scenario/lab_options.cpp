@@ -152,8 +152,9 @@ const OptionTable& lab_options() {
       {"lab.grain_density_kg_m3", T::number, U::as_given, "", Range{100, 20000}, {}, "kg/m3",
        "mu(I): grain density rho_s, at least the material's density (default: the material's)", "VofConfig::mu_i.grain_density"},
       {"lab.bed_normal_stress", T::choice, U::keep, "pressure", {}, {"pressure", "column"}, "",
-       "the normal load of coulomb-friction sides: the face's pressure, or the weight of the material in the cells above each "
-       "bed face (the column found by walking the mesh away from the face), as on the DEM (docs/design/vof.md)",
+       "the normal load of the bottom's coulomb-friction parts: the face's pressure, or the weight of the material in the cells "
+       "above each bed face (the column found by walking the mesh away from the face), as on the DEM; plane beds only, other "
+       "sides keep the face's pressure (docs/design/vof.md)",
        "VofConfig::column_friction"},
       {"lab.side_wall_width_m", T::number, U::as_given, "", Range{0, 10, true}, {}, "m",
        "plane set-ups: the width between the side walls they stand for (with side_wall_friction_deg)", "VofConfig::side_walls.width"},

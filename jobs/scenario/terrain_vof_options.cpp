@@ -28,7 +28,7 @@ const OptionTable& terrain_vof_options() {
        "ColumnMeshSpec::growth"},
       {"mesh.band_height_m", T::number, U::as_given, "", Range{0, kHeight, true}, {}, "m",
        "from the ground to the mesh's top; default eight times the thickest release column", "ColumnMeshSpec::band_height_m"},
-      {"mesh.refinement", T::integer, U::fill, "1", Range{0, 8}, {}, "",
+      {"mesh.refinement", T::integer, U::keep, "1", Range{0, 8}, {}, "",
        "columns per grid cell along each axis, so that cells are not far longer than the flow is deep (the maps stay on "
        "the grid: each cell integrates its columns); 0: the rule, the smallest of 1, 2, 4 whose columns are within ten times "
        "the thickest release column, as far as 250,000 cells allow (docs/design/vof.md)",

@@ -213,7 +213,8 @@ TEST(Scenarios, LabPolygonFillHoldsTheTriangle) {
 }
 
 // A curved chute's errors name the field: a 2D set-up, a mesh reaching the bend's centre of
-// curvature, a cap higher than its sphere.
+// curvature, a cap higher than its sphere, the column's weight as the bed's load (its bend's
+// centripetal load is not in the laboratory's columns).
 TEST(Scenarios, LabChuteErrorsNameTheField) {
   const std::string base = std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b8-curved-chute.json";
   auto expect = [&](const std::function<void(runout::v1::Lab*)>& edit, const std::string& field) {
@@ -231,6 +232,7 @@ TEST(Scenarios, LabChuteErrorsNameTheField) {
   expect([](runout::v1::Lab* l) { l->mutable_fill(0)->set_cap_height(0.5); }, "lab.fill[0].cap_height");
   expect([](runout::v1::Lab* l) { l->mutable_chute()->set_bend_end_m(1.0); }, "lab.chute.bend_end_m");
   expect([](runout::v1::Lab* l) { l->set_phi_deg(85); }, "lab.phi_deg");
+  expect([](runout::v1::Lab* l) { l->set_bed_normal_stress("column"); }, "lab.bed_normal_stress");
 }
 
 // comparison.png (validation.md part B): a plane run draws its section and monitors, a 3D run its
@@ -410,23 +412,29 @@ TEST(Scenarios, LabSideWallsAreValidatedAndReachTheConfiguration) {
 }
 
 // lab.bed_normal_stress: "pressure" by default (left unset, older scenarios keep their hash),
-// "column" takes the coulomb-friction sides' friction on the weight of the material above each of
-// their faces (the sides themselves then free of shear), and refuses a set-up without such a side.
+// "column" takes the friction of the bottom's coulomb-friction parts on the weight of the material
+// above each of their faces (those parts then free of shear); other coulomb-friction sides keep the
+// face's pressure; a set-up without a coulomb-friction part of the bottom is refused.
 TEST(Scenarios, LabBedNormalStressIsValidatedAndReachesTheConfiguration) {
   expect_unset_default_option("bed_normal_stress", "pressure", "column", "weight", [](const v1::Lab& l) { return l.bed_normal_stress(); });
   const std::string head = R"({"engine": "vof", "lab": {"x_max": 1, "y_max": 0.1, "nx": 20, "ny": 4, "bed_normal_stress": "column",
       "fill": [{"x_max": 0.5, "y_max": 0.05}])";
   const auto r = jobs::resolve_scenario(
-      jobs::parse_scenario_json(head + R"(, "boundaries": [{"side": "bottom", "to": 0.6, "kind": "coulomb-friction"}, {"side": "top", "kind": "atmosphere"}]}})"), ".");
+      jobs::parse_scenario_json(head + R"(, "boundaries": [{"side": "bottom", "to": 0.6, "kind": "coulomb-friction"}, {"side": "top", "kind": "atmosphere"},
+          {"side": "right", "kind": "coulomb-friction"}]}})"), ".");
   runout::jobs::vof_lab::LabSetup su;
   runout::jobs::vof_lab::build_setup(r.scenario.lab(), su);
   EXPECT_EQ(su.config.column_friction.columns.columns(), 12);  // the bottom's faces up to x = 0.6
   EXPECT_EQ(su.config.column_friction.columns.cells.size(), 12u * 4u);
   EXPECT_NEAR(su.config.column_friction.tan_delta, std::tan(su.mat.delta_deg * M_PI / 180), 1e-15);
   EXPECT_EQ(su.config.bc.at("bottom-0").type, "symmetry");
+  EXPECT_EQ(su.config.bc.at("right-2").type, "coulomb_friction");  // not the bottom: its face's pressure
   try {
     runout::jobs::vof_lab::LabSetup none;
-    runout::jobs::vof_lab::build_setup(jobs::resolve_scenario(jobs::parse_scenario_json(head + "}}"), ".").scenario.lab(), none);
+    runout::jobs::vof_lab::build_setup(
+        jobs::resolve_scenario(jobs::parse_scenario_json(head + R"(, "boundaries": [{"side": "right", "kind": "coulomb-friction"}]}})"), ".")
+            .scenario.lab(),
+        none);
     ADD_FAILURE() << "no coulomb-friction side accepted";
   } catch (const jobs::ScenarioError& e) {
     EXPECT_NE(std::string(e.what()).find("lab.bed_normal_stress"), std::string::npos) << e.what();

@@ -27,6 +27,7 @@
 #include "jobs/drivers/vof_terrain/setup.hpp"
 #include "jobs/scenario/options.hpp"
 #include "terrain/column_mesh.hpp"
+#include "tests/support/local_raster.hpp"
 #include "tests/support/temp_dir.hpp"
 
 namespace {
@@ -81,6 +82,7 @@ struct PlaneRun {
   int footprint_growth = 0;        ///< columns deeper than 1 cm at the end that were not at the start
   int footprint_reach = 0;         ///< of those, the farthest from the start's footprint, in columns
   double reach_m = 0;              ///< the same in metres
+  double t0_depth_error = 0;       ///< the hazard maps' depth per grid cell at the start against the release's [m]
 };
 
 // A square block of normal thickness `thickness_m` whose centre lies a quarter of the plane above its
@@ -118,7 +120,14 @@ PlaneRun run_plane(const PlaneCase& pc, double t_end) {
   runout::jobs::apply_option_rules(runout::jobs::terrain_vof_options(), r.scenario);
   const vof::MeshColumns cols = vt::bed_columns(vt::columns_of(cm), m, g);
   vof::VofSolver s(m, vt::terrain_config(r, cols));
+  double out_t0_error = 0;
   s.initialise(alpha);
+  {  // The maps integrate each grid cell's columns: at the start their depth is the release's.
+    const vt::Columns vc = vt::columns_of(cm);
+    const vt::ColumnHazard hz(vc, m, runout::engine::SurfaceGeometry::from(t2).c, {});
+    const auto d = hz.depth(s);
+    for (std::size_t k = 0; k < g.cells(); ++k) out_t0_error = std::max(out_t0_error, std::abs(d[k] - h0[k]));
+  }
   // Downslope in the engine's frame (x east, y up, z south).
   const vof::Vec down{std::cos(th) * std::cos(a), -std::sin(th), -std::cos(th) * std::sin(a)};
   // The material's mean velocity over the cells `in` takes (all by default).
@@ -136,6 +145,7 @@ PlaneRun run_plane(const PlaneCase& pc, double t_end) {
   double v0 = 0;
   for (int c = 0; c < m.cells(); ++c) v0 += alpha[std::size_t(c)] * m.volume[std::size_t(c)];
   PlaneRun out;
+  out.t0_depth_error = out_t0_error;
   // Material that leaves through the plane's sides (thin fast edges, turned 45 deg) is counted.
   double outflow = 0;
   auto count_outflow = [&](const vof::StepStats& st) {
@@ -318,6 +328,7 @@ TEST(TerrainVof, RefinedBlockSlumpsAsTheDepthAveragedOneOnTheSameCells) {
   EXPECT_NEAR(r.reach_m, reach, 5.0);
   EXPECT_LT(r.speed_end, 1e-2);
   EXPECT_LT(r.volume_error, 1e-6);
+  EXPECT_LT(r.t0_depth_error, 1e-9);  // the maps integrate each 10 m cell's 16 columns
 }
 
 // A layer over the whole plane (no edges, 2 m on 15 deg, delta 20): on the column's weight (the
@@ -390,6 +401,41 @@ TEST(TerrainVof, ArelenCoarseRunWritesTheHazardMapsFramesAndRecord) {
   EXPECT_NE(runout::test_support::read_text(d.p / "fields.xmf").find("Precision=\"8\" Format=\"HDF\">fields.h5:/centres"), std::string::npos);
   std::printf("Arelen at 90 m, 5 s: %d of %d columns, %d cells, %ld steps, %.1f s run; volume error %.1e, outflow %.0f m3, runout %.0f m\n",
               tm.columns(), tm.domain_columns(), tm.cells(), sum.steps, sum.seconds_run, sum.volume_error, sum.volume_outflow, sum.runout_m);
+}
+
+// In den Arelen on refined columns (90 m grid, mesh.refinement 2, 2 s): four columns per grid cell,
+// run.json's refinement, column width and reason, the release's volume, the volume balance, the
+// farmhouse's profile from its own column, and the rasters on the scenario's grid.
+TEST(TerrainVof, ArelenRefinedRunMapsItsColumnsOnTheGrid) {
+  auto sc = runout::jobs::parse_scenario_json(runout::test_support::read_text(kArelen3d));
+  sc.mutable_grid()->set_resolution_m(90);
+  sc.mutable_numerics()->set_end_time_s(2);
+  sc.mutable_vof()->set_write_interval_s(0);
+  sc.mutable_mesh()->set_refinement(2);
+  const auto r = runout::jobs::resolve_scenario(sc, kArelen3d.parent_path().string());
+  runout::test_support::TempDir d;
+  const auto sum = runout::jobs::run_scenario(r, d.p.string());
+  const auto rec = runout::jobs::read_run_record((d.p / "run.json").string());
+  const auto& tm = rec.terrain_mesh();
+  EXPECT_EQ(tm.refinement(), 2);
+  EXPECT_EQ(tm.column_width_m(), 45);
+  EXPECT_EQ(tm.refinement_reason(), "mesh.refinement 2");
+  EXPECT_EQ(tm.domain_columns(), 4 * 1371);
+  EXPECT_EQ(tm.columns() % 4, 0);
+  EXPECT_EQ(tm.cells(), tm.columns() * tm.layers());
+  EXPECT_NEAR(rec.release().volume_on_mesh_m3() / rec.release().volume_m3(), 1.0, 0.01);
+  EXPECT_LT(rec.mass_balance().relative_error(), 1e-6);
+  ASSERT_EQ(rec.profiles_size(), 1);
+  const auto band = runout::test_support::read_raster_band((d.p / "max_depth.tif").string());
+  EXPECT_EQ(band.nx, rec.grid().nx());
+  EXPECT_EQ(band.ny, rec.grid().ny());
+  EXPECT_NEAR(band.gt[1], 90, 1e-9);
+  double deepest = 0;  // over the cells with data
+  for (double v : band.values)
+    if (std::isfinite(v)) deepest = std::max(deepest, v);
+  EXPECT_NEAR(deepest, rec.results().max_depth_m(), 1e-6);
+  std::printf("Arelen at 90 m, refinement 2, 2 s: %d columns, %d cells, %ld steps, %.1f s run; max depth %.2f m\n", tm.columns(), tm.cells(),
+              sum.steps, sum.seconds_run, rec.results().max_depth_m());
 }
 
 // A corridor polygon (mesh.corridor "polygon") must hold the release: one around the farmhouse,

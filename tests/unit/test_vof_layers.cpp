@@ -183,7 +183,7 @@ TEST(VofSolver, CoulombFrictionBedLetsTheLayerSlideAtDelta) {
 
 // The columns above a block mesh's bottom (columns_above, the laboratory's lab.bed_normal_stress
 // "column"): one per bottom face, its cells from the bottom up; over a cut-out obstacle the columns
-// stop below it; a face whose cell has no face opposite it is refused.
+// stop below it; an internal face is refused.
 TEST(VofSolver, ColumnsAboveTheBottomOfABlockMesh) {
   BlockSpec b;
   b.x1 = 0.1, b.y1 = 0.05, b.nx = 10, b.ny = 5, b.thickness = 0.01, b.y_grading = 2;

@@ -28,24 +28,24 @@ E choose(const std::string& value, const char* field, const engine::NameTable<E,
   }
 }
 
-// lab.bed_normal_stress "column": the coulomb-friction sides' friction on the weight of the
-// material in the cells above each of their faces (engine/vof/column_friction.hpp), as the terrain
-// runs take it; the sides themselves then take no shear (symmetry), so that it is counted once.
+// lab.bed_normal_stress "column": the friction of the bottom's coulomb-friction parts on the weight
+// of the material in the cells above each of their faces (engine/vof/column_friction.hpp), as the
+// terrain runs take it; those parts then take no shear (symmetry), so that it is counted once.
+// Other coulomb-friction sides (the walls of a 3D box, an obstacle) keep the load of their face's
+// pressure: their columns would run along the channel or cross the bottom's.
 void take_column_load(const Material& mat, const vof::Mesh& m, vof::VofConfig& c) {
   std::vector<int> faces;
   for (auto& [name, pb] : c.bc) {
-    if (pb.type != "coulomb_friction") continue;
+    if (pb.type != "coulomb_friction" || name.rfind("bottom", 0) != 0) continue;
     const auto& p = m.patch(name);
     for (int f = p.start; f < p.start + p.size; ++f) faces.push_back(f);
     pb.type = "symmetry";
   }
-  if (faces.empty()) throw ScenarioError("lab.bed_normal_stress \"column\": no side of lab.boundaries is coulomb-friction");
+  if (faces.empty()) throw ScenarioError("lab.bed_normal_stress \"column\": no part of the bottom is coulomb-friction (lab.boundaries)");
   try {
     c.column_friction.columns = vof::columns_above(m, faces);
   } catch (const vof::VofError& e) {
-    throw ScenarioError(std::string("lab.bed_normal_stress \"column\": ") + e.what() +
-                        " (the cells must stack away from every coulomb-friction face: a stair-stepped obstacle's do not, so give it "
-                        "another kind)");
+    throw ScenarioError(std::string("lab.bed_normal_stress \"column\": ") + e.what());
   }
   c.column_friction.tan_delta = std::tan(mat.delta_deg * kPi / 180);
 }

@@ -22,15 +22,16 @@ std::vector<double> release_alpha(const terrain::ColumnMesh& c, const std::vecto
   std::vector<double> alpha(std::size_t(c.kept_columns()) * std::size_t(c.layers()), 0.0);
   for (std::size_t col = 0; col < cols.columns(); ++col) {
     const double h = vertical_m[c.grid_cell(col)];  // every column of a grid cell takes the cell's thickness
-    const int i = int(col % std::size_t(c.ni)), k = int(col / std::size_t(c.ni));
+    // The grid cell, as the user's rasters number it (the refined column lies in it).
+    const int i = int(col % std::size_t(c.ni)) / c.refinement, k = int(col / std::size_t(c.ni)) / c.refinement;
     if (!c.kept[col]) {
       if (h > 0)
-        throw terrain::TerrainError("release: material in the column (" + std::to_string(i) + ", " + std::to_string(k) + ") outside the domain");
+        throw terrain::TerrainError("release: material in the grid cell (" + std::to_string(i) + ", " + std::to_string(k) + ") outside the domain");
       continue;
     }
     if (h > band)
       throw terrain::TerrainError("mesh.band_height_m: " + std::to_string(band) + " m does not hold the release's " + std::to_string(h) +
-                                  " m in column (" + std::to_string(i) + ", " + std::to_string(k) + ")");
+                                  " m in grid cell (" + std::to_string(i) + ", " + std::to_string(k) + ")");
     for (int j = 0; j < c.layers(); ++j) {
       const double lo = c.levels[std::size_t(j)], hi = c.levels[std::size_t(j) + 1];
       alpha[std::size_t(cols.cell(col, j))] = std::clamp((h - lo) / (hi - lo), 0.0, 1.0);

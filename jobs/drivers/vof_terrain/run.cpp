@@ -167,7 +167,7 @@ RunSummary summary_of_setup(const ResolvedScenario& r, const TerrainSetup& su) {
   sum.notes.push_back("mesh: " + std::to_string(su.columns_mesh.kept_columns()) + " columns x " + std::to_string(su.columns.layers) +
                       " layers = " + std::to_string(su.mesh.cells()) + " cells (corridor \"" + su.corridor.kind + "\": " +
                       std::to_string(su.columns_mesh.kept_columns()) + " of the domain's " + std::to_string(su.domain_columns) + " columns)");
-  if (su.columns.refinement > 1 || r.scenario.mesh().refinement() == 0)
+  if (su.columns.refinement > 1 || (r.scenario.mesh().has_refinement() && r.scenario.mesh().refinement() == 0))
     sum.notes.push_back("mesh: columns of " + json_number(su.columns_mesh.dx) + " m, " + std::to_string(su.columns.refinement) + " x " +
                         std::to_string(su.columns.refinement) + " per grid cell (" + su.refinement_reason + "); the maps integrate them per grid cell");
   return sum;

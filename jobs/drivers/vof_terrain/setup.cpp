@@ -31,7 +31,7 @@ std::string fixed(double v, int digits) {
 
 int choose_refinement(int asked, double dx, double max_vertical_m, long columns, int layers, std::string& reason) {
   if (asked > 0) {
-    reason = "mesh.refinement " + std::to_string(asked) + " as given";
+    reason = "mesh.refinement " + std::to_string(asked);
     return asked;
   }
   int want = 1;
@@ -61,7 +61,8 @@ void build_terrain_setup(const ResolvedScenario& r, TerrainSetup& out) {
   long unrefined = 0;
   for (std::size_t c = 0; c < out.grid.cells(); ++c)
     unrefined += (out.grid.outside.empty() || out.grid.outside[c] == 0) && (out.corridor.cells.empty() || out.corridor.cells[c] != 0);
-  const int asked = r.scenario.mesh().refinement();
+  const auto& me = r.scenario.mesh();
+  const int asked = me.has_refinement() ? me.refinement() : 1;
   if (asked < 0 || asked > 8) throw terrain::TerrainError("mesh.refinement: must lie in [0, 8], got " + std::to_string(asked));
   out.spec.refinement = choose_refinement(asked, out.grid.dx, *std::max_element(out.vertical.begin(), out.vertical.end()), unrefined,
                                           int(terrain::layer_levels(out.spec).size()) - 1, out.refinement_reason);
