@@ -85,6 +85,18 @@ struct PlaneRun {
   double t0_depth_error = 0;       ///< the hazard maps' depth per grid cell at the start against the release's [m]
 };
 
+// The hazard maps integrate each grid cell's columns: the largest difference between their depth
+// per grid cell and the release's normal thickness h0 [m].
+double start_depth_error(const runout::terrain::ColumnMesh& cm, const vof::Mesh& m, const runout::engine::Terrain2D& t2,
+                         const vof::VofSolver& s, const std::vector<double>& h0) {
+  const vt::Columns vc = vt::columns_of(cm);
+  const vt::ColumnHazard hz(vc, m, runout::engine::SurfaceGeometry::from(t2).c, {});
+  const auto d = hz.depth(s);
+  double e = 0;
+  for (std::size_t k = 0; k < h0.size(); ++k) e = std::max(e, std::abs(d[k] - h0[k]));
+  return e;
+}
+
 // A square block of normal thickness `thickness_m` whose centre lies a quarter of the plane above its
 // centre (upslope), run for `t_end` s.
 PlaneRun run_plane(const PlaneCase& pc, double t_end) {
@@ -120,14 +132,7 @@ PlaneRun run_plane(const PlaneCase& pc, double t_end) {
   runout::jobs::apply_option_rules(runout::jobs::terrain_vof_options(), r.scenario);
   const vof::MeshColumns cols = vt::bed_columns(vt::columns_of(cm), m, g);
   vof::VofSolver s(m, vt::terrain_config(r, cols));
-  double out_t0_error = 0;
   s.initialise(alpha);
-  {  // The maps integrate each grid cell's columns: at the start their depth is the release's.
-    const vt::Columns vc = vt::columns_of(cm);
-    const vt::ColumnHazard hz(vc, m, runout::engine::SurfaceGeometry::from(t2).c, {});
-    const auto d = hz.depth(s);
-    for (std::size_t k = 0; k < g.cells(); ++k) out_t0_error = std::max(out_t0_error, std::abs(d[k] - h0[k]));
-  }
   // Downslope in the engine's frame (x east, y up, z south).
   const vof::Vec down{std::cos(th) * std::cos(a), -std::sin(th), -std::cos(th) * std::sin(a)};
   // The material's mean velocity over the cells `in` takes (all by default).
@@ -145,7 +150,7 @@ PlaneRun run_plane(const PlaneCase& pc, double t_end) {
   double v0 = 0;
   for (int c = 0; c < m.cells(); ++c) v0 += alpha[std::size_t(c)] * m.volume[std::size_t(c)];
   PlaneRun out;
-  out.t0_depth_error = out_t0_error;
+  out.t0_depth_error = start_depth_error(cm, m, t2, s, h0);  // before the first step
   // Material that leaves through the plane's sides (thin fast edges, turned 45 deg) is counted.
   double outflow = 0;
   auto count_outflow = [&](const vof::StepStats& st) {
