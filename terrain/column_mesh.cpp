@@ -90,7 +90,6 @@ ColumnMesh column_mesh(const Grid& g, const ColumnMeshSpec& s, const std::vector
   m.levels = layer_levels(s);
   const int r = s.refinement;
   m.refinement = r;
-  m.grid_nx = g.nx;
   m.ni = g.nx * r;
   m.nk = g.ny * r;
   m.x_min = g.x_min;

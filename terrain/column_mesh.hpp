@@ -32,10 +32,16 @@ struct ColumnMeshSpec {
 /// factor (at most 1) so that they end exactly there. Throws TerrainError naming the option.
 std::vector<double> layer_levels(const ColumnMeshSpec& s);
 
+/// The grid cell (j * (ni / refinement) + i) of refined column col = k * ni + i, with ni columns
+/// along x and `refinement` columns per grid cell along each axis.
+inline std::size_t grid_cell_of(std::size_t col, int ni, int refinement) {
+  const std::size_t i = col % std::size_t(ni), k = col / std::size_t(ni), r = std::size_t(refinement);
+  return (k / r) * (std::size_t(ni) / r) + i / r;
+}
+
 struct ColumnMesh {
   int ni = 0, nk = 0;        ///< columns along x (east) and y (north): the grid's cells times the refinement
   int refinement = 1;        ///< columns per grid cell along each axis
-  int grid_nx = 0;           ///< the grid's cells along x
   double x_min = 0, y_min = 0, dx = 0;  ///< the grid's corner; the columns' width (the grid's cell / refinement)
   std::vector<double> levels;           ///< layer interfaces above the ground (layer_levels)
   std::vector<double> ground;           ///< (ni + 1) (nk + 1) node elevations, node (i, k) at k (ni + 1) + i
@@ -47,11 +53,8 @@ struct ColumnMesh {
   double node_y(int k) const { return y_min + k * dx; }
   double node_z(int i, int k, int j) const { return ground_at(i, k) + levels[std::size_t(j)]; }
   int kept_columns() const;
-  /// The grid cell (j * grid_nx + i) that column col = k * ni + i lies in.
-  std::size_t grid_cell(std::size_t col) const {
-    const std::size_t i = col % std::size_t(ni), k = col / std::size_t(ni), r = std::size_t(refinement);
-    return (k / r) * std::size_t(grid_nx) + i / r;
-  }
+  /// The grid cell (j * (ni / refinement) + i) that column col = k * ni + i lies in.
+  std::size_t grid_cell(std::size_t col) const { return grid_cell_of(col, ni, refinement); }
 };
 
 /// The column mesh over `g` (at least 2 x 2 cells): the columns inside the domain, and when

@@ -41,10 +41,7 @@ struct Columns {
   int grid_nx() const { return ni / refinement; }
   std::size_t grid_cells() const { return columns() / std::size_t(refinement * refinement); }
   /// The grid cell (j * grid_nx + i) of column col.
-  std::size_t grid_cell(std::size_t col) const {
-    const std::size_t i = col % std::size_t(ni), k = col / std::size_t(ni), r = std::size_t(refinement);
-    return (k / r) * std::size_t(grid_nx()) + i / r;
-  }
+  std::size_t grid_cell(std::size_t col) const { return terrain::grid_cell_of(col, ni, refinement); }
   /// Column n (0 to R^2 - 1) of grid cell gc.
   std::size_t sub_column(std::size_t gc, int n) const {
     const std::size_t r = std::size_t(refinement), gi = gc % std::size_t(grid_nx()), gj = gc / std::size_t(grid_nx());

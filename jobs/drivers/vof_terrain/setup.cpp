@@ -57,10 +57,12 @@ void build_terrain_setup(const ResolvedScenario& r, TerrainSetup& out) {
   out.spec = mesh_spec(r.scenario.mesh(), *std::max_element(out.vertical.begin(), out.vertical.end()));
   out.corridor = build_corridor(r, out.grid, out.h0);
   out.domain_columns = 0;
-  for (std::size_t c = 0; c < out.grid.cells(); ++c) out.domain_columns += out.grid.outside.empty() || out.grid.outside[c] == 0;
-  long unrefined = 0;
-  for (std::size_t c = 0; c < out.grid.cells(); ++c)
-    unrefined += (out.grid.outside.empty() || out.grid.outside[c] == 0) && (out.corridor.cells.empty() || out.corridor.cells[c] != 0);
+  long unrefined = 0;  // the corridor's columns inside the domain, one per grid cell
+  for (std::size_t c = 0; c < out.grid.cells(); ++c) {
+    const bool inside = out.grid.outside.empty() || out.grid.outside[c] == 0;
+    out.domain_columns += inside;
+    unrefined += inside && (out.corridor.cells.empty() || out.corridor.cells[c] != 0);
+  }
   const auto& me = r.scenario.mesh();
   const int asked = me.has_refinement() ? me.refinement() : 1;
   if (asked < 0 || asked > 8) throw terrain::TerrainError("mesh.refinement: must lie in [0, 8], got " + std::to_string(asked));
