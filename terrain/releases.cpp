@@ -164,14 +164,15 @@ struct CellFill {
   std::vector<double>& h;
   std::vector<double>& area;
   // `geom` (null: all of each cell) and the thickness per sample: `raster` (a thickness raster's
-  // request, resampled at the samples) or `t`, over the cells [i0, i1) x [j0, j1).
-  void operator()(const std::string& what, bool vertical, double smin, double smax, const OGRGeometry* geom, const ReleaseRequest* raster,
+  // request, resampled at the samples) or `t`, over the cells [i0, i1) x [j0, j1). Returns the plan
+  // area of `geom` inside the domain (the grid, the area of interest, the DEM's data) [m2].
+  double operator()(const std::string& what, bool vertical, double smin, double smax, const OGRGeometry* geom, const ReleaseRequest* raster,
                   const OGRSpatialReference& dst, double t, double factor, int i0, int j0, int i1, int j1) const;
 };
 
 std::vector<double> raster_thickness(const Grid& g, const ReleaseRequest& rq, const OGRSpatialReference& dst);
 
-void CellFill::operator()(const std::string& what, bool vertical, double smin, double smax, const OGRGeometry* geom,
+double CellFill::operator()(const std::string& what, bool vertical, double smin, double smax, const OGRGeometry* geom,
                           const ReleaseRequest* raster, const OGRSpatialReference& dst, double t, double factor, int i0, int j0, int i1,
                           int j1) const {
   const Grid& g = lat.g;
@@ -181,7 +182,7 @@ void CellFill::operator()(const std::string& what, bool vertical, double smin, d
   i1 = std::min(i1, g.nx);
   j1 = std::min(j1, g.ny);
   long inside = 0, kept = 0;
-  double smin_seen = 90, smax_seen = 0;
+  double smin_seen = 90, smax_seen = 0, covered_m2 = 0;
   std::vector<double> vol(g.cells(), 0.0), plan(g.cells(), 0.0);
   std::vector<std::size_t> touched;
   // Bands of rows of at most about 4 million samples and 4 million cells of the slope surface.
@@ -203,6 +204,7 @@ void CellFill::operator()(const std::string& what, bool vertical, double smin, d
         const std::size_t k = std::size_t(b0 + v / n) * g.nx + std::size_t(i0 + u / n);
         if (!(cov[q] > 0) || !(thick[q] > 0) || (!g.outside.empty() && g.outside[k])) continue;  // no release where the domain has no terrain
         ++inside;
+        covered_m2 += cov[q] * a;
         smin_seen = std::min(smin_seen, sl[q]);
         smax_seen = std::max(smax_seen, sl[q]);
         if (sl[q] < smin || sl[q] > smax) continue;
@@ -224,6 +226,18 @@ void CellFill::operator()(const std::string& what, bool vertical, double smin, d
       area[k] = plan[k];
     }
   }
+  return covered_m2;
+}
+
+// A note when part of a polygon lies outside the domain (more than 1 % of its area, beyond the
+// sampling's resolution): that part is not released, and the user should know.
+void note_clipped(const std::string& what, const OGRGeometry& geom, double inside_m2, ReleaseReport& rep) {
+  const double all = OGR_G_Area(OGRGeometry::ToHandle(const_cast<OGRGeometry*>(&geom)));
+  if (!(all > 0) || inside_m2 >= 0.99 * all) return;
+  char b[200];
+  std::snprintf(b, sizeof b, ": %.1f %% of its area (%.0f of %.0f m2) lies outside the grid, the area of interest or the DEM's data and is not released",
+                100 * (1 - inside_m2 / all), all - inside_m2, all);
+  rep.notes.push_back(what + b);
 }
 
 // The cells [i0, i1) x [j0, j1) that the envelope of `geom` meets.
@@ -369,10 +383,12 @@ void release_polygons(const ReleaseRequest& rq, const OGRSpatialReference& dst, 
       if (areas) {  // a secondary release: each polygon an area of its own
         areas->push_back({what, std::vector<double>(g.cells(), 0.0), 0});
         std::vector<double> area(g.cells(), 0.0);
-        CellFill{fill.lat, fill.slope, fill.extent, areas->back().h, area}(named, rq.vertical, smin, smax, geom.get(), raster ? &rq : nullptr,
-                                                                           dst, t, rq.thickness_factor, c[0], c[1], c[2], c[3]);
+        const double in = CellFill{fill.lat, fill.slope, fill.extent, areas->back().h, area}(
+            named, rq.vertical, smin, smax, geom.get(), raster ? &rq : nullptr, dst, t, rq.thickness_factor, c[0], c[1], c[2], c[3]);
+        if (!raster) note_clipped(what, *geom, in, rep);
       } else {
-        fill(named, rq.vertical, smin, smax, geom.get(), raster ? &rq : nullptr, dst, t, rq.thickness_factor, c[0], c[1], c[2], c[3]);
+        const double in = fill(named, rq.vertical, smin, smax, geom.get(), raster ? &rq : nullptr, dst, t, rq.thickness_factor, c[0], c[1], c[2], c[3]);
+        if (!raster) note_clipped(what, *geom, in, rep);
       }
       ++rep.polygons;
     }

@@ -30,6 +30,7 @@ figures::HazardMap map_base(const ResolvedScenario& s, const terrain::Grid& grid
   base.max_depth = hz.max_depth;
   base.outline_threshold = s.outline_threshold;
   base.parameters = map_parameters(s, grid, sum.release_volume_m3);
+  for (const auto& n : sum.notes) base.parameters.push_back("note: " + n);  // run.json's notes, on every map
   for (const auto& p : overlay.points) base.points.push_back({p.name, p.x, p.y});
   base.path = overlay.path;
   base.path_marks = overlay.path_marks;

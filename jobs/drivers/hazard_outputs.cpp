@@ -40,6 +40,8 @@ std::pair<double, double> release_centroid(const terrain::Grid& grid, const std:
 // The maximum depth, the affected area and the runout from the release's centroid.
 void hazard_figures(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
                     RunSummary& sum) {
+  if (!s.terrain)  // the depth-averaged engine's limit (the 3D engine reports its mesh's quality)
+    if (const auto steep = steep_terrain_note(s, grid, h0, hz); !steep.empty()) sum.notes.push_back(steep);
   const auto [mx, my] = release_centroid(grid, h0);
   long affected = 0;
   for (int j = 0; j < grid.ny; ++j)
@@ -59,6 +61,28 @@ void require_finite_figures(std::initializer_list<std::pair<const char*, double>
     if (!std::isfinite(v))
       throw std::runtime_error(std::string("the run's ") + name + " is not finite (" + json_number(v) +
                                "): the flow state became NaN or infinite; no results written");
+}
+
+std::string steep_terrain_note(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz) {
+  const auto slope = terrain::slope_deg(grid);
+  long released = 0, reached = 0;
+  double steepest = 0;
+  for (std::size_t k = 0; k < slope.size(); ++k) {
+    if (!(slope[k] > kSteepSlopeDeg) || (!grid.outside.empty() && grid.outside[k])) continue;
+    const bool rel = h0[k] > 0, flow = hz.max_depth[k] > s.outline_threshold;
+    released += rel;
+    reached += flow && !rel;
+    if (rel || flow) steepest = std::max(steepest, slope[k]);
+  }
+  if (released + reached == 0) return "";
+  char b[400];
+  std::snprintf(b, sizeof b,
+                "near-vertical terrain: %ld cell(s) of the release and %ld further cell(s) of the flow are steeper than %.0f deg "
+                "(steepest %.1f deg): the depth-averaged model holds h / cos(slope) of a vertical column there (twice the thickness "
+                "at 60 deg, six times at 80 deg), so depth, speed and pressure on and just below these cells are not reliable; check "
+                "them against the DEM (a cliff, or an artefact) before using the maps there",
+                released, reached, kSteepSlopeDeg, steepest);
+  return b;
 }
 
 namespace {

@@ -24,12 +24,20 @@ engine::Terrain2D engine_terrain(const terrain::Grid& grid);
 std::pair<double, double> release_centroid(const terrain::Grid& grid, const std::vector<double>& h0);
 
 /// The maximum depth, the affected area (max_depth above the outline threshold) and the runout from
-/// the centroid of the release h0 into `sum`.
+/// the centroid of the release h0 into `sum`, and for the depth-averaged engine the note on
+/// near-vertical terrain (steep_terrain_note).
 void hazard_figures(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
                     RunSummary& sum);
 
 /// Throws std::runtime_error when one of the named figures is not finite: the flow state became NaN
 /// or infinite, and nothing is written.
+/// Slopes steeper than this [deg] are outside what the depth-averaged model describes (its
+/// thickness normal to the ground holds h / cos(slope) of a vertical column).
+inline constexpr double kSteepSlopeDeg = 60;
+/// A note (empty when none) naming the cells steeper than kSteepSlopeDeg under the release or the
+/// flow (max depth above the outline threshold): depth and speed there are not physical.
+std::string steep_terrain_note(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz);
+
 void require_finite_figures(std::initializer_list<std::pair<const char*, double>> figures);
 
 /// What write_hazard_outputs wrote that the run record reports.

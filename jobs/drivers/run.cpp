@@ -67,6 +67,8 @@ void write_record(const std::string& path, const ResolvedScenario& s, const terr
   so->set_cell_updates(d.cell_updates);
   so->set_mean_active_fraction(d.mean_active_fraction);
   so->set_max_active_fraction(d.max_active_fraction);
+  for (const auto& n : sum.notes)  // what the reader of the maps must know (the release's own notes stay in release.notes)
+    if (std::find(rel_rep.notes.begin(), rel_rep.notes.end(), n) == rel_rep.notes.end()) rec.add_notes(n);
   auto* re = rec.mutable_results();
   record_hazard_results(s, sum, outputs, *re);
   re->set_timeseries_frames(frames);

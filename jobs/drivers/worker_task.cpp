@@ -2,14 +2,17 @@
 
 #include <omp.h>
 #include <signal.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "jobs/drivers/ensemble_aggregate.hpp"
 #include "jobs/drivers/run.hpp"
@@ -21,6 +24,20 @@
 namespace runout::jobs {
 
 namespace {
+
+// A failed run's error with the disk's state when the disk that holds its results (or its
+// checkpoint) is full: the libraries that wrote say only "Input/output error" or "writing ... failed".
+std::string with_disk_state(const std::string& error, const std::vector<std::string>& paths) {
+  if (error.find("disk is full") != std::string::npos) return error;
+  for (const auto& p : paths) {
+    struct statvfs v {};
+    if (p.empty() || ::statvfs(p.c_str(), &v) != 0) continue;
+    const double free_bytes = double(v.f_bavail) * double(v.f_frsize);
+    if (free_bytes < kFullDiskBytes)
+      return error + " (the disk is full: " + std::to_string(std::int64_t(free_bytes) >> 10) + " KiB free where the results are written)";
+  }
+  return error;
+}
 
 volatile std::sig_atomic_t g_stop = 0;
 extern "C" void on_stop(int) { g_stop = 1; }
@@ -99,7 +116,8 @@ int worker_main(int in_fd, int out_fd) {
   v1::WorkerTask task;
   auto failed = [&](const std::string& error, bool bad_input) {
     v1::WorkerEvent ev;
-    ev.mutable_failed()->set_error(error);
+    const std::string ckpt = task.checkpoint_path().empty() ? "" : std::filesystem::path(task.checkpoint_path()).parent_path().string();
+    ev.mutable_failed()->set_error(bad_input ? error : with_disk_state(error, {task.out_dir(), ckpt}));
     ev.mutable_failed()->set_bad_input(bad_input);
     return send_event(events, ev) ? 0 : 3;
   };

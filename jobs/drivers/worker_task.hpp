@@ -5,6 +5,10 @@
 
 namespace runout::jobs {
 
+/// A run that fails with less than this free on the disk of its results failed for the full disk,
+/// and its error says so [bytes].
+inline constexpr double kFullDiskBytes = 4 << 20;
+
 /// Reads one WorkerTask from `in_fd` (to its end), runs it and writes events to `out_fd`. Returns
 /// the process's exit status (0 when an outcome was written).
 int worker_main(int in_fd, int out_fd);

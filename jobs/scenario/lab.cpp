@@ -130,6 +130,8 @@ ResolvedScenario resolve_lab(v1::Scenario s) {
   const auto& ref = l.reference();
   if (ref.has_front_x_min() != ref.has_front_x_max() || (ref.has_front_x_min() && ref.front_x_max() < ref.front_x_min()))
     bad("lab.reference.front_x_max", "the front is a range: give front_x_min and front_x_max >= front_x_min");
+  check_output_interval("lab.write_interval_s", l.write_interval_s(), "lab.end_time_s", l.end_time_s());
+  check_output_interval("lab.checkpoint_interval_s", l.checkpoint_interval_s(), "lab.end_time_s", l.end_time_s());
   require_finite(s, "");
   ResolvedScenario r;
   r.vof = true;

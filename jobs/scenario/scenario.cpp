@@ -5,6 +5,7 @@
 
 #include "jobs/digest/sha256.hpp"
 #include "jobs/scenario/json_shape.hpp"
+#include "jobs/scenario/text_limits.hpp"
 #include "jobs/scenario/mu_i_fields.hpp"
 #include "jobs/scenario/options.hpp"
 #include "jobs/scenario/scenario_impl.hpp"
@@ -116,6 +117,7 @@ v1::Scenario parse_scenario_json(const std::string& json) {
   opt.ignore_unknown_fields = false;
   const auto st = google::protobuf::util::JsonStringToMessage(json, &s, opt);
   if (!st.ok()) throw ScenarioError("scenario JSON: " + std::string(st.message()));
+  check_text_limits(s);
   try {
     check_json_shape(json);  // what protobuf's parser lets through: duplicate keys, a value for a list
   } catch (const ScenarioError& e) {
@@ -289,6 +291,7 @@ void check_terrain_vof(const v1::Scenario& s) {
 }  // namespace
 
 ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
+  check_text_limits(s);  // first: nothing else reads an unbounded name or a path cut by a NUL byte
   apply_option_rules(scenario_options(), s);
   const bool vof = s.engine() == "vof";
   if (vof && s.has_lab()) return resolve_lab(std::move(s));
@@ -305,6 +308,12 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   map_options(depth_averaged_options(), s, r);
   if (vof) check_terrain_vof(s);  // first: the 3D engine takes one friction law
   check_material(s.material(), r.config.material);
+  const double t_end = s.numerics().end_time_s();
+  check_output_interval("outputs.timeseries_interval_s", s.outputs().timeseries_interval_s(), "numerics.end_time_s", t_end);
+  if (vof) {
+    check_output_interval("vof.write_interval_s", s.vof().write_interval_s(), "numerics.end_time_s", t_end);
+    check_output_interval("vof.checkpoint_interval_s", s.vof().checkpoint_interval_s(), "numerics.end_time_s", t_end);
+  }
   r.terrain = vof;
   require_finite(s, "");
   r.scenario = std::move(s);

@@ -253,6 +253,7 @@ struct Scheduler::Attempt {
   std::optional<v1::WorkerEvent> outcome;  // its outcome event, when it sent one
   WorkerExit exit;
   std::string start_error;  // it could not be started
+  bool stuck = false;       // it did not end after SIGKILL: left behind (reaped by a thread of its own)
 };
 
 void Scheduler::run_job(StoredJob job) {
@@ -425,7 +426,15 @@ Scheduler::Attempt Scheduler::supervise(JobContext& jc, const v1::WorkerTask& ta
         kill_at = now + jc.grace;
       } else if (a.why != Why::none && now > kill_at) {
         w.signal(SIGKILL);
+        if (now > kill_at + std::chrono::milliseconds(std::int64_t(1000 * cfg_.stuck_after_kill_s))) {
+          a.stuck = true;
+          break;
+        }
       }
+    }
+    if (a.stuck) {
+      leave_behind(jc, std::move(run), a);
+      return a;
     }
     auto e = w.wait(jc.grace + std::chrono::seconds(5));
     if (!e) {
@@ -437,6 +446,24 @@ Scheduler::Attempt Scheduler::supervise(JobContext& jc, const v1::WorkerTask& ta
     a.start_error = e.what();
   }
   return a;
+}
+
+// A worker process that has not ended after SIGKILL (Attempt::stuck) cannot end yet: its job ends
+// now, and a thread of its own reaps the process whenever it ends.
+void Scheduler::leave_behind(JobContext& jc, std::unique_ptr<Execution> run, Attempt& a) {
+  if (const auto e = run->wait(std::chrono::milliseconds(0))) {
+    a.exit = *e;
+  } else {
+    a.exit.signal = SIGKILL;
+    a.exit.signal_ours = true;
+    std::thread([left = std::move(run)]() mutable { left.reset(); }).detach();
+  }
+  char b[40];
+  std::snprintf(b, sizeof b, "%g", cfg_.stuck_after_kill_s);
+  jc.say(std::string("worker process did not end within ") + b +
+         " s of SIGKILL (stuck in uninterruptible I/O, or its output held open by a process it started): left behind, its slot "
+         "released");
+  log("job " + jc.id + ": its worker process did not end after SIGKILL; left behind, its slot released");
 }
 
 bool Scheduler::conclude(JobContext& jc, v1::WorkerTask& task, const Attempt& a, int round) {

@@ -44,6 +44,9 @@ struct SchedulerConfig {
   double max_job_wall_s = 86400;    ///< wall time of one attempt (a scenario's limits may lower it)
   std::int64_t max_job_memory_bytes = 0;  ///< resident memory of a worker; 0: no limit
   double stop_grace_s = 1;          ///< a stopped or cancelled worker is killed after this long
+  /// A worker whose process has not ended this long after SIGKILL (stuck in uninterruptible I/O: a
+  /// hung network filesystem, a failing disk) is left behind: its job ends and its slot is free.
+  double stuck_after_kill_s = 10;
   int max_crashes = 3;              ///< a job whose worker crashed this often fails
   std::vector<std::string> data_roots;  ///< the server's data roots (left out of messages to clients)
   bool terrain_cache = true;        ///< depth-averaged runs share prepared grids (STATE/cache/terrain)
@@ -108,6 +111,7 @@ class Scheduler {
   Attempt supervise(JobContext& jc, const v1::WorkerTask& task);
   /// Record what an ended attempt means for the job; true: run it again at once.
   bool conclude(JobContext& jc, v1::WorkerTask& task, const Attempt& a, int round);
+  void leave_behind(JobContext& jc, std::unique_ptr<Execution> run, Attempt& a);
   /// Publish progress; false when the job should stop (cancel or server stop).
   bool on_progress(const std::string& id, const v1::Progress& p);
   void log(const std::string& line) const;

@@ -167,6 +167,15 @@ static bool is_stamp(const std::string& t) {
   return true;
 }
 
+namespace {
+const char* const kRequestHead = "request '";
+const char* const kRequestTail = "' answered by this job (request digest ";
+}  // namespace
+
+std::string request_log_line(const std::string& request_id, const std::string& request_digest) {
+  return kRequestHead + request_id + kRequestTail + request_digest + ")";
+}
+
 // A job as its record and its log tell it: "TIME attempt N: started ...", "TIME STATE: reason",
 // "TIME error: ..." (lines without the job system's time stamp are the worker's own output).
 static StoredJob rebuild_job(const v1::JobRecord& rec, const fs::path& state, RecoveryReport& rep) {
@@ -197,6 +206,13 @@ static StoredJob rebuild_job(const v1::JobRecord& rec, const fs::path& state, Re
     if (text.rfind("attempt ", 0) == 0 && text.find(": started") != std::string::npos) {
       ++attempts;
       add(v1::RUNNING, when, "started (attempt " + std::to_string(attempts) + ")");
+      continue;
+    }
+    if (text.rfind(kRequestHead, 0) == 0) {  // a request id answered with this job (request_log_line)
+      const auto tail = text.rfind(kRequestTail);
+      const std::size_t head = std::string(kRequestHead).size(), after = tail + std::string(kRequestTail).size();
+      if (tail != std::string::npos && tail >= head && text.size() == after + 65 && text.back() == ')')
+        j.more_requests.emplace_back(text.substr(head, tail - head), text.substr(after, 64));
       continue;
     }
     if (text.rfind("error: ", 0) == 0) {

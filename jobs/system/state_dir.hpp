@@ -58,6 +58,10 @@ struct RecoveryReport {
 /// The caller holds the state directory's lock (`held`), so no server starts meanwhile.
 RecoveryReport recover_store(const std::string& state_dir, const StateLock& held);
 
+/// The job-log line (after its time stamp) that records a request id answered with this earlier
+/// identical job, so that recovery gives the id back to the same job.
+std::string request_log_line(const std::string& request_id, const std::string& request_digest);
+
 /// STATE/server.json, written by a server once it listens (atomically: a temporary file renamed).
 void write_server_info(const std::string& state_dir, const v1::ServerInfo& info);
 /// STATE/server.json of a running server; nothing when there is none or it cannot be read.

@@ -147,7 +147,13 @@ JobStore::JobStore(const std::string& path) {
            time TEXT NOT NULL,
            state INTEGER NOT NULL,
            reason TEXT NOT NULL);
-         CREATE INDEX IF NOT EXISTS transitions_job ON transitions(job);)");
+         CREATE INDEX IF NOT EXISTS transitions_job ON transitions(job);
+         CREATE TABLE IF NOT EXISTS requests(
+           owner TEXT NOT NULL,
+           request_id TEXT NOT NULL,
+           job TEXT NOT NULL REFERENCES jobs(id),
+           request_hash TEXT NOT NULL DEFAULT '',
+           PRIMARY KEY(owner, request_id));)");
   // Stores written before the cancel flag existed get the column.
   sqlite3_stmt* probe = nullptr;
   if (sqlite3_prepare_v2(db_, "SELECT cancel_requested FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
@@ -252,7 +258,10 @@ SubmitOutcome JobStore::submit_ensemble(const std::string& owner, const std::str
     return true;
   };
   if (!request_id.empty()) {
-    Stmt st(db_, (std::string("SELECT ") + kColumns + " FROM jobs WHERE owner = ? AND request_id = ?").c_str());
+    // The job this request id names: the one it created, or the identical one that answered it.
+    Stmt st(db_, (std::string("SELECT ") + kColumns +
+                  " FROM jobs WHERE owner = ?1 AND (request_id = ?2 OR id = (SELECT job FROM requests WHERE owner = ?1 AND request_id = ?2))")
+                     .c_str());
     st.bind(1, owner).bind(2, request_id);
     if (existing(st)) {
       if (out.job.job.scenario_hash() != hash)
@@ -269,6 +278,11 @@ SubmitOutcome JobStore::submit_ensemble(const std::string& owner, const std::str
                      .c_str());
     st.bind(1, owner).bind(2, hash);
     if (existing(st)) {
+      if (!request_id.empty()) {  // from now on the request id names this job (a retry, or another scenario: refused)
+        Stmt(db_, "INSERT INTO requests(owner, request_id, job, request_hash) VALUES (?, ?, ?, ?)")
+            .bind(1, owner).bind(2, request_id).bind(3, out.job.job.id()).bind(4, request_hash).step();
+        out.request_recorded = true;
+      }
       tx.commit();
       return out;
     }
@@ -419,7 +433,8 @@ constexpr const char* kCancelledQueued = "cancelled by the client before it star
 constexpr const char* kMemberCancelled = "its ensemble was cancelled by the client before it started";
 }  // namespace
 
-std::optional<StoredJob> JobStore::cancel(const std::string& id, const std::string& owner, std::vector<Change>* ended) {
+std::optional<StoredJob> JobStore::cancel(const std::string& id, const std::string& owner, std::vector<Change>* ended,
+                                          const std::function<void(const std::vector<Change>&)>& before_commit) {
   {
     std::lock_guard lk(mu_);
     Transaction tx(db_);
@@ -449,6 +464,7 @@ std::optional<StoredJob> JobStore::cancel(const std::string& id, const std::stri
       // after a crash loses it.
       Stmt(db_, "UPDATE jobs SET cancel_requested = 1 WHERE id = ?").bind(1, id).step();
     }
+    if (before_commit && ended) before_commit(*ended);
     tx.commit();
   }
   return get(id, owner);
@@ -580,6 +596,9 @@ void JobStore::insert_recovered(const StoredJob& j) {
       .bind(16, std::int64_t(j.job.parent_id().empty() ? -1 : j.job.member_index()));
   ins.step();
   for (const auto& t : j.job.transitions()) add_transition(db_, j.job.id(), t.state(), t.time_utc(), t.reason());
+  for (const auto& [rid, digest] : j.more_requests)
+    Stmt(db_, "INSERT OR IGNORE INTO requests(owner, request_id, job, request_hash) VALUES (?, ?, ?, ?)")
+        .bind(1, j.owner).bind(2, rid).bind(3, j.job.id()).bind(4, digest).step();
   tx.commit();
 }
 
@@ -588,7 +607,16 @@ std::optional<std::pair<StoredJob, std::string>> JobStore::find_request(const st
   std::lock_guard lk(mu_);
   Stmt st(db_, (std::string("SELECT ") + kColumns + ", COALESCE(request_hash, '') FROM jobs WHERE owner = ? AND request_id = ?").c_str());
   st.bind(1, owner).bind(2, request_id);
-  if (!st.step()) return std::nullopt;
+  if (!st.step()) {  // a request answered with an earlier identical job
+    Stmt al(db_, (std::string("SELECT ") + kColumns +
+                  ", (SELECT request_hash FROM requests WHERE owner = ?1 AND request_id = ?2) FROM jobs "
+                  "WHERE id = (SELECT job FROM requests WHERE owner = ?1 AND request_id = ?2)").c_str());
+    al.bind(1, owner).bind(2, request_id);
+    if (!al.step()) return std::nullopt;
+    std::pair<StoredJob, std::string> out{read_row(&al), al.text(kNextColumn)};
+    load_transitions(out.first);
+    return out;
+  }
   std::pair<StoredJob, std::string> out{read_row(&st), st.text(kNextColumn)};
   load_transitions(out.first);
   return out;

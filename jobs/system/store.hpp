@@ -8,6 +8,7 @@
 // or restarts during a run.
 #include <cstdint>
 #include <mutex>
+#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -38,11 +39,17 @@ struct StoredJob {
   v1::Scenario scenario;  ///< as resolved on the server (absolute input paths)
   bool results_removed = false;  ///< results deleted by the retention policy
   int crashes = 0;               ///< attempts whose worker process died of a signal nobody sent
+  /// Further request ids that name this job (owner's request id, digest of that request): a request
+  /// answered with this earlier identical job. Filled by recovery (from the job's log) only.
+  std::vector<std::pair<std::string, std::string>> more_requests = {};
 };
 
 struct SubmitOutcome {
   StoredJob job;
   bool created = false;  ///< false: an existing job answered (same request id or identical scenario)
+  /// The request id was new and is now recorded for the existing identical job that answered it
+  /// (the caller writes it to that job's log, from which recovery rebuilds it).
+  bool request_recorded = false;
 };
 
 class JobStore {
@@ -99,7 +106,8 @@ class JobStore {
   /// An ensemble's queued members are cancelled with it and its running ones asked to stop.
   /// `ended` (when given) receives each job this call moved to CANCELLED: the job itself when it
   /// was queued, and an ensemble's queued members (their logs want the line).
-  std::optional<StoredJob> cancel(const std::string& id, const std::string& owner, std::vector<Change>* ended = nullptr);
+  std::optional<StoredJob> cancel(const std::string& id, const std::string& owner, std::vector<Change>* ended = nullptr,
+                                  const std::function<void(const std::vector<Change>&)>& before_commit = {});
   /// Jobs left running by a server that went down: queued again (cancelled when the client had
   /// asked). The server's death does not count against a job. Returns how many were queued again;
   /// `changed` (optional) receives each job's id, new state and reason.

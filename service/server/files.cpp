@@ -179,6 +179,10 @@ Status Server::Impl::DownloadResult(grpc::ServerContext* ctx, const v1::Download
     if (first) c.set_total_bytes(total);
     if (last) c.set_sha256(h.hex());
     if (!w->Write(c)) return {StatusCode::CANCELLED, "the client went away"};
+    {
+      std::lock_guard lk(stop_mu);  // a stop ends a download between chunks
+      if (stopped) return {StatusCode::UNAVAILABLE, "the server is stopping; fetch again when it is back"};
+    }
     offset += std::int64_t(n);
     first = false;
     if (last) break;
@@ -205,7 +209,25 @@ Status Server::Impl::UploadInput(grpc::ServerContext* ctx, grpc::ServerReader<v1
   jobs::Sha256 set_hash;
   std::unique_ptr<jobs::Sha256> file_hash;
   std::int64_t bytes = 0;
-  const std::int64_t held = store->upload_bytes(owner);
+  // This upload's bytes count against the client's quota while they arrive, so that uploads of one
+  // client at once cannot together exceed it.
+  struct Arriving {
+    Impl& m;
+    const std::string& owner;
+    std::int64_t bytes = 0;
+    bool take(std::int64_t n, std::int64_t quota) {
+      std::lock_guard lk(m.upload_mu);
+      auto& total = m.bytes_arriving[owner];
+      if (m.store->upload_bytes(owner) + total + n > quota) return false;
+      total += n;
+      bytes += n;
+      return true;
+    }
+    ~Arriving() {
+      std::lock_guard lk(m.upload_mu);
+      if ((m.bytes_arriving[owner] -= bytes) <= 0) m.bytes_arriving.erase(owner);
+    }
+  } arriving{*this, owner};
   auto close_file = [&] {
     if (!current.empty()) {
       out.close();
@@ -230,7 +252,7 @@ Status Server::Impl::UploadInput(grpc::ServerContext* ctx, grpc::ServerReader<v1
     bytes += std::int64_t(c.data().size());
     if (bytes > cfg.max_upload_bytes())
       return fail(StatusCode::RESOURCE_EXHAUSTED, "upload larger than the server's limit of " + std::to_string(cfg.max_upload_bytes()) + " bytes");
-    if (held + bytes > cfg.max_upload_bytes_per_client())
+    if (!arriving.take(std::int64_t(c.data().size()), cfg.max_upload_bytes_per_client()))
       return fail(StatusCode::RESOURCE_EXHAUSTED,
                   "this client's uploads would exceed its quota of " + std::to_string(cfg.max_upload_bytes_per_client()) +
                       " bytes (uploads no queued or running job uses are removed after " + jobs::json_number(cfg.upload_ttl_s()) + " s)");

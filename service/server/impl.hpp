@@ -42,6 +42,7 @@ struct Server::Impl final : v1::Runout::Service {
   std::mutex log_mu;
   std::mutex upload_mu;
   std::map<std::string, int> uploads_in_flight;  // guarded by upload_mu
+  std::map<std::string, std::int64_t> bytes_arriving;  // per client, of its uploads in progress; guarded by upload_mu
   std::mutex validate_mu;
   std::condition_variable validate_cv;
   int validating = 0;
@@ -113,6 +114,9 @@ struct Server::Impl final : v1::Runout::Service {
     // The answer to a request id used before: its job (the same request), or ALREADY_EXISTS.
     std::optional<Status> answer_retry(const std::string& owner, const v1::SubmitRequest& req, const std::string& request_hash,
                                        v1::Job* resp);
+
+    // A submission's inputs resolved on this server; the uploads it names into `uploads`.
+    Status resolve_inputs(v1::Scenario& s, InFlight& in_flight, std::vector<std::string>& uploads);
 
     Status SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRequest* req, v1::Job* resp) override;
 

@@ -2,6 +2,7 @@
 
 #include <gdal.h>
 #include <signal.h>
+#include <sys/statvfs.h>
 
 #include <chrono>
 #include <fstream>
@@ -47,6 +48,15 @@ bool inside(const fs::path& p, const fs::path& root) {
   return true;
 }
 
+
+grpc::Status full_disk(const v1::ServerConfig& cfg, const std::string& why) {
+  struct statvfs v {};
+  if (::statvfs(cfg.state_dir().c_str(), &v) != 0) return Status::OK;
+  const std::int64_t left = std::int64_t(v.f_bavail) * std::int64_t(v.f_frsize);
+  if (left >= kMinFreeBytes && (why.empty() || left >= 4 * kMinFreeBytes)) return Status::OK;
+  return {StatusCode::RESOURCE_EXHAUSTED, "the server's disk is full (" + std::to_string(left >> 10) + " KiB free)" +
+                                              (why.empty() ? "" : ": " + why) + "; try again when its operator has freed space"};
+}
 
 // A scenario's input path on this server: an uploaded file or a file inside a data root.
 Status resolve_input(const v1::ServerConfig& cfg, const std::string& field, std::string* path) {

@@ -4,6 +4,7 @@
 // in a worker process of their own.
 #include <grpcpp/grpcpp.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -26,6 +27,12 @@ bool inside(const std::filesystem::path& p, const std::filesystem::path& root);
 grpc::Status resolve_input(const v1::ServerConfig& cfg, const std::string& field, std::string* path);
 /// Only formats that cannot point at other files or URLs (no VRT, no /vsi paths inside).
 grpc::Status allowed_format(const std::string& field, const std::string& path);
+/// A submission is refused (RESOURCE_EXHAUSTED) while the state directory's disk has less than
+/// this free [bytes]: its check, its record and its job could not be written.
+inline constexpr std::int64_t kMinFreeBytes = 1 << 20;
+/// The refusal of a submission or upload for a full disk (OK while there is room). `why`: what
+/// failed, when something did ("" for the check before anything is written).
+grpc::Status full_disk(const v1::ServerConfig& cfg, const std::string& why = "");
 /// The longest a submission's check may take; a longer one is accepted and checked by its job.
 inline constexpr double kValidateSeconds = 30;
 /// Every check `runout run` makes (fields, inputs read, grid or mesh built, one step), in a worker

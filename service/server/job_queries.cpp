@@ -93,15 +93,27 @@ Status Server::Impl::CancelJob(grpc::ServerContext* ctx, const v1::CancelJobRequ
   std::string owner;
   if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
   std::vector<jobs::JobStore::Change> ended;
-  auto j = store->cancel(req->id(), owner, &ended);
+  // Each log keeps its job's history (`runout serve --recover` reads it): the line is written before
+  // the store commits, so that no reader (a client, or a recovery after a crash) sees a cancelled
+  // job whose log does not say so; a commit that fails says so in the log after it.
+  auto write_lines = [&](const std::vector<jobs::JobStore::Change>& changes, const std::string& word, const std::string& why) {
+    for (const auto& e : changes) {
+      std::ofstream lg(sched->log_path(e.id), std::ios::app);
+      lg << jobs::utc_now() << " " << word << ": " << (why.empty() ? e.reason : why) << "\n";
+      lg.flush();
+    }
+  };
+  std::optional<jobs::StoredJob> j;
+  try {
+    j = store->cancel(req->id(), owner, &ended, [&](const auto& changes) { write_lines(changes, "cancelled", ""); });
+  } catch (const std::exception& e) {
+    write_lines(ended, "queued", std::string("the cancel could not be recorded (") + e.what() + ")");
+    return {StatusCode::INTERNAL, std::string("the job store failed: ") + e.what()};
+  }
   if (!j) return {StatusCode::NOT_FOUND, "no job '" + req->id() + "'"};
   if (j->job.state() == v1::RUNNING) {
     sched->cancel_running(req->id());
     log("job " + req->id() + ": cancel requested");
-  }
-  for (const auto& e : ended) {  // each log keeps its job's history (`runout serve --recover` reads it)
-    std::ofstream lg(sched->log_path(e.id), std::ios::app);
-    lg << jobs::utc_now() << " cancelled: " << e.reason << "\n";
   }
   sched->touch(req->id());
   *resp = with_live(*j);

@@ -228,7 +228,9 @@ void Server::shutdown() {
     m.server->GetHealthCheckService()->SetServingStatus(false);
     m.log("stopping: interrupting running jobs (they run again at the next start)");
     if (m.sched) m.sched->stop();
-    m.server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(5));
+    // Calls still in flight after half a second are cancelled: a fetch whose client stopped reading
+    // would otherwise hold the stop until the deadline (clients retry; nothing of theirs is lost).
+    m.server->Shutdown(std::chrono::system_clock::now() + std::chrono::milliseconds(500));
     std::error_code ec;
     fs::remove(fs::path(m.cfg.state_dir()) / "server.json", ec);
     m.log("stopped");

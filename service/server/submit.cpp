@@ -34,6 +34,7 @@
 
 #include "jobs/ensemble/variations.hpp"
 #include "jobs/scenario/scenario.hpp"
+#include "jobs/scenario/text_limits.hpp"
 #include "jobs/system/scheduler.hpp"
 #include "jobs/digest/sha256.hpp"
 #include "jobs/system/state_dir.hpp"
@@ -94,14 +95,58 @@ std::optional<Status> Server::Impl::answer_retry(const std::string& owner, const
   }
 }
 
+namespace {
+
+// Text first: nothing after it reads an unbounded name or a path cut short by a NUL byte.
+Status check_text(const v1::SubmitRequest& req) {
+  if (!req.has_scenario()) return {StatusCode::INVALID_ARGUMENT, "scenario: missing"};
+  if (const auto p = jobs::text_problem(req.request_id(), jobs::kMaxRequestIdBytes); !p.empty())
+    return {StatusCode::INVALID_ARGUMENT, "request_id: " + p};
+  try {
+    jobs::check_text_limits(req.scenario());
+  } catch (const jobs::ScenarioError& e) {
+    return {StatusCode::INVALID_ARGUMENT, e.what()};
+  }
+  return Status::OK;
+}
+
+// The job's limits: within the server's.
+Status check_limits(const v1::ServerConfig& cfg, const v1::JobLimits& l) {
+  if (!(std::isfinite(l.max_wall_s()) && l.max_wall_s() >= 0 && l.max_wall_s() <= cfg.max_job_wall_s()))
+    return {StatusCode::INVALID_ARGUMENT, "limits.max_wall_s: must lie in [0, " + jobs::json_number(cfg.max_job_wall_s()) +
+                                              "] s (0: the server's limit), got " + jobs::json_number(l.max_wall_s())};
+  if (l.max_memory_bytes() < 0 || (cfg.max_job_memory_bytes() > 0 && l.max_memory_bytes() > cfg.max_job_memory_bytes()))
+    return {StatusCode::INVALID_ARGUMENT, "limits.max_memory_bytes: must lie in [0, " + std::to_string(cfg.max_job_memory_bytes()) +
+                                              "] (0: the server's limit), got " + std::to_string(l.max_memory_bytes())};
+  return Status::OK;
+}
+
+}  // namespace
+
+// A submission's inputs resolved on this server (the first refusal returned). Every upload it names
+// goes into `uploads`, to be removed if the submission is refused whatever the reason (also one
+// refused here, and those not looked at after it).
+Status Server::Impl::resolve_inputs(v1::Scenario& s, InFlight& in_flight, std::vector<std::string>& uploads) {
+  Status bad_input = Status::OK;
+  jobs::for_each_input_path(s, [&](const std::string& field, std::string* path) {
+    const bool upload = path->rfind("upload:", 0) == 0;
+    const std::string id = upload ? path->substr(7, 64) : "";
+    if (upload && is_hex64(id)) uploads.push_back(id);
+    if (!bad_input.ok()) return;
+    if (upload) in_flight.take(id);  // before it is looked at: not collected meanwhile
+    bad_input = resolve_input(cfg, field, path);
+  });
+  return bad_input;
+}
+
 Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRequest* req, v1::Job* resp) {
   std::string owner;
   if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
-  if (!req->has_scenario()) return {StatusCode::INVALID_ARGUMENT, "scenario: missing"};
-  if (req->request_id().size() > 200) return {StatusCode::INVALID_ARGUMENT, "request_id: longer than 200 characters"};
+  if (auto st = check_text(*req); !st.ok()) return st;
   // A retry (the same request id) is answered before anything else, by the digest of the request.
   const std::string request_hash = request_digest(req->scenario());
   if (auto st = answer_retry(owner, *req, request_hash, resp)) return *st;
+  if (auto st = full_disk(cfg); !st.ok()) return st;
   v1::Scenario s = req->scenario();
   std::vector<std::string> uploads;  // of this submission: removed when it is refused
   InFlight in_flight{*this, {}};
@@ -110,29 +155,8 @@ Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRe
     if (!uploads.empty()) collect_uploads(uploads, owner);
     return st;
   };
-  auto input = [&](const std::string& field, std::string* path) {
-    const bool upload = path->rfind("upload:", 0) == 0;
-    if (upload) in_flight.take(path->substr(7, 64));  // before it is looked at: not collected meanwhile
-    Status st = resolve_input(cfg, field, path);
-    if (st.ok() && upload) uploads.push_back(fs::path(*path).parent_path().filename().string());
-    return st;
-  };
-  Status bad_input = Status::OK;
-  jobs::for_each_input_path(s, [&](const std::string& field, std::string* path) {
-    if (bad_input.ok()) bad_input = input(field, path);
-  });
-  if (!bad_input.ok()) return refuse(bad_input);
-  // The job's limits: within the server's.
-  {
-    const auto& l = s.limits();
-    if (!(std::isfinite(l.max_wall_s()) && l.max_wall_s() >= 0 && l.max_wall_s() <= cfg.max_job_wall_s()))
-      return refuse({StatusCode::INVALID_ARGUMENT, "limits.max_wall_s: must lie in [0, " + jobs::json_number(cfg.max_job_wall_s()) +
-                                                       "] s (0: the server's limit), got " + jobs::json_number(l.max_wall_s())});
-    if (l.max_memory_bytes() < 0 || (cfg.max_job_memory_bytes() > 0 && l.max_memory_bytes() > cfg.max_job_memory_bytes()))
-      return refuse({StatusCode::INVALID_ARGUMENT, "limits.max_memory_bytes: must lie in [0, " +
-                                                       std::to_string(cfg.max_job_memory_bytes()) + "] (0: the server's limit), got " +
-                                                       std::to_string(l.max_memory_bytes())});
-  }
+  if (auto st = resolve_inputs(s, in_flight, uploads); !st.ok()) return refuse(st);
+  if (auto st = check_limits(cfg, s.limits()); !st.ok()) return refuse(st);
   const std::vector<std::string> roots(cfg.data_roots().begin(), cfg.data_roots().end());
   std::string hash;
   std::optional<jobs::ensemble::Plan> plan;  // an ensemble: its members
@@ -165,7 +189,10 @@ Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRe
     // An ensemble: its first member stands for the others' inputs (they differ in numbers only).
     const Status st = check_in_worker(cfg, plan ? plan->members.front().member.scenario : s, [this](const std::string& l) { log(l); });
     leave_validation();
-    if (!st.ok()) return refuse(st);
+    if (!st.ok()) {  // a check that could not write for a full disk says so, not that the scenario is bad
+      if (auto fd = full_disk(cfg, "checking the scenario failed (" + st.error_message() + ")"); !fd.ok()) return refuse(fd);
+      return refuse(st);
+    }
   }
   try {
     std::vector<jobs::JobStore::NewMember> members;
@@ -173,6 +200,10 @@ Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRe
       for (const auto& m : plan->members) members.push_back({m.member.index, m.hash, m.member.scenario});
     const auto out = store->submit_ensemble(owner, hash, req->request_id(), s, members, cfg.max_queued_per_client(), request_hash);
     *resp = with_live(out.job);
+    if (out.request_recorded) {  // the job's log keeps it (`runout serve --recover` reads the line)
+      std::ofstream lg(sched->log_path(resp->id()), std::ios::app);
+      lg << jobs::utc_now() << " " << jobs::request_log_line(req->request_id(), request_hash) << "\n";
+    }
     if (out.created) {
       try {
         sched->write_record(out.job);
@@ -189,7 +220,9 @@ Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRe
   } catch (const jobs::QueueFull& e) {
     return refuse({StatusCode::RESOURCE_EXHAUSTED, e.what()});
   } catch (const std::exception& e) {
-    return {StatusCode::INTERNAL, jobs::client_message(e.what(), cfg.state_dir(), roots)};
+    const std::string m = jobs::client_message(e.what(), cfg.state_dir(), roots);
+    if (auto st = full_disk(cfg, "the job store cannot be written (" + m + ")"); !st.ok()) return refuse(st);
+    return {StatusCode::INTERNAL, m};
   }
   return Status::OK;
 }

@@ -208,6 +208,7 @@ TEST(BadScenario, ValuesAtTheBoundsAreAccepted) {
   auto l = b10();
   l.mutable_lab()->set_max_courant(0.01);
   l.mutable_lab()->set_end_time_s(1e4);
+  l.mutable_lab()->set_write_interval_s(10);  // at most 1000 frames
   EXPECT_EQ(resolve_error(l, kLabDir), "");
 }
 
@@ -252,7 +253,7 @@ TEST(BadScenario, InputsThatAreNotRegularFilesAreRefused) {
   fs::create_directories(d.p / "folder.tif");
   EXPECT_EQ(with_dem("folder.tif"), "dem.path: '" + (d / "folder.tif") + "' is not a regular file");
   EXPECT_EQ(with_dem("/dev/zero"), "dem.path: '/dev/zero' is not a regular file");
-  EXPECT_EQ(with_dem(std::string("dem.tif\0.txt", 12)), "dem.path: the path holds a NUL character");
+  EXPECT_EQ(with_dem(std::string("dem.tif\0.txt", 12)).rfind("dem.path: holds a control character (U+0000) at byte ", 0), 0u);
   // A companion file read with the DEM.
   fs::copy_file(kSrc + "/scenarios/data/arelen/davos_srtm3.tif", d.p / "dem.tif");
   EXPECT_EQ(with_dem("dem.tif"), "");

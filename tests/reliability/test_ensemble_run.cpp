@@ -13,13 +13,14 @@
 #include <algorithm>
 #include <thread>
 
+#include "tests/support/server_process.hpp"
 #include "tests/support/temp_dir.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kBin = RUNOUT_BIN;
+const std::string kBin = runout::test_support::runout_binary();
 const std::string kScenario = std::string(RUNOUT_SOURCE_DIR) + "/tests/data/arelen-ensemble-30m.json";
 
 std::string read_file(const fs::path& p) {

@@ -2,6 +2,7 @@
 // kills and stops during jobs, two servers, a damaged store, tokens, a full disk, crashing workers,
 // limits, cancel and stop latency, a replaced program file. Each test starts its own `runout serve`
 // on loopback and stops it by its pid, and prints a `reliability:` line with its figures.
+#include "jobs/system/scheduler.hpp"
 #include "tests/support/reliability_helpers.hpp"
 
 using namespace runout::test_support::reliability;
@@ -27,7 +28,7 @@ TEST(Reliability, KillsAndStopsDuringJobsLoseNothingAndChangeNothing) {
   const fs::path state = d.p / "state";
   const std::vector<std::string> args = {"--data-root", kScenarios, "--workers", "2", "--threads-per-run", "1"};
   std::map<std::string, std::string> ids;  // request id -> job id
-  int kills = 0, terms = 0, retries = 0;
+  int kills = 0, terms = 0, retries = 0, hits = 0;
   auto submit_all = [&](service::Client& c) {
     for (const auto& k : cases) {
       std::string id;
@@ -50,6 +51,13 @@ TEST(Reliability, KillsAndStopsDuringJobsLoseNothingAndChangeNothing) {
     }
     for (int round = 0; round < 6; ++round) {
       std::this_thread::sleep_for(std::chrono::milliseconds(std::uniform_int_distribution<int>(700, 2500)(rng)));
+      {  // did this kill hit a job while it ran (past its first step)?
+        service::Client c(client_options(srv->address(), ""));
+        const auto list = c.list();
+        bool running = false;
+        for (const auto& j : list.jobs()) running |= j.state() == v1::RUNNING && j.progress().steps() > 0;
+        hits += running;
+      }
       const bool hard = round % 3 != 2;
       const int st = srv->stop(hard ? SIGKILL : SIGTERM);
       (hard ? kills : terms) += 1;
@@ -74,7 +82,7 @@ TEST(Reliability, KillsAndStopsDuringJobsLoseNothingAndChangeNothing) {
   int identical = 0, attempts = 0;
   for (const auto& k : cases) {
     const fs::path out = d.p / ("ref-" + k.name);
-    const std::string cmd = std::string(RUNOUT_BIN) + " run " + scenario_file(k.s, d.p, k.name).string() + " --out " + out.string() +
+    const std::string cmd = runout_binary() + " run " + scenario_file(k.s, d.p, k.name).string() + " --out " + out.string() +
                             " --quiet --threads 1";
     ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
     std::string hash;
@@ -93,10 +101,12 @@ TEST(Reliability, KillsAndStopsDuringJobsLoseNothingAndChangeNothing) {
     service::Client c(client_options(srv.address(), ""));
     for (const auto& [name, id] : ids) attempts += c.get(id).attempts();
   }
-  std::printf("reliability: kills survived %d (kill -9 %d, SIGTERM %d), jobs %zu (attempts %d, submissions retried %d), lost 0, "
-              "duplicated 0, identical after continuation %d of %zu\n",
-              kills + terms, kills, terms, cases.size(), attempts, retries, identical, cases.size());
+  std::printf("reliability: kills survived %d (kill -9 %d, SIGTERM %d; %d of them while a job ran past its first step), jobs %zu "
+              "(attempts %d, submissions retried %d), lost 0, duplicated 0, identical after continuation %d of %zu\n",
+              kills + terms, kills, terms, hits, cases.size(), attempts, retries, identical, cases.size());
   EXPECT_EQ(identical, int(cases.size()));
+  EXPECT_GE(hits, 3) << "the kills must hit running jobs, or the test proves nothing about continuation";
+  EXPECT_GT(attempts, int(cases.size())) << "some job must have run again after a kill";
 }
 
 // One writer per state directory: a second server on it exits at once naming the first (pid and
@@ -217,27 +227,69 @@ TEST(Reliability, TokensFailClosed) {
   std::printf("reliability: tokens file emptied / malformed / deleted: every token refused 3 of 3\n");
 }
 
-// A full disk (a file-size limit on the server and its workers): the job that cannot write fails
-// with a message, the server stays up, the next job succeeds and SIGTERM stops the server cleanly.
+// A full disk: the server's state directory on a small filesystem the test mounts (tmpfs, 32 MiB),
+// filled up. The job that cannot write fails saying the disk is full; an upload and a submission
+// (the store's write) are refused saying so; the server stays up, succeeds once space is freed and
+// stops cleanly.
 TEST(Reliability, FullDiskFailsTheJobNotTheServer) {
   TempDir d;
-  ServerOptions o;
-  o.file_size_limit = 2 << 20;
-  ServerProcess srv(d.p / "state", {"--data-root", kScenarios}, o);
+  const fs::path disk = d.p / "disk";
+  fs::create_directories(disk);
+  if (std::system(("mount -t tmpfs -o size=32m runout-full-disk-test " + disk.string() + " 2>/dev/null").c_str()) != 0)
+    GTEST_SKIP() << "cannot mount a small filesystem here (mounting needs root): the full-disk test did not run";
+  struct Unmount {
+    fs::path p;
+    ~Unmount() { (void)std::system(("umount -l " + p.string()).c_str()); }
+  } unmount{disk};
+  auto free_bytes = [&] {
+    struct statvfs v {};
+    statvfs(disk.c_str(), &v);
+    return std::int64_t(v.f_bavail) * std::int64_t(v.f_frsize);
+  };
+  // Fill the disk up to `left` bytes free (a filler file beside the state directory).
+  const fs::path filler = disk / "filler";
+  auto leave_free = [&](std::int64_t left) {
+    fs::remove(filler);
+    const std::int64_t n = std::max<std::int64_t>(0, free_bytes() - left);
+    std::ofstream f(filler, std::ios::binary);
+    const std::string block(1 << 16, 'f');
+    for (std::int64_t w = 0; w < n; w += std::int64_t(block.size())) f.write(block.data(), std::streamsize(std::min<std::int64_t>(n - w, std::int64_t(block.size()))));
+  };
+  ServerProcess srv(disk / "state", {"--data-root", kScenarios});
   ASSERT_TRUE(srv.running()) << srv.errors();
   service::Client c(client_options(srv.address(), ""));
   auto big = arelen(15, 600);
-  big.mutable_outputs()->set_timeseries_interval_s(0.5);
-  const auto fail = c.watch(c.submit(big).id());
+  big.mutable_outputs()->set_timeseries_interval_s(2);
+  const std::string failing = [&] {
+    std::string id;
+    leave_free(12 << 20);
+    EXPECT_EQ(code_of([&] { id = c.submit(big).id(); }), 0);
+    leave_free(1 << 20);  // the job's frames fill the rest
+    return id;
+  }();
+  const auto fail = c.watch(failing);
   EXPECT_EQ(fail.state(), v1::FAILED);
-  EXPECT_FALSE(fail.error().empty());
-  EXPECT_EQ(fail.error().find((d.p / "state").string()), std::string::npos) << "names the server's folder: " << fail.error();
+  EXPECT_NE(fail.error().find("disk is full"), std::string::npos) << fail.error();
+  EXPECT_EQ(fail.error().find((disk / "state").string()), std::string::npos) << "names the server's folder: " << fail.error();
+  // An upload and a submission (the store's write) on the full disk.
+  leave_free(0);
+  write_random_file(d.p / "dem.tif", 4 << 20, 5);
+  std::string m;
+  EXPECT_EQ(code_of([&] { c.upload({(d.p / "dem.tif").string()}); }, &m), int(grpc::StatusCode::RESOURCE_EXHAUSTED));
+  EXPECT_NE(m.find("disk is full"), std::string::npos) << m;
+  const int submit_code = code_of([&] { c.submit(arelen(15.25, 60)); }, &m);
+  EXPECT_EQ(submit_code, int(grpc::StatusCode::RESOURCE_EXHAUSTED)) << m;
+  EXPECT_NE(m.find("disk is full"), std::string::npos) << m;
+  EXPECT_TRUE(c.healthy());
+  // Space freed: the next job succeeds, and the server stops cleanly.
+  fs::remove(filler);
   const auto ok = c.watch(c.submit(arelen(15, 60)).id());
   EXPECT_EQ(ok.state(), v1::SUCCEEDED) << ok.error();
   const int st = srv.stop(SIGTERM);
   EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << "status " << st << " (signal " << (WIFSIGNALED(st) ? WTERMSIG(st) : 0) << ")";
-  std::printf("reliability: full disk: the writing job failed (%s), the next succeeded, the server stopped cleanly\n",
-              fail.error().c_str());
+  std::printf("reliability: full disk (tmpfs 32 MiB): job failed (%s); upload refused (%s); submission refused (%s, %s); "
+              "after freeing space the next job succeeded, the server stopped cleanly\n",
+              fail.error().c_str(), code_name(int(grpc::StatusCode::RESOURCE_EXHAUSTED)).c_str(), code_name(submit_code).c_str(), m.c_str());
 }
 
 // A job whose own worker process crashes (a signal nobody sent) runs again and fails after three
@@ -303,8 +355,10 @@ TEST(Reliability, LimitsEndRunawayJobs) {
   std::printf("reliability: limits: wall-time and memory runaways failed with their reasons in %.1f s\n", wall);
 }
 
-// Cancel and stop reach a big VOF job within about a second: they are a signal to its process.
-TEST(Reliability, CancelAndStopTakeEffectWithinASecond) {
+// Cancel and stop reach a big VOF job (steps of up to 1.5 s) within about a second: they are a
+// signal to its process, SIGKILL after stop_grace_s (1 s). operations.md's bounds: a cancel within
+// the grace and half a second, a stop of the whole server within 2.5 s.
+TEST(Reliability, CancelAndStopTakeEffectWithinAboutASecond) {
   TempDir d;
   const fs::path state = d.p / "state";
   auto big = coarse_collapse();
@@ -321,7 +375,7 @@ TEST(Reliability, CancelAndStopTakeEffectWithinASecond) {
   c.cancel(id);
   ASSERT_TRUE(wait_for([&] { return c.get(id).state() == v1::CANCELLED; }, 10s));
   const double cancel_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  EXPECT_LT(cancel_s, 2.5);
+  EXPECT_LT(cancel_s, 1.5);
   auto big2 = big;
   big2.mutable_lab()->set_end_time_s(5.01);
   const std::string id2 = c.submit(big2).id();
@@ -331,7 +385,7 @@ TEST(Reliability, CancelAndStopTakeEffectWithinASecond) {
   const int st = srv->stop(SIGTERM);
   const double stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << st;
-  EXPECT_LT(stop_s, 8);  // the server's own shutdown (gRPC) included
+  EXPECT_LT(stop_s, 2.5);  // the server's own shutdown (gRPC) included
   srv = std::make_unique<ServerProcess>(state, std::vector<std::string>{"--data-root", kScenarios});
   service::Client c2(client_options(srv->address(), ""));
   EXPECT_EQ(c2.get(id2).state() == v1::QUEUED || c2.get(id2).state() == v1::RUNNING, true);
@@ -344,7 +398,7 @@ TEST(Reliability, CancelAndStopTakeEffectWithinASecond) {
 TEST(Reliability, ReplacedProgramFileStillRunsJobs) {
   TempDir d;
   const fs::path bin = d.p / "runout";
-  fs::copy_file(RUNOUT_BIN, bin);
+  fs::copy_file(runout_binary(), bin);
   fs::permissions(bin, fs::perms::owner_all);
   ServerOptions o;
   o.binary = bin.string();
@@ -382,4 +436,61 @@ TEST(Reliability, ThreeKillsDuringOneJobNeverFailIt) {
         << "kill " << kill;
     srv.stop(SIGKILL);
   }
+}
+
+// A worker process that does not end after SIGKILL holds no slot for ever: after
+// stuck_after_kill_s its job ends and the slot runs the next job. The stuck worker here keeps its
+// output open through a process it started (as a process in uninterruptible I/O keeps it: neither
+// ends nor closes); the scheduler is the server's, driven directly with that worker program.
+TEST(Reliability, AWorkerThatCannotEndReleasesItsSlot) {
+  TempDir d;
+  const fs::path state = d.p / "state";
+  for (const char* sub : {"logs", "results", "checkpoints", "uploads"}) fs::create_directories(state / sub);
+  const fs::path exe = d.p / "worker.sh", pids = d.p / "held.pid";
+  {
+    std::ofstream w(exe);
+    w << "#!/bin/sh\ncat > \"$0.task.$$\"\n"
+      << "if grep -q stuck-worker \"$0.task.$$\"; then\n  trap '' TERM\n  sleep 600 &\n  echo $! >> " << pids.string()
+      << "\n  exec sleep 600\nfi\nexec " << runout_binary() << " worker < \"$0.task.$$\"\n";
+  }
+  fs::permissions(exe, fs::perms::owner_all);
+  jobs::JobStore store((state / "jobs.db").string());
+  jobs::SchedulerConfig sc;
+  sc.state_dir = state.string();
+  sc.workers = 1;
+  sc.threads_per_run = 1;
+  sc.worker_exe = exe.string();
+  sc.stop_grace_s = 0.2;
+  sc.stuck_after_kill_s = 1;
+  jobs::Scheduler sched(store, sc);
+  sched.start();
+  auto submit = [&](v1::Scenario s) {
+    const fs::path f = scenario_file(s, d.p, s.name());
+    const auto r = jobs::load_scenario(f.string());
+    const auto out = store.submit("me", jobs::scenario_hash(r), "", r.scenario, 10);
+    sched.notify();
+    return out.job.job.id();
+  };
+  auto state_of = [&](const std::string& id) { return store.get(id, "me")->job.state(); };
+  auto stuck = arelen(15, 9e4, 0);
+  stuck.set_name("stuck-worker");
+  const std::string a = submit(stuck);
+  ASSERT_TRUE(wait_for([&] { return state_of(a) == v1::RUNNING && fs::exists(pids); }, 30s));
+  auto next = arelen(15, 60);
+  next.set_name("next");
+  const std::string b = submit(next);
+  const auto t0 = std::chrono::steady_clock::now();
+  store.cancel(a, "me");
+  sched.cancel_running(a);
+  EXPECT_TRUE(wait_for([&] { return state_of(a) == v1::CANCELLED; }, 10s)) << "the stuck worker's job never ended";
+  const double released = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_TRUE(wait_for([&] { return jobs::is_final(state_of(b)); }, 60s)) << "the next job never ran";
+  EXPECT_EQ(state_of(b), v1::SUCCEEDED) << store.get(b, "me")->job.error();
+  EXPECT_NE(read_text(state / "logs" / (a + ".log")).find("did not end within 1 s of SIGKILL"), std::string::npos);
+  sched.stop();
+  std::ifstream in(pids);
+  for (pid_t p; in >> p;) kill(p, SIGKILL);
+  std::printf("reliability: a worker that cannot end: its job cancelled and its slot released %.2f s after the cancel "
+              "(grace 0.2 s, left behind after 1 s); the next job %s\n",
+              released, jobs::state_name(state_of(b)).c_str());
 }

@@ -4,6 +4,7 @@
 #include <grpcpp/grpcpp.h>
 #include <gtest/gtest.h>
 #include <hdf5.h>
+#include <sys/statvfs.h>
 #include <google/protobuf/struct.pb.h>
 #include <google/protobuf/util/json_util.h>
 
@@ -34,6 +35,7 @@ using namespace runout;
 using namespace std::chrono_literals;
 using test_support::client_options;
 using test_support::read_text;
+using test_support::runout_binary;
 using test_support::ServerOptions;
 using test_support::ServerProcess;
 using test_support::TempDir;
@@ -156,6 +158,14 @@ inline std::map<std::string, std::string> fingerprint(const fs::path& dir) {
       for (const auto& [k, v] : figures(e.path())) fp[n + ":" + k] = v;
   }
   return fp;
+}
+
+// A file of `bytes` random bytes (from `seed`): content no format reads, and no upload repeats.
+inline void write_random_file(const fs::path& p, std::size_t bytes, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::string b(bytes, '\0');
+  for (auto& c : b) c = char(rng());
+  std::ofstream(p, std::ios::binary) << b;
 }
 
 inline int code_of(const std::function<void()>& f, std::string* message = nullptr) {

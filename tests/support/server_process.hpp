@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -22,11 +23,18 @@ namespace runout::test_support {
 
 namespace fs = std::filesystem;
 
+/// The program under test: RUNOUT_BIN, or the one $RUNOUT_TEST_BINARY names (to run the
+/// fault-injection suite against another build, e.g. an older one).
+inline std::string runout_binary() {
+  const char* e = std::getenv("RUNOUT_TEST_BINARY");
+  return e && *e ? std::string(e) : std::string(RUNOUT_BIN);
+}
+
 struct ServerOptions {
   std::int64_t file_size_limit = 0;  ///< RLIMIT_FSIZE of the server (and its workers); 0: none
   bool expect_listening = true;      ///< false: the server is expected to refuse to start
   std::string listen = "127.0.0.1:0";
-  std::string binary = RUNOUT_BIN;   ///< the program to start
+  std::string binary = runout_binary();  ///< the program to start
 };
 
 // `runout serve` as a child process; its standard error goes to STATE/../server.err.
