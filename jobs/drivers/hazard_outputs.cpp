@@ -75,14 +75,15 @@ std::string steep_terrain_note(const ResolvedScenario& s, const terrain::Grid& g
     if (rel || flow) steepest = std::max(steepest, slope[k]);
   }
   if (released + reached == 0) return "";
-  char b[400];
+  char b[200];
   std::snprintf(b, sizeof b,
                 "near-vertical terrain: %ld cell(s) of the release and %ld further cell(s) of the flow are steeper than %.0f deg "
-                "(steepest %.1f deg): the depth-averaged model holds h / cos(slope) of a vertical column there (twice the thickness "
-                "at 60 deg, six times at 80 deg), so depth, speed and pressure on and just below these cells are not reliable; check "
-                "them against the DEM (a cliff, or an artefact) before using the maps there",
+                "(steepest %.1f deg)",
                 released, reached, kSteepSlopeDeg, steepest);
-  return b;
+  return std::string(b) +
+         ": the depth-averaged model holds h / cos(slope) of a vertical column there (twice the thickness at 60 deg, six times at "
+         "80 deg), so depth, speed and pressure on and just below these cells are not reliable; check them against the DEM (a "
+         "cliff, or an artefact) before using the maps there";
 }
 
 namespace {

@@ -108,7 +108,9 @@ void apply_lab_rheology(const v1::Lab& l, engine::vof::VofConfig& c) {
 ResolvedScenario resolve_lab(v1::Scenario s) {
   if (!s.has_lab()) bad("lab", "engine \"vof\" needs the lab block (domain, cells, fill, boundaries)");
   if (s.has_mesh() || s.has_vof()) bad(s.has_mesh() ? "mesh" : "vof", "not used by a laboratory set-up (`lab`)");
+  const double write_given = s.lab().write_interval_s();
   apply_option_rules(lab_options(), s);
+  s.mutable_lab()->set_write_interval_s(default_frame_interval(write_given, s.lab().write_interval_s(), s.lab().end_time_s()));
   const auto& l = s.lab();
   if (!(l.x_max() > l.x_min())) bad("lab.x_max", "must exceed lab.x_min");
   if (!(l.y_max() > l.y_min())) bad("lab.y_max", "must exceed lab.y_min");
@@ -130,8 +132,8 @@ ResolvedScenario resolve_lab(v1::Scenario s) {
   const auto& ref = l.reference();
   if (ref.has_front_x_min() != ref.has_front_x_max() || (ref.has_front_x_min() && ref.front_x_max() < ref.front_x_min()))
     bad("lab.reference.front_x_max", "the front is a range: give front_x_min and front_x_max >= front_x_min");
-  check_output_interval("lab.write_interval_s", l.write_interval_s(), "lab.end_time_s", l.end_time_s());
-  check_output_interval("lab.checkpoint_interval_s", l.checkpoint_interval_s(), "lab.end_time_s", l.end_time_s());
+  check_output_interval("lab.write_interval_s", l.write_interval_s(), "lab.end_time_s", l.end_time_s(), false);
+  check_output_interval("lab.checkpoint_interval_s", l.checkpoint_interval_s(), "lab.end_time_s", l.end_time_s(), true);
   require_finite(s, "");
   ResolvedScenario r;
   r.vof = true;

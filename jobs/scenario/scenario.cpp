@@ -300,7 +300,11 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   // The option tables fill the defaults and check every field's range or choices; the checks
   // between fields and the input files follow.
   apply_option_rules(depth_averaged_options(), s);
-  if (vof) apply_option_rules(terrain_vof_options(), s);
+  if (vof) {
+    const double write_given = s.vof().write_interval_s();
+    apply_option_rules(terrain_vof_options(), s);
+    s.mutable_vof()->set_write_interval_s(default_frame_interval(write_given, s.vof().write_interval_s(), s.numerics().end_time_s()));
+  }
   ResolvedScenario r;
   resolve_inputs(s, base, r);
   resolve_releases(s, base, r);
@@ -309,10 +313,10 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   if (vof) check_terrain_vof(s);  // first: the 3D engine takes one friction law
   check_material(s.material(), r.config.material);
   const double t_end = s.numerics().end_time_s();
-  check_output_interval("outputs.timeseries_interval_s", s.outputs().timeseries_interval_s(), "numerics.end_time_s", t_end);
+  check_output_interval("outputs.timeseries_interval_s", s.outputs().timeseries_interval_s(), "numerics.end_time_s", t_end, true);
   if (vof) {
-    check_output_interval("vof.write_interval_s", s.vof().write_interval_s(), "numerics.end_time_s", t_end);
-    check_output_interval("vof.checkpoint_interval_s", s.vof().checkpoint_interval_s(), "numerics.end_time_s", t_end);
+    check_output_interval("vof.write_interval_s", s.vof().write_interval_s(), "numerics.end_time_s", t_end, false);
+    check_output_interval("vof.checkpoint_interval_s", s.vof().checkpoint_interval_s(), "numerics.end_time_s", t_end, true);
   }
   r.terrain = vof;
   require_finite(s, "");

@@ -426,7 +426,8 @@ Scheduler::Attempt Scheduler::supervise(JobContext& jc, const v1::WorkerTask& ta
         kill_at = now + jc.grace;
       } else if (a.why != Why::none && now > kill_at) {
         w.signal(SIGKILL);
-        if (now > kill_at + std::chrono::milliseconds(std::int64_t(1000 * cfg_.stuck_after_kill_s))) {
+        // Local workers only: a Slurm step ends by the cluster's own kill timeout (KillWait).
+        if (!slurm_ && now > kill_at + std::chrono::milliseconds(std::int64_t(1000 * cfg_.stuck_after_kill_s))) {
           a.stuck = true;
           break;
         }

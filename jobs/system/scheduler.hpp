@@ -44,8 +44,9 @@ struct SchedulerConfig {
   double max_job_wall_s = 86400;    ///< wall time of one attempt (a scenario's limits may lower it)
   std::int64_t max_job_memory_bytes = 0;  ///< resident memory of a worker; 0: no limit
   double stop_grace_s = 1;          ///< a stopped or cancelled worker is killed after this long
-  /// A worker whose process has not ended this long after SIGKILL (stuck in uninterruptible I/O: a
-  /// hung network filesystem, a failing disk) is left behind: its job ends and its slot is free.
+  /// A local worker whose process has not ended this long after SIGKILL (stuck in uninterruptible
+  /// I/O: a hung network filesystem, a failing disk) is left behind: its job ends and its slot is
+  /// free. (A Slurm step ends by the cluster's own kill timeout.)
   double stuck_after_kill_s = 10;
   int max_crashes = 3;              ///< a job whose worker crashed this often fails
   std::vector<std::string> data_roots;  ///< the server's data roots (left out of messages to clients)

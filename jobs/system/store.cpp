@@ -246,7 +246,8 @@ SubmitOutcome JobStore::submit(const std::string& owner, const std::string& hash
 
 SubmitOutcome JobStore::submit_ensemble(const std::string& owner, const std::string& hash, const std::string& request_id,
                                         const v1::Scenario& scenario, const std::vector<NewMember>& members, int max_queued,
-                                        const std::string& request_hash) {
+                                        const std::string& request_hash,
+                                        const std::function<void(const StoredJob&)>& record_request) {
   std::lock_guard lk(mu_);
   Transaction tx(db_);
   SubmitOutcome out;
@@ -282,6 +283,7 @@ SubmitOutcome JobStore::submit_ensemble(const std::string& owner, const std::str
         Stmt(db_, "INSERT INTO requests(owner, request_id, job, request_hash) VALUES (?, ?, ?, ?)")
             .bind(1, owner).bind(2, request_id).bind(3, out.job.job.id()).bind(4, request_hash).step();
         out.request_recorded = true;
+        if (record_request) record_request(out.job);
       }
       tx.commit();
       return out;

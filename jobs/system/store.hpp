@@ -76,9 +76,13 @@ class JobStore {
   /// transaction (no member is lost, none is left without its ensemble). An existing ensemble job
   /// answers as submit() says; the ensemble counts as one job against `max_queued`. The ensemble's
   /// job is claimed only once none of its members is queued or running (it then aggregates).
+  /// `record_request` (when given) is called, before the commit, when the request id is recorded for
+  /// an earlier identical job (SubmitOutcome::request_recorded): it writes that job's log line, and
+  /// an exception from it leaves nothing recorded.
   SubmitOutcome submit_ensemble(const std::string& owner, const std::string& hash, const std::string& request_id,
                                 const v1::Scenario& scenario, const std::vector<NewMember>& members, int max_queued,
-                                const std::string& request_hash = "");
+                                const std::string& request_hash = "",
+                                const std::function<void(const StoredJob&)>& record_request = {});
   /// An ensemble's members, in order.
   std::vector<StoredJob> members(const std::string& parent) const;
   /// The owner's job with this request id, and the digest of the request that created it ("" for

@@ -269,7 +269,9 @@ Status Server::Impl::UploadInput(grpc::ServerContext* ctx, grpc::ServerReader<v1
   close_file();
   const std::string id = set_hash.hex();
   const fs::path dest = up / id;
-  std::lock_guard ulk(upload_mu);  // not while the collector decides
+  // Not while the collector decides. Declared after `arriving`, so released before ~Arriving locks
+  // upload_mu again.
+  std::lock_guard ulk(upload_mu);
   if (fs::exists(dest, ec)) {
     fs::remove_all(tmp, ec);  // the same files were uploaded before
     fs::last_write_time(dest, fs::file_time_type::clock::now(), ec);

@@ -5,6 +5,7 @@
 // (uploads and results).
 #include <grpcpp/grpcpp.h>
 
+#include <atomic>
 #include <condition_variable>
 #include <fstream>
 #include <map>
@@ -50,6 +51,7 @@ struct Server::Impl final : v1::Runout::Service {
   std::mutex stop_mu;
   std::condition_variable stop_cv;
   bool stopped = false;
+  std::atomic<bool> stopping{false};  // set first by shutdown(): submissions being checked end
 
 
 
@@ -115,8 +117,8 @@ struct Server::Impl final : v1::Runout::Service {
     std::optional<Status> answer_retry(const std::string& owner, const v1::SubmitRequest& req, const std::string& request_hash,
                                        v1::Job* resp);
 
-    // A submission's inputs resolved on this server; the uploads it names into `uploads`.
-    Status resolve_inputs(v1::Scenario& s, InFlight& in_flight, std::vector<std::string>& uploads);
+    // A submission's inputs resolved on this server (its uploads taken as in flight first).
+    Status resolve_inputs(v1::Scenario& s, InFlight& in_flight);
 
     Status SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRequest* req, v1::Job* resp) override;
 

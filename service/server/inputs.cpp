@@ -111,7 +111,8 @@ Status allowed_format(const std::string& field, const std::string& path) {
 
 // Every check `runout run` makes, in a worker process of its own (a DEM that crashes or hangs
 // GDAL takes only that process down): the inputs read, the grid or mesh built, one step run.
-Status check_in_worker(const v1::ServerConfig& cfg, const v1::Scenario& s, const std::function<void(const std::string&)>& log) {
+Status check_in_worker(const v1::ServerConfig& cfg, const v1::Scenario& s, const std::function<void(const std::string&)>& log,
+                       const std::function<bool()>& stop) {
   const fs::path dir = fs::path(cfg.state_dir()) / "validate" / jobs::new_job_id();
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -127,10 +128,15 @@ Status check_in_worker(const v1::ServerConfig& cfg, const v1::Scenario& s, const
     jobs::WorkerProcess w(jobs::self_executable(), task, (dir / "validate.log").string());
     std::optional<v1::WorkerEvent> outcome;
     const auto t0 = std::chrono::steady_clock::now();
-    bool timed_out = false, too_big = false;
+    bool timed_out = false, too_big = false, stopped = false;
     for (;;) {  // every event, also those read with the end of the output
       auto ev = w.next_event(std::chrono::milliseconds(100));
       if (!ev && w.output_closed()) break;
+      if (stop && stop()) {
+        stopped = true;
+        w.signal(SIGKILL);
+        break;
+      }
       if (ev && !ev->has_progress()) outcome = ev;
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       if (wall > kValidateSeconds || (cfg.max_job_memory_bytes() > 0 && w.resident_bytes() > cfg.max_job_memory_bytes())) {
@@ -145,7 +151,9 @@ Status check_in_worker(const v1::ServerConfig& cfg, const v1::Scenario& s, const
       w.signal(SIGKILL);
       ex = w.wait(std::chrono::seconds(60));
     }
-    if (outcome && outcome->has_failed()) {
+    if (stopped) {
+      st = {StatusCode::UNAVAILABLE, "the server is stopping; submit again when it is back"};
+    } else if (outcome && outcome->has_failed()) {
       const std::string m = jobs::client_message(outcome->failed().error(), cfg.state_dir(),
                                                  {cfg.data_roots().begin(), cfg.data_roots().end()});
       st = outcome->failed().bad_input() ? Status(StatusCode::INVALID_ARGUMENT, m)

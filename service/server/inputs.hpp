@@ -37,6 +37,8 @@ grpc::Status full_disk(const v1::ServerConfig& cfg, const std::string& why = "")
 inline constexpr double kValidateSeconds = 30;
 /// Every check `runout run` makes (fields, inputs read, grid or mesh built, one step), in a worker
 /// process of its own: a DEM that crashes or hangs GDAL takes only that process down.
-grpc::Status check_in_worker(const v1::ServerConfig& cfg, const v1::Scenario& s, const std::function<void(const std::string&)>& log);
+/// `stop` true ends the check (UNAVAILABLE: the server is stopping).
+grpc::Status check_in_worker(const v1::ServerConfig& cfg, const v1::Scenario& s, const std::function<void(const std::string&)>& log,
+                             const std::function<bool()>& stop = {});
 
 }  // namespace runout::service

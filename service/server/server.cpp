@@ -224,6 +224,8 @@ void Server::shutdown() {
     if (m.stopped) return;
     m.stopped = true;
   }
+  m.stopping = true;  // checks of submissions end (UNAVAILABLE): gRPC's shutdown waits for their handlers
+  m.validate_cv.notify_all();
   if (m.server) {
     m.server->GetHealthCheckService()->SetServingStatus(false);
     m.log("stopping: interrupting running jobs (they run again at the next start)");

@@ -54,7 +54,7 @@ namespace runout::service {
 bool Server::Impl::enter_validation() {
   std::unique_lock lk(validate_mu);
   const int limit = std::max(2, cfg.workers());
-  if (!validate_cv.wait_for(lk, std::chrono::seconds(60), [&] { return validating < limit; })) return false;
+  if (!validate_cv.wait_for(lk, std::chrono::seconds(60), [&] { return validating < limit || stopping; }) || stopping) return false;
   ++validating;
   return true;
 }
@@ -123,17 +123,13 @@ Status check_limits(const v1::ServerConfig& cfg, const v1::JobLimits& l) {
 
 }  // namespace
 
-// A submission's inputs resolved on this server (the first refusal returned). Every upload it names
-// goes into `uploads`, to be removed if the submission is refused whatever the reason (also one
-// refused here, and those not looked at after it).
-Status Server::Impl::resolve_inputs(v1::Scenario& s, InFlight& in_flight, std::vector<std::string>& uploads) {
+// A submission's inputs resolved on this server (the first refusal returned); each upload is taken
+// as in flight before it is looked at, so that it is not collected meanwhile.
+Status Server::Impl::resolve_inputs(v1::Scenario& s, InFlight& in_flight) {
   Status bad_input = Status::OK;
   jobs::for_each_input_path(s, [&](const std::string& field, std::string* path) {
-    const bool upload = path->rfind("upload:", 0) == 0;
-    const std::string id = upload ? path->substr(7, 64) : "";
-    if (upload && is_hex64(id)) uploads.push_back(id);
     if (!bad_input.ok()) return;
-    if (upload) in_flight.take(id);  // before it is looked at: not collected meanwhile
+    if (path->rfind("upload:", 0) == 0) in_flight.take(path->substr(7, 64));
     bad_input = resolve_input(cfg, field, path);
   });
   return bad_input;
@@ -142,20 +138,24 @@ Status Server::Impl::resolve_inputs(v1::Scenario& s, InFlight& in_flight, std::v
 Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRequest* req, v1::Job* resp) {
   std::string owner;
   if (auto st = authenticate(ctx, &owner); !st.ok()) return st;
-  if (auto st = check_text(*req); !st.ok()) return st;
-  // A retry (the same request id) is answered before anything else, by the digest of the request.
-  const std::string request_hash = request_digest(req->scenario());
-  if (auto st = answer_retry(owner, *req, request_hash, resp)) return *st;
-  if (auto st = full_disk(cfg); !st.ok()) return st;
   v1::Scenario s = req->scenario();
-  std::vector<std::string> uploads;  // of this submission: removed when it is refused
+  // Every upload the submission names is removed when it is refused, whatever the reason.
+  std::vector<std::string> uploads;
+  jobs::for_each_input_path(s, [&](const std::string&, std::string* path) {
+    if (path->rfind("upload:", 0) == 0 && is_hex64(path->substr(7, 64))) uploads.push_back(path->substr(7, 64));
+  });
   InFlight in_flight{*this, {}};
   auto refuse = [&](Status st) {
     in_flight.release();
     if (!uploads.empty()) collect_uploads(uploads, owner);
     return st;
   };
-  if (auto st = resolve_inputs(s, in_flight, uploads); !st.ok()) return refuse(st);
+  if (auto st = check_text(*req); !st.ok()) return refuse(st);
+  // A retry (the same request id) is answered before anything else, by the digest of the request.
+  const std::string request_hash = request_digest(req->scenario());
+  if (auto st = answer_retry(owner, *req, request_hash, resp)) return st->ok() ? *st : refuse(*st);
+  if (auto st = full_disk(cfg); !st.ok()) return refuse(st);
+  if (auto st = resolve_inputs(s, in_flight); !st.ok()) return refuse(st);
   if (auto st = check_limits(cfg, s.limits()); !st.ok()) return refuse(st);
   const std::vector<std::string> roots(cfg.data_roots().begin(), cfg.data_roots().end());
   std::string hash;
@@ -185,9 +185,11 @@ Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRe
   }
   if (!known) {
     if (!enter_validation())
-      return refuse({StatusCode::RESOURCE_EXHAUSTED, "the server is checking too many submissions at once; try again"});
+      return refuse(stopping ? Status(StatusCode::UNAVAILABLE, "the server is stopping; submit again when it is back")
+                             : Status(StatusCode::RESOURCE_EXHAUSTED, "the server is checking too many submissions at once; try again"));
     // An ensemble: its first member stands for the others' inputs (they differ in numbers only).
-    const Status st = check_in_worker(cfg, plan ? plan->members.front().member.scenario : s, [this](const std::string& l) { log(l); });
+    const Status st = check_in_worker(cfg, plan ? plan->members.front().member.scenario : s, [this](const std::string& l) { log(l); },
+                                      [this] { return stopping.load(); });
     leave_validation();
     if (!st.ok()) {  // a check that could not write for a full disk says so, not that the scenario is bad
       if (auto fd = full_disk(cfg, "checking the scenario failed (" + st.error_message() + ")"); !fd.ok()) return refuse(fd);
@@ -198,12 +200,17 @@ Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRe
     std::vector<jobs::JobStore::NewMember> members;
     if (plan)
       for (const auto& m : plan->members) members.push_back({m.member.index, m.hash, m.member.scenario});
-    const auto out = store->submit_ensemble(owner, hash, req->request_id(), s, members, cfg.max_queued_per_client(), request_hash);
-    *resp = with_live(out.job);
-    if (out.request_recorded) {  // the job's log keeps it (`runout serve --recover` reads the line)
-      std::ofstream lg(sched->log_path(resp->id()), std::ios::app);
+    // A request id answered by an earlier identical job: that job's log keeps it, written before the
+    // store commits (`runout serve --recover` reads the line).
+    auto record_request = [&](const jobs::StoredJob& j) {
+      std::ofstream lg(sched->log_path(j.job.id()), std::ios::app);
       lg << jobs::utc_now() << " " << jobs::request_log_line(req->request_id(), request_hash) << "\n";
-    }
+      lg.flush();
+      if (!lg) throw std::runtime_error("cannot write the log of job " + j.job.id());
+    };
+    const auto out =
+        store->submit_ensemble(owner, hash, req->request_id(), s, members, cfg.max_queued_per_client(), request_hash, record_request);
+    *resp = with_live(out.job);
     if (out.created) {
       try {
         sched->write_record(out.job);
@@ -222,7 +229,7 @@ Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRe
   } catch (const std::exception& e) {
     const std::string m = jobs::client_message(e.what(), cfg.state_dir(), roots);
     if (auto st = full_disk(cfg, "the job store cannot be written (" + m + ")"); !st.ok()) return refuse(st);
-    return {StatusCode::INTERNAL, m};
+    return refuse({StatusCode::INTERNAL, m});
   }
   return Status::OK;
 }

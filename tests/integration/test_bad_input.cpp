@@ -208,7 +208,9 @@ TEST(BadScenario, ValuesAtTheBoundsAreAccepted) {
   auto l = b10();
   l.mutable_lab()->set_max_courant(0.01);
   l.mutable_lab()->set_end_time_s(1e4);
-  l.mutable_lab()->set_write_interval_s(10);  // at most 1000 frames
+  l.mutable_lab()->set_write_interval_s(10);  // b10's 0.05 s would be 200,000 frames (at most 1000)
+  EXPECT_EQ(resolve_error(l, kLabDir), "");
+  l.mutable_lab()->set_write_interval_s(0);  // unset: every 10 s, not the default 0.05 s
   EXPECT_EQ(resolve_error(l, kLabDir), "");
 }
 

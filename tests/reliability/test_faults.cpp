@@ -292,6 +292,30 @@ TEST(Reliability, FullDiskFailsTheJobNotTheServer) {
               fail.error().c_str(), code_name(int(grpc::StatusCode::RESOURCE_EXHAUSTED)).c_str(), code_name(submit_code).c_str(), m.c_str());
 }
 
+// A file-size limit on the server and its workers (EFBIG, where a test cannot mount a small
+// filesystem for a real ENOSPC, this one still runs): the job that cannot write fails with a
+// message, the server stays up, the next job succeeds and SIGTERM stops the server cleanly.
+TEST(Reliability, FileSizeLimitFailsTheJobNotTheServer) {
+  TempDir d;
+  ServerOptions o;
+  o.file_size_limit = 2 << 20;
+  ServerProcess srv(d.p / "state", {"--data-root", kScenarios}, o);
+  ASSERT_TRUE(srv.running()) << srv.errors();
+  service::Client c(client_options(srv.address(), ""));
+  auto big = arelen(15, 600);
+  big.mutable_outputs()->set_timeseries_interval_s(1);
+  const auto fail = c.watch(c.submit(big).id());
+  EXPECT_EQ(fail.state(), v1::FAILED);
+  EXPECT_FALSE(fail.error().empty());
+  EXPECT_EQ(fail.error().find((d.p / "state").string()), std::string::npos) << "names the server's folder: " << fail.error();
+  const auto ok = c.watch(c.submit(arelen(15, 60)).id());
+  EXPECT_EQ(ok.state(), v1::SUCCEEDED) << ok.error();
+  const int st = srv.stop(SIGTERM);
+  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << "status " << st << " (signal " << (WIFSIGNALED(st) ? WTERMSIG(st) : 0) << ")";
+  std::printf("reliability: file-size limit: the writing job failed (%s), the next succeeded, the server stopped cleanly\n",
+              fail.error().c_str());
+}
+
 // A job whose own worker process crashes (a signal nobody sent) runs again and fails after three
 // crashes, naming the signal; the other jobs and the server are not touched.
 TEST(Reliability, CrashingWorkerFailsOnlyItsOwnJob) {
@@ -357,7 +381,7 @@ TEST(Reliability, LimitsEndRunawayJobs) {
 
 // Cancel and stop reach a big VOF job (steps of up to 1.5 s) within about a second: they are a
 // signal to its process, SIGKILL after stop_grace_s (1 s). operations.md's bounds: a cancel within
-// the grace and half a second, a stop of the whole server within 2.5 s.
+// 2 s, a stop of the whole server within 3 s.
 TEST(Reliability, CancelAndStopTakeEffectWithinAboutASecond) {
   TempDir d;
   const fs::path state = d.p / "state";
@@ -375,7 +399,7 @@ TEST(Reliability, CancelAndStopTakeEffectWithinAboutASecond) {
   c.cancel(id);
   ASSERT_TRUE(wait_for([&] { return c.get(id).state() == v1::CANCELLED; }, 10s));
   const double cancel_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  EXPECT_LT(cancel_s, 1.5);
+  EXPECT_LT(cancel_s, 2.0);
   auto big2 = big;
   big2.mutable_lab()->set_end_time_s(5.01);
   const std::string id2 = c.submit(big2).id();
@@ -385,7 +409,7 @@ TEST(Reliability, CancelAndStopTakeEffectWithinAboutASecond) {
   const int st = srv->stop(SIGTERM);
   const double stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << st;
-  EXPECT_LT(stop_s, 2.5);  // the server's own shutdown (gRPC) included
+  EXPECT_LT(stop_s, 3.0);  // the server's own shutdown (gRPC) included
   srv = std::make_unique<ServerProcess>(state, std::vector<std::string>{"--data-root", kScenarios});
   service::Client c2(client_options(srv->address(), ""));
   EXPECT_EQ(c2.get(id2).state() == v1::QUEUED || c2.get(id2).state() == v1::RUNNING, true);

@@ -62,7 +62,27 @@ TEST(Reliability, RefusedUploadsAreRemovedWhateverTheReason) {
     EXPECT_EQ(uploads_left(state), 0) << "the refused submission's uploads stay (" << m << ")";
   }
   EXPECT_EQ(refused, 3);
-  std::printf("reliability: submissions refused for an unreadable 4 MiB DEM %d, uploads left %d\n", refused, uploads_left(state));
+  // Refused before its inputs are looked at: for its text, and for a request id that names another job.
+  auto upload_dem = [&](unsigned seed) {
+    write_random_file(d.p / "dem.tif", 1 << 20, seed);
+    auto s = arelen();
+    s.mutable_dem()->set_path(c.upload({(d.p / "dem.tif").string()}).ref());
+    return s;
+  };
+  auto text = upload_dem(21);
+  text.set_name("two\nlines");
+  EXPECT_EQ(code_of([&] { c.submit(text); }), int(grpc::StatusCode::INVALID_ARGUMENT));
+  EXPECT_EQ(uploads_left(state), 0) << "refused for its text";
+  auto plain = arelen();
+  for (auto* p : {plain.mutable_dem()->mutable_path(), plain.mutable_area_of_interest()->mutable_path(), plain.mutable_releases(0)->mutable_path()})
+    *p = c.upload({kScenarios + "/" + *p}).ref();
+  const std::string job = c.submit(plain, "R").id();
+  const int kept = uploads_left(state);  // the job's three inputs
+  EXPECT_EQ(code_of([&] { c.submit(upload_dem(23), "R"); }), int(grpc::StatusCode::ALREADY_EXISTS));
+  EXPECT_EQ(uploads_left(state), kept) << "refused for its request id";
+  c.cancel(job);
+  std::printf("reliability: refused submissions (an unreadable 4 MiB DEM 3 times, a line break in the name, a request id of "
+              "another job): their uploads left %d\n", uploads_left(state) - kept);
 }
 
 // A request id names one job, also when the answer is an earlier identical job: another scenario
@@ -165,6 +185,10 @@ TEST(Reliability, FrameIntervalsHaveALowerBound) {
   lab.mutable_lab()->set_write_interval_s(1e-4);
   EXPECT_EQ(code_of([&] { c.submit(lab); }, &m), int(grpc::StatusCode::INVALID_ARGUMENT));
   EXPECT_NE(m.find("lab.write_interval_s: at least lab.end_time_s / 1000"), std::string::npos) << m;
+  auto long_lab = coarse_collapse();  // frames unset: the default 0.05 s becomes end time / 1000
+  long_lab.mutable_lab()->set_end_time_s(100);
+  long_lab.mutable_lab()->set_write_interval_s(0);
+  EXPECT_EQ(code_of([&] { c.cancel(c.submit(long_lab).id()); }, &m), 0) << m;
   every_step.mutable_outputs()->set_timeseries_interval_s(0.6);  // the bound itself is accepted
   EXPECT_EQ(code_of([&] { c.cancel(c.submit(every_step).id()); }, &m), 0) << m;
   std::printf("reliability: frame intervals below end time / 1000 refused (depth-averaged, laboratory)\n");
@@ -237,11 +261,12 @@ TEST(Reliability, ACancelIsLoggedBeforeItIsSeen) {
     watcher.join();
   }
   c.cancel(blocker);
+  EXPECT_EQ(seen, 8);
   EXPECT_EQ(unlogged, 0);
   std::printf("reliability: queued jobs cancelled 8, seen cancelled %d, of which without the log line %d\n", seen, unlogged);
 }
 
-// SIGTERM after 40 MB of downloads, with one more fetch in progress whose client has stopped
+// SIGTERM after 50 MB of downloads, with one more fetch in progress whose client has stopped
 // reading, stops the server within its documented time, and the state directory is free for the
 // next server at once.
 TEST(Reliability, StopAfterALargeFetchIsQuick) {
@@ -255,17 +280,28 @@ TEST(Reliability, StopAfterALargeFetchIsQuick) {
   const std::string id = c.submit(s).id();
   ASSERT_EQ(c.watch(id).state(), v1::SUCCEEDED);
   const auto listed = c.results(id);
-  for (const auto& f : listed.files()) {
+  v1::ResultFile biggest;
+  for (const auto& f : listed.files()) {  // every result, then the largest again up to 50 MB
     c.download(id, f.name(), (d.p / "fetched").string());
     fetched += f.bytes();
+    if (f.bytes() > biggest.bytes()) biggest = f;
   }
+  for (; fetched < 50'000'000; fetched += biggest.bytes()) c.download(id, biggest.name(), (d.p / "fetched").string());
   // A second fetch, stopped (SIGSTOP) while it downloads: its stream stalls in the server.
   const fs::path pid_file = d.p / "fetch.pid";
   ASSERT_EQ(std::system((runout_binary() + " fetch " + id + " --server " + srv->address() + " --out " + (d.p / "stalled").string() +
                          " > /dev/null 2>&1 & echo $! > " + pid_file.string()).c_str()), 0);
   const pid_t fetcher = pid_t(std::atol(read_text(pid_file).c_str()));
-  std::this_thread::sleep_for(150ms);
+  auto partial_bytes = [&] {  // what the fetch has written so far (beside its --out folder)
+    std::int64_t n = 0;
+    std::error_code ec;
+    for (const auto& e : fs::recursive_directory_iterator(d.p, ec))
+      if (e.path().string().find("stalled") != std::string::npos && e.is_regular_file(ec)) n += std::int64_t(e.file_size(ec));
+    return n;
+  };
+  ASSERT_TRUE(wait_for([&] { return partial_bytes() > 0; }, 20s)) << "the second fetch never started";
   kill(fetcher, SIGSTOP);
+  ASSERT_FALSE(fs::exists(d.p / "stalled")) << "the second fetch ended before it was stopped: nothing stalled";
   const auto t0 = std::chrono::steady_clock::now();
   const int st = srv->stop(SIGTERM);
   const double stop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -367,6 +403,7 @@ TEST(Reliability, ClippedReleasesAndNearVerticalTerrainAreNoted) {
     }
     if (*k.note) {
       EXPECT_NE(notes.find(k.note), std::string::npos) << k.what << ": " << notes;
+      EXPECT_NE(notes.find("before using the maps there\n"), std::string::npos) << k.what << ": the note is cut short: " << notes;
       noted += notes.find(k.note) != std::string::npos;
     } else {
       EXPECT_EQ(notes.find("near-vertical"), std::string::npos) << k.what << ": " << notes;
