@@ -42,7 +42,6 @@
 #include "runout/v1/service.grpc.pb.h"
 #include "service/server/inputs.hpp"
 #include "service/server/tokens.hpp"
-#include "terrain/terrain.hpp"
 
 namespace fs = std::filesystem;
 

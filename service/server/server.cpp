@@ -39,7 +39,6 @@
 #include "runout/v1/service.grpc.pb.h"
 #include "service/server/inputs.hpp"
 #include "service/server/tokens.hpp"
-#include "terrain/terrain.hpp"
 
 #include "service/server/impl.hpp"
 
