@@ -41,7 +41,6 @@ namespace {
 // would block the reader (GDAL's open, which SIGTERM does not interrupt); a folder cannot be hashed.
 std::string path_in(const std::string& base, const std::string& p, const std::string& field) {
   if (p.empty()) bad(field, "missing");
-  if (p.find('\0') != std::string::npos) bad(field, "the path holds a NUL character");
   fs::path q(p);
   if (q.is_relative()) q = fs::path(base) / q;
   std::error_code ec;

@@ -65,10 +65,7 @@ void Scheduler::start() {
   std::vector<JobStore::Change> changed;
   const int n = store_.requeue_running(
       "the server went down during the run; queued to run again (from its last checkpoint where it has one)", &changed);
-  for (const auto& c : changed) {  // each job's log keeps its history (`runout serve --recover` reads it)
-    std::ofstream lg(log_path(c.id), std::ios::app);
-    lg << utc_now() << " " << state_name(c.state) << ": " << c.reason << "\n";
-  }
+  for (const auto& c : changed) append_job_log(c.id, state_name(c.state) + ": " + c.reason);
   if (n) log("queued again " + std::to_string(n) + " job(s) left running by the previous server process");
   // Work in progress of a dead process is worthless: its jobs run again.
   std::error_code ec;

@@ -93,6 +93,9 @@ class Scheduler {
 
   std::string results_dir(const std::string& hash) const;
   std::string log_path(const std::string& id) const;
+  /// Append "TIME line" to a job's log (its history, which `runout serve --recover` reads); false
+  /// when it could not be written.
+  bool append_job_log(const std::string& id, const std::string& line) const;
   /// A VOF job's checkpoint while it runs (its frames so far beside it, ID.h5.fields.h5).
   std::string checkpoint_path(const std::string& id) const;
   void remove_checkpoint(const std::string& id) const;

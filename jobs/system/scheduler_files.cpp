@@ -53,6 +53,13 @@ std::string Scheduler::log_path(const std::string& id) const {
   return (fs::path(cfg_.state_dir) / "logs" / (id + ".log")).string();
 }
 
+bool Scheduler::append_job_log(const std::string& id, const std::string& line) const {
+  std::ofstream lg(log_path(id), std::ios::app);
+  lg << utc_now() << " " << line << "\n";
+  lg.flush();
+  return bool(lg);
+}
+
 void Scheduler::remove_orphan_checkpoints() {
   // A checkpoint is kept only for a job that will run again: one cancelled while it waited in the
   // queue, or ended by the store at a restart (cancel flag, too many attempts), leaves its own.

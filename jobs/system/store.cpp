@@ -18,6 +18,11 @@ constexpr const char* kColumns =
     "id, owner, name, hash, request_id, state, created, updated, error, attempts, scenario, progress, result_bytes, "
     "results_removed, crashes, parent, member";
 constexpr int kNextColumn = 17;  // the first column a query adds after kColumns
+// The job a request id (?2) of a client (?1) names: the one it created, or the earlier identical one
+// that answered it (table requests); the one it created first.
+constexpr const char* kNamedByRequest =
+    " FROM jobs WHERE owner = ?1 AND (request_id = ?2 OR id = (SELECT job FROM requests WHERE owner = ?1 AND request_id = ?2)) "
+    "ORDER BY request_id IS ?2 DESC LIMIT 1";
 
 void add_transition(sqlite3* db, const std::string& id, v1::JobState s, const std::string& when, const std::string& reason) {
   Stmt(db, "INSERT INTO transitions(job, time, state, reason) VALUES (?, ?, ?, ?)")
@@ -108,102 +113,6 @@ std::string state_name(v1::JobState s) {
 
 bool is_final(v1::JobState s) { return s == v1::SUCCEEDED || s == v1::FAILED || s == v1::CANCELLED; }
 
-JobStore::JobStore(const std::string& path) {
-  if (sqlite3_open_v2(path.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_FULLMUTEX, nullptr) !=
-      SQLITE_OK) {
-    const std::string m = db_ ? sqlite3_errmsg(db_) : "out of memory";
-    sqlite3_close(db_);
-    db_ = nullptr;
-    throw StoreError("job store '" + path + "': " + m);
-  }
-  sqlite3_busy_timeout(db_, 10000);
-  exec("PRAGMA journal_mode=WAL");
-  // Every committed state change survives a power loss: the WAL is synced at each commit.
-  exec("PRAGMA synchronous=FULL");
-  exec("PRAGMA foreign_keys=ON");
-  exec(R"(CREATE TABLE IF NOT EXISTS jobs(
-           seq INTEGER PRIMARY KEY AUTOINCREMENT,
-           id TEXT UNIQUE NOT NULL,
-           owner TEXT NOT NULL,
-           name TEXT NOT NULL,
-           hash TEXT NOT NULL,
-           request_id TEXT,
-           state INTEGER NOT NULL,
-           created TEXT NOT NULL,
-           updated TEXT NOT NULL,
-           error TEXT NOT NULL DEFAULT '',
-           attempts INTEGER NOT NULL DEFAULT 0,
-           scenario BLOB NOT NULL,
-           progress BLOB,
-           result_bytes INTEGER NOT NULL DEFAULT 0,
-           results_removed INTEGER NOT NULL DEFAULT 0,
-           cancel_requested INTEGER NOT NULL DEFAULT 0,
-           interrupted INTEGER NOT NULL DEFAULT 0);
-         CREATE UNIQUE INDEX IF NOT EXISTS jobs_request ON jobs(owner, request_id) WHERE request_id IS NOT NULL;
-         CREATE INDEX IF NOT EXISTS jobs_owner_hash ON jobs(owner, hash);
-         CREATE INDEX IF NOT EXISTS jobs_state ON jobs(state, seq);
-         CREATE TABLE IF NOT EXISTS transitions(
-           job TEXT NOT NULL REFERENCES jobs(id),
-           time TEXT NOT NULL,
-           state INTEGER NOT NULL,
-           reason TEXT NOT NULL);
-         CREATE INDEX IF NOT EXISTS transitions_job ON transitions(job);
-         CREATE TABLE IF NOT EXISTS requests(
-           owner TEXT NOT NULL,
-           request_id TEXT NOT NULL,
-           job TEXT NOT NULL REFERENCES jobs(id),
-           request_hash TEXT NOT NULL DEFAULT '',
-           PRIMARY KEY(owner, request_id));)");
-  // Stores written before the cancel flag existed get the column.
-  sqlite3_stmt* probe = nullptr;
-  if (sqlite3_prepare_v2(db_, "SELECT cancel_requested FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
-    exec("ALTER TABLE jobs ADD COLUMN cancel_requested INTEGER NOT NULL DEFAULT 0");
-  sqlite3_finalize(probe);
-  // ... and the count of attempts the server ended cleanly (interrupted by a stop, queued again).
-  probe = nullptr;
-  if (sqlite3_prepare_v2(db_, "SELECT interrupted FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK) {
-    // The clean interruptions so far, from the transitions they left.
-    exec("ALTER TABLE jobs ADD COLUMN interrupted INTEGER NOT NULL DEFAULT 0;"
-         "UPDATE jobs SET interrupted = (SELECT COUNT(*) FROM transitions t WHERE t.job = jobs.id AND t.state = 1 "
-         "AND t.reason LIKE 'interrupted by the server stopping%')");
-  }
-  sqlite3_finalize(probe);
-  // ... and the count of the job's worker processes that crashed (died of a signal nobody sent).
-  probe = nullptr;
-  if (sqlite3_prepare_v2(db_, "SELECT crashes FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
-    exec("ALTER TABLE jobs ADD COLUMN crashes INTEGER NOT NULL DEFAULT 0");
-  sqlite3_finalize(probe);
-  // ... and the digest of the request that created a job (a retry must send the same).
-  probe = nullptr;
-  if (sqlite3_prepare_v2(db_, "SELECT request_hash FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
-    exec("ALTER TABLE jobs ADD COLUMN request_hash TEXT");
-  sqlite3_finalize(probe);
-  // ... and an ensemble's members: their ensemble's job and their place in it.
-  probe = nullptr;
-  if (sqlite3_prepare_v2(db_, "SELECT parent FROM jobs LIMIT 0", -1, &probe, nullptr) != SQLITE_OK)
-    exec("ALTER TABLE jobs ADD COLUMN parent TEXT NOT NULL DEFAULT '';"
-         "ALTER TABLE jobs ADD COLUMN member INTEGER NOT NULL DEFAULT -1");
-  sqlite3_finalize(probe);
-  exec("CREATE INDEX IF NOT EXISTS jobs_parent ON jobs(parent, member)");
-  exec(R"(CREATE TABLE IF NOT EXISTS uploads(
-           id TEXT NOT NULL,
-           owner TEXT NOT NULL,
-           bytes INTEGER NOT NULL,
-           time REAL NOT NULL,
-           PRIMARY KEY(id, owner));)");
-}
-
-JobStore::~JobStore() { sqlite3_close(db_); }
-
-void JobStore::exec(const char* sql) const {
-  char* err = nullptr;
-  if (sqlite3_exec(db_, sql, nullptr, nullptr, &err) != SQLITE_OK) {
-    std::string m = err ? err : "?";
-    sqlite3_free(err);
-    throw StoreError("job store: " + m);
-  }
-}
-
 StoredJob JobStore::read_row(void* p) const {
   auto* st = static_cast<Stmt*>(p);
   StoredJob j;
@@ -259,10 +168,7 @@ SubmitOutcome JobStore::submit_ensemble(const std::string& owner, const std::str
     return true;
   };
   if (!request_id.empty()) {
-    // The job this request id names: the one it created, or the identical one that answered it.
-    Stmt st(db_, (std::string("SELECT ") + kColumns +
-                  " FROM jobs WHERE owner = ?1 AND (request_id = ?2 OR id = (SELECT job FROM requests WHERE owner = ?1 AND request_id = ?2))")
-                     .c_str());
+    Stmt st(db_, (std::string("SELECT ") + kColumns + kNamedByRequest).c_str());
     st.bind(1, owner).bind(2, request_id);
     if (existing(st)) {
       if (out.job.job.scenario_hash() != hash)
@@ -282,7 +188,6 @@ SubmitOutcome JobStore::submit_ensemble(const std::string& owner, const std::str
       if (!request_id.empty()) {  // from now on the request id names this job (a retry, or another scenario: refused)
         Stmt(db_, "INSERT INTO requests(owner, request_id, job, request_hash) VALUES (?, ?, ?, ?)")
             .bind(1, owner).bind(2, request_id).bind(3, out.job.job.id()).bind(4, request_hash).step();
-        out.request_recorded = true;
         if (record_request) record_request(out.job);
       }
       tx.commit();
@@ -607,18 +512,13 @@ void JobStore::insert_recovered(const StoredJob& j) {
 std::optional<std::pair<StoredJob, std::string>> JobStore::find_request(const std::string& owner,
                                                                        const std::string& request_id) const {
   std::lock_guard lk(mu_);
-  Stmt st(db_, (std::string("SELECT ") + kColumns + ", COALESCE(request_hash, '') FROM jobs WHERE owner = ? AND request_id = ?").c_str());
+  // The digest of the request: the job's own where the id created it, else the one recorded with the id.
+  Stmt st(db_, (std::string("SELECT ") + kColumns +
+                ", CASE WHEN request_id IS ?2 THEN COALESCE(request_hash, '') "
+                "ELSE (SELECT request_hash FROM requests WHERE owner = ?1 AND request_id = ?2) END" + kNamedByRequest)
+                   .c_str());
   st.bind(1, owner).bind(2, request_id);
-  if (!st.step()) {  // a request answered with an earlier identical job
-    Stmt al(db_, (std::string("SELECT ") + kColumns +
-                  ", (SELECT request_hash FROM requests WHERE owner = ?1 AND request_id = ?2) FROM jobs "
-                  "WHERE id = (SELECT job FROM requests WHERE owner = ?1 AND request_id = ?2)").c_str());
-    al.bind(1, owner).bind(2, request_id);
-    if (!al.step()) return std::nullopt;
-    std::pair<StoredJob, std::string> out{read_row(&al), al.text(kNextColumn)};
-    load_transitions(out.first);
-    return out;
-  }
+  if (!st.step()) return std::nullopt;
   std::pair<StoredJob, std::string> out{read_row(&st), st.text(kNextColumn)};
   load_transitions(out.first);
   return out;

@@ -47,9 +47,6 @@ struct StoredJob {
 struct SubmitOutcome {
   StoredJob job;
   bool created = false;  ///< false: an existing job answered (same request id or identical scenario)
-  /// The request id was new and is now recorded for the existing identical job that answered it
-  /// (the caller writes it to that job's log, from which recovery rebuilds it).
-  bool request_recorded = false;
 };
 
 class JobStore {
@@ -77,7 +74,7 @@ class JobStore {
   /// answers as submit() says; the ensemble counts as one job against `max_queued`. The ensemble's
   /// job is claimed only once none of its members is queued or running (it then aggregates).
   /// `record_request` (when given) is called, before the commit, when the request id is recorded for
-  /// an earlier identical job (SubmitOutcome::request_recorded): it writes that job's log line, and
+  /// an earlier identical job that answers (created false): it writes that job's log line, and
   /// an exception from it leaves nothing recorded.
   SubmitOutcome submit_ensemble(const std::string& owner, const std::string& hash, const std::string& request_id,
                                 const v1::Scenario& scenario, const std::vector<NewMember>& members, int max_queued,

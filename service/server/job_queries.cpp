@@ -96,11 +96,7 @@ Status Server::Impl::CancelJob(grpc::ServerContext* ctx, const v1::CancelJobRequ
   // the store commits, so that no reader (a client, or a recovery after a crash) sees a cancelled
   // job whose log does not say so; a commit that fails says so in the log after it.
   auto write_lines = [&](const std::vector<jobs::JobStore::Change>& changes, const std::string& word, const std::string& why) {
-    for (const auto& e : changes) {
-      std::ofstream lg(sched->log_path(e.id), std::ios::app);
-      lg << jobs::utc_now() << " " << word << ": " << (why.empty() ? e.reason : why) << "\n";
-      lg.flush();
-    }
+    for (const auto& e : changes) sched->append_job_log(e.id, word + ": " + (why.empty() ? e.reason : why));
   };
   std::optional<jobs::StoredJob> j;
   try {

@@ -203,10 +203,8 @@ Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRe
     // A request id answered by an earlier identical job: that job's log keeps it, written before the
     // store commits (`runout serve --recover` reads the line).
     auto record_request = [&](const jobs::StoredJob& j) {
-      std::ofstream lg(sched->log_path(j.job.id()), std::ios::app);
-      lg << jobs::utc_now() << " " << jobs::request_log_line(req->request_id(), request_hash) << "\n";
-      lg.flush();
-      if (!lg) throw std::runtime_error("cannot write the log of job " + j.job.id());
+      if (!sched->append_job_log(j.job.id(), jobs::request_log_line(req->request_id(), request_hash)))
+        throw std::runtime_error("cannot write the log of job " + j.job.id());
     };
     const auto out =
         store->submit_ensemble(owner, hash, req->request_id(), s, members, cfg.max_queued_per_client(), request_hash, record_request);
