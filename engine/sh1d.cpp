@@ -1,5 +1,7 @@
 #include "engine/sh1d.hpp"
 
+#include "engine/stepping.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -85,7 +87,7 @@ void validate(const Channel1D& ch, const Sh1dConfig& cfg, const Sh1dState& s) {
 
 // The scheme's state and steps on one channel: ghosts, earth pressure, predictor, positivity
 // limiter, corrector on the staggered cells and the average back onto the cells.
-class Sh1dSolver {
+class Sh1dSolver final : public SteppingEngine {
  public:
   Sh1dSolver(const Channel1D& ch, const Sh1dConfig& cfg, const Sh1dState& init)
       : cfg_(cfg), n(ch.n), dx(ch.dx), g(cfg.gravity), hdry(cfg.dry_depth), lim(cfg.limiter),
@@ -115,6 +117,11 @@ class Sh1dSolver {
   }
 
   Sh1dResult run();
+  // The engine's side of the run loop (engine/stepping.hpp).
+  double time() const override { return t_; }
+  long steps() const override { return r_.steps; }
+  StepReport step(double t_end) override;
+  double kinetic_energy() const override { return ke_; }
 
  private:
   double vel(double h, double m) const { return h > hdry ? m / h : 0.0; }
@@ -126,9 +133,9 @@ class Sh1dSolver {
   void fill_ghosts(double t);
   void fill_side(Boundary1D b, bool left, double t);
   void set_beta();
-  double next_dt(double t) const;
+  double next_dt(double t, double t_end) const;
   template <MuForm M>
-  void step(double dt, double lam, Sh1dResult& r);
+  void advance(double dt, double lam, Sh1dResult& r);
   template <MuForm M>
   void predictor(double dt, double lam);
   void positivity(double lam);
@@ -176,6 +183,8 @@ class Sh1dSolver {
   double mu = 0, ixi = 0, kact = 1, kpas = 1;
   bool kap = false;
   Work w;
+  double t_ = 0, ke_ = 0;  // the time reached, the last step's kinetic energy
+  Sh1dResult r_;          // the run's figures so far
 };
 
 void Sh1dSolver::fill_side(Boundary1D b, bool left, double t) {
@@ -223,20 +232,20 @@ void Sh1dSolver::set_beta() {
   w.beta[n + 2 * G - 1] = w.beta[n + 2 * G - 2];
 }
 
-double Sh1dSolver::next_dt(double t) const {
+double Sh1dSolver::next_dt(double t, double t_end) const {
   const auto& tc = cfg_.time;
   double amax = 0;
   for (int k = 0; k < n + 2 * G; ++k)
     amax = std::max(amax, std::abs(vel(w.h[k], w.m[k])) + std::sqrt(w.beta[k] * std::max(w.h[k], 0.0)));
   double dt = amax > 0 ? tc.cfl * dx / amax : tc.dt_max;
-  dt = std::min({dt, tc.dt_max, tc.t_end - t});
-  if (!(dt > 0) || !std::isfinite(dt)) dt = tc.t_end - t;
+  dt = std::min({dt, tc.dt_max, t_end - t});
+  if (!(dt > 0) || !std::isfinite(dt)) dt = t_end - t;
   return dt;
 }
 
 // One step of the scheme, with the friction coefficient's form M.
 template <MuForm M>
-void Sh1dSolver::step(double dt, double lam, Sh1dResult& r) {
+void Sh1dSolver::advance(double dt, double lam, Sh1dResult& r) {
   predictor<M>(dt, lam);
   positivity(lam);
   corrector<M>(dt, lam, r);
@@ -314,60 +323,61 @@ void Sh1dSolver::average_back() {
   }
 }
 
+StepReport Sh1dSolver::step(double t_end) {
+  Sh1dResult& r = r_;
+  fill_ghosts(t_);
+  set_beta();
+  const double dt = next_dt(t_, t_end);
+  const double lam = dt / dx;
+  const double mass_before = open ? mass() : 0.0;
+  switch (fr.form()) {
+    case MuForm::constant: advance<MuForm::constant>(dt, lam, r); break;
+    case MuForm::flow: advance<MuForm::flow>(dt, lam, r); break;
+    case MuForm::hysteresis: advance<MuForm::hysteresis>(dt, lam, r); break;
+  }
+  t_ += dt;
+  ++r.steps;
+  if (open) r.boundary_exchange += mass() - mass_before;
+  double ke = 0, umax = 0;
+  for (int i = 0; i < n; ++i) {
+    const double h = w.h[i + G], u = vel(h, w.m[i + G]);
+    r.max_depth[i] = std::max(r.max_depth[i], h);
+    r.max_speed[i] = std::max(r.max_speed[i], std::abs(u));
+    ke += 0.5 * h * u * u * dx;
+    umax = std::max(umax, std::abs(u));
+  }
+  ke_ = ke;
+  StepReport rep;
+  rep.t = t_;
+  rep.dt = dt;
+  rep.mass = mass();
+  rep.kinetic_energy = ke;
+  rep.max_speed = umax;
+  rep.active_fraction = 1.0;
+  return rep;
+}
+
 Sh1dResult Sh1dSolver::run() {
   const auto wall0 = std::chrono::steady_clock::now();
-  Sh1dResult r;
-  r.max_depth.assign(n, 0.0);
-  r.max_speed.assign(n, 0.0);
-  r.mass_initial = mass();
-  double t = 0, ke_peak = 0;
+  r_.max_depth.assign(n, 0.0);
+  r_.max_speed.assign(n, 0.0);
+  r_.mass_initial = mass();
   const auto& tc = cfg_.time;
-  while (t < tc.t_end) {
-    if (r.steps >= tc.max_steps) {
-      r.stop = StopReason::max_steps;
-      break;
-    }
-    fill_ghosts(t);
-    set_beta();
-    const double dt = next_dt(t);
-    const double lam = dt / dx;
-    const double mass_before = open ? mass() : 0.0;
-    switch (fr.form()) {
-      case MuForm::constant: step<MuForm::constant>(dt, lam, r); break;
-      case MuForm::flow: step<MuForm::flow>(dt, lam, r); break;
-      case MuForm::hysteresis: step<MuForm::hysteresis>(dt, lam, r); break;
-    }
-    t += dt;
-    ++r.steps;
-    if (open) r.boundary_exchange += mass() - mass_before;
-
-    double ke = 0, umax = 0;
-    for (int i = 0; i < n; ++i) {
-      const double h = w.h[i + G], u = vel(h, w.m[i + G]);
-      r.max_depth[i] = std::max(r.max_depth[i], h);
-      r.max_speed[i] = std::max(r.max_speed[i], std::abs(u));
-      ke += 0.5 * h * u * u * dx;
-      umax = std::max(umax, std::abs(u));
-    }
-    ke_peak = std::max(ke_peak, ke);
-    if (tc.progress && r.steps % tc.progress_every == 0) {
-      Progress p{t, dt, mass(), umax, ke, 1.0, r.steps};
-      if (!tc.progress(p)) {
-        r.stop = StopReason::cancelled;
-        break;
-      }
-    }
-    if (tc.stop_fraction > 0 && ke_peak > 0 && ke < tc.stop_fraction * ke_peak) {
-      r.stop = StopReason::kinetic_energy;
-      break;
-    }
-  }
-  r.t = t;
-  r.state.h.assign(w.h.begin() + G, w.h.begin() + G + n);
-  r.state.m.assign(w.m.begin() + G, w.m.begin() + G + n);
-  r.mass_final = mass();
-  r.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  return r;
+  LoopSchedule schedule;
+  schedule.t_end = tc.t_end;
+  schedule.stop_fraction = tc.stop_fraction;
+  schedule.max_steps = tc.max_steps;
+  schedule.progress_every = tc.progress_every;
+  LoopHooks hooks;
+  hooks.progress = tc.progress;
+  LoopState loop;
+  r_.stop = run_steps(*this, schedule, loop, hooks, false);
+  r_.t = t_;
+  r_.state.h.assign(w.h.begin() + G, w.h.begin() + G + n);
+  r_.state.m.assign(w.m.begin() + G, w.m.begin() + G + n);
+  r_.mass_final = mass();
+  r_.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return std::move(r_);
 }
 
 }  // namespace

@@ -43,12 +43,14 @@
 // so results are bitwise identical for any thread count.
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "engine/limiters.hpp"
 #include "engine/rheology.hpp"
 #include "engine/run_control.hpp"
+#include "engine/stepping.hpp"
 
 namespace runout::engine {
 
@@ -213,7 +215,44 @@ Sh2dState state_from_normal_depth(const Terrain2D& terrain, const std::vector<do
 /// Normal depth h = H cos(theta) per cell.
 std::vector<double> normal_depth(const Terrain2D& terrain, const Sh2dState& s);
 
-/// Run the 2D solver. Throws std::invalid_argument naming the problem on inconsistent input, and
+namespace sh2d_detail {
+class Solver;
+}
+
+/// The 2D solver as the run loop (engine/stepping.hpp) drives it. It keeps references to the
+/// terrain and the configuration: both must outlive it. The constructors throw
+/// std::invalid_argument naming the problem on inconsistent input; a step throws std::runtime_error
+/// when the state becomes non-finite (NaN or infinite depth or momentum).
+class Sh2dEngine final : public SteppingEngine {
+ public:
+  Sh2dEngine(const Terrain2D& terrain, const Sh2dConfig& config, Sh2dState initial);
+  /// Continues a run from a checkpoint taken by the same terrain and configuration (the end time and
+  /// the intervals may differ).
+  Sh2dEngine(const Terrain2D& terrain, const Sh2dConfig& config, const Sh2dCheckpoint& from);
+  ~Sh2dEngine() override;
+  double time() const override;
+  long steps() const override;
+  StepReport step(double t_end) override;
+  double kinetic_energy() const override;
+  /// The state now (valid until the next step).
+  Sh2dStateView state() const;
+  /// The whole state between two steps, with the loop's running figures: a run continued from it
+  /// computes the same bits as the uninterrupted run.
+  Sh2dCheckpoint checkpoint(const LoopState& loop) const;
+  /// The loop's running figures a checkpoint carries.
+  static LoopState loop_state(const Sh2dCheckpoint& cp);
+  /// The run's diagnostics and results, moved out of the engine: once, after the loop.
+  Sh2dResult finish(StopReason stop, const LoopState& loop);
+
+ private:
+  std::unique_ptr<sh2d_detail::Solver> s_;
+};
+
+/// The loop's schedule of a configuration: its end time, stop rule and step limit, its snapshots (as
+/// frames, the final state included) and checkpoints, its progress cadence.
+LoopSchedule loop_schedule(const Sh2dConfig& config);
+
+/// Run the 2D solver through the run loop with the configuration's hooks. Throws std::invalid_argument naming the problem on inconsistent input, and
 /// std::runtime_error when the state becomes non-finite (NaN or infinite depth or momentum).
 Sh2dResult run_sh2d(const Terrain2D& terrain, const Sh2dConfig& config, Sh2dState initial);
 /// Continue a run from a checkpoint taken by the same terrain and configuration (the end time, the

@@ -107,16 +107,20 @@ inline double flow_mu(const BasalFriction& f, double h, double speed, double gn)
   else return p.mu;
 }
 
-/// A parameter of a law: the scenario's field (in `material`), its symbol and what it is.
+/// A parameter of a law: the scenario's field (in `material`), its symbol, how maps print it and
+/// what it is.
 struct FrictionParameter {
   std::string_view field;   ///< e.g. "bed_friction_deg"
   std::string_view symbol;  ///< e.g. "delta"
+  std::string_view label;   ///< the symbol on maps, e.g. "δ"
+  std::string_view unit;    ///< the unit on maps, e.g. "°", "m/s²"; empty: none
   std::string_view doc;
   std::string_view unset = {};  ///< what an unset field means; empty: the field is required
 };
 
 struct FrictionLaw {
   std::string_view name;      ///< the scenario's material.rheology
+  std::string_view caption;   ///< the law's name on maps, e.g. "Voellmy"
   std::string_view equation;  ///< tau_b in words and symbols, with the source
   std::array<FrictionParameter, 6> parameters;  ///< those it reads (an empty field ends the list)
   BasalFriction (*coefficients)(const FrictionParams&);

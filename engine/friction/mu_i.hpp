@@ -13,14 +13,15 @@ namespace runout::engine::friction {
 
 inline constexpr FrictionLaw mu_i{
     "mu_i",
+    "μ(I)",
     "tau_b = mu(I) N, mu = mu_s + (mu_2 - mu_s) / (I_0 / I + 1), I = 5 d \\|u\\| / (2 h sqrt(phi g_n h)), "
     "phi = rho / rho_s (`material.density_kg_m3` / `grain_density_kg_m3`) (Jop, Forterre & Pouliquen 2006; "
     "depth-averaged with the Bagnold profile)",
-    {{{"mu_s", "mu_s", "friction coefficient as I -> 0"},
-      {"mu_2", "mu_2", "friction coefficient as I -> infinity"},
-      {"mu_i0", "I_0", "inertial number where mu is halfway from mu_s to mu_2"},
-      {"grain_diameter_m", "d", "grain diameter"},
-      {"grain_density_kg_m3", "rho_s", "grain density"}}},
+    {{{"mu_s", "mu_s", "μs", "", "friction coefficient as I -> 0"},
+      {"mu_2", "mu_2", "μ₂", "", "friction coefficient as I -> infinity"},
+      {"mu_i0", "I_0", "I₀", "", "inertial number where mu is halfway from mu_s to mu_2"},
+      {"grain_diameter_m", "d", "d", "m", "grain diameter"},
+      {"grain_density_kg_m3", "rho_s", "ρs", "kg/m³", "grain density"}}},
     [](const FrictionParams& p) {  // a = beta / L = 2 I_0 sqrt(phi) / (5 d), no static branch
       return flow_friction(p.mu_s, p.mu_2 - p.mu_s, 2.0 * p.mu_i0 * std::sqrt(p.density / p.grain_density) / (5.0 * p.grain_diameter));
     },

@@ -16,15 +16,16 @@ namespace runout::engine::friction {
 
 inline constexpr FrictionLaw pouliquen_forterre{
     "pouliquen_forterre",
+    "Pouliquen–Forterre",
     "tau_b = mu(h, Fr) N, mu = tan d1 + (tan d2 - tan d1) / (beta h / (L (Fr + gamma)) + 1) while Fr >= beta - gamma, "
     "rising to mu_start(h) = tan d3 + (tan d2 - tan d1) / (h / L + 1) at rest, Fr = \\|u\\| / sqrt(g_n h) "
     "(Pouliquen & Forterre 2002; Forterre & Pouliquen 2003)",
-    {{{"bed_friction_1_deg", "delta_1", "lowest friction angle of steady flow"},
-      {"bed_friction_2_deg", "delta_2", "friction angle of thin layers"},
-      {"bed_friction_3_deg", "delta_3", "friction angle of mu_start", "delta_1, no start/stop hysteresis"},
-      {"pf_beta", "beta", "slope of the flow rule Fr = beta h / h_stop - gamma"},
-      {"pf_length_m", "L", "length of h_stop"},
-      {"pf_gamma", "gamma", "offset of the flow rule", "0"}}},
+    {{{"bed_friction_1_deg", "delta_1", "δ₁", "°", "lowest friction angle of steady flow"},
+      {"bed_friction_2_deg", "delta_2", "δ₂", "°", "friction angle of thin layers"},
+      {"bed_friction_3_deg", "delta_3", "δ₃", "°", "friction angle of mu_start", "delta_1, no start/stop hysteresis"},
+      {"pf_beta", "beta", "β", "", "slope of the flow rule Fr = beta h / h_stop - gamma"},
+      {"pf_length_m", "L", "L", "m", "length of h_stop"},
+      {"pf_gamma", "gamma", "γ", "", "offset of the flow rule", "0"}}},
     [](const FrictionParams& p) {
       const double t1 = std::tan(p.delta1), t3 = std::isnan(p.delta3) ? t1 : std::tan(p.delta3);
       return flow_friction(t1, std::tan(p.delta2) - t1, p.pf_beta / p.pf_length, p.pf_gamma, p.pf_beta, t3 - t1);

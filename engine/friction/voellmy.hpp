@@ -8,8 +8,9 @@ namespace runout::engine::friction {
 
 inline constexpr FrictionLaw voellmy{
     "voellmy",
+    "Voellmy",
     "tau_b = mu N + rho g \\|u\\|^2 / xi (Voellmy 1955; Salm 1993)",
-    {{{"voellmy_mu", "mu", "dry-friction coefficient"}, {"voellmy_xi", "xi", "turbulent-friction coefficient"}}},
+    {{{"voellmy_mu", "mu", "μ", "", "dry-friction coefficient"}, {"voellmy_xi", "xi", "ξ", "m/s²", "turbulent-friction coefficient"}}},
     [](const FrictionParams& p) { return BasalFriction{p.mu, 1.0 / p.xi}; },
     [](const FrictionParams& p) -> const char* {
       if (!(p.mu >= 0.0 && std::isfinite(p.mu))) return "Voellmy mu must be >= 0";

@@ -1,5 +1,5 @@
-// The depth-averaged 2D solver: set-up, the time loop over the active tiles, checkpoints and the
-// entry points run_sh2d.
+// The depth-averaged 2D solver: set-up, the step over the active tiles, checkpoints, the engine's
+// side of the run loop (Sh2dEngine) and the entry points run_sh2d.
 #include <omp.h>
 
 #include <algorithm>
@@ -128,6 +128,9 @@ Solver::Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
   for (int tt = 0; tt < ntiles_; ++tt) fill_whole(tt);
   rebuild_active();
   secondary_time_.assign(cfg.secondary.size(), nan);
+  volume_initial_ = sum_tiles(tile_mass_) * (t_.dx * t_.dy);
+  work_.resize(std::size_t(omp_get_max_threads()));
+  for (auto& w : work_) w.reserve(T_);
 }
 
 // Each waiting secondary release area that the flow has reached (a cell of it flowing at the end of
@@ -237,7 +240,7 @@ void Solver::rebuild_active() {
   }
 }
 
-Sh2dCheckpoint Solver::checkpoint() const {
+Sh2dCheckpoint Solver::checkpoint(const LoopState& loop) const {
   Sh2dCheckpoint cp;
   cp.nx = nx_;
   cp.ny = ny_;
@@ -263,12 +266,12 @@ Sh2dCheckpoint Solver::checkpoint() const {
   cp.tile_wet = tile_wet_;
   cp.tile_active = active_flag_;
   cp.volume_initial = volume_initial_;
-  cp.kinetic_energy_peak = ke_peak_;
+  cp.kinetic_energy_peak = loop.kinetic_energy_peak;
   cp.cell_updates = cell_updates_;
   cp.active_fraction_sum = active_sum_;
   cp.max_active_fraction = max_active_fraction_;
-  cp.next_snapshot = next_snapshot_;
-  cp.last_snapshot = last_snapshot_;
+  cp.next_snapshot = loop.next_frame;
+  cp.last_snapshot = loop.last_frame;
   cp.secondary_time = secondary_time_;
   cp.volume_secondary = volume_secondary_;
   return cp;
@@ -315,15 +318,11 @@ void Solver::restore(const Sh2dCheckpoint& cp) {
   t_now_ = cp.t;
   steps_ = cp.steps;
   volume_initial_ = cp.volume_initial;
-  ke_peak_ = cp.kinetic_energy_peak;
   cell_updates_ = cp.cell_updates;
   active_sum_ = cp.active_fraction_sum;
   max_active_fraction_ = cp.max_active_fraction;
-  next_snapshot_ = cp.next_snapshot;
-  last_snapshot_ = cp.last_snapshot;
   secondary_time_ = cp.secondary_time;
   volume_secondary_ = cp.volume_secondary;
-  restored_ = true;
 }
 
 double Solver::sum_tiles(const std::vector<double>& v) const {
@@ -339,27 +338,27 @@ void Solver::not_finite(const char* what) const {
 }
 
 // The step length from the fastest active tile's CFL rate, capped by dt_max and the end time.
-double Solver::next_dt() const {
+double Solver::next_dt(double t_end) const {
   const auto& tc = cfg_.time;
   const double t = t_now_;
   double rate = 0;
   for (int tt : active_) rate = std::max(rate, tile_rate_[tt]);
   if (!std::isfinite(rate)) not_finite("depth or momentum");
   double dt = rate > 0 ? tc.cfl / rate : tc.dt_max;
-  dt = std::min({dt, tc.dt_max, tc.t_end - t});
-  if (!(dt > 0) || !std::isfinite(dt)) dt = tc.t_end - t;
+  dt = std::min({dt, tc.dt_max, t_end - t});
+  if (!(dt > 0) || !std::isfinite(dt)) dt = t_end - t;
   return dt;
 }
 
 // One step of every active tile (in parallel, each thread with its own work space), then the swap of
 // the time levels, the step's bookkeeping and the new set of active tiles. Returns the fraction of
 // the cells computed.
-double Solver::step_all(double dt, std::vector<TileWork>& work) {
+double Solver::step_all(double dt) {
   const double t = t_now_;
   const int na = int(active_.size());
   long ncells = 0;  // the cells computed: those of the active tiles within reach of material
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : ncells)
-  for (int a = 0; a < na; ++a) ncells += step_tile(active_[a], t, dt, work[omp_get_thread_num()]);
+  for (int a = 0; a < na; ++a) ncells += step_tile(active_[a], t, dt, work_[omp_get_thread_num()]);
   cur_ = 1 - cur_;
   t_now_ += dt;
   ++steps_;
@@ -371,92 +370,35 @@ double Solver::step_all(double dt, std::vector<TileWork>& work) {
   return frac;
 }
 
-Sh2dResult Solver::run() {
-  const auto wall0 = std::chrono::steady_clock::now();
-  const auto& tc = cfg_.time;
-  Sh2dDiagnostics d;
-  const double cell_area = t_.dx * t_.dy;
-  if (!restored_) volume_initial_ = sum_tiles(tile_mass_) * cell_area;
-  double& t = t_now_;
-  const auto loop0 = std::chrono::steady_clock::now();
-  std::vector<TileWork> work(omp_get_max_threads());
-  for (auto& w : work) w.reserve(T_);
-  const bool snapshots = cfg_.snapshot && cfg_.snapshot_interval > 0;
-  auto snapshot = [&] {
-    cfg_.snapshot(t, Sh2dStateView{H_[cur_], HU_[cur_], HV_[cur_]});
-    last_snapshot_ = t;
-    while (next_snapshot_ <= t) next_snapshot_ += cfg_.snapshot_interval;
-  };
-  // Checkpoints are taken at step boundaries only: the first one at or after each multiple of the
-  // interval (steps are not shortened for them, so they change nothing).
-  const bool checkpoints = bool(cfg_.checkpoint);
-  const double cp_every = cfg_.checkpoint_interval > 0 ? cfg_.checkpoint_interval : 0.0;
-  double next_cp = cp_every > 0 ? cp_every * (std::floor(t / cp_every) + 1) : std::numeric_limits<double>::infinity();
-  const auto stop_rule = [&](double ke) {
-    return tc.stop_fraction > 0 && ke_peak_ > 0 && ke * cell_area < tc.stop_fraction * ke_peak_;
-  };
-  bool ran = true;
-  if (!restored_) {
-    if (snapshots) snapshot();
-  } else if (stop_rule(sum_tiles(tile_ke_))) {
-    // A checkpoint of a cancelled run is taken before the stopping rule looked at its last step.
-    d.stop = StopReason::kinetic_energy;
-    ran = false;
-  }
-  while (ran && t < tc.t_end) {
-    if (steps_ >= tc.max_steps) {
-      d.stop = StopReason::max_steps;
-      break;
-    }
-    const double dt = next_dt();
-    const double frac = step_all(dt, work);
-    if (!cfg_.secondary.empty()) release_secondary();
-    // Cheap guard on the whole state: a NaN or infinite depth shows in the volume, a NaN or
-    // infinite momentum in the kinetic energy.
-    const double ke = sum_tiles(tile_ke_);
-    const double mass = sum_tiles(tile_mass_);
-    if (!std::isfinite(mass)) not_finite("depth");
-    if (!std::isfinite(ke)) not_finite("momentum");
-    if (snapshots && t >= next_snapshot_) snapshot();
-    ke_peak_ = std::max(ke_peak_, ke * cell_area);
-    if (tc.progress && steps_ % tc.progress_every == 0) {
-      double vmax = 0;
-      for (int tt = 0; tt < ntiles_; ++tt) vmax = std::max(vmax, tile_speed_[tt]);
-      Progress p{t, dt, mass * cell_area, vmax, ke * cell_area, frac, steps_};
-      if (!tc.progress(p)) {
-        d.stop = StopReason::cancelled;
-        if (checkpoints) cfg_.checkpoint(checkpoint());  // the run can continue from here
-        break;
-      }
-    }
-    if (stop_rule(ke)) {
-      d.stop = StopReason::kinetic_energy;
-      break;
-    }
-    if (checkpoints && t >= next_cp && t < tc.t_end) {
-      cfg_.checkpoint(checkpoint());
-      while (next_cp <= t) next_cp += cp_every;
-    }
-  }
-  if (snapshots && last_snapshot_ != t) snapshot();  // the final state, unless just written
-  d.loop_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - loop0).count();
-  Sh2dResult res = finish(d);
-  res.diag.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  return res;
+StepReport Solver::step(double t_end) {
+  const double dt = next_dt(t_end);
+  StepReport r;
+  r.active_fraction = step_all(dt);
+  if (!cfg_.secondary.empty()) release_secondary();
+  // Cheap guard on the whole state: a NaN or infinite depth shows in the volume, a NaN or infinite
+  // momentum in the kinetic energy.
+  const double ke = sum_tiles(tile_ke_), mass = sum_tiles(tile_mass_), cell_area = t_.dx * t_.dy;
+  if (!std::isfinite(mass)) not_finite("depth");
+  if (!std::isfinite(ke)) not_finite("momentum");
+  r.t = t_now_;
+  r.dt = dt;
+  r.mass = mass * cell_area;
+  r.kinetic_energy = ke * cell_area;
+  for (int tt = 0; tt < ntiles_; ++tt) r.max_speed = std::max(r.max_speed, tile_speed_[tt]);
+  return r;
 }
 
-// The diagnostics of the run and its results (maps, final state), moved out of the solver.
-Sh2dResult Solver::finish(const Sh2dDiagnostics& loop) {
+Sh2dResult Solver::finish(StopReason stop, const LoopState& loop) {
   Sh2dResult res;
-  res.diag = loop;
   auto& d = res.diag;
   const double cell_area = t_.dx * t_.dy;
+  d.stop = stop;
   d.t = t_now_;
   d.steps = steps_;
   d.volume_initial = volume_initial_;
   d.volume_secondary = volume_secondary_;
   d.secondary_time = secondary_time_;
-  d.kinetic_energy_peak = ke_peak_;
+  d.kinetic_energy_peak = loop.kinetic_energy_peak;
   d.cell_updates = cell_updates_;
   d.max_active_fraction = max_active_fraction_;
   d.volume_final = sum_tiles(tile_mass_) * cell_area;
@@ -477,18 +419,77 @@ Sh2dResult Solver::finish(const Sh2dDiagnostics& loop) {
 
 }  // namespace sh2d_detail
 
-Sh2dResult run_sh2d(const Terrain2D& terrain, const Sh2dConfig& config, Sh2dState initial) {
+Sh2dEngine::Sh2dEngine(const Terrain2D& terrain, const Sh2dConfig& config, Sh2dState initial) {
   sh2d_detail::validate(terrain, config, initial);
-  sh2d_detail::Solver s(terrain, config, std::move(initial));
-  return s.run();
+  s_ = std::make_unique<sh2d_detail::Solver>(terrain, config, std::move(initial));
+}
+
+Sh2dEngine::Sh2dEngine(const Terrain2D& terrain, const Sh2dConfig& config, const Sh2dCheckpoint& from) {
+  Sh2dState st{from.H, from.HU, from.HV};
+  sh2d_detail::validate(terrain, config, st);
+  s_ = std::make_unique<sh2d_detail::Solver>(terrain, config, std::move(st));
+  s_->restore(from);
+}
+
+Sh2dEngine::~Sh2dEngine() = default;
+double Sh2dEngine::time() const { return s_->time(); }
+long Sh2dEngine::steps() const { return s_->steps(); }
+StepReport Sh2dEngine::step(double t_end) { return s_->step(t_end); }
+double Sh2dEngine::kinetic_energy() const { return s_->kinetic_energy(); }
+Sh2dStateView Sh2dEngine::state() const { return s_->state(); }
+Sh2dCheckpoint Sh2dEngine::checkpoint(const LoopState& loop) const { return s_->checkpoint(loop); }
+Sh2dResult Sh2dEngine::finish(StopReason stop, const LoopState& loop) { return s_->finish(stop, loop); }
+
+LoopState Sh2dEngine::loop_state(const Sh2dCheckpoint& cp) {
+  LoopState st;
+  st.kinetic_energy_peak = cp.kinetic_energy_peak;
+  st.next_frame = cp.next_snapshot;
+  st.last_frame = cp.last_snapshot;
+  return st;
+}
+
+LoopSchedule loop_schedule(const Sh2dConfig& c) {
+  LoopSchedule s;
+  s.t_end = c.time.t_end;
+  s.stop_fraction = c.time.stop_fraction;
+  s.max_steps = c.time.max_steps;
+  s.frame_interval = c.snapshot ? c.snapshot_interval : 0.0;
+  s.final_frame = true;
+  s.checkpoint_interval = c.checkpoint_interval;
+  s.progress_every = c.time.progress_every;
+  return s;
+}
+
+namespace {
+
+// The one loop with the configuration's hooks (snapshots, checkpoints, progress).
+Sh2dResult drive(Sh2dEngine& e, const Sh2dConfig& config, LoopState loop, bool continued,
+                 std::chrono::steady_clock::time_point wall0) {
+  LoopHooks h;
+  if (config.snapshot) h.frame = [&](double t) { config.snapshot(t, e.state()); };
+  if (config.checkpoint) h.checkpoint = [&](const LoopState& st) { config.checkpoint(e.checkpoint(st)); };
+  h.progress = config.time.progress;
+  const auto loop0 = std::chrono::steady_clock::now();
+  const StopReason stop = run_steps(e, loop_schedule(config), loop, h, continued);
+  const auto loop1 = std::chrono::steady_clock::now();
+  Sh2dResult res = e.finish(stop, loop);
+  res.diag.loop_seconds = std::chrono::duration<double>(loop1 - loop0).count();
+  res.diag.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return res;
+}
+
+}  // namespace
+
+Sh2dResult run_sh2d(const Terrain2D& terrain, const Sh2dConfig& config, Sh2dState initial) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  Sh2dEngine e(terrain, config, std::move(initial));
+  return drive(e, config, LoopState{}, false, wall0);
 }
 
 Sh2dResult run_sh2d(const Terrain2D& terrain, const Sh2dConfig& config, const Sh2dCheckpoint& from) {
-  Sh2dState st{from.H, from.HU, from.HV};
-  sh2d_detail::validate(terrain, config, st);
-  sh2d_detail::Solver s(terrain, config, std::move(st));
-  s.restore(from);
-  return s.run();
+  const auto wall0 = std::chrono::steady_clock::now();
+  Sh2dEngine e(terrain, config, from);
+  return drive(e, config, Sh2dEngine::loop_state(from), true, wall0);
 }
 
 }  // namespace runout::engine

@@ -1,6 +1,7 @@
 #pragma once
 // The depth-averaged 2D solver's internals (engine/sh2d.hpp is the interface): the tile work space,
-// the face types and the Solver. solver.cpp holds the set-up, the time loop and checkpoints;
+// the face types and the Solver. solver.cpp holds the set-up, the step over the active tiles and
+// checkpoints (the time loop is engine/stepping.cpp's);
 // step.cpp the first half of one tile's step (predictor, face fluxes), update.cpp the second
 // (positivity limiter, update, hazard maps, tile sums).
 #include <algorithm>
@@ -88,12 +89,20 @@ class Solver {
  public:
   Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s);
 
-  Sh2dResult run();
+  // The engine's side of the run loop (engine/sh2d.hpp, Sh2dEngine).
+  StepReport step(double t_end);
+  double time() const { return t_now_; }
+  long steps() const { return steps_; }
+  double kinetic_energy() const { return sum_tiles(tile_ke_) * (t_.dx * t_.dy); }
+  Sh2dStateView state() const { return Sh2dStateView{H_[cur_], HU_[cur_], HV_[cur_]}; }
+  /// The whole state between two steps, with the loop's running figures.
+  Sh2dCheckpoint checkpoint(const LoopState& loop) const;
   /// Take up a checkpoint's state (after construction from its depths and momenta).
   void restore(const Sh2dCheckpoint& cp);
+  /// The diagnostics of the run and its results (maps, final state), moved out of the solver.
+  Sh2dResult finish(StopReason stop, const LoopState& loop);
 
  private:
-  Sh2dCheckpoint checkpoint() const;
   std::size_t idx(int i, int j) const { return std::size_t(j) * nx_ + i; }
   void tile_range(int tt, int& i0, int& i1, int& j0, int& j1) const {
     const int ti = tt % ntx_, tj = tt / ntx_;
@@ -154,13 +163,11 @@ class Solver {
     return std::sqrt(MU * MU + MV * MV + w * w);
   }
 
-  // The time loop's parts (solver.cpp): the next step's length, one step of every active tile, the
-  // diagnostics and results at the end.
-  double next_dt() const;
-  double step_all(double dt, std::vector<TileWork>& work);
+  // A step's parts (solver.cpp): its length, one step of every active tile, the guard on the state.
+  double next_dt(double t_end) const;
+  double step_all(double dt);
   [[noreturn]] void not_finite(const char* what) const;
   double sum_tiles(const std::vector<double>& v) const;
-  Sh2dResult finish(const Sh2dDiagnostics& loop);
   void tile_scan(int tt);
   void release_secondary();
   void record_hazard(std::size_t k, double t);
@@ -216,11 +223,11 @@ class Solver {
   // level; every other cell of the tile is empty there (see clear_outside).
   std::vector<CellBox> filled_[2];
   HazardMaps hz_;
-  // The time loop's running figures (members so that a checkpoint can carry them).
-  double t_now_ = 0, active_sum_ = 0, next_snapshot_ = 0, last_snapshot_ = -1;
+  // The run's running figures (members so that a checkpoint can carry them).
+  double t_now_ = 0, active_sum_ = 0;
   long steps_ = 0;
-  double cell_updates_ = 0, max_active_fraction_ = 0, ke_peak_ = 0, volume_initial_ = 0;
-  bool restored_ = false;
+  double cell_updates_ = 0, max_active_fraction_ = 0, volume_initial_ = 0;
+  std::vector<TileWork> work_;  // per OpenMP thread
   std::vector<double> secondary_time_;  // per secondary release area: when released, NaN while waiting
   double volume_secondary_ = 0;
 };

@@ -1,6 +1,7 @@
 // The VOF solver: its parts, the initial state, checkpoints, and one time step (PISO, or PIMPLE with
 // outer correctors) written as the algorithm.
 #include "engine/vof/solver.hpp"
+#include "engine/vof/stepping.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -283,7 +284,7 @@ void VofSolver::restore(const VofState& st) {
 
 // One step: the phase fraction with the last fluxes, then the momentum matrix and the pressure
 // correctors (PISO; PIMPLE with outer correctors), then the viscosity of the new velocity.
-StepStats VofSolver::step() {
+StepStats VofSolver::step(double t_limit) {
   using clk = std::chrono::steady_clock;
   const auto t0 = clk::now();
   auto& I = *impl_;
@@ -291,7 +292,7 @@ StepStats VofSolver::step() {
   StepStats st;
   const auto co = I.courant(dt_);  // of the last step's fluxes
   const char* limit = "";
-  dt_ = I.next_dt(co, dt_, t_limit_ - t_, limit);
+  dt_ = I.next_dt(co, dt_, t_limit - t_, limit);
   t_ += dt_;
   I.update_gravity(t_);
   I.keep_old_time();
@@ -337,12 +338,14 @@ StepStats VofSolver::step() {
 }
 
 void VofSolver::run(double t_end, const std::function<bool(const StepStats&)>& hook) {
-  t_limit_ = t_end;
-  while (t_ < t_end - 1e-12) {
-    const auto st = step();
-    if (hook && !hook(st)) break;
-  }
-  t_limit_ = 1e300;
+  VofStepping e(*this);
+  LoopSchedule schedule;
+  schedule.t_end = t_end;
+  schedule.progress_every = 1;
+  LoopHooks h;
+  if (hook) h.progress = [&](const Progress&) { return hook(e.last()); };
+  LoopState loop;
+  run_steps(e, schedule, loop, h, false);
 }
 
 }  // namespace runout::engine::vof

@@ -277,9 +277,10 @@ class VofSolver {
   VofState state() const;
   /// Continue from a checkpoint (in place of initialise()); sizes must match the mesh.
   void restore(const VofState& st);
-  /// One time step of the length chosen by the Courant control.
-  StepStats step();
-  /// Step until `t_end`; `hook` is called after every step and may return false to stop.
+  /// One time step of the length chosen by the Courant control, never past t_limit.
+  StepStats step(double t_limit = 1e300);
+  /// Step until `t_end` through the run loop (engine/stepping.hpp); `hook` is called after every
+  /// step and may return false to stop.
   void run(double t_end, const std::function<bool(const StepStats&)>& hook = {});
 
   const Mesh& mesh() const { return mesh_; }
@@ -298,7 +299,7 @@ class VofSolver {
   struct Impl;  // the fields, the equations and their solvers (engine/vof/solver.cpp)
   Mesh mesh_;
   VofConfig cfg_;
-  double t_ = 0, dt_ = 0, t_limit_ = 1e300;
+  double t_ = 0, dt_ = 0;
   std::unique_ptr<Impl> impl_;
 };
 

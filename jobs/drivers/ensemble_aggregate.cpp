@@ -170,73 +170,170 @@ void runout_distribution(const std::vector<MemberResults>& members, const ensemb
   (void)members;
 }
 
+// What the parts of the aggregate share: the ensemble, its members, the aggregate's grid and folder,
+// the record being written and the maps' common part.
+struct Aggregate {
+  const ResolvedScenario& e;
+  const std::vector<MemberResults>& members;
+  const ensemble::AggregateSettings settings;
+  const terrain::Grid& g;
+  const std::string& out_dir;
+  v1::EnsembleRecord& rec;
+  figures::HazardMap base;
+  std::string name;  // the maps' titles
+  std::string out(const std::string& f) const { return (fs::path(out_dir) / f).string(); }
+  void add(const std::string& f) { rec.add_outputs(f); }
+};
+
+// Every member's three rasters on the aggregate's grid, its record, which points of interest it
+// reached and the path's runout criterion.
+std::vector<MemberStack> read_members(Aggregate& a, std::vector<int>& reached, std::string& criterion,
+                                      const std::function<bool(int, int)>& progress) {
+  std::vector<MemberStack> stack(3);
+  for (auto& s : stack) {
+    s.cells = a.g.cells();
+    s.members = int(a.members.size());
+    s.v.resize(s.cells * a.members.size());
+  }
+  for (std::size_t m = 0; m < a.members.size(); ++m) {
+    const auto r = member_record(a.members[m]);
+    record_member(a.members[m], r, a.rec, reached);
+    if (criterion.empty()) criterion = r.results().path().criterion();
+    for (std::size_t q = 0; q < 3; ++q) {
+      const std::string file = (fs::path(a.members[m].dir) / (std::string(kQuantities[q].raster) + ".tif")).string();
+      const auto v = terrain::read_raster_on(file, a.g, "member " + std::to_string(a.members[m].member.index));
+      float* dst = stack[q].v.data() + m * a.g.cells();
+      for (std::size_t c = 0; c < v.size(); ++c) dst[c] = std::isfinite(v[c]) ? float(v[c]) : 0.0f;  // no data inside: not reached
+    }
+    if (progress && !progress(int(m + 1), int(a.members.size()))) throw AggregateStopped{};
+  }
+  return stack;
+}
+
+// The points of interest: the share of the members that reached each, in the record and on the maps.
+void points_of_interest(Aggregate& a, const std::vector<int>& reached) {
+  const auto& pois = a.e.scenario.outputs().points_of_interest();
+  for (int k = 0; k < pois.size(); ++k) {
+    const auto at = terrain::place_point(a.g, pois[k].x(), pois[k].y(), pois[k].crs(), "outputs.points_of_interest[" + std::to_string(k) + "]");
+    const int n = std::size_t(k) < reached.size() ? reached[std::size_t(k)] : 0;
+    auto* pp = a.rec.add_points_of_interest();
+    pp->set_name(pois[k].name());
+    pp->set_x(at.x);
+    pp->set_y(at.y);
+    pp->set_members_reached(n);
+    pp->set_probability(double(n) / double(a.members.size()));
+    a.base.points.push_back({pois[k].name() + ": P = " + num(std::round(pp->probability() * 1000) / 1000), at.x, at.y});
+  }
+}
+
+// The probability that a member exceeds threshold t of quantity q: raster, style, record and map.
+void write_probability(Aggregate& a, std::size_t q, const MemberStack& stack, double t) {
+  const Quantity& Q = kQuantities[q];
+  const auto& g = a.g;
+  const auto p = ensemble::exceedance_probability(stack, t, Q.strict, g.outside);
+  const std::string stem = std::string("probability_") + Q.word + "_" + num(t) + Q.file_unit;
+  const std::string criterion_text = std::string(Q.title) + (Q.strict ? " > " : " >= ") + num(t) + " " + Q.unit +
+                                     (q == 2 ? " where max depth > " + num(a.e.outline_threshold) + " m" : "");
+  terrain::write_cog(a.out(stem + ".tif"), g, p,
+                     {"probability that a member's " + criterion_text + " (" + std::to_string(a.members.size()) + " members)", "",
+                      {{"THRESHOLD", num(t)}, {"MEMBERS", std::to_string(a.members.size())}}});
+  figures::write_qml_ramp(a.out(stem + ".qml"), figures::probability_palette());
+  for (const char* ext : {".tif", ".qml"}) a.add(stem + ext);
+  auto* pr = a.rec.add_probabilities();
+  pr->set_quantity(Q.raster);
+  pr->set_threshold(t);
+  pr->set_unit(Q.unit);
+  pr->set_criterion(criterion_text);
+  pr->set_file(stem + ".tif");
+  double any = 0, half = 0, all = 0;
+  for (double v : p) {
+    if (!(v > 0)) continue;
+    any += g.dx * g.dx;
+    if (v >= 0.5) half += g.dx * g.dx;
+    if (v == 1) all += g.dx * g.dx;
+  }
+  pr->set_area_any_m2(any);
+  pr->set_area_half_m2(half);
+  pr->set_area_all_m2(all);
+  if (!a.e.maps) return;
+  figures::HazardMap m = a.base;
+  m.palette = figures::probability_palette();
+  m.palette.title = "probability that " + criterion_text;
+  m.title = a.name + ": probability that " + criterion_text;
+  m.values = p;
+  figures::draw_hazard_map(a.out("map_" + stem + ".png"), a.out("map_" + stem + ".pdf"), g, m);
+  for (const char* ext : {".png", ".pdf"}) a.add("map_" + stem + ext);
+}
+
+// The members' percentiles of quantity q's maximum: rasters and styles.
+void write_percentiles(Aggregate& a, std::size_t q, const std::vector<std::vector<double>>& pv) {
+  const Quantity& Q = kQuantities[q];
+  for (std::size_t k = 0; k < a.settings.percentiles.size(); ++k) {
+    const std::string stem = std::string(Q.raster) + "_" + percentile_tag(a.settings.percentiles[k]);
+    terrain::write_cog(a.out(stem + ".tif"), a.g, pv[k],
+                       {"percentile " + num(a.settings.percentiles[k]) + " of the members' " + Q.title, Q.unit,
+                        {{"PERCENTILE", num(a.settings.percentiles[k])}, {"MEMBERS", std::to_string(a.members.size())}}});
+    figures::write_qml_ramp(a.out(stem + ".qml"), figures::hazard_palette(Q.raster));
+    for (const char* ext : {".tif", ".qml"}) a.add(stem + ext);
+  }
+}
+
+// The runout along the path: its distribution in the record, the CSV and the histogram.
+void write_runout(Aggregate& a, const std::string& criterion) {
+  runout_distribution(a.members, a.settings, criterion, a.rec);
+  write_runout_csv(a.out("runout_distribution.csv"), a.members, a.rec);
+  a.add("runout_distribution.csv");
+  if (!a.e.maps) return;
+  figures::Histogram h;
+  h.title = a.name + ": runout along the path, " + std::to_string(a.members.size()) + " members";
+  h.note = "runout point: the last cross-section where " + criterion + "; " + std::to_string(a.rec.runout().members_reached()) +
+           " of " + std::to_string(a.members.size()) + " members reach one";
+  h.x_label = "runout along the path (horizontal) [m]";
+  for (const auto& m : a.rec.members())
+    if (m.has_runout_s_m()) h.values.push_back(m.runout_s_m());
+  for (int k = 0; k < a.rec.runout().percentiles_m_size(); ++k)
+    h.marks.push_back({percentile_tag(a.settings.percentiles[std::size_t(k)]), a.rec.runout().percentiles_m(k)});
+  figures::draw_histogram(a.out("runout_histogram.png"), a.out("runout_histogram.pdf"), h);
+  for (const char* f : {"runout_histogram.png", "runout_histogram.pdf"}) a.add(f);
+}
+
+// The record's head: software, kind, scenario, design, creation time.
+v1::EnsembleRecord record_head(const ResolvedScenario& e) {
+  v1::EnsembleRecord rec;
+  *rec.mutable_software() = this_software();
+  rec.set_kind("ensemble");
+  *rec.mutable_scenario() = e.scenario;
+  rec.set_design(e.scenario.variations().design().empty() ? "cross-product" : e.scenario.variations().design());
+  char b[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  rec.set_created_utc(b);
+  return rec;
+}
+
 }  // namespace
 
 v1::EnsembleRecord aggregate_ensemble(const ResolvedScenario& e, const std::vector<MemberResults>& members, const std::string& out_dir,
                                       const std::function<bool(int, int)>& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   if (members.empty()) throw std::runtime_error("an ensemble without members");
-  const auto settings = ensemble::aggregate_settings(e);
   const terrain::Grid g = aggregate_grid(e, members);
-  auto out = [&](const std::string& f) { return (fs::path(out_dir) / f).string(); };
-  v1::EnsembleRecord rec;
-  *rec.mutable_software() = this_software();
-  rec.set_kind("ensemble");
-  *rec.mutable_scenario() = e.scenario;
-  rec.set_design(e.scenario.variations().design().empty() ? "cross-product" : e.scenario.variations().design());
-  {
-    char b[32];
-    const std::time_t now = std::time(nullptr);
-    std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-    rec.set_created_utc(b);
-  }
-  // Every member's three rasters on the aggregate's grid, and its record.
-  std::vector<MemberStack> stack(3);
-  for (auto& s : stack) {
-    s.cells = g.cells();
-    s.members = int(members.size());
-    s.v.resize(s.cells * members.size());
-  }
+  v1::EnsembleRecord rec = record_head(e);
+  Aggregate a{e, members, ensemble::aggregate_settings(e), g, out_dir, rec, {}, e.scenario.name().empty() ? "runout" : e.scenario.name()};
   std::vector<int> reached;
   std::string criterion;
-  for (std::size_t m = 0; m < members.size(); ++m) {
-    const auto r = member_record(members[m]);
-    record_member(members[m], r, rec, reached);
-    if (criterion.empty()) criterion = r.results().path().criterion();
-    for (std::size_t q = 0; q < 3; ++q) {
-      const std::string file = (fs::path(members[m].dir) / (std::string(kQuantities[q].raster) + ".tif")).string();
-      const auto v = terrain::read_raster_on(file, g, "member " + std::to_string(members[m].member.index));
-      float* dst = stack[q].v.data() + m * g.cells();
-      for (std::size_t c = 0; c < v.size(); ++c) dst[c] = std::isfinite(v[c]) ? float(v[c]) : 0.0f;  // no data inside: not reached
-    }
-    if (progress && !progress(int(m + 1), int(members.size()))) throw AggregateStopped{};
-  }
-  auto& files = *rec.mutable_outputs();
-  // Probabilities of exceedance.
-  figures::HazardMap base;
-  base.release = terrain::rasterize_releases(g, e.dem, e.releases);
-  base.parameters = map_block(e, members, g);
+  const std::vector<MemberStack> stack = read_members(a, reached, criterion, progress);
+  const auto& settings = a.settings;
+  a.base.release = terrain::rasterize_releases(g, e.dem, e.releases);
+  a.base.parameters = map_block(e, members, g);
   // The members' percentiles of max depth (written below), and the median's outline on the maps.
   const auto depth_pct = ensemble::percentiles(stack[0], settings.percentiles, g.outside);
   const auto p50 = std::find(settings.percentiles.begin(), settings.percentiles.end(), 50.0);
-  base.max_depth = p50 != settings.percentiles.end() ? depth_pct[std::size_t(p50 - settings.percentiles.begin())]
-                                                      : ensemble::percentiles(stack[0], {50}, g.outside)[0];
-  base.outline_threshold = e.outline_threshold;
-  const auto& pois = e.scenario.outputs().points_of_interest();
-  for (int k = 0; k < pois.size(); ++k) {
-    const auto at = terrain::place_point(g, pois[k].x(), pois[k].y(), pois[k].crs(), "outputs.points_of_interest[" + std::to_string(k) + "]");
-    const int n = std::size_t(k) < reached.size() ? reached[std::size_t(k)] : 0;
-    auto* pp = rec.add_points_of_interest();
-    pp->set_name(pois[k].name());
-    pp->set_x(at.x);
-    pp->set_y(at.y);
-    pp->set_members_reached(n);
-    pp->set_probability(double(n) / double(members.size()));
-    base.points.push_back({pois[k].name() + ": P = " + num(std::round(pp->probability() * 1000) / 1000), at.x, at.y});
-  }
-  const std::string name = e.scenario.name().empty() ? "runout" : e.scenario.name();
+  a.base.max_depth = p50 != settings.percentiles.end() ? depth_pct[std::size_t(p50 - settings.percentiles.begin())]
+                                                        : ensemble::percentiles(stack[0], {50}, g.outside)[0];
+  a.base.outline_threshold = e.outline_threshold;
+  points_of_interest(a, reached);
   for (std::size_t q = 0; q < 3; ++q) {
-    const Quantity& Q = kQuantities[q];
     const auto& thresholds = q == 0 ? settings.depth_m : q == 1 ? settings.speed_m_s : settings.pressure_kpa;
     // A member's pressure counts where its max depth exceeds the outline threshold, as its pressure
     // zones count it: identical members give probability 1 exactly on their zones.
@@ -246,74 +343,15 @@ v1::EnsembleRecord aggregate_ensemble(const ResolvedScenario& e, const std::vect
       for (std::size_t k = 0; k < zoned.v.size(); ++k)
         if (!(stack[0].v[k] > e.outline_threshold)) zoned.v[k] = 0;
     }
-    for (double t : thresholds) {
-      const auto p = ensemble::exceedance_probability(q == 2 ? zoned : stack[q], t, Q.strict, g.outside);
-      const std::string stem = std::string("probability_") + Q.word + "_" + num(t) + Q.file_unit;
-      const std::string criterion_text = std::string(Q.title) + (Q.strict ? " > " : " >= ") + num(t) + " " + Q.unit +
-                                         (q == 2 ? " where max depth > " + num(e.outline_threshold) + " m" : "");
-      terrain::write_cog(out(stem + ".tif"), g, p,
-                         {"probability that a member's " + criterion_text + " (" + std::to_string(members.size()) + " members)", "",
-                          {{"THRESHOLD", num(t)}, {"MEMBERS", std::to_string(members.size())}}});
-      figures::write_qml_ramp(out(stem + ".qml"), figures::probability_palette());
-      for (const char* ext : {".tif", ".qml"}) files.Add(stem + ext);
-      auto* pr = rec.add_probabilities();
-      pr->set_quantity(Q.raster);
-      pr->set_threshold(t);
-      pr->set_unit(Q.unit);
-      pr->set_criterion(criterion_text);
-      pr->set_file(stem + ".tif");
-      double any = 0, half = 0, all = 0;
-      for (double v : p) {
-        if (!(v > 0)) continue;
-        any += g.dx * g.dx;
-        if (v >= 0.5) half += g.dx * g.dx;
-        if (v == 1) all += g.dx * g.dx;
-      }
-      pr->set_area_any_m2(any);
-      pr->set_area_half_m2(half);
-      pr->set_area_all_m2(all);
-      if (!e.maps) continue;
-      figures::HazardMap m = base;
-      m.palette = figures::probability_palette();
-      m.palette.title = "probability that " + criterion_text;
-      m.title = name + ": probability that " + criterion_text;
-      m.values = p;
-      figures::draw_hazard_map(out("map_" + stem + ".png"), out("map_" + stem + ".pdf"), g, m);
-      for (const char* ext : {".png", ".pdf"}) files.Add("map_" + stem + ext);
-    }
-    // Percentiles of the maximum.
-    const auto pv = q == 0 ? depth_pct : ensemble::percentiles(stack[q], settings.percentiles, g.outside);
-    for (std::size_t k = 0; k < settings.percentiles.size(); ++k) {
-      const std::string stem = std::string(Q.raster) + "_" + percentile_tag(settings.percentiles[k]);
-      terrain::write_cog(out(stem + ".tif"), g, pv[k],
-                         {"percentile " + num(settings.percentiles[k]) + " of the members' " + Q.title, Q.unit,
-                          {{"PERCENTILE", num(settings.percentiles[k])}, {"MEMBERS", std::to_string(members.size())}}});
-      figures::write_qml_ramp(out(stem + ".qml"), figures::hazard_palette(Q.raster));
-      for (const char* ext : {".tif", ".qml"}) files.Add(stem + ext);
-    }
+    for (double t : thresholds) write_probability(a, q, q == 2 ? zoned : stack[q], t);
+    write_percentiles(a, q, q == 0 ? depth_pct : ensemble::percentiles(stack[q], settings.percentiles, g.outside));
   }
   for (double p : settings.percentiles) rec.add_percentiles(p);
-  // The runout along the path.
-  runout_distribution(members, settings, criterion, rec);
-  write_runout_csv(out("runout_distribution.csv"), members, rec);
-  files.Add("runout_distribution.csv");
-  if (e.maps) {
-    figures::Histogram h;
-    h.title = name + ": runout along the path, " + std::to_string(members.size()) + " members";
-    h.note = "runout point: the last cross-section where " + criterion + "; " + std::to_string(rec.runout().members_reached()) +
-             " of " + std::to_string(members.size()) + " members reach one";
-    h.x_label = "runout along the path (horizontal) [m]";
-    for (const auto& m : rec.members())
-      if (m.has_runout_s_m()) h.values.push_back(m.runout_s_m());
-    for (int k = 0; k < rec.runout().percentiles_m_size(); ++k)
-      h.marks.push_back({percentile_tag(settings.percentiles[std::size_t(k)]), rec.runout().percentiles_m(k)});
-    figures::draw_histogram(out("runout_histogram.png"), out("runout_histogram.pdf"), h);
-    for (const char* f : {"runout_histogram.png", "runout_histogram.pdf"}) files.Add(f);
-  }
+  write_runout(a, criterion);
   *rec.mutable_grid() = grid_report(g);
-  files.Add("run.json");
+  a.add("run.json");
   rec.set_aggregate_seconds(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  write_record_json(out("run.json"), rec);
+  write_record_json(a.out("run.json"), rec);
   return rec;
 }
 

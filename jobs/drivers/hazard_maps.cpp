@@ -1,5 +1,7 @@
 #include "jobs/drivers/hazard_maps.hpp"
 
+#include "jobs/drivers/engine_run.hpp"
+
 #include "jobs/drivers/hazard_outputs.hpp"
 
 #include <algorithm>
@@ -97,22 +99,35 @@ void write_path_outputs(const ResolvedScenario& s, const products::PathProfile& 
   for (const char* f : {"map_path_profile.png", "map_path_profile.pdf"}) sum.files.push_back(f);
 }
 
+namespace {
+
+// The friction law's line of the parameter block, from the law's own rows (engine/friction): its
+// caption and each parameter the scenario sets, with the internal friction angle where given.
+std::string friction_line(const engine::FrictionLaw& law, const v1::Material& m) {
+  std::string line = "friction: " + std::string(law.caption);
+  const auto* d = m.GetDescriptor();
+  const auto* refl = m.GetReflection();
+  auto add = [&](std::string_view label, std::string_view unit, double v) {
+    const std::string u(unit);
+    line += ", " + std::string(label) + " = " + num(v) + (u.empty() ? "" : u.rfind("°", 0) == 0 ? u : " " + u);
+  };
+  for (const auto& p : law.parameters) {
+    if (p.field.empty()) break;
+    const auto* f = d->FindFieldByName(std::string(p.field));
+    if (!f || f->cpp_type() != google::protobuf::FieldDescriptor::CPPTYPE_DOUBLE || (f->has_presence() && !refl->HasField(m, f))) continue;
+    add(p.label, p.unit, refl->GetDouble(m, f));
+  }
+  if (m.has_internal_friction_deg()) add("φ", "°", m.internal_friction_deg());
+  return line;
+}
+
+}  // namespace
+
 std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain::Grid& grid, double release_volume_m3) {
   const auto& m = s.scenario.material();
   std::vector<std::string> p;
-  p.push_back(std::string("engine: ") + (s.terrain ? "3D VOF Navier–Stokes (Coulomb viscosity)" : "depth-averaged Savage–Hutter"));
-  if (m.rheology() == "voellmy")
-    p.push_back("friction: Voellmy, μ = " + num(m.voellmy_mu()) + ", ξ = " + num(m.voellmy_xi()) + " m/s²");
-  else if (m.rheology() == "pouliquen_forterre")
-    p.push_back("friction: Pouliquen–Forterre, δ₁ = " + num(m.bed_friction_1_deg()) + "°, δ₂ = " + num(m.bed_friction_2_deg()) +
-                "°, δ₃ = " + num(m.has_bed_friction_3_deg() ? m.bed_friction_3_deg() : m.bed_friction_1_deg()) + "°, β = " +
-                num(m.pf_beta()) + ", L = " + num(m.pf_length_m()) + " m, γ = " + num(m.pf_gamma()));
-  else if (m.rheology() == "mu_i")
-    p.push_back("friction: μ(I), μs = " + num(m.mu_s()) + ", μ₂ = " + num(m.mu_2()) + ", I₀ = " + num(m.mu_i0()) +
-                ", d = " + num(m.grain_diameter_m()) + " m, ρs = " + num(m.grain_density_kg_m3()) + " kg/m³");
-  else
-    p.push_back("friction: Coulomb, δ = " + num(m.bed_friction_deg()) + "°" +
-                (m.has_internal_friction_deg() ? ", φ = " + num(m.internal_friction_deg()) + "°" : ""));
+  p.push_back("engine: " + std::string(engine_row(s.engine).caption));
+  p.push_back(friction_line(*s.config.material.rheology, m));
   p.push_back("density: " + num(m.density_kg_m3()) + " kg/m³");
   p.push_back("release: " + num(std::round(release_volume_m3)) + " m³ in " + std::to_string(s.releases.size()) +
               (s.releases.size() == 1 ? " release" : " releases"));

@@ -40,7 +40,7 @@ std::pair<double, double> release_centroid(const terrain::Grid& grid, const std:
 // The maximum depth, the affected area and the runout from the release's centroid.
 void hazard_figures(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
                     RunSummary& sum) {
-  if (!s.terrain)  // the depth-averaged engine's limit (the 3D engine reports its mesh's quality)
+  if (s.engine == kDepthAveragedEngine)  // the depth-averaged engine's limit (the 3D engine reports its mesh's quality)
     if (const auto steep = steep_terrain_note(s, grid, h0, hz); !steep.empty()) sum.notes.push_back(steep);
   const auto [mx, my] = release_centroid(grid, h0);
   long affected = 0;

@@ -46,7 +46,7 @@ std::vector<T> get(hid_t g, const char* name, hid_t mem_type, const std::string&
 
 }  // namespace
 
-void write_checkpoint(const std::string& path, const LabCheckpoint& cp) {
+void write_checkpoint(const std::string& path, const VofCheckpoint& cp) {
   const std::string tmp = path + ".part";
   {
     std::lock_guard lk(hdf5_mutex());
@@ -103,14 +103,14 @@ void write_checkpoint(const std::string& path, const LabCheckpoint& cp) {
   if (ec) throw std::runtime_error("cannot move the checkpoint into place at " + path + ": " + ec.message());
 }
 
-LabCheckpoint read_checkpoint(const std::string& path) {
+VofCheckpoint read_checkpoint(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw ScenarioError("checkpoint " + path + ": no such file");
   std::lock_guard lk(hdf5_mutex());
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   if (H5Fis_hdf5(path.c_str()) <= 0) throw ScenarioError("checkpoint " + path + ": not an HDF5 file");
   hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   if (f < 0) throw ScenarioError("checkpoint " + path + ": cannot open it");
-  LabCheckpoint cp;
+  VofCheckpoint cp;
   try {
     const std::string format = get_attr_string(f, "format");
     if (format.rfind("runout VOF checkpoint ", 0) == 0 && format != kFormat)

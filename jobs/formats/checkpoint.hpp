@@ -10,7 +10,7 @@
 
 namespace runout::jobs {
 
-struct LabCheckpoint {
+struct VofCheckpoint {
   std::string scenario_hash;
   long steps = 0;
   std::map<std::string, double> figures;  ///< the run's running figures by name (peak speed, ...)
@@ -19,8 +19,8 @@ struct LabCheckpoint {
 };
 
 /// Write atomically (a temporary file renamed over `path`). Throws std::runtime_error.
-void write_checkpoint(const std::string& path, const LabCheckpoint& cp);
+void write_checkpoint(const std::string& path, const VofCheckpoint& cp);
 /// Read; throws ScenarioError naming the file and what is wrong with it.
-LabCheckpoint read_checkpoint(const std::string& path);
+VofCheckpoint read_checkpoint(const std::string& path);
 
 }  // namespace runout::jobs

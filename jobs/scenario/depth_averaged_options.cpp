@@ -77,8 +77,8 @@ const OptionTable& scenario_options() {
   static const OptionTable t = {
       {"name", T::text, U::as_given, "", {}, {}, "", "free text, copied to the run record", "run record"},
       {"engine", T::choice, U::fill, "depth-averaged", {}, {"depth-averaged", "vof"}, "",
-       "the engine: depth-averaged (Savage-Hutter, on a DEM) or vof (3D: on the DEM, or the laboratory set-up of `lab`)", "ResolvedScenario::vof",
-       "", [](const S& s, R& r) { r.vof = s.engine() == "vof"; }},
+       "the engine: depth-averaged (Savage-Hutter, on a DEM) or vof (3D: on the DEM, or the laboratory set-up of `lab`)", "ResolvedScenario::engine",
+       "", [](const S& s, R& r) { r.engine = s.engine() == "vof" ? kVofTerrainEngine : kDepthAveragedEngine; }},
       {"limits.max_wall_s", T::number, U::as_given, "", {}, {}, "s",
        "the service's wall-time limit of one attempt (checked by the server); not part of the hash", "the service's job", "the server's"},
       {"limits.max_memory_bytes", T::integer, U::as_given, "", {}, {}, "bytes",
@@ -189,11 +189,9 @@ OptionTable variation_options() {
   };
 }
 
-}  // namespace
-
-const OptionTable& depth_averaged_options() {
-  static const OptionTable t = [] {
-    OptionTable v = {
+// The terrain, the grid and the releases.
+OptionTable terrain_options() {
+  return {
       {"dem.path", T::path, U::required, "", {}, {}, "", "the terrain: any raster GDAL reads (GeoTIFF, ESRI ASCII grid, SRTM .hgt, ...)",
        "DemRequest::dem_path"},
       {"dem.crs", T::text, U::as_given, "", {}, {}, "", "the DEM's CRS when the file has none (\"EPSG:2056\"; \"local\": local metres)",
@@ -235,6 +233,12 @@ const OptionTable& depth_averaged_options() {
       {"releases[].secondary", T::flag, U::as_given, "false", {}, {}, "",
        "a secondary release: each polygon lies at rest until the flow reaches it, then starts (depth-averaged engine)",
        "ReleaseRequest::secondary"},
+  };
+}
+
+// The material: density and the friction law's parameters.
+OptionTable material_options() {
+  return {
       {"material.rheology", T::choice, U::fill, "coulomb", {}, friction_law_names(), "",
        "the basal friction law (engine/friction; the section below)", "Material::rheology", "",
        [](const S& s, R& r) { r.config.material.rheology = &engine::friction_law(s.material().rheology()); }},
@@ -312,6 +316,12 @@ const OptionTable& depth_averaged_options() {
       {"material.earth_pressure", T::choice, U::fill, "unity", {}, names(engine::kEarthPressureNames), "",
        "earth-pressure coefficient: 1 (hydrostatic) or active/passive from phi and delta", "Material::earth_pressure", "",
        [](const S& s, R& r) { r.config.material.earth_pressure = value(engine::kEarthPressureNames, s.material().earth_pressure()); }},
+  };
+}
+
+// The scheme, the time step, the end time and the stop rule, the boundaries.
+OptionTable numerics_options() {
+  return {
       {"numerics.scheme", T::choice, U::fill, "noc-tvd", {}, {"noc-tvd"}, "",
        "NOC predictor with TVD-limited slopes, central face fluxes (the only one)", "-"},
       {"numerics.limiter", T::choice, U::fill, "minmod", {}, names(engine::kLimiterNames), "", "the TVD slope limiter",
@@ -331,8 +341,15 @@ const OptionTable& depth_averaged_options() {
       {"numerics.curvature_off", T::flag, U::as_given, "false", {}, {}, "", "true: no centrifugal term in the friction",
        "Sh2dConfig::curvature (negated)", "", [](const S& s, R& r) { r.config.curvature = !s.numerics().curvature_off(); }},
   };
-    for (auto& o : output_options()) v.push_back(std::move(o));
-    for (auto& o : variation_options()) v.push_back(std::move(o));
+}
+
+}  // namespace
+
+const OptionTable& depth_averaged_options() {
+  static const OptionTable t = [] {
+    OptionTable v;
+    for (auto* part : {terrain_options, material_options, numerics_options, output_options, variation_options})
+      for (auto& o : part()) v.push_back(std::move(o));
     return v;
   }();
   return t;

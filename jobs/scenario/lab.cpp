@@ -136,7 +136,7 @@ ResolvedScenario resolve_lab(v1::Scenario s) {
   check_output_interval("lab.checkpoint_interval_s", l.checkpoint_interval_s(), "lab.end_time_s", l.end_time_s(), true);
   require_finite(s, "");
   ResolvedScenario r;
-  r.vof = true;
+  r.engine = kVofLabEngine;
   r.scenario = std::move(s);
   return r;
 }

@@ -46,8 +46,11 @@ const std::vector<LabMaterial>& lab_materials() {
   return m;
 }
 
-const OptionTable& lab_options() {
-  static const OptionTable t = {
+namespace {
+
+// The channel's geometry, the mesh and the boundaries.
+OptionTable lab_geometry_options() {
+  return {
       {"lab.inclination_deg", T::number, U::as_given, "", Range{-90, 90, true, true}, {}, "deg", "zeta, the channel's inclination",
        "VofConfig::gravity"},
       coord("lab.x_min", "domain: x down the channel"),
@@ -80,6 +83,12 @@ const OptionTable& lab_options() {
       {"lab.boundaries[].inflow_dudy", T::number, U::as_given, "", Range{-1e4, 1e4}, {}, "1/s",
        "inflow: the velocity's growth with y up to the fill height", "VofConfig::bc inflow_velocity"},
       length("lab.boundaries[].inflow_height", "inflow: granular material below this y, air above"),
+  };
+}
+
+// The material, the run's times and controls, the obstacles and the published reference.
+OptionTable lab_run_options() {
+  return {
       {"lab.material", T::choice, U::fill, "pvc", {}, material_names(), "", "the granular material (the table below)",
        "VofConfig::rho1, phi_deg; coulomb-slip delta"},
       {"lab.phi_deg", T::number, U::as_given, "", Range{0, 80, true, true}, {}, "deg", "internal friction angle instead of the material's",
@@ -121,6 +130,12 @@ const OptionTable& lab_options() {
       {"lab.reference.gate_strain_rate_1_s", T::number, U::as_given, "", Range{0}, {}, "1/s", "strain rate at the gate", "figures"},
       {"lab.reference.depth_ratio_max", T::number, U::as_given, "", Range{0}, {}, "",
        "3D: the deepest column at most this many times the undisturbed depth", "figures"},
+  };
+}
+
+// The engine's models and numerical choices.
+OptionTable lab_model_options() {
+  return {
       {"lab.viscous_transpose", T::choice, U::fill, "harmonic", {}, names_of(engine::vof::kTransposeNames), "",
        "the viscous stress's transpose part: harmonic face viscosity, linear (interFoam) or none", "VofConfig::viscous_transpose"},
       {"lab.chute.bend_deg", T::number, U::as_given, "", Range{0, 90, true, true}, {}, "deg",
@@ -162,6 +177,17 @@ const OptionTable& lab_options() {
        "plane set-ups: the side walls' friction angle; 2 tan(delta_w) p / width per unit volume against the velocity",
        "VofConfig::side_walls.tan_delta"},
   };
+}
+
+}  // namespace
+
+const OptionTable& lab_options() {
+  static const OptionTable t = [] {
+    OptionTable v;
+    for (auto* part : {lab_geometry_options, lab_run_options, lab_model_options})
+      for (auto& o : part()) v.push_back(std::move(o));
+    return v;
+  }();
   return t;
 }
 

@@ -1,5 +1,7 @@
 #include "jobs/scenario/scenario.hpp"
 
+#include "engine/friction/registry.hpp"
+
 #include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
 
@@ -127,7 +129,7 @@ v1::Scenario parse_scenario_json(const std::string& json) {
 
 void apply_material_rheology(const v1::Material& m, engine::vof::VofConfig& c) {
   c.rho1 = m.density_kg_m3();
-  c.rheology = m.rheology() == "mu_i" ? "mu_i" : "coulomb";
+  c.rheology = m.rheology();  // a granular viscosity's name (check_terrain_vof)
   c.phi_deg = m.internal_friction_deg();
   take_mu_i_fields(m, c.mu_i);
 }
@@ -262,8 +264,16 @@ void check_material(const v1::Material& m, const engine::Material& mat) {
 // join), and the bed's friction angle.
 void check_terrain_vof(const v1::Scenario& s) {
   const auto& m = s.material();
-  if (m.rheology() != "coulomb" && m.rheology() != "mu_i")
-    bad("material.rheology", "the 3D engine takes \"coulomb\" or \"mu_i\" (got \"" + m.rheology() + "\")");
+  // The friction laws the 3D engine has a granular viscosity of the same name for.
+  std::string laws;
+  bool found = false;
+  for (const auto* law : engine::kFrictionLaws)
+    for (const auto& v : engine::vof::kGranularViscosityNames)
+      if (law->name == v) {
+        laws += (laws.empty() ? "\"" : ", \"") + std::string(v) + "\"";
+        found = found || v == m.rheology();
+      }
+  if (!found) bad("material.rheology", "the 3D engine takes " + laws + " (got \"" + m.rheology() + "\")");
   if (m.rheology() == "coulomb" && !m.has_internal_friction_deg())
     bad("material.internal_friction_deg", "needed by the 3D engine's Coulomb viscosity");
   if (m.rheology() == "mu_i" && m.has_mu_s() && m.has_mu_2() && m.has_mu_i0() && m.has_grain_diameter_m() && m.has_grain_density_kg_m3()) {
@@ -317,7 +327,6 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
     check_output_interval("vof.write_interval_s", s.vof().write_interval_s(), "numerics.end_time_s", t_end, false);
     check_output_interval("vof.checkpoint_interval_s", s.vof().checkpoint_interval_s(), "numerics.end_time_s", t_end, true);
   }
-  r.terrain = vof;
   require_finite(s, "");
   r.scenario = std::move(s);
   return r;
@@ -374,7 +383,7 @@ std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version,
   h.update("runout.v1.Scenario\n");
   h.update(bytes);
   // What the engine's results contain, by version (kVofResultsVersion, kDepthAveragedResultsVersion).
-  if (r.vof) h.update("\nvof results " + std::to_string(vof_version));
+  if (r.three_d()) h.update("\nvof results " + std::to_string(vof_version));
   else h.update("\ndepth-averaged results " + std::to_string(depth_averaged_version));
   for (const auto& f : r.input_files) {
     h.update("\n");

@@ -4,6 +4,7 @@
 // error names the field and the problem.
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "engine/sh2d.hpp"
@@ -34,6 +35,11 @@ struct PathSettings {
   double threshold = 1, width_m = 600, beta_deg = 10;
 };
 
+/// The engine registry's rows (jobs/drivers/engines.cpp) a scenario resolves to.
+inline constexpr std::string_view kDepthAveragedEngine = "depth-averaged";
+inline constexpr std::string_view kVofLabEngine = "vof-lab";
+inline constexpr std::string_view kVofTerrainEngine = "vof-terrain";
+
 struct ResolvedScenario {
   v1::Scenario scenario;  ///< as given, with the defaults filled in
   std::string source;     ///< the file it came from (empty when given as a message)
@@ -49,12 +55,15 @@ struct ResolvedScenario {
   std::string corridor_path;  ///< mesh.corridor_path (3D engine on the DEM), resolved; empty: none
   bool maps = true;  ///< outputs.maps: the report maps (PNG, PDF)
   std::vector<std::string> input_files;  ///< for hashing
-  bool vof = false;  ///< engine "vof": a laboratory set-up (`lab`) or, with `terrain`, on the DEM
-  /// engine "vof" without `lab`: the 3D engine on the DEM and releases (blocks `mesh` and `vof`;
-  /// config holds the material, end time and stop rule as for the depth-averaged engine).
-  bool terrain = false;
+  /// The engine registry's row that runs it (jobs/drivers/engines.cpp): kDepthAveragedEngine;
+  /// kVofLabEngine, engine "vof" with a laboratory set-up (`lab`); kVofTerrainEngine, engine "vof"
+  /// on the DEM and releases (blocks `mesh` and `vof`; config holds the material, end time and stop
+  /// rule as for the depth-averaged engine).
+  std::string engine = std::string(kDepthAveragedEngine);
+  /// The 3D engine runs it (either set-up).
+  bool three_d() const { return engine != kDepthAveragedEngine; }
   /// The simulated time the run goes to at most [s].
-  double end_time_s() const { return vof && !terrain ? scenario.lab().end_time_s() : config.time.t_end; }
+  double end_time_s() const { return engine == kVofLabEngine ? scenario.lab().end_time_s() : config.time.t_end; }
 };
 
 /// The version of what a VOF run's results contain (run.json, the fields) for an unchanged scenario.

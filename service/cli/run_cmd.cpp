@@ -130,105 +130,60 @@ int execute(const jobs::ResolvedScenario& resolved, const fs::path& tmp, const j
   return kOk;
 }
 
-}  // namespace
-
-int run(const std::vector<std::string>& args) {
-  RunArgs a;
-  auto& [scenario, out, iseesnow, checkpoint, restart, threads, force, quiet, state_dir, workers_text, members, no_cache] = a;
-  CLI::App app{kRunHelp, "runout run"};
-  add_run_options(app, a);
-  if (const int rc = parse_args(app, args); rc >= 0) return rc;
-  if (app.count("--iseesnow") &&
-      (iseesnow.empty() || iseesnow.find_first_of("_/\\ .") != std::string::npos)) {
-    std::cerr << "runout run: --iseesnow '" << iseesnow
+// The options' own checks: --iseesnow's id, --checkpoint and --restart (made absolute), --threads
+// and the two required ones. Returns an exit code, or -1 when they hold.
+int check_run_args(const CLI::App& app, RunArgs& a) {
+  if (app.count("--iseesnow") && (a.iseesnow.empty() || a.iseesnow.find_first_of("_/\\ .") != std::string::npos)) {
+    std::cerr << "runout run: --iseesnow '" << a.iseesnow
               << "': the simulation id names files and may not be empty or hold '_', '/', '\\', '.' or spaces"
                  " (the benchmark's ids: 01IdealizedTopo, 02RealTopo, 03CoulombOnly)\n";
     return kUsage;
   }
-  for (auto* f : {&checkpoint, &restart}) {
-    if (app.count(f == &checkpoint ? "--checkpoint" : "--restart") && f->empty())
-      return usage_error("runout run", std::string(f == &checkpoint ? "--checkpoint" : "--restart") + " needs a file");
+  for (auto* f : {&a.checkpoint, &a.restart}) {
+    if (app.count(f == &a.checkpoint ? "--checkpoint" : "--restart") && f->empty())
+      return usage_error("runout run", std::string(f == &a.checkpoint ? "--checkpoint" : "--restart") + " needs a file");
     if (!f->empty()) *f = fs::absolute(*f).string();
   }
   if (app.count("--threads")) {
-    const auto n = positive_int(threads);
-    if (!n) return usage_error("runout run", "--threads takes a positive integer, got '" + threads + "'");
+    const auto n = positive_int(a.threads);
+    if (!n) return usage_error("runout run", "--threads takes a positive integer, got '" + a.threads + "'");
     omp_set_num_threads(*n);
   }
-  if (scenario.empty() || out.empty()) {
+  if (a.scenario.empty() || a.out.empty()) {
     return usage_error("runout run",
                        "usage: runout run SCENARIO.json --out DIR [--force] [--quiet] [--threads N] [--iseesnow "
                        "SIMULATION_ID] [--checkpoint FILE] [--restart FILE] (see runout run --help)");
   }
-  // DIR: absent, or with --force a previous result (output_dir.hpp); never anything else.
-  const fs::path dest = output_path(out);
-  if (const auto why = check_output_dir(dest, force, out); !why.empty()) {
-    std::cerr << "runout run: " << why << "\n";
-    return kOutput;
-  }
+  return -1;
+}
 
-  jobs::ResolvedScenario resolved;
-  try {
-    resolved = jobs::load_scenario(scenario);
-  } catch (const jobs::ScenarioError& e) {
-    std::cerr << "runout run: " << e.what() << "\n";
-    return kBadInput;
-  }
-
-  const bool ensemble = jobs::ensemble::is_ensemble(resolved.scenario);
-  if (ensemble && (!checkpoint.empty() || !restart.empty() || !iseesnow.empty()))
+// The options of one kind of run only: single runs' and ensembles'. Returns an exit code, or -1.
+int check_run_kind(const CLI::App& app, const RunArgs& a, bool ensemble, int& workers) {
+  if (ensemble && (!a.checkpoint.empty() || !a.restart.empty() || !a.iseesnow.empty()))
     return usage_error("runout run", "--checkpoint, --restart and --iseesnow are for single runs; an ensemble keeps its members' "
                                      "checkpoints in its state directory (--state-dir)");
-  if (!ensemble && (app.count("--state-dir") || app.count("--workers") || members || no_cache))
+  if (!ensemble && (app.count("--state-dir") || app.count("--workers") || a.members || a.no_terrain_cache))
     return usage_error("runout run",
                        "--state-dir, --workers, --members and --no-terrain-cache are for ensembles (a scenario with variations)");
-  int workers = 0;
   if (app.count("--workers")) {
     const auto n = positive_int(a.workers);
     if (!n) return usage_error("runout run", "--workers takes a positive integer, got '" + a.workers + "'");
     workers = *n;
   }
-  {  // A previous result that --force replaces must not hold what this run reads or writes.
-    std::vector<std::string> used = resolved.input_files;
-    for (const auto& f : {fs::absolute(scenario).string(), checkpoint, restart}) used.push_back(f);
-    if (const auto f = input_inside(dest, used); !f.empty()) {
-      std::cerr << "runout run: output directory '" << out << "' holds '" << f
-                << "', which this run needs: --force would delete it; choose another --out\n";
-      return kOutput;
-    }
-  }
-  // Results go to a temporary sibling directory first and appear under DIR only when complete.
-  StagedOutput staged(dest, force);
-  if (!staged.ok()) {
-    std::cerr << "runout run: " << staged.error() << "\n";
-    return kOutput;
-  }
-  const fs::path tmp = staged.path();
+  return -1;
+}
 
-  std::signal(SIGINT, on_interrupt);
-  std::signal(SIGTERM, on_interrupt);
+// One run into the staged folder, with a progress line; the folder becomes DIR when complete.
+int run_single(const jobs::ResolvedScenario& resolved, const RunArgs& a, StagedOutput& staged, const fs::path& dest) {
   const auto wall0 = std::chrono::steady_clock::now();
   const bool tty = isatty(fileno(stderr));
-  if (ensemble) {
-    EnsembleRun er{tmp.string(), a.state_dir, workers, quiet, tty, members, !no_cache, [] { return g_interrupted.load(); }};
-    RunSummaryOut es;
-    if (const int rc = run_ensemble(resolved, er, es); rc != kOk) return rc;
-    if (!staged.publish()) {
-      std::cerr << "runout run: " << staged.error() << "\n";
-      return kOutput;
-    }
-    if (!quiet)
-      std::printf("ensemble    %d members in %.1f s (job %s, state %s)\nresults in  %s\n", es.members, es.seconds, es.job.c_str(),
-                  es.state_dir.c_str(), dest.string().c_str());
-    return kOk;
-  }
   jobs::RunOptions opt;
-  opt.iseesnow_id = iseesnow;
-  opt.checkpoint_path = checkpoint;
-  opt.restart_path = restart;
+  opt.iseesnow_id = a.iseesnow;
+  opt.checkpoint_path = a.checkpoint;
+  opt.restart_path = a.restart;
   const double t_end = resolved.end_time_s();
   opt.progress = [&](const engine::Progress& p) {
-    if (!quiet) {
+    if (!a.quiet) {
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
       const double left = p.t > 0 ? wall * (t_end - p.t) / p.t : 0.0;
       std::fprintf(stderr, "%st = %7.2f s  dt = %.4f s  volume = %.4g m3  max speed = %6.2f m/s  active = %5.1f %%  time left <= %.0f s%s",
@@ -238,12 +193,13 @@ int run(const std::vector<std::string>& args) {
     return !g_interrupted.load();
   };
   jobs::RunSummary sum;
-  if (const int rc = execute(resolved, tmp, opt, !quiet && tty, sum); rc != kOk) return rc;
-  if (!quiet && tty) std::fprintf(stderr, "\n");
+  if (const int rc = execute(resolved, staged.path(), opt, !a.quiet && tty, sum); rc != kOk) return rc;
+  if (!a.quiet && tty) std::fprintf(stderr, "\n");
   if (sum.stop == "cancelled") {
     std::cerr << "runout run: cancelled at t = " << sum.t << " s; no results written\n";
-    if (!checkpoint.empty())
-      std::cerr << "runout run: checkpoint at t = " << sum.t << " s in " << checkpoint << " (continue with --restart " << checkpoint << ")\n";
+    if (!a.checkpoint.empty())
+      std::cerr << "runout run: checkpoint at t = " << sum.t << " s in " << a.checkpoint << " (continue with --restart " << a.checkpoint
+                << ")\n";
     return kCancelled;
   }
   if (!staged.publish()) {
@@ -251,8 +207,68 @@ int run(const std::vector<std::string>& args) {
     return kOutput;
   }
   if (!staged.note().empty()) std::cerr << "runout run: note: " << staged.note() << "\n";
-  if (!quiet) print_summary(sum, resolved.vof && !resolved.terrain, dest);
+  if (!a.quiet) print_summary(sum, resolved.engine == jobs::kVofLabEngine, dest);
   return kOk;
+}
+
+// An ensemble into the staged folder; the folder becomes DIR when complete.
+int run_ensemble_into(const jobs::ResolvedScenario& resolved, const RunArgs& a, int workers, StagedOutput& staged, const fs::path& dest) {
+  EnsembleRun er{staged.path().string(), a.state_dir, workers, a.quiet, bool(isatty(fileno(stderr))), a.members, !a.no_terrain_cache,
+                 [] { return g_interrupted.load(); }};
+  RunSummaryOut es;
+  if (const int rc = run_ensemble(resolved, er, es); rc != kOk) return rc;
+  if (!staged.publish()) {
+    std::cerr << "runout run: " << staged.error() << "\n";
+    return kOutput;
+  }
+  if (!a.quiet)
+    std::printf("ensemble    %d members in %.1f s (job %s, state %s)\nresults in  %s\n", es.members, es.seconds, es.job.c_str(),
+                es.state_dir.c_str(), dest.string().c_str());
+  return kOk;
+}
+
+}  // namespace
+
+int run(const std::vector<std::string>& args) {
+  RunArgs a;
+  CLI::App app{kRunHelp, "runout run"};
+  add_run_options(app, a);
+  if (const int rc = parse_args(app, args); rc >= 0) return rc;
+  if (const int rc = check_run_args(app, a); rc >= 0) return rc;
+  // DIR: absent, or with --force a previous result (output_dir.hpp); never anything else.
+  const fs::path dest = output_path(a.out);
+  if (const auto why = check_output_dir(dest, a.force, a.out); !why.empty()) {
+    std::cerr << "runout run: " << why << "\n";
+    return kOutput;
+  }
+  jobs::ResolvedScenario resolved;
+  try {
+    resolved = jobs::load_scenario(a.scenario);
+  } catch (const jobs::ScenarioError& e) {
+    std::cerr << "runout run: " << e.what() << "\n";
+    return kBadInput;
+  }
+  const bool ensemble = jobs::ensemble::is_ensemble(resolved.scenario);
+  int workers = 0;
+  if (const int rc = check_run_kind(app, a, ensemble, workers); rc >= 0) return rc;
+  {  // A previous result that --force replaces must not hold what this run reads or writes.
+    std::vector<std::string> used = resolved.input_files;
+    for (const auto& f : {fs::absolute(a.scenario).string(), a.checkpoint, a.restart}) used.push_back(f);
+    if (const auto f = input_inside(dest, used); !f.empty()) {
+      std::cerr << "runout run: output directory '" << a.out << "' holds '" << f
+                << "', which this run needs: --force would delete it; choose another --out\n";
+      return kOutput;
+    }
+  }
+  // Results go to a temporary sibling directory first and appear under DIR only when complete.
+  StagedOutput staged(dest, a.force);
+  if (!staged.ok()) {
+    std::cerr << "runout run: " << staged.error() << "\n";
+    return kOutput;
+  }
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+  return ensemble ? run_ensemble_into(resolved, a, workers, staged, dest) : run_single(resolved, a, staged, dest);
 }
 
 }  // namespace runout::cli

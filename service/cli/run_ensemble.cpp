@@ -49,11 +49,65 @@ std::string default_state_dir() {
   return (fs::temp_directory_path() / "runout").string();
 }
 
+namespace {
+
+int fail(const std::string& m, int code) {
+  std::cerr << "runout run: " << m << "\n";
+  return code;
+}
+
+// Follows the ensemble's job until it ends (`job` its last state), with a progress line; stops the
+// scheduler on Ctrl-C. Returns an exit code, or -1 when the job ended.
+int follow(jobs::JobStore& store, jobs::Scheduler& sched, const std::string& id, const EnsembleRun& a, const std::string& state,
+           std::optional<jobs::StoredJob>& job) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string last;
+  for (;;) {
+    job = store.get(id);
+    if (!job) return fail("the ensemble's job " + id + " vanished from the store", kInternal);
+    if (!a.quiet) {
+      const std::string line = ensemble_progress(job->job.members(), a.tty);
+      if (line != last || a.tty) {
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        std::fprintf(stderr, "%s%s  %.0f s%s", a.tty ? "\r" : "", line.c_str(), wall, a.tty ? "   " : "\n");
+        std::fflush(stderr);
+        last = line;
+      }
+    }
+    if (jobs::is_final(job->job.state())) return -1;
+    if (a.interrupted && a.interrupted()) {
+      sched.stop();  // running members end at their step with a checkpoint, and are queued again
+      const auto c = store.get(id)->job.members();
+      if (!a.quiet && a.tty) std::fprintf(stderr, "\n");
+      std::cerr << "runout run: interrupted: " << c.succeeded() << " of " << c.total()
+                << " members done; the same command continues the ensemble (state in " << state << ")\n";
+      return kCancelled;
+    }
+    sched.wait_change(id, 0, std::chrono::milliseconds(250));
+    std::this_thread::sleep_for(std::chrono::milliseconds(a.tty ? 250 : 1000));
+  }
+}
+
+// The aggregate (and, on request, each member's results) into the staged output. Returns an exit
+// code, or -1.
+int copy_results(jobs::JobStore& store, jobs::Scheduler& sched, const jobs::StoredJob& job, const EnsembleRun& a) {
+  std::error_code ec;
+  fs::copy(sched.results_dir(job.job.scenario_hash()), a.out_dir, fs::copy_options::recursive, ec);
+  if (ec) return fail("cannot copy the aggregate into the output: " + ec.message(), kOutput);
+  if (a.with_members) {
+    for (const auto& m : store.members(job.job.id())) {
+      const fs::path to = fs::path(a.out_dir) / "members" / ("member_" + std::to_string(m.job.member_index()));
+      fs::create_directories(to, ec);
+      fs::copy(sched.results_dir(m.job.scenario_hash()), to, fs::copy_options::recursive, ec);
+      if (ec) return fail("cannot copy member " + std::to_string(m.job.member_index()) + "'s results: " + ec.message(), kOutput);
+    }
+  }
+  return -1;
+}
+
+}  // namespace
+
 int run_ensemble(const jobs::ResolvedScenario& r, const EnsembleRun& a, RunSummaryOut& summary) {
-  auto fail = [&](const std::string& m, int code) {
-    std::cerr << "runout run: " << m << "\n";
-    return code;
-  };
   // The members' worker processes resolve their scenarios from "/": the inputs absolute.
   jobs::ResolvedScenario e = r;
   jobs::absolute_inputs(e.scenario, r.source.empty() ? "." : fs::path(r.source).parent_path().string());
@@ -106,31 +160,7 @@ int run_ensemble(const jobs::ResolvedScenario& r, const EnsembleRun& a, RunSumma
   sched.start();
   sched.notify();
   std::optional<jobs::StoredJob> job;
-  std::string last;
-  for (;;) {
-    job = store.get(id);
-    if (!job) return fail("the ensemble's job " + id + " vanished from the store", kInternal);
-    if (!a.quiet) {
-      const std::string line = ensemble_progress(job->job.members(), a.tty);
-      if (line != last || a.tty) {
-        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        std::fprintf(stderr, "%s%s  %.0f s%s", a.tty ? "\r" : "", line.c_str(), wall, a.tty ? "   " : "\n");
-        std::fflush(stderr);
-        last = line;
-      }
-    }
-    if (jobs::is_final(job->job.state())) break;
-    if (a.interrupted && a.interrupted()) {
-      sched.stop();  // running members end at their step with a checkpoint, and are queued again
-      const auto c = store.get(id)->job.members();
-      if (!a.quiet && a.tty) std::fprintf(stderr, "\n");
-      std::cerr << "runout run: interrupted: " << c.succeeded() << " of " << c.total()
-                << " members done; the same command continues the ensemble (state in " << state << ")\n";
-      return kCancelled;
-    }
-    sched.wait_change(id, 0, std::chrono::milliseconds(250));
-    std::this_thread::sleep_for(std::chrono::milliseconds(a.tty ? 250 : 1000));
-  }
+  if (const int rc = follow(store, sched, id, a, state, job); rc >= 0) return rc;
   if (!a.quiet && a.tty) std::fprintf(stderr, "\n");
   sched.stop();
   if (job->job.state() != v1::SUCCEEDED) {
@@ -138,17 +168,7 @@ int run_ensemble(const jobs::ResolvedScenario& r, const EnsembleRun& a, RunSumma
                     " (the members' logs: " + (fs::path(state) / "logs").string() + ")",
                 job->job.state() == v1::CANCELLED ? kCancelled : kFailed);
   }
-  // The aggregate (and, on request, each member's results) into the staged output.
-  fs::copy(sched.results_dir(job->job.scenario_hash()), a.out_dir, fs::copy_options::recursive, ec);
-  if (ec) return fail("cannot copy the aggregate into the output: " + ec.message(), kOutput);
-  if (a.with_members) {
-    for (const auto& m : store.members(id)) {
-      const fs::path to = fs::path(a.out_dir) / "members" / ("member_" + std::to_string(m.job.member_index()));
-      fs::create_directories(to, ec);
-      fs::copy(sched.results_dir(m.job.scenario_hash()), to, fs::copy_options::recursive, ec);
-      if (ec) return fail("cannot copy member " + std::to_string(m.job.member_index()) + "'s results: " + ec.message(), kOutput);
-    }
-  }
+  if (const int rc = copy_results(store, sched, *job, a); rc >= 0) return rc;
   summary.members = int(plan.members.size());
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   summary.state_dir = state;

@@ -8,9 +8,9 @@ using namespace runout::test_support::run;
 // older kind (e.g. B6's shock as the resting deposit's edge) are not answered for it.
 TEST(Scenarios, VofHashCarriesTheResultsVersion) {
   auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b6-shock-sand-50deg-10cm.json");
-  ASSERT_TRUE(r.vof);
+  ASSERT_EQ(r.engine, jobs::kVofLabEngine);
   auto plain = r;
-  plain.vof = false;
+  plain.engine = jobs::kDepthAveragedEngine;
   EXPECT_NE(jobs::scenario_hash(r), jobs::scenario_hash(plain));
   EXPECT_EQ(jobs::scenario_hash(r), jobs::scenario_hash(jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b6-shock-sand-50deg-10cm.json")));
   // The hash itself is pinned: a change to how it is formed would make services recompute every
@@ -25,8 +25,8 @@ TEST(Scenarios, VofHashCarriesTheResultsVersion) {
 TEST(Scenarios, HashCarriesEachEnginesResultsVersion) {
   const auto sh = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/tests/data/arelen-30m.json");
   const auto vof = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b2-collapse-0deg.json");
-  ASSERT_FALSE(sh.vof);
-  ASSERT_TRUE(vof.vof);
+  ASSERT_EQ(sh.engine, jobs::kDepthAveragedEngine);
+  ASSERT_EQ(vof.engine, jobs::kVofLabEngine);
   const int d = jobs::kDepthAveragedResultsVersion, v = jobs::kVofResultsVersion;
   EXPECT_NE(jobs::scenario_hash(sh, d + 1, v), jobs::scenario_hash(sh, d, v));
   EXPECT_EQ(jobs::scenario_hash(sh, d, v + 1), jobs::scenario_hash(sh, d, v));

@@ -373,7 +373,7 @@ TEST(TerrainVof, ArelenCoarseRunWritesTheHazardMapsFramesAndRecord) {
   sc.mutable_numerics()->set_end_time_s(5);
   sc.mutable_vof()->set_write_interval_s(2.5);
   const auto r = runout::jobs::resolve_scenario(sc, kArelen3d.parent_path().string());
-  ASSERT_TRUE(r.vof && r.terrain);
+  ASSERT_EQ(r.engine, runout::jobs::kVofTerrainEngine);
   runout::test_support::TempDir d;
   const auto sum = runout::jobs::run_scenario(r, d.p.string());
   for (const char* f : {"max_depth.tif", "max_speed.tif", "max_pressure.tif", "deposit.tif", "arrival_time.tif", "outline.geojson", "outline.gpkg",

@@ -9,7 +9,7 @@ using namespace runout::test_support::run;
 // The VOF engine through the same run driver: B2 (validation.md) on a coarse mesh.
 TEST(Scenarios, LabCollapseRunsThroughTheRunDriver) {
   auto r = coarse_b2(0.4);
-  ASSERT_TRUE(r.vof);
+  ASSERT_EQ(r.engine, jobs::kVofLabEngine);
   TempDir d;
   const auto sum = jobs::run_scenario(r, d.p.string());
   EXPECT_EQ(sum.stop, "end-time");

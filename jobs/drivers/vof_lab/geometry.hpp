@@ -4,12 +4,12 @@
 #include <google/protobuf/repeated_field.h>
 
 #include "engine/vof/solver.hpp"
-#include "jobs/formats/lab_frames.hpp"
+#include "jobs/formats/vof_frames.hpp"
 #include "runout/v1/scenario.pb.h"
 
 namespace runout::jobs::vof_lab {
 
-/// The lab block's grid (jobs/formats/lab_frames.hpp) with the channel's width and centre line.
+/// The lab block's grid (jobs/formats/vof_frames.hpp) with the channel's width and centre line.
 struct LabGrid : FrameGrid {
   double width = 0;  ///< across the channel: the modelled width in 3D, the plane mesh's thickness in 2D
   int kc = 0;        ///< the slice along the centre line (stations, gate monitor)

@@ -1,6 +1,6 @@
 #pragma once
-// What a laboratory run follows as it goes: the running figures of every step (peak speed, time to
-// rest, alpha bounds, cost) and the benchmark monitors sampled every 10 ms (or 1/50 of the run),
+// What a laboratory run follows as it goes besides the running figures (jobs/drivers/vof_figures.hpp):
+// the benchmark monitors sampled every 10 ms (or 1/50 of the run),
 // each a small class that samples the solver and writes its figures into the run record. The
 // figures and series so far travel with a checkpoint, so that a continued run's record is the
 // uninterrupted run's.
@@ -13,24 +13,10 @@
 #include "engine/vof/solver.hpp"
 #include "jobs/drivers/vof_lab/setup.hpp"
 #include "jobs/formats/checkpoint.hpp"
+#include "jobs/drivers/vof_figures.hpp"
 #include "runout/v1/run_record.pb.h"
 
 namespace runout::jobs::vof_lab {
-
-/// The figures every step updates.
-struct RunningFigures {
-  double peak = 0, t_peak = 0, t_rest = -1, pressure_s = 0, pressure_solve_s = 0, alpha_min = 1, alpha_max = 0, div = 0, last_speed = 0;
-  long steps = 0, p_its = 0;
-  double active_sum = 0;
-  int active_max = 0;
-
-  void step(const engine::vof::StepStats& st);
-  void save(LabCheckpoint& cp) const;
-  /// Throws ScenarioError naming `path` when the checkpoint lacks a figure.
-  void restore(const LabCheckpoint& cp, const std::string& path);
-  /// solver.*, results' speeds and times, the pressure timings.
-  void write(v1::RunRecord& rec) const;
-};
 
 /// The median of a series' finite samples whose times lie in [a, b] (NaN if there is none).
 double median_between(const std::vector<double>& t, const std::vector<double>& v, double a, double b);
@@ -137,9 +123,9 @@ class LabMonitors {
   LabMonitors(const LabSetup& su, const v1::Lab& L, double t_start);
   /// Sample when the next sample is due.
   void after_step(double t, const engine::vof::VofSolver& s);
-  void save(LabCheckpoint& cp);
+  void save(VofCheckpoint& cp);
   /// Throws ScenarioError naming `path` when the checkpoint lacks a series or the monitor times.
-  void restore(const LabCheckpoint& cp, const std::string& path);
+  void restore(const VofCheckpoint& cp, const std::string& path);
   void write(v1::RunRecord& rec) const;
 
   std::vector<double> t;

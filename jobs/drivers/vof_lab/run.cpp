@@ -1,9 +1,15 @@
-#include "jobs/drivers/vof_lab/run.hpp"
+// The 3D engine's laboratory set-ups (scenario engine "vof", block `lab`) as a run set-up
+// (jobs/drivers/engine_run.hpp): mesh and conditions from the scenario (setup.hpp, config.hpp), the
+// monitors (monitors.hpp), checkpoints, and the outputs: fields.h5 + fields.xmf
+// (jobs/formats/vof_frames.hpp), figure.png and comparison.png (figures.hpp) and run.json
+// (jobs/formats/run_record.hpp) with the figures the validation cases compare (results.hpp).
+#include "jobs/drivers/engine_run.hpp"
 
 #include <google/protobuf/util/json_util.h>
 
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <mutex>
 
 #include "jobs/digest/sha256.hpp"
@@ -14,8 +20,9 @@
 #include "jobs/drivers/vof_lab/results.hpp"
 #include "jobs/drivers/vof_lab/setup.hpp"
 #include "jobs/formats/checkpoint.hpp"
-#include "jobs/formats/lab_frames.hpp"
+#include "jobs/formats/vof_frames.hpp"
 #include "jobs/formats/run_record.hpp"
+#include "engine/vof/stepping.hpp"
 
 namespace runout::jobs {
 
@@ -42,8 +49,8 @@ std::string lab_state_hash(const ResolvedScenario& r) {
 }
 
 // The checkpoint to continue from, checked against the scenario.
-LabCheckpoint read_restart(const std::string& path, const std::string& state_hash, const v1::Lab& L) {
-  LabCheckpoint restart = read_checkpoint(path);
+VofCheckpoint read_restart(const std::string& path, const std::string& state_hash, const v1::Lab& L) {
+  VofCheckpoint restart = read_checkpoint(path);
   if (restart.scenario_hash != state_hash)
     throw ScenarioError("checkpoint " + path + " belongs to another scenario (only end_time_s, write_interval_s and "
                         "checkpoint_interval_s may differ)");
@@ -51,50 +58,6 @@ LabCheckpoint read_restart(const std::string& path, const std::string& state_has
     throw ScenarioError("checkpoint " + path + " is at t = " + json_number(restart.state.t) + " s, not before lab.end_time_s");
   return restart;
 }
-
-// The run from the first (or restored) step to the end: frames, monitors, checkpoints, progress and
-// cancellation after every step.
-struct Stepper {
-  const v1::Lab& L;
-  const RunOptions& opt;
-  vof::VofSolver& s;
-  const LabSetup& su;
-  LabFrameWriter& frames;
-  RunningFigures& fig;
-  LabMonitors& mon;
-  std::string state_hash;
-  double next_write = 1e300, cp_every = 1e300, next_cp = 1e300;
-  bool cancelled = false;
-
-  void write_checkpoint_now() {
-    LabCheckpoint cp;
-    cp.scenario_hash = state_hash;
-    fig.save(cp);
-    mon.save(cp);
-    cp.state = s.state();
-    write_checkpoint(opt.checkpoint_path, cp);
-  }
-
-  bool operator()(const vof::StepStats& st) {
-    fig.step(st);
-    if (st.t >= next_write - 1e-12) {
-      frames.write(st.t, s);
-      next_write += L.write_interval_s();
-    }
-    mon.after_step(st.t, s);
-    const bool checkpoints = !opt.checkpoint_path.empty();
-    if (checkpoints && st.t >= next_cp - 1e-12 && st.t < L.end_time_s() - 1e-12) {
-      write_checkpoint_now();
-      next_cp += cp_every;
-    }
-    if (!report_step(opt, st, fig.steps, su.m.cells()) && st.t < L.end_time_s() - 1e-12) {  // on the last step the run is done anyway
-      cancelled = true;
-      if (checkpoints) write_checkpoint_now();  // the run can continue from here
-      return false;
-    }
-    return true;
-  }
-};
 
 void write_timings(const RunSummary& sum, const RunningFigures& fig, int cells, v1::RunRecord& rec) {
   auto* ti = rec.mutable_timings_s();
@@ -105,99 +68,147 @@ void write_timings(const RunSummary& sum, const RunningFigures& fig, int cells, 
   ti->set_microseconds_per_active_cell_step(fig.active_sum > 0 ? 1e6 * sum.seconds_run / fig.active_sum : NAN);
 }
 
-}  // namespace
+// The run: mesh, conditions and the solver from the initial state or a checkpoint, frames, figures
+// and monitors.
+class LabRun final : public EngineRun {
+ public:
+  LabRun(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt);
+  engine::SteppingEngine& engine() override { return *step_; }
+  engine::LoopSchedule schedule() const override;
+  engine::LoopHooks hooks() override;
+  RunSummary finish(engine::StopReason stop, const RunTimes& times) override;
 
-RunSummary run_lab(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt) {
-  std::lock_guard turn(petsc_turn());
-  const auto t0 = clk::now();
-  const auto& L = r.scenario.lab();
-  LabSetup su;
-  build_setup(L, su);
-  const LabGrid& g = su.g;
-  vof::VofSolver s(su.m, su.config);
-  const std::string state_hash = lab_state_hash(r);
-  const bool continued = !opt.restart_path.empty();
-  LabCheckpoint restart;
+ private:
+  std::lock_guard<std::mutex> turn_{petsc_turn()};  // first: held until the solver is gone
+  const ResolvedScenario& r_;
+  const v1::Lab& L_;
+  std::string out_dir_;
+  const RunOptions& opt_;
+  LabSetup su_;
+  std::unique_ptr<vof::VofSolver> s_;
+  std::string state_hash_;
+  double continued_from_ = 0;
+  std::unique_ptr<VofFrameWriter> frames_;
+  RunningFigures fig_;
+  std::unique_ptr<LabMonitors> mon_;
+  std::unique_ptr<vof::VofStepping> step_;
+};
+
+LabRun::LabRun(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt)
+    : r_(r), L_(r.scenario.lab()), out_dir_(out_dir), opt_(opt) {
+  build_setup(L_, su_);
+  s_ = std::make_unique<vof::VofSolver>(su_.m, su_.config);
+  state_hash_ = lab_state_hash(r);
+  continued = !opt.restart_path.empty();
+  VofCheckpoint restart;
   if (continued) {
-    restart = read_restart(opt.restart_path, state_hash, L);
+    restart = read_restart(opt.restart_path, state_hash_, L_);
     try {
-      s.restore(restart.state);
+      s_->restore(restart.state);
     } catch (const vof::VofError& e) {
       throw ScenarioError("checkpoint " + opt.restart_path + ": " + e.what());
     }
+    continued_from_ = restart.state.t;
   } else {
-    s.initialise(su.alpha);
+    s_->initialise(su_.alpha);
   }
+  // With checkpoints the frames are written next to the checkpoint (CHECKPOINT.fields.h5), so that
+  // a continued run carries on with them; a run continued from RESTART takes RESTART.fields.h5's
+  // frames up to its time.
+  frames_ = std::make_unique<VofFrameWriter>(out_dir, su_.g, L_.has_chute() ? &su_.m.centre : nullptr,
+                                             opt.checkpoint_path.empty() ? std::string() : opt.checkpoint_path + ".fields.h5",
+                                             continued ? opt.restart_path + ".fields.h5" : std::string(), restart.state.t);
+  mon_ = std::make_unique<LabMonitors>(su_, L_, s_->time());
+  if (continued) {
+    fig_.restore(restart, opt.restart_path);
+    mon_->restore(restart, opt.restart_path);
+    loop.next_frame = engine::next_multiple(L_.write_interval_s(), restart.state.t);  // the next regular frame
+  }
+  step_ = std::make_unique<vof::VofStepping>(*s_, fig_.steps);
+}
 
+engine::LoopSchedule LabRun::schedule() const {
+  engine::LoopSchedule sc;
+  sc.t_end = L_.end_time_s();
+  sc.frame_interval = L_.write_interval_s();
+  sc.checkpoint_interval = L_.checkpoint_interval_s() > 0 ? L_.checkpoint_interval_s() : opt_.checkpoint_interval_s;
+  return sc;
+}
+
+engine::LoopHooks LabRun::hooks() {
+  engine::LoopHooks h;
+  h.after_step = [this](const engine::StepReport& r) {
+    fig_.step(step_->last());
+    mon_->after_step(r.t, *s_);
+  };
+  h.frame = [this](double t) { frames_->write(t, *s_); };
+  h.checkpoint = [this](const engine::LoopState&) {
+    VofCheckpoint cp;
+    cp.scenario_hash = state_hash_;
+    fig_.save(cp);
+    mon_->save(cp);
+    cp.state = s_->state();
+    write_checkpoint(opt_.checkpoint_path, cp);
+  };
+  return h;
+}
+
+RunSummary LabRun::finish(engine::StopReason stop, const RunTimes& times) {
+  const LabGrid& g = su_.g;
+  const vof::VofSolver& s = *s_;
   RunSummary sum;
   sum.nx = g.nx;
   sum.ny = g.ny * g.nz;
   sum.dx = g.dx;
   sum.crs = "channel coordinates";
-  sum.release_volume_m3 = su.v0;
-  sum.volume_initial = su.v0;
-  sum.seconds_prepare = since(t0);
-  // With checkpoints the frames are written next to the checkpoint (CHECKPOINT.fields.h5), so that
-  // a continued run carries on with them; a run continued from RESTART takes RESTART.fields.h5's
-  // frames up to its time.
-  LabFrameWriter frames(out_dir, g, L.has_chute() ? &su.m.centre : nullptr,
-                        opt.checkpoint_path.empty() ? std::string() : opt.checkpoint_path + ".fields.h5",
-                        continued ? opt.restart_path + ".fields.h5" : std::string(), restart.state.t);
-  RunningFigures fig;
-  LabMonitors mon(su, L, s.time());
-  Stepper step{L, opt, s, su, frames, fig, mon, state_hash};
-  step.next_write = L.write_interval_s() > 0 ? L.write_interval_s() : 1e300;
-  if (continued) {
-    fig.restore(restart, opt.restart_path);
-    mon.restore(restart, opt.restart_path);
-    if (L.write_interval_s() > 0)  // the next regular frame after the checkpoint
-      step.next_write = next_multiple(L.write_interval_s(), restart.state.t);
-  } else {
-    frames.write(0, s);
-  }
-  step.cp_every = L.checkpoint_interval_s() > 0 ? L.checkpoint_interval_s() : opt.checkpoint_interval_s > 0 ? opt.checkpoint_interval_s : 1e300;
-  step.next_cp = step.cp_every < 1e300 ? next_multiple(step.cp_every, s.time()) : 1e300;
-  const auto t1 = clk::now();
-  s.run(L.end_time_s(), [&step](const vof::StepStats& st) { return step(st); });
-  sum.seconds_run = since(t1);
-  sum.steps = fig.steps;
+  sum.release_volume_m3 = su_.v0;
+  sum.volume_initial = su_.v0;
+  sum.seconds_prepare = times.prepare;
+  sum.seconds_run = times.run;
+  sum.steps = fig_.steps;
   sum.t = s.time();
-  sum.stop = step.cancelled ? "cancelled" : "end-time";
-  if (step.cancelled) return sum;
+  sum.stop = std::string(engine::to_string(stop));
+  if (stop == engine::StopReason::cancelled) return sum;
 
   const auto t2 = clk::now();
-  const Deposit dep = deposit(su, s);
+  const Deposit dep = deposit(su_, s);
   sum.volume_final = dep.volume;
-  sum.volume_error = su.has_inflow ? NAN : std::abs(dep.volume - su.v0) / su.v0;  // material comes in: no conservation figure
-  sum.max_speed = fig.peak;
+  sum.volume_error = su_.has_inflow ? NAN : std::abs(dep.volume - su_.v0) / su_.v0;  // material comes in: no conservation figure
+  sum.max_speed = fig_.peak;
   sum.runout_m = dep.front;
   sum.max_depth = dep.height;
-  const int n_frames = frames.finish();
-  write_state_figure(out_dir + "/figure.png", s, g, std::max(fig.peak, 0.01));
-  const std::string title = figure_title(r, g, s.time());
+  const int n_frames = frames_->finish();
+  write_state_figure(out_dir_ + "/figure.png", s, g, std::max(fig_.peak, 0.01));
+  const std::string title = figure_title(r_, g, s.time());
 
-  v1::RunRecord rec = run_record_head(r, "vof");
-  write_mesh(su, rec);
-  fig.write(rec);
+  v1::RunRecord rec = run_record_head(r_, "vof");
+  write_mesh(su_, rec);
+  fig_.write(rec);
   rec.mutable_solver()->set_simulated_s(s.time());
   rec.mutable_solver()->set_stop(sum.stop);
-  if (continued) rec.mutable_solver()->set_continued_from_t_s(restart.state.t);
-  write_deposit(dep, su, n_frames, rec);
-  write_stations(L, su, s, rec);
-  mon.write(rec);
+  if (continued) rec.mutable_solver()->set_continued_from_t_s(continued_from_);
+  write_deposit(dep, su_, n_frames, rec);
+  write_stations(L_, su_, s, rec);
+  mon_->write(rec);
   figures::PlanFigure plan;  // comparison.png of a 3D run
   plan.title = title;
-  if (g.three_d) write_chute(L, su, s, plan, rec);
+  if (g.three_d) write_chute(L_, su_, s, plan, rec);
   sum.files = {"fields.h5", "fields.xmf", "figure.png", "run.json", "comparison.png"};
   sum.seconds_write = since(t2);
 
-  write_timings(sum, fig, su.m.cells(), rec);
+  write_timings(sum, fig_, su_.m.cells(), rec);
   for (const auto& f : sum.files) rec.add_outputs(f);
   rec.mutable_execution()->set_petsc_options(petsc_options());
-  write_run_record(out_dir + "/run.json", rec);
-  if (g.three_d) figures::write_plan_figure(out_dir + "/comparison.png", plan);
-  else write_section_comparison(out_dir + "/comparison.png", title, L, su, s, dep, mon);
+  write_run_record(out_dir_ + "/run.json", rec);
+  if (g.three_d) figures::write_plan_figure(out_dir_ + "/comparison.png", plan);
+  else write_section_comparison(out_dir_ + "/comparison.png", title, L_, su_, s, dep, *mon_);
   return sum;
+}
+
+}  // namespace
+
+std::unique_ptr<EngineRun> prepare_vof_lab(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt) {
+  return std::make_unique<LabRun>(s, out_dir, opt);
 }
 
 }  // namespace runout::jobs

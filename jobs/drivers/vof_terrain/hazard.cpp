@@ -101,7 +101,7 @@ std::vector<double> ColumnHazard::depth(const vof::VofSolver& s) const {
 
 void ColumnHazard::finish(const vof::VofSolver& s) { hz_.final_depth = depth(s); }
 
-void ColumnHazard::save(LabCheckpoint& cp) const {
+void ColumnHazard::save(VofCheckpoint& cp) const {
   cp.series["max_depth"] = hz_.max_depth;
   cp.series["max_speed"] = hz_.max_speed;
   cp.series["max_pressure"] = hz_.max_pressure;
@@ -116,7 +116,7 @@ void ColumnHazard::save(LabCheckpoint& cp) const {
   }
 }
 
-void ColumnHazard::restore(const LabCheckpoint& cp, const std::string& path) {
+void ColumnHazard::restore(const VofCheckpoint& cp, const std::string& path) {
   auto take = [&](const char* name, std::vector<double>& into, std::size_t n) {
     auto it = cp.series.find(name);
     if (it == cp.series.end() || it->second.size() != n)

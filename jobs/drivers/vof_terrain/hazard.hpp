@@ -55,9 +55,9 @@ class ColumnHazard {
   double deepest_time(std::size_t n) const { return deepest_t_[n]; }
   const Profile& deepest_profile(std::size_t n) const { return deepest_[n]; }
 
-  void save(LabCheckpoint& cp) const;
+  void save(VofCheckpoint& cp) const;
   /// Throws ScenarioError naming `path` when the checkpoint lacks the maps or they are of another grid.
-  void restore(const LabCheckpoint& cp, const std::string& path);
+  void restore(const VofCheckpoint& cp, const std::string& path);
 
  private:
   struct Column {

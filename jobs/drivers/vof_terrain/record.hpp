@@ -16,7 +16,7 @@ namespace runout::jobs::vof_terrain {
 struct TerrainRunFacts {
   const TerrainSetup& su;
   const ColumnHazard& hazard;
-  const vof_lab::RunningFigures& fig;
+  const RunningFigures& fig;
   const RunSummary& sum;
   double continued_from = 0;  ///< NaN: not continued
   const HazardOutputs& outputs;

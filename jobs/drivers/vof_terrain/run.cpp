@@ -1,10 +1,18 @@
-#include "jobs/drivers/vof_terrain/run.hpp"
+// The 3D engine on the DEM (scenario engine "vof" without `lab`) as a run set-up
+// (jobs/drivers/engine_run.hpp): grid, release and terrain-following mesh (setup.hpp), the hazard
+// maps integrated through the depth after every step (hazard.hpp), and the outputs: the
+// depth-averaged engine's rasters, outline and map (jobs/drivers/hazard_outputs.hpp),
+// max_surface_speed.tif, max_ground_stress.tif, the 3D frames (fields.h5 + fields.xmf, in the grid's
+// CRS with z up) and run.json (record.hpp).
+#include "jobs/drivers/engine_run.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
+#include <mutex>
 
 #include "jobs/drivers/hazard_outputs.hpp"
 #include "jobs/drivers/vof_lab/monitors.hpp"
@@ -14,7 +22,8 @@
 #include "jobs/drivers/vof_terrain/record.hpp"
 #include "jobs/drivers/vof_terrain/setup.hpp"
 #include "jobs/formats/checkpoint.hpp"
-#include "jobs/formats/lab_frames.hpp"
+#include "jobs/formats/vof_frames.hpp"
+#include "engine/vof/stepping.hpp"
 
 namespace runout::jobs {
 
@@ -57,92 +66,6 @@ FrameGrid frame_grid(const TerrainSetup& su) {
   return g;
 }
 
-// The run from the first (or restored) step to the end: hazard maps, frames, the outflow, the stop
-// rule, checkpoints, progress and cancellation after every step.
-struct Stepper {
-  const ResolvedScenario& r;
-  const RunOptions& opt;
-  vof::VofSolver& s;
-  const TerrainSetup& su;
-  ColumnHazard& hazard;
-  LabFrameWriter* frames;
-  vof_lab::RunningFigures& fig;
-  std::string state_hash;
-  double write_every = 0, next_write = 1e300, cp_every = 1e300, next_cp = 1e300;
-  double outflow = 0, ke_peak = 0;
-  double outflow_corridor = 0, outflow_edge = 0;  ///< through the corridor's edge, through the domain's edge
-  bool cancelled = false, settled = false;
-
-  void save(LabCheckpoint& cp) const {
-    cp.scenario_hash = state_hash;
-    fig.save(cp);
-    hazard.save(cp);
-    cp.figures["outflow_m3"] = outflow;
-    cp.figures["ke_peak"] = ke_peak;
-    cp.figures["corridor_outflow_m3"] = outflow_corridor;
-    cp.figures["domain_edge_outflow_m3"] = outflow_edge;
-  }
-  void restore(const LabCheckpoint& cp, const std::string& path) {
-    fig.restore(cp, path);
-    hazard.restore(cp, path);
-    for (const char* k : {"outflow_m3", "ke_peak", "corridor_outflow_m3", "domain_edge_outflow_m3"})
-      if (!cp.figures.count(k)) throw ScenarioError("checkpoint " + path + ": damaged (no figure '" + k + "')");
-    outflow = cp.figures.at("outflow_m3");
-    ke_peak = cp.figures.at("ke_peak");
-    outflow_corridor = cp.figures.at("corridor_outflow_m3");
-    outflow_edge = cp.figures.at("domain_edge_outflow_m3");
-  }
-  void write_checkpoint_now() {
-    LabCheckpoint cp;
-    save(cp);
-    cp.state = s.state();
-    write_checkpoint(opt.checkpoint_path, cp);
-  }
-  // The granular kinetic energy and the volume through the boundary in this step (the sides': the
-  // corridor's edge apart from the domain's).
-  void balance(double dt) {
-    const auto& m = s.mesh();
-    const int sp = m.patch_index("sides");
-    const int s0 = sp < 0 ? 0 : m.patches[std::size_t(sp)].start, s1 = sp < 0 ? 0 : s0 + m.patches[std::size_t(sp)].size;
-    for (int f = m.n_internal; f < m.faces(); ++f) {
-      const double q = s.granular_flux()[std::size_t(f)] * dt;
-      outflow += q;
-      if (su.corridor_edge[std::size_t(f)]) outflow_corridor += q;
-      else if (f >= s0 && f < s1) outflow_edge += q;
-    }
-    double ke = 0;
-    for (int c = 0; c < m.cells(); ++c) {
-      const double a = s.alpha()[std::size_t(c)];
-      if (a > 0) ke += 0.5 * a * m.volume[std::size_t(c)] * dot(s.velocity()[std::size_t(c)], s.velocity()[std::size_t(c)]);
-    }
-    ke_peak = std::max(ke_peak, ke);
-    const double frac = r.config.time.stop_fraction;
-    settled = frac > 0 && ke_peak > 0 && ke < frac * ke_peak;
-  }
-
-  bool operator()(const vof::StepStats& st) {
-    fig.step(st);
-    hazard.update(st.t, s);
-    balance(st.dt);
-    if (frames && st.t >= next_write - 1e-12) {
-      frames->write(st.t, s);
-      next_write += write_every;
-    }
-    const bool checkpoints = !opt.checkpoint_path.empty();
-    const double t_end = r.end_time_s();
-    if (checkpoints && st.t >= next_cp - 1e-12 && st.t < t_end - 1e-12) {
-      write_checkpoint_now();
-      next_cp += cp_every;
-    }
-    if (!report_step(opt, st, fig.steps, su.mesh.cells()) && st.t < t_end - 1e-12 && !settled) {
-      cancelled = true;
-      if (checkpoints) write_checkpoint_now();  // the run can continue from here
-      return false;
-    }
-    return !settled;
-  }
-};
-
 // The rasters only the 3D engine gives, beside the depth-averaged engine's.
 void write_3d_rasters(const TerrainSetup& su, const ColumnHazard& hz, const std::string& out_dir, RunSummary& sum) {
   terrain::write_cog(out_dir + "/max_surface_speed.tif", su.grid, terrain::masked_outside(su.grid, hz.max_surface_speed()),
@@ -173,105 +96,198 @@ RunSummary summary_of_setup(const ResolvedScenario& r, const TerrainSetup& su) {
   return sum;
 }
 
-}  // namespace
+// The run: grid, release, mesh and the solver from the initial state or a checkpoint, the hazard
+// maps integrated through the depth after every step, the volume through the boundary, frames.
+class TerrainRun final : public EngineRun {
+ public:
+  TerrainRun(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt);
+  engine::SteppingEngine& engine() override { return *step_; }
+  engine::LoopSchedule schedule() const override;
+  engine::LoopHooks hooks() override;
+  RunSummary finish(engine::StopReason stop, const RunTimes& times) override;
 
-RunSummary run_terrain_vof(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt) {
-  std::lock_guard turn(petsc_turn());
-  const auto t0 = clk::now();
-  TerrainSetup su;
-  build_terrain_setup(r, su);
-  vof::VofSolver s(su.mesh, terrain_config(r, bed_columns(su.columns, su.mesh, su.grid)));
-  const bool continued = !opt.restart_path.empty();
-  const std::string state_hash = continued || !opt.checkpoint_path.empty() ? terrain_state_hash(r) : std::string();
-  LabCheckpoint restart;
+ private:
+  // The volume through the boundary in this step (the sides': the corridor's edge apart from the domain's).
+  void balance(double dt);
+  void save(VofCheckpoint& cp) const;
+  void restore(const VofCheckpoint& cp, const std::string& path);
+  std::vector<std::string> corridor_notes() const;
+
+  std::lock_guard<std::mutex> turn_{petsc_turn()};  // first: held until the solver is gone
+  const ResolvedScenario& r_;
+  std::string out_dir_;
+  const RunOptions& opt_;
+  TerrainSetup su_;
+  std::unique_ptr<vof::VofSolver> s_;
+  std::string state_hash_;
+  double continued_from_ = std::numeric_limits<double>::quiet_NaN();
+  std::unique_ptr<ColumnHazard> hazard_;
+  FrameGrid frame_grid_;  // the frames' grid (the writer keeps a reference)
+  std::unique_ptr<VofFrameWriter> frames_;
+  RunningFigures fig_;
+  std::unique_ptr<vof::VofStepping> step_;
+  double outflow_ = 0;
+  double outflow_corridor_ = 0, outflow_edge_ = 0;  // through the corridor's edge, through the domain's edge
+};
+
+TerrainRun::TerrainRun(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt) : r_(r), out_dir_(out_dir), opt_(opt) {
+  build_terrain_setup(r, su_);
+  s_ = std::make_unique<vof::VofSolver>(su_.mesh, terrain_config(r, bed_columns(su_.columns, su_.mesh, su_.grid)));
+  continued = !opt.restart_path.empty();
+  state_hash_ = continued || !opt.checkpoint_path.empty() ? terrain_state_hash(r) : std::string();
+  VofCheckpoint restart;
   if (continued) {
     restart = read_checkpoint(opt.restart_path);
-    if (restart.scenario_hash != state_hash)
+    if (restart.scenario_hash != state_hash_)
       throw ScenarioError("checkpoint " + opt.restart_path +
                           " belongs to another scenario (only numerics.end_time_s, vof.write_interval_s and vof.checkpoint_interval_s may differ)");
     if (!(restart.state.t < r.end_time_s()))
       throw ScenarioError("checkpoint " + opt.restart_path + " is at t = " + json_number(restart.state.t) + " s, not before numerics.end_time_s");
     try {
-      s.restore(restart.state);
+      s_->restore(restart.state);
     } catch (const vof::VofError& e) {
       throw ScenarioError("checkpoint " + opt.restart_path + ": " + e.what());
     }
+    continued_from_ = restart.state.t;
   } else {
-    s.initialise(su.alpha);
+    s_->initialise(su_.alpha);
   }
   std::vector<ColumnHazard::Tracked> tracked;
-  for (const auto& p : su.points) tracked.push_back({p.column, p.mesh_column});
+  for (const auto& p : su_.points) tracked.push_back({p.column, p.mesh_column});
   HazardSettings hs;
   hs.rho = r.scenario.material().density_kg_m3();
   hs.flow_threshold = r.config.flow_threshold;
-  ColumnHazard hazard(su.columns, s.mesh(), su.cos_slope, hs, tracked);
-
-  RunSummary sum = summary_of_setup(r, su);
-  sum.seconds_prepare = since(t0);
-
+  hazard_ = std::make_unique<ColumnHazard>(su_.columns, s_->mesh(), su_.cos_slope, hs, tracked);
   const double write_every = r.scenario.vof().write_interval_s();
-  const FrameGrid fg = frame_grid(su);
-  std::unique_ptr<LabFrameWriter> frames;
+  frame_grid_ = frame_grid(su_);
   if (write_every > 0)
-    frames = std::make_unique<LabFrameWriter>(out_dir, fg, &s.mesh().centre,
-                                              opt.checkpoint_path.empty() ? std::string() : opt.checkpoint_path + ".fields.h5",
-                                              continued ? opt.restart_path + ".fields.h5" : std::string(), restart.state.t);
-  vof_lab::RunningFigures fig;
-  Stepper step{r, opt, s, su, hazard, frames.get(), fig, state_hash};
-  step.write_every = write_every;
+    frames_ = std::make_unique<VofFrameWriter>(out_dir, frame_grid_, &s_->mesh().centre,
+                                               opt.checkpoint_path.empty() ? std::string() : opt.checkpoint_path + ".fields.h5",
+                                               continued ? opt.restart_path + ".fields.h5" : std::string(), restart.state.t);
   if (continued) {
-    step.restore(restart, opt.restart_path);
-    if (write_every > 0) step.next_write = next_multiple(write_every, restart.state.t);
+    restore(restart, opt.restart_path);
+    if (write_every > 0) loop.next_frame = engine::next_multiple(write_every, restart.state.t);
   } else {
-    hazard.update(0, s);
-    if (frames) frames->write(0, s);
-    step.next_write = write_every > 0 ? write_every : 1e300;
+    hazard_->update(0, *s_);
   }
-  const double cp_interval = r.scenario.vof().checkpoint_interval_s();
-  step.cp_every = cp_interval > 0 ? cp_interval : opt.checkpoint_interval_s > 0 ? opt.checkpoint_interval_s : 1e300;
-  step.next_cp = step.cp_every < 1e300 ? next_multiple(step.cp_every, s.time()) : 1e300;
-  const auto t1 = clk::now();
-  s.run(r.end_time_s(), [&step](const vof::StepStats& st) { return step(st); });
-  sum.seconds_run = since(t1);
-  sum.steps = fig.steps;
+  step_ = std::make_unique<vof::VofStepping>(*s_, fig_.steps);
+}
+
+void TerrainRun::save(VofCheckpoint& cp) const {
+  cp.scenario_hash = state_hash_;
+  fig_.save(cp);
+  hazard_->save(cp);
+  cp.figures["outflow_m3"] = outflow_;
+  cp.figures["ke_peak"] = loop.kinetic_energy_peak;
+  cp.figures["corridor_outflow_m3"] = outflow_corridor_;
+  cp.figures["domain_edge_outflow_m3"] = outflow_edge_;
+}
+
+void TerrainRun::restore(const VofCheckpoint& cp, const std::string& path) {
+  fig_.restore(cp, path);
+  hazard_->restore(cp, path);
+  for (const char* k : {"outflow_m3", "ke_peak", "corridor_outflow_m3", "domain_edge_outflow_m3"})
+    if (!cp.figures.count(k)) throw ScenarioError("checkpoint " + path + ": damaged (no figure '" + k + "')");
+  outflow_ = cp.figures.at("outflow_m3");
+  loop.kinetic_energy_peak = cp.figures.at("ke_peak");
+  outflow_corridor_ = cp.figures.at("corridor_outflow_m3");
+  outflow_edge_ = cp.figures.at("domain_edge_outflow_m3");
+}
+
+void TerrainRun::balance(double dt) {
+  const auto& m = s_->mesh();
+  const int sp = m.patch_index("sides");
+  const int s0 = sp < 0 ? 0 : m.patches[std::size_t(sp)].start, s1 = sp < 0 ? 0 : s0 + m.patches[std::size_t(sp)].size;
+  for (int f = m.n_internal; f < m.faces(); ++f) {
+    const double q = s_->granular_flux()[std::size_t(f)] * dt;
+    outflow_ += q;
+    if (su_.corridor_edge[std::size_t(f)]) outflow_corridor_ += q;
+    else if (f >= s0 && f < s1) outflow_edge_ += q;
+  }
+}
+
+engine::LoopSchedule TerrainRun::schedule() const {
+  engine::LoopSchedule sc;
+  sc.t_end = r_.end_time_s();
+  sc.stop_fraction = r_.config.time.stop_fraction;
+  sc.frame_interval = frames_ ? r_.scenario.vof().write_interval_s() : 0.0;
+  const double cp_interval = r_.scenario.vof().checkpoint_interval_s();
+  sc.checkpoint_interval = cp_interval > 0 ? cp_interval : opt_.checkpoint_interval_s;
+  return sc;
+}
+
+engine::LoopHooks TerrainRun::hooks() {
+  engine::LoopHooks h;
+  h.after_step = [this](const engine::StepReport& r) {
+    fig_.step(step_->last());
+    hazard_->update(r.t, *s_);
+    balance(r.dt);
+  };
+  if (frames_) h.frame = [this](double t) { frames_->write(t, *s_); };
+  h.checkpoint = [this](const engine::LoopState&) {
+    VofCheckpoint cp;
+    save(cp);  // the loop's figures are `loop`'s
+    cp.state = s_->state();
+    write_checkpoint(opt_.checkpoint_path, cp);
+  };
+  return h;
+}
+
+// What the reader of the maps must know about the corridor: run.json's notes and the summary's.
+std::vector<std::string> TerrainRun::corridor_notes() const {
+  std::vector<std::string> notes;
+  if (su_.corridor.kind != "none" && outflow_corridor_ > kCorridorLossNote * su_.volume_on_mesh) {
+    char pct[32];
+    std::snprintf(pct, sizeof pct, "%.1f", 100 * outflow_corridor_ / su_.volume_on_mesh);
+    notes.push_back(std::string("the map is not complete: ") + pct +
+                    " % of the released volume left the mesh through the corridor's edge (mesh.corridor \"" + su_.corridor.kind +
+                    "\"): widen mesh.corridor_margin_m, give a wider mesh.corridor_path, or mesh.corridor \"none\"");
+  }
+  return notes;
+}
+
+RunSummary TerrainRun::finish(engine::StopReason stop, const RunTimes& times) {
+  const vof::VofSolver& s = *s_;
+  RunSummary sum = summary_of_setup(r_, su_);
+  sum.seconds_prepare = times.prepare;
+  sum.seconds_run = times.run;
+  sum.steps = fig_.steps;
   sum.t = s.time();
-  sum.stop = step.cancelled ? "cancelled" : step.settled ? "kinetic-energy" : "end-time";
-  if (step.cancelled) return sum;
+  sum.stop = std::string(engine::to_string(stop));
+  if (stop == engine::StopReason::cancelled) return sum;
 
   const auto t2 = clk::now();
-  hazard.finish(s);
+  hazard_->finish(s);
   double v_final = 0;
   for (int c = 0; c < s.mesh().cells(); ++c) v_final += s.alpha()[std::size_t(c)] * s.mesh().volume[std::size_t(c)];
   sum.volume_final = v_final;
-  sum.volume_outflow = step.outflow;
-  sum.volume_error = std::abs(v_final + step.outflow - su.volume_on_mesh) / su.volume_on_mesh;
+  sum.volume_outflow = outflow_;
+  sum.volume_error = std::abs(v_final + outflow_ - su_.volume_on_mesh) / su_.volume_on_mesh;
   sum.max_speed = 0;
-  for (double v : hazard.maps().max_speed) sum.max_speed = std::max(sum.max_speed, v);
-  hazard_figures(r, su.grid, su.h0, hazard.maps(), sum);
-  require_finite_figures({{"final volume", v_final}, {"outflow volume", step.outflow}, {"maximum speed", sum.max_speed},
+  for (double v : hazard_->maps().max_speed) sum.max_speed = std::max(sum.max_speed, v);
+  hazard_figures(r_, su_.grid, su_.h0, hazard_->maps(), sum);
+  require_finite_figures({{"final volume", v_final}, {"outflow volume", outflow_}, {"maximum speed", sum.max_speed},
                           {"maximum depth", sum.max_depth}, {"runout", sum.runout_m}});
-  const auto outputs = write_hazard_outputs(r, su.grid, su.h0, hazard.maps(), su.output_inputs, out_dir, sum);
-  write_3d_rasters(su, hazard, out_dir, sum);
-  const int n_frames = frames ? frames->finish() : 0;
-  if (frames) {
+  const auto outputs = write_hazard_outputs(r_, su_.grid, su_.h0, hazard_->maps(), su_.output_inputs, out_dir_, sum);
+  write_3d_rasters(su_, *hazard_, out_dir_, sum);
+  const int n_frames = frames_ ? frames_->finish() : 0;
+  if (frames_) {
     sum.files.push_back("fields.h5");
     sum.files.push_back("fields.xmf");
   }
   sum.seconds_write = since(t2);
-  std::vector<std::string> record_notes;  // what the reader of the maps must know: run.json's notes and the summary's
-  if (su.corridor.kind != "none" && step.outflow_corridor > kCorridorLossNote * su.volume_on_mesh) {
-    char pct[32];
-    std::snprintf(pct, sizeof pct, "%.1f", 100 * step.outflow_corridor / su.volume_on_mesh);
-    record_notes.push_back(std::string("the map is not complete: ") + pct +
-                           " % of the released volume left the mesh through the corridor's edge (mesh.corridor \"" + su.corridor.kind +
-                           "\"): widen mesh.corridor_margin_m, give a wider mesh.corridor_path, or mesh.corridor \"none\"");
-  }
+  const std::vector<std::string> record_notes = corridor_notes();
   sum.notes.insert(sum.notes.end(), record_notes.begin(), record_notes.end());
-  TerrainRunFacts facts{su, hazard, fig, sum, continued ? restart.state.t : std::numeric_limits<double>::quiet_NaN(),
-                        outputs, n_frames, step.outflow_corridor, step.outflow_edge, record_notes};
-  write_terrain_record(out_dir + "/run.json", r, facts);
+  TerrainRunFacts facts{su_, *hazard_, fig_, sum, continued_from_, outputs, n_frames, outflow_corridor_, outflow_edge_, record_notes};
+  write_terrain_record(out_dir_ + "/run.json", r_, facts);
   sum.files.push_back("run.json");
   return sum;
+}
+
+}  // namespace
+
+std::unique_ptr<EngineRun> prepare_vof_terrain(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt) {
+  return std::make_unique<TerrainRun>(s, out_dir, opt);
 }
 
 }  // namespace runout::jobs

@@ -27,7 +27,7 @@ struct FrameGrid {
   int id(int i, int j, int k) const { return cell[at(i, j, k)]; }
 };
 
-class LabFrameWriter {
+class VofFrameWriter {
  public:
   /// `centres`: for a mesh that is not the lab block's box (a curved chute), the mesh's cell
   /// centres, written once as /centres so that fields.xmf places the values where they are.
@@ -36,11 +36,11 @@ class LabFrameWriter {
   /// copies them to dir/fields.h5. `continue_from`: a frames file of an interrupted run; its frames up
   /// to `t_restart` are kept and the run's frames follow them. Throws ScenarioError when that file
   /// is missing or damaged, std::runtime_error when writing fails.
-  LabFrameWriter(const std::string& dir, const FrameGrid& g, const std::vector<engine::vof::Vec>* centres = nullptr, std::string work = {},
+  VofFrameWriter(const std::string& dir, const FrameGrid& g, const std::vector<engine::vof::Vec>* centres = nullptr, std::string work = {},
                  const std::string& continue_from = {}, double t_restart = 0);
-  ~LabFrameWriter();
-  LabFrameWriter(const LabFrameWriter&) = delete;
-  LabFrameWriter& operator=(const LabFrameWriter&) = delete;
+  ~VofFrameWriter();
+  VofFrameWriter(const VofFrameWriter&) = delete;
+  VofFrameWriter& operator=(const VofFrameWriter&) = delete;
 
   /// Append the solver's state as frame at time t.
   void write(double t, const engine::vof::VofSolver& s);

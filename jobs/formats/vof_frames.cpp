@@ -1,4 +1,4 @@
-#include "jobs/formats/lab_frames.hpp"
+#include "jobs/formats/vof_frames.hpp"
 
 #include <hdf5.h>
 
@@ -18,7 +18,7 @@ namespace runout::jobs {
 
 namespace vof = engine::vof;
 
-LabFrameWriter::LabFrameWriter(const std::string& dir, const FrameGrid& g, const std::vector<vof::Vec>* centres, std::string work,
+VofFrameWriter::VofFrameWriter(const std::string& dir, const FrameGrid& g, const std::vector<vof::Vec>* centres, std::string work,
                                const std::string& continue_from, double t_restart)
     : dir_(dir), work_(work.empty() ? dir + "/fields.h5" : std::move(work)), g_(g) {
   std::lock_guard lk(hdf5_mutex());
@@ -36,7 +36,7 @@ LabFrameWriter::LabFrameWriter(const std::string& dir, const FrameGrid& g, const
 // The frames written before the checkpoint: without them the results would lack the run's start, so
 // a missing or unreadable file is an error, not a fresh file. Keeps the frames up to the checkpoint's
 // time, in order, and drops the later ones.
-void LabFrameWriter::continue_frames(const std::string& continue_from, double t_restart) {
+void VofFrameWriter::continue_frames(const std::string& continue_from, double t_restart) {
   if (!std::filesystem::is_regular_file(continue_from) || H5Fis_hdf5(continue_from.c_str()) <= 0)
     throw ScenarioError("the checkpoint's frames " + continue_from + " are missing or not HDF5 (they are written beside the checkpoint)");
   std::error_code ec;
@@ -67,7 +67,7 @@ void LabFrameWriter::continue_frames(const std::string& continue_from, double t_
   }
 }
 
-void LabFrameWriter::write_centres(const std::vector<vof::Vec>& centres) {
+void VofFrameWriter::write_centres(const std::vector<vof::Vec>& centres) {
   const auto& g = g_;
   std::vector<double> xyz(3 * g.cell.size(), NAN);
   for (std::size_t q = 0; q < g.cell.size(); ++q)
@@ -91,12 +91,12 @@ void LabFrameWriter::write_centres(const std::vector<vof::Vec>& centres) {
   }
 }
 
-LabFrameWriter::~LabFrameWriter() {
+VofFrameWriter::~VofFrameWriter() {
   std::lock_guard lk(hdf5_mutex());
   if (file_ >= 0) H5Fclose(file_);
 }
 
-void LabFrameWriter::write(double t, const vof::VofSolver& s) {
+void VofFrameWriter::write(double t, const vof::VofSolver& s) {
   const auto n = g_.cell.size();
   std::vector<float> a(n, NAN), ux(n, NAN), uy(n, NAN), uz(n, NAN), p(n, NAN), nu(n, NAN);
   for (std::size_t q = 0; q < n; ++q) {
@@ -139,7 +139,7 @@ void LabFrameWriter::write(double t, const vof::VofSolver& s) {
   times_.push_back(t);
 }
 
-int LabFrameWriter::finish() {
+int VofFrameWriter::finish() {
   {
     std::lock_guard lk(hdf5_mutex());
     if (file_ >= 0) H5Fclose(file_);
@@ -157,7 +157,7 @@ int LabFrameWriter::finish() {
 }
 
 // fields.xmf: a temporal collection on the cell centres (ORIGIN_DXDY, ORIGIN_DXDYDZ in 3D).
-void LabFrameWriter::write_xdmf() const {
+void VofFrameWriter::write_xdmf() const {
   const auto& g = g_;
   std::ostringstream dims;
   if (g.three_d) dims << g.nz << " " << g.ny << " " << g.nx;

@@ -1,0 +1,267 @@
+// The depth-averaged engine on the DEM as a run set-up (jobs/drivers/engine_run.hpp): grid,
+// releases, the engine, its time series and checkpoints; hazard outputs and run.json at the end.
+#include "jobs/digest/sha256.hpp"
+#include "jobs/drivers/engine_run.hpp"
+#include "jobs/drivers/hazard_maps.hpp"
+#include "jobs/drivers/hazard_outputs.hpp"
+#include "jobs/drivers/record_head.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "engine/sh2d.hpp"
+#include "jobs/formats/iseesnow.hpp"
+#include "jobs/formats/sh_checkpoint.hpp"
+#include "jobs/formats/timeseries.hpp"
+#include "jobs/figures/qml.hpp"
+
+namespace runout::jobs {
+namespace fs = std::filesystem;
+
+namespace {
+
+// run.json of a depth-averaged run; continued_from: NaN for a run not continued from a checkpoint.
+void write_record(const std::string& path, const ResolvedScenario& s, const terrain::DemReport& dem_rep, const terrain::Grid& grid,
+                  const terrain::ReleaseReport& rel_rep, const engine::Sh2dResult& res, const RunSummary& sum, double continued_from,
+                  const HazardOutputs& outputs, int frames, const std::vector<terrain::ReleaseArea>& secondary) {
+  const auto& d = res.diag;
+  const bool continued = !std::isnan(continued_from);
+  v1::RunRecord rec = run_record_head(s, "depth-averaged");
+  record_inputs(rec, dem_rep, grid, rel_rep);
+  auto* gr = rec.mutable_grid();
+  gr->add_local_origin(grid.x_min + 0.5 * grid.nx * grid.dx);
+  gr->add_local_origin(grid.y_min + 0.5 * grid.ny * grid.dx);
+  auto* mb = rec.mutable_mass_balance();
+  mb->set_volume_initial_m3(d.volume_initial);
+  mb->set_volume_final_m3(d.volume_final);
+  mb->set_volume_outflow_m3(d.volume_outflow);
+  mb->set_relative_error(d.volume_error());
+  mb->set_volume_secondary_m3(d.volume_secondary);
+  for (std::size_t a = 0; a < secondary.size(); ++a) {
+    auto* sr = rec.mutable_release()->add_secondary();
+    sr->set_name(secondary[a].name);
+    sr->set_cells(int(std::count_if(secondary[a].h.begin(), secondary[a].h.end(), [](double h) { return h > 0; })));
+    sr->set_volume_m3(secondary[a].volume_m3);
+    if (a < d.secondary_time.size() && std::isfinite(d.secondary_time[a])) sr->set_released_at_s(d.secondary_time[a]);
+  }
+  auto* so = rec.mutable_solver();
+  so->set_steps(int(d.steps));
+  so->set_simulated_s(d.t);
+  so->set_stop(sum.stop);
+  if (continued) so->set_continued_from_t_s(continued_from);
+  so->set_max_speed_m_s(d.max_speed);
+  so->set_kinetic_energy_peak(d.kinetic_energy_peak);
+  so->set_positivity_limited(double(d.positivity_limited));
+  so->set_cell_updates(d.cell_updates);
+  so->set_mean_active_fraction(d.mean_active_fraction);
+  so->set_max_active_fraction(d.max_active_fraction);
+  for (const auto& n : sum.notes)  // what the reader of the maps must know (the release's own notes stay in release.notes)
+    if (std::find(rel_rep.notes.begin(), rel_rep.notes.end(), n) == rel_rep.notes.end()) rec.add_notes(n);
+  auto* re = rec.mutable_results();
+  record_hazard_results(s, sum, outputs, *re);
+  re->set_timeseries_frames(frames);
+  auto* ti = rec.mutable_timings_s();
+  ti->set_prepare(sum.seconds_prepare);
+  ti->set_run(sum.seconds_run);
+  ti->set_write(sum.seconds_write);
+  for (const auto& f : sum.files) rec.add_outputs(f);
+  rec.add_outputs("run.json");
+  write_run_record(path, rec);
+}
+
+// The secondary release areas as the engine takes them: the cells of each and their depths.
+std::vector<engine::SecondaryRelease> engine_secondary(const std::vector<terrain::ReleaseArea>& areas) {
+  std::vector<engine::SecondaryRelease> out;
+  for (const auto& a : areas) {
+    engine::SecondaryRelease sr{a.name, {}, {}};
+    for (std::size_t k = 0; k < a.h.size(); ++k)
+      if (a.h[k] > 0) {
+        sr.cells.push_back(k);
+        sr.depth.push_back(a.h[k]);
+      }
+    out.push_back(std::move(sr));
+  }
+  return out;
+}
+
+// The checkpoint a run continues from, checked against the scenario (its hash) and the grid.
+ShCheckpoint load_restart(const RunOptions& opt, const std::string& hash, const engine::Terrain2D& t, int tile) {
+  ShCheckpoint restart = read_sh_checkpoint(opt.restart_path);
+  if (restart.scenario_hash != hash)
+    throw ScenarioError("checkpoint " + opt.restart_path + " belongs to another scenario (its scenario hash " +
+                        restart.scenario_hash.substr(0, 12) + "... is not this one's " + hash.substr(0, 12) + "...)");
+  if (restart.state.nx != t.nx || restart.state.ny != t.ny || restart.state.tile != tile)
+    throw ScenarioError("checkpoint " + opt.restart_path + " is of another grid");
+  return restart;
+}
+
+// The grid from the terrain cache (`dir`) when it holds this DEM, area of interest and grid, else
+// prepared and saved there. The key is the request and each input file's path, size and
+// modification time: a file changed in place gets a new entry.
+terrain::Grid cached_grid(const terrain::DemRequest& q, const std::string& dir, terrain::DemReport& rep) {
+  if (dir.empty()) return terrain::prepare_grid(q, &rep);
+  Sha256 h;
+  h.update("runout terrain cache 1\n");
+  for (const auto& f : {q.dem_path, q.aoi_path}) {
+    std::error_code ec;
+    const auto canon = f.empty() ? fs::path() : fs::canonical(f, ec);
+    const auto size = f.empty() ? 0 : fs::file_size(f, ec);
+    const auto mtime = f.empty() ? fs::file_time_type() : fs::last_write_time(f, ec);
+    if (ec) return terrain::prepare_grid(q, &rep);  // the preparation names the file's problem
+    h.update(canon.string() + "\n" + std::to_string(size) + "\n" + std::to_string(mtime.time_since_epoch().count()) + "\n");
+  }
+  char b[200];
+  std::snprintf(b, sizeof b, "%.17g %.17g %.17g\n", q.resolution, q.memory_budget_bytes, q.bytes_per_cell);
+  h.update(q.dem_crs + "\n" + q.target_crs + "\n" + q.resampling + "\n" + b);
+  const std::string path = (fs::path(dir) / (h.hex() + ".grid")).string();
+  terrain::Grid g;
+  if (terrain::load_grid(path, g, rep)) return g;
+  g = terrain::prepare_grid(q, &rep);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  terrain::save_grid(path, g, rep);
+  return g;
+}
+
+// The run: the grid and releases, the engine from the initial state or a checkpoint, the time series.
+class DepthAveragedRun final : public EngineRun {
+ public:
+  DepthAveragedRun(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt);
+  engine::SteppingEngine& engine() override { return *engine_; }
+  engine::LoopSchedule schedule() const override;
+  engine::LoopHooks hooks() override;
+  RunSummary finish(engine::StopReason stop, const RunTimes& times) override;
+
+ private:
+  const ResolvedScenario& s_;
+  std::string out_dir_;
+  const RunOptions& opt_;
+  terrain::DemReport dem_rep_;
+  terrain::Grid grid_;
+  terrain::ReleaseReport rel_rep_;
+  std::vector<double> h0_;
+  OutputInputs output_inputs_;
+  engine::Terrain2D t_;
+  engine::Sh2dConfig cfg_;
+  std::vector<terrain::ReleaseArea> secondary_;
+  std::string hash_;  // the scenario's, in checkpoints
+  double continued_from_ = std::numeric_limits<double>::quiet_NaN();  // NaN: not continued
+  std::unique_ptr<TimeSeriesWriter> series_;
+  std::unique_ptr<engine::Sh2dEngine> engine_;
+  RunSummary sum_;
+};
+
+DepthAveragedRun::DepthAveragedRun(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt)
+    : s_(s), out_dir_(out_dir), opt_(opt) {
+  grid_ = cached_grid(s.dem, opt.terrain_cache_dir, dem_rep_);
+  h0_ = terrain::rasterize_releases(grid_, s.dem, s.releases, &rel_rep_);
+  output_inputs_ = read_output_inputs(s, grid_, h0_);  // a bad point, line or outline: refused before the run
+  sum_.nx = grid_.nx;
+  sum_.ny = grid_.ny;
+  sum_.dx = grid_.dx;
+  sum_.crs = grid_.crs_name;
+  sum_.release_area_m2 = rel_rep_.area_m2;
+  sum_.release_volume_m3 = rel_rep_.volume_m3;
+  sum_.notes = rel_rep_.notes;
+  t_ = engine_terrain(grid_);
+  cfg_ = s.config;
+  secondary_ = terrain::secondary_release_areas(grid_, s.dem, s.releases);
+  cfg_.secondary = engine_secondary(secondary_);
+
+  // Checkpoints: the solver's whole state between two steps, with the scenario's hash; the time
+  // series so far lies beside it (CHECKPOINT.timeseries.h5), so that a continued run's outputs are
+  // the whole run's.
+  continued = !opt.restart_path.empty();
+  if (!opt.checkpoint_path.empty() || continued) hash_ = scenario_hash(s);
+  if (!continued) {
+    engine_ = std::make_unique<engine::Sh2dEngine>(t_, cfg_, engine::state_from_normal_depth(t_, h0_));
+  } else {
+    const ShCheckpoint restart = load_restart(opt, hash_, t_, cfg_.tile);
+    try {
+      engine_ = std::make_unique<engine::Sh2dEngine>(t_, cfg_, restart.state);
+    } catch (const std::invalid_argument& e) {  // the engine's checks of the checkpoint
+      throw ScenarioError("checkpoint " + opt.restart_path + ": " + e.what());
+    }
+    loop = engine::Sh2dEngine::loop_state(restart.state);
+    continued_from_ = restart.state.t;
+    if (s.timeseries_interval > 0)
+      series_ = std::make_unique<TimeSeriesWriter>(out_dir, grid_, t_, cfg_.flow_threshold, opt.restart_path + ".timeseries.h5",
+                                                   restart.timeseries_frames);
+  }
+  if (s.timeseries_interval > 0 && !series_) series_ = std::make_unique<TimeSeriesWriter>(out_dir, grid_, t_, cfg_.flow_threshold);
+}
+
+engine::LoopSchedule DepthAveragedRun::schedule() const {
+  engine::LoopSchedule sc = engine::loop_schedule(cfg_);
+  sc.frame_interval = series_ ? s_.timeseries_interval : 0.0;
+  sc.checkpoint_interval = opt_.checkpoint_interval_s;
+  return sc;
+}
+
+engine::LoopHooks DepthAveragedRun::hooks() {
+  engine::LoopHooks h;
+  if (series_) h.frame = [this](double time) { series_->write(time, engine_->state()); };
+  h.checkpoint = [this](const engine::LoopState& st) {
+    // The frames first: a checkpoint never refers to frames that are not beside it.
+    if (series_) series_->save_copy(opt_.checkpoint_path + ".timeseries.h5");
+    write_sh_checkpoint(opt_.checkpoint_path, hash_, series_ ? series_->frames() : 0, engine_->checkpoint(st));
+  };
+  return h;
+}
+
+RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& times) {
+  RunSummary sum = std::move(sum_);
+  const engine::Sh2dResult res = engine_->finish(stop, loop);
+  sum.seconds_prepare = times.prepare;
+  sum.cpu_seconds = times.cpu;
+  int frames = 0;
+  if (series_) frames = series_->finish();
+  sum.seconds_run = times.run;
+  const auto& d = res.diag;
+  sum.volume_initial = d.volume_initial;
+  sum.volume_final = d.volume_final;
+  sum.volume_outflow = d.volume_outflow;
+  sum.volume_error = d.volume_error();
+  sum.t = d.t;
+  sum.steps = d.steps;
+  sum.stop = std::string(engine::to_string(d.stop));
+  sum.max_speed = d.max_speed;
+
+  hazard_figures(s_, grid_, h0_, res.hazard, sum);
+  require_finite_figures({{"final volume", d.volume_final}, {"outflow volume", d.volume_outflow}, {"maximum speed", d.max_speed},
+                          {"maximum depth", sum.max_depth}, {"kinetic-energy peak", d.kinetic_energy_peak}, {"runout", sum.runout_m}});
+
+  // Outputs.
+  const auto t2 = std::chrono::steady_clock::now();
+  const auto outputs = write_hazard_outputs(s_, grid_, h0_, res.hazard, output_inputs_, out_dir_, sum);
+  if (series_) {
+    // QGIS styles for the frames' GeoTIFFs: the depth and speed maps' classes, on any band chosen.
+    figures::write_qml_ramp((fs::path(out_dir_) / "timeseries_depth.qml").string(), figures::hazard_palette("max_depth"));
+    figures::write_qml_ramp((fs::path(out_dir_) / "timeseries_speed.qml").string(), figures::hazard_palette("max_speed"));
+    for (const char* f : {"timeseries.h5", "timeseries.xmf", "timeseries_depth.tif", "timeseries_depth.qml", "timeseries_speed.tif",
+                          "timeseries_speed.qml"})
+      sum.files.push_back(f);
+  }
+  sum.seconds_write = std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
+
+  const std::string record = (fs::path(out_dir_) / "run.json").string();
+  if (!opt_.iseesnow_id.empty())
+    for (auto& f : write_iseesnow(s_, opt_.iseesnow_id, out_dir_, grid_, res, sum.cpu_seconds)) sum.files.push_back(std::move(f));
+  write_record(record, s_, dem_rep_, grid_, rel_rep_, res, sum, continued_from_, outputs, frames, secondary_);
+  sum.files.push_back("run.json");
+  return sum;
+}
+
+}  // namespace
+
+std::unique_ptr<EngineRun> prepare_depth_averaged(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt) {
+  return std::make_unique<DepthAveragedRun>(s, out_dir, opt);
+}
+
+}  // namespace runout::jobs
