@@ -169,12 +169,12 @@ class Solver {
   template <Basal B>
   void update_cells(int tt, TileWork& w, const CellBox& c, double t, double dt);
   template <Basal B>
-  void update_cell(TileWork& w, int i, int j, int i0, double dt, double& out);
+  void update_cell(TileWork& w, int i, int j, int i0, double t1, double dt, double& out);
   template <Basal B>
-  void update_row(TileWork& w, int j, int ia, int ib, int i0, double dt);
+  void update_row(TileWork& w, int j, int ia, int ib, int i0, double t1, double dt);
   template <Basal B, bool Row = false>
-  void update_run(TileWork& w, int j, int ia, int ib, int i0, double dt, double sw, double se, double ss, double sn,
-                  double smu, double swt);
+  void update_run(TileWork& w, int j, int ia, int ib, int i0, double t1, double dt, double sw, double se, double ss,
+                  double sn, double smu, double swt);
 
   const Terrain2D& t_;
   const Sh2dConfig& cfg_;

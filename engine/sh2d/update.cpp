@@ -50,7 +50,7 @@ long Solver::positivity(TileWork& w, int i0, int i1, int j0, int j1, double dt) 
 // the face fluxes scaled by the sending cells' draining factors (1 beyond the domain's edge), the
 // outflow through its edges into `out`, then the kernels of the row kernel.
 template <Basal B>
-void Solver::update_cell(TileWork& w, int i, int j, int i0, double dt, double& out) {
+void Solver::update_cell(TileWork& w, int i, int j, int i0, double t1, double dt, double& out) {
   const std::size_t q = w.at(i, j), x = w.fx(i, j), y = w.fy(i, j);
   const double rc = w.r[q];
   const double rw = i > 0 ? w.r[q - 1] : 1.0, re = i < nx_ - 1 ? w.r[q + 1] : 1.0;
@@ -71,7 +71,7 @@ void Solver::update_cell(TileWork& w, int i, int j, int i0, double dt, double& o
     smu = p.mu;
     swt = start_weight(p.q);
   }
-  update_run<B>(w, j, i, i + 1, i0, dt, sw, se, ss, sn, smu, swt);
+  update_run<B>(w, j, i, i + 1, i0, t1, dt, sw, se, ss, sn, smu, swt);
 }
 
 // The update of cells (ia..ib-1, j), all inside the domain and away from its edges, in a loop the
@@ -80,16 +80,16 @@ void Solver::update_cell(TileWork& w, int i, int j, int i0, double dt, double& o
 // hazard maps and the tile sums. B: the friction's kernel; without Voellmy's drag its factor would be
 // exactly 1 and its square root is skipped.
 template <Basal B>
-RUNOUT_SIMD_CLONES void Solver::update_row(TileWork& w, int j, int ia, int ib, int i0, double dt) {
-  update_run<B, true>(w, j, ia, ib, i0, dt, 0, 0, 0, 0, 0, 0);
+RUNOUT_SIMD_CLONES void Solver::update_row(TileWork& w, int j, int ia, int ib, int i0, double t1, double dt) {
+  update_run<B, true>(w, j, ia, ib, i0, t1, dt, 0, 0, 0, 0, 0, 0);
 }
 
 // The update of cells (ia..ib-1, j): Row, the draining factors from the work space's neighbours and
 // the start/stop law's parts from start_terms; else one cell with the factors sw, se, ss, sn and
 // the parts smu, swt given.
 template <Basal B, bool Row>
-RUNOUT_KERNEL void Solver::update_run(TileWork& w, int j, int ia, int ib, int i0, double dt, double sw1, double se1,
-                               double ss1, double sn1, double smu1, double swt1) {
+RUNOUT_KERNEL void Solver::update_run(TileWork& w, int j, int ia, int ib, int i0, double t1, double dt, double sw1,
+                                      double se1, double ss1, double sn1, double smu1, double swt1) {
   const std::size_t k0 = idx(ia, j), q0 = w.at(ia, j);
   const std::ptrdiff_t bw = w.bw;
   const double *__restrict H0 = &H_[cur_][k0], *__restrict HU0 = &HU_[cur_][k0], *__restrict HV0 = &HV_[cur_][k0];
@@ -98,7 +98,7 @@ RUNOUT_KERNEL void Solver::update_run(TileWork& w, int j, int ia, int ib, int i0
   const double *__restrict cc = &geo_.c[k0], *__restrict bx = &geo_.bx[k0], *__restrict by = &geo_.by[k0];
   const double *__restrict hxx = &geo_.hxx[k0], *__restrict hxy = &geo_.hxy[k0], *__restrict hyy = &geo_.hyy[k0];
   double *__restrict md = &hz_.max_depth[k0], *__restrict ms = &hz_.max_speed[k0];
-  double* __restrict mp = &hz_.max_pressure[k0];
+  double *__restrict mp = &hz_.max_pressure[k0], *__restrict at = &hz_.arrival_time[k0];
   const double *__restrict Hp = &w.Hp[q0], *__restrict Up = &w.Up[q0], *__restrict Vp = &w.Vp[q0];
   const double *__restrict Ps = &w.Ps[q0], *__restrict r = &w.r[q0];
   const std::size_t x0 = w.fx(ia, j), y0 = w.fy(ia, j);
@@ -145,12 +145,13 @@ RUNOUT_KERNEL void Solver::update_run(TileWork& w, int j, int ia, int ib, int i0
   // The maps, in a loop of their own: inside the one above the compiler splits the paths of flowing
   // and resting cells and turns the maxima into conditional stores, which blocks vectorisation.
   // Speeds and pressures are >= 0, so the maximum with the 0 of a resting cell leaves them as they
-  // are. The arrival time is set in update's sum loop.
+  // are. The arrival time t1 where a cell flows for the first time, as a select (stored always).
 #pragma omp simd
   for (int m = 0; m < n; ++m) {
     md[m] = vmax(md[m], oh[m]);
     ms[m] = vmax(ms[m], osp[m]);
     mp[m] = vmax(mp[m], opr[m]);
+    at[m] = std::isnan(at[m]) && oh[m] > thr ? t1 : at[m];
   }
 }
 
@@ -168,7 +169,7 @@ template <Basal B>
 void Solver::update_cells(int tt, TileWork& w, const CellBox& c, double t, double dt) {
   const int i0 = c.i0, i1 = c.i1, j0 = c.j0, j1 = c.j1;
   const auto &H1 = H_[1 - cur_], &HU1 = HU_[1 - cur_], &HV1 = HV_[1 - cur_];
-  double out = 0, travel = 0, mass = 0, ke = 0, vmax = 0, rate = 0;
+  double out = 0, travel = 0, mass = 0, ke = 0, top = 0, rate = 0;
   bool wet = false;
   for (int j = j0; j < j1; ++j) {
     // The row's cells: the row kernel away from the domain's edges, the general function elsewhere.
@@ -183,33 +184,37 @@ void Solver::update_cells(int tt, TileWork& w, const CellBox& c, double t, doubl
           const std::size_t q = w.at(ia, j);
           start_terms(ib - ia, idx(ia, j), &w.Hp[q], &w.Up[q], &w.Vp[q], w);
         }
-        update_row<B>(w, j, ia, ib, i0, dt);
+        update_row<B>(w, j, ia, ib, i0, t + dt, dt);
         i = ib - 1;
         continue;
       }
-      if (w.has_outside && outside(i, j)) continue;  // never holds material (both buffers stay 0)
-      update_cell<B>(w, i, j, i0, dt, out);
+      if (w.has_outside && outside(i, j)) {  // never holds material (both buffers stay 0)
+        w.cell_ke[i - i0] = w.cell_speed[i - i0] = w.cell_rate[i - i0] = 0.0;
+        continue;
+      }
+      update_cell<B>(w, i, j, i0, t + dt, dt, out);
     }
-    // The tile's sums, cell by cell in a fixed order.
-    for (int i = i0; i < i1; ++i) {
-      const std::size_t k = idx(i, j);
-      if (w.has_outside && outside(i, j)) continue;
-      if (cfg_.track_travel) travel += dt * std::sqrt(HU1[k] * HU1[k] + HV1[k] * HV1[k]);
-      mass += H1[k];
-      ke += w.cell_ke[i - i0];  // the stopping rule sees every cell
-      vmax = std::max(vmax, w.cell_speed[i - i0]);
-      rate = std::max(rate, w.cell_rate[i - i0]);
-      wet = wet || H1[k] > cfg_.activation_depth;
-      // The arrival time of a cell that flows for the first time (the cell kernels leave it).
-      if (std::isnan(hz_.arrival_time[k]) && H1[k] * geo_.c[k] > cfg_.flow_threshold)
-        hz_.arrival_time[k] = t + dt;
+    // The tile's sums, cell by cell in a fixed order; a cell outside the domain adds exact zeros.
+    const std::size_t k = idx(i0, j);
+    const int n = i1 - i0;
+    const double *h1 = &H1[k], *hu1 = &HU1[k], *hv1 = &HV1[k];
+    if (cfg_.track_travel)
+      for (int m = 0; m < n; ++m)
+        if (!(w.has_outside && outside(i0 + m, j))) travel += dt * std::sqrt(hu1[m] * hu1[m] + hv1[m] * hv1[m]);
+    const double act = cfg_.activation_depth;
+    for (int m = 0; m < n; ++m) {
+      mass += h1[m];
+      ke += w.cell_ke[m];  // the stopping rule sees every cell
+      top = sh2d_detail::vmax(top, w.cell_speed[m]);
+      rate = sh2d_detail::vmax(rate, w.cell_rate[m]);
+      wet = wet || h1[m] > act;
     }
   }
   tile_out_[tt] += out;
   tile_travel_[tt] += travel;
   tile_mass_[tt] = mass;
   tile_ke_[tt] = ke;
-  tile_speed_[tt] = vmax;
+  tile_speed_[tt] = top;
   tile_rate_[tt] = rate;
   tile_wet_[tt] = wet;
 }
