@@ -79,33 +79,37 @@ void Solver::faces(TileWork& w, int ci0, int ci1, int cj0, int cj1) const {
     w.Fy1[k] = g.f2;
     w.Fy2[k] = g.f1;
   };
-  // Faces between two cells of the domain take the row kernel where every tile around is active and
-  // no cell is outside; the domain's edges and the rest the general function.
-  const bool rows = w.all_active && !w.has_outside;
-  const int xa = std::max(ci0, 1), xb = std::min(ci1, nx_ - 1);  // x faces [xa, xb] between two cells
-  for (int j = cj0; j < cj1; ++j) {
-    if (rows && xb >= xa) {
-      const std::size_t q = w.at(xa, j), f = w.fx(xa, j);
-      face_row(xb - xa + 1, 1, &w.Hp[q], &w.sHx[q], &w.Up[q], &w.sux[q], &w.Vp[q], &w.svx[q], &w.Pxx[q], &w.Pxy[q],
-               &w.held[q], &w.Fx0[f], &w.Fx1[f], &w.Fx2[f]);
-    }
+  // A face takes the row kernel where both its cells lie in the domain (inside its edges, neither
+  // outside it) and every tile around is active: there the general function computes the same flux.
+  auto plain = [&](int ia, int ja, int ib, int jb) {
+    return w.all_active && !(w.has_outside && (outside(ia, ja) || outside(ib, jb)));
+  };
+  for (int j = cj0; j < cj1; ++j)  // x faces: the face left of cell (i, j)
     for (int i = ci0; i <= ci1; ++i) {
-      if (rows && i == xa && xb >= xa) i = xb + 1;  // done above
-      if (i > ci1) break;
-      const bool west = i == 0, east = i == nx_;
-      put_x(i, j, face<true>(w, i - 1, j, i, j, west, east, cfg_.west, cfg_.east));
+      if (i > 0 && i < nx_ && plain(i - 1, j, i, j)) {
+        int e = i + 1;  // a run of faces for the row kernel
+        while (e <= ci1 && e < nx_ && plain(e - 1, j, e, j)) ++e;
+        const std::size_t q = w.at(i, j), f = w.fx(i, j);
+        face_row(e - i, 1, &w.Hp[q], &w.sHx[q], &w.Up[q], &w.sux[q], &w.Vp[q], &w.svx[q], &w.Pxx[q], &w.Pxy[q],
+                 &w.held[q], &w.Fx0[f], &w.Fx1[f], &w.Fx2[f]);
+        i = e - 1;
+        continue;
+      }
+      put_x(i, j, face<true>(w, i - 1, j, i, j, i == 0, i == nx_, cfg_.west, cfg_.east));
     }
-  }
-  for (int j = cj0; j <= cj1; ++j) {  // y faces: the face below row j
-    const bool south = j == 0, north = j == ny_;
-    if (rows && !south && !north) {
-      const std::size_t q = w.at(ci0, j), f = w.fy(ci0, j);
-      face_row(ci1 - ci0, w.bw, &w.Hp[q], &w.sHy[q], &w.Vp[q], &w.svy[q], &w.Up[q], &w.suy[q], &w.Pyy[q], &w.Pxy[q],
-               &w.held[q], &w.Fy0[f], &w.Fy2[f], &w.Fy1[f]);
-      continue;
+  for (int j = cj0; j <= cj1; ++j)  // y faces: the face below cell (i, j)
+    for (int i = ci0; i < ci1; ++i) {
+      if (j > 0 && j < ny_ && plain(i, j - 1, i, j)) {
+        int e = i + 1;
+        while (e < ci1 && plain(e, j - 1, e, j)) ++e;
+        const std::size_t q = w.at(i, j), f = w.fy(i, j);
+        face_row(e - i, w.bw, &w.Hp[q], &w.sHy[q], &w.Vp[q], &w.svy[q], &w.Up[q], &w.suy[q], &w.Pyy[q], &w.Pxy[q],
+                 &w.held[q], &w.Fy0[f], &w.Fy2[f], &w.Fy1[f]);
+        i = e - 1;
+        continue;
+      }
+      put_y(i, j, face<false>(w, i, j - 1, i, j, j == 0, j == ny_, cfg_.south, cfg_.north));
     }
-    for (int i = ci0; i < ci1; ++i) put_y(i, j, face<false>(w, i, j - 1, i, j, south, north, cfg_.south, cfg_.north));
-  }
 }
 
 }  // namespace runout::engine::sh2d_detail

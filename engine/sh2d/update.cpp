@@ -1,10 +1,10 @@
 // The positivity limiter and the update of the depth-averaged 2D scheme: the draining factors, the
 // conservative update with the sources and friction at the half step (the point kernels in
 // kernels.hpp), the hazard maps and the tile's sums. The update runs as a branch-free row kernel
-// (vectorised); cells at the domain's edges and next to cells outside it take the general cell
-// function, which calls the same kernels. The tile's sums are taken afterwards in a scalar loop over
-// the cells in their fixed order, so that they are the same bits for any thread count and any
-// vector width.
+// (vectorised) for runs of cells away from the domain's edges and from cells outside it; the
+// others take the general cell function, which calls the same kernels. The tile's sums are taken
+// afterwards in a scalar loop over the cells in their fixed order, so that they are the same bits
+// for any thread count and any vector width.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -172,20 +172,20 @@ void Solver::update_cells(int tt, TileWork& w, const CellBox& c, double t, doubl
   double out = 0, travel = 0, mass = 0, ke = 0, top = 0, rate = 0;
   bool wet = false;
   for (int j = j0; j < j1; ++j) {
-    // The row's cells: the row kernel away from the domain's edges, the general function elsewhere.
-    int ia = i0, ib = i0;
-    if (!w.has_outside && j > 0 && j < ny_ - 1) {
-      ia = std::max(i0, 1);
-      ib = std::max(ia, std::min(i1, nx_ - 1));
-    }
+    // The row's cells: the row kernel for runs of cells away from the domain's edges and from cells
+    // outside it, the general function for the others (the same kernels, the same bits).
+    const bool inner = j > 0 && j < ny_ - 1;
+    const int fb = std::min(i1, nx_ - 1);
     for (int i = i0; i < i1; ++i) {
-      if (i == ia && ib > ia) {
+      if (inner && i > 0 && i < fb && !near_outside(idx(i, j))) {
+        int e = i + 1;  // a run of cells for the row kernel
+        while (e < fb && !near_outside(idx(e, j))) ++e;
         if constexpr (B == Basal::hysteresis) {
-          const std::size_t q = w.at(ia, j);
-          start_terms(ib - ia, idx(ia, j), &w.Hp[q], &w.Up[q], &w.Vp[q], w);
+          const std::size_t q = w.at(i, j);
+          start_terms(e - i, idx(i, j), &w.Hp[q], &w.Up[q], &w.Vp[q], w);
         }
-        update_row<B>(w, j, ia, ib, i0, t + dt, dt);
-        i = ib - 1;
+        update_row<B>(w, j, i, e, i0, t + dt, dt);
+        i = e - 1;
         continue;
       }
       if (w.has_outside && outside(i, j)) {  // never holds material (both buffers stay 0)
