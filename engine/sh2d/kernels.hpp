@@ -87,7 +87,7 @@ RUNOUT_KERNEL double basal_mu(const BasalFriction& fr, double h, double speed, d
 // The start/stop law's parts of a cell at depth H and velocity (U, V): mu without the start/stop
 // term and q (engine/friction/law.hpp flow_mu_parts), with the load of basal_mu.
 RUNOUT_KERNEL MuParts start_parts(const StepConstants& k, double H, double U, double V, double c, double bx, double by,
-                           double hxx, double hxy, double hyy) {
+                                  double hxx, double hxy, double hyy) {
   const double gn = normal_load(U, V, hxx, hxy, hyy, k.g, k.qcap);
   return flow_mu_parts(k.fr, H * c, speed3(bx, by, U, V), c * friction_load(k, gn));
 }
@@ -97,8 +97,8 @@ RUNOUT_KERNEL MuParts start_parts(const StepConstants& k, double H, double U, do
 RUNOUT_KERNEL double resistance(double H, double mu, double c, double load) { return H * mu * c * load; }
 
 // Coulomb friction as a bounded impulse against momentum of 3D magnitude m3 (engine/rheology.hpp
-// apply_friction, as selects): the factor that shrinks it, never reversing it; `rest` where the
-// impulse stops it (the factor is then not used).
+// apply_friction, as selects): the factor that shrinks it, never reversing it; `stopped` where the
+// impulse brings it to rest (the momentum is then 0 and the factor not used).
 RUNOUT_KERNEL double friction_factor(double m3, double impulse) { return 1.0 - impulse / m3; }
 RUNOUT_KERNEL bool stopped(double m3, double impulse) { return m3 <= impulse; }
 
@@ -119,7 +119,7 @@ struct Slopes {
 // only between wet neighbours.
 template <Limiter L>
 RUNOUT_KERNEL Slopes limited_slopes(const double* H, const double* U, const double* V, std::ptrdiff_t k, std::ptrdiff_t l,
-                             std::ptrdiff_t r, std::ptrdiff_t b, std::ptrdiff_t a, bool tx, bool ty, double dry) {
+                                    std::ptrdiff_t r, std::ptrdiff_t b, std::ptrdiff_t a, bool tx, bool ty, double dry) {
   const double h = H[k], u = U[k], v = V[k];
   const bool wx = tx && vmin(H[k + l], H[k + r]) > dry, wy = ty && vmin(H[k + b], H[k + a]) > dry;
   const double sHx = limited_slope(L, h - H[k + l], H[k + r] - h), sHy = limited_slope(L, h - H[k + b], H[k + a] - h);
@@ -141,8 +141,8 @@ struct Predicted {
 // basal_mu, the start/stop law's parts smu, sw), and Voellmy's drag implicitly (B).
 template <Basal B>
 RUNOUT_KERNEL Predicted predict(const StepConstants& k, double H, double U, double V, double HU, double HV, Slopes& s,
-                         double Pxx, double Pxy, double Pyy, double c, double bx, double by, double hxx, double hxy,
-                         double hyy, double hx, double hy, double dt, double gxd, double smu, double sw) {
+                                double Pxx, double Pxy, double Pyy, double c, double bx, double by, double hxx, double hxy,
+                                double hyy, double hx, double hy, double dt, double gxd, double smu, double sw) {
   const double gn = normal_load(U, V, hxx, hxy, hyy, k.g, k.qcap);
   const double acc = -c * c * gn;  // gravity + normal reaction per unit volume
   const bool wet = H > k.dry;
@@ -175,7 +175,7 @@ RUNOUT_KERNEL Predicted predict(const StepConstants& k, double H, double U, doub
 // The state on one side of a face from its cell's predicted values and slopes in face coordinates:
 // half = +0.5 on the cell's upper face, -0.5 on its lower face.
 RUNOUT_KERNEL FaceState face_side(double Hp, double sH, double un, double sun, double ut, double sut, double Pnn,
-                           double Pnt, double half) {
+                                  double Pnt, double half) {
   return FaceState{Hp + half * sH, un + half * sun, ut + half * sut, Pnn, Pnt};
 }
 
@@ -228,7 +228,7 @@ RUNOUT_KERNEL double upwind_blend(double f0, double rl, double rr) {
 // A conserved quantity after one step from its fluxes through the faces west, east, south, north,
 // scaled by the factors sw, se, ss, sn (lx = dt / dx, ly = dt / dy).
 RUNOUT_KERNEL double flux_update(double Q0, double lx, double ly, double fw, double fe, double fs, double fn, double sw,
-                          double se, double ss, double sn) {
+                                 double se, double ss, double sn) {
   return Q0 - lx * (fe * se - fw * sw) - ly * (fn * sn - fs * ss);
 }
 
@@ -243,8 +243,8 @@ struct NewState {
 // state, then Voellmy's drag implicitly in the speed (gxd = dt g / xi). Dry cells keep no momentum.
 template <Basal B>
 RUNOUT_KERNEL NewState update_sources(const StepConstants& k, double H, double MU, double MV, double Hp, double Up,
-                               double Vp, double c, double bx, double by, double hxx, double hxy, double hyy,
-                               double dt, double gxd, double smu, double sw) {
+                                      double Vp, double c, double bx, double by, double hxx, double hxy, double hyy,
+                                      double dt, double gxd, double smu, double sw) {
   H = H < 0 ? 0.0 : H;  // round-off only: the limiter bounds the outflow by the content
   const double gn = normal_load(Up, Vp, hxx, hxy, hyy, k.g, k.qcap);
   const double drive = -Hp * c * c * gn;
@@ -276,7 +276,7 @@ struct CellTerms {
   double h, pressure, ke, speed, rate;
 };
 RUNOUT_KERNEL CellTerms cell_terms(const NewState& s, double c, double Ps, double dx, double dy, double threshold,
-                            double density) {
+                                   double density) {
   const double h = s.H * c, sp2 = s.sp * s.sp;
   const bool flowing = h > threshold;
   return CellTerms{h, flowing ? density * sp2 : 0.0, 0.5 * s.H * sp2, flowing ? s.sp : 0.0,
