@@ -1,9 +1,12 @@
 #pragma once
-// The depth-averaged 2D solver's internals (engine/sh2d.hpp is the interface): the tile work space,
-// the face types and the Solver. solver.cpp holds the set-up, the step over the active tiles and
-// checkpoints (the time loop is engine/stepping.cpp's);
-// step.cpp the first half of one tile's step (predictor, face fluxes), update.cpp the second
-// (positivity limiter, update, hazard maps, tile sums).
+// The depth-averaged 2D solver's internals (engine/sh2d.hpp is the interface): the tile work space
+// and the Solver. The scheme's equations are point kernels of one cell or face (kernels.hpp), which
+// the general cell loops and the vectorised row kernels share. solver.cpp holds the set-up, the step
+// over the active tiles and checkpoints (the time loop is engine/stepping.cpp's); tile.cpp one tile's
+// step (the cells it computes, the order of the stages); predictor.cpp the reconstruction and the
+// predictor to the half step (with the earth pressure and the start/stop law's terms); fluxes.cpp the
+// face fluxes with the boundary and outflow ghosts; update.cpp the positivity limiter, the update with
+// its sources and friction, the hazard maps and the tile sums; surface.cpp the surface geometry.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -11,6 +14,7 @@
 #include <vector>
 
 #include "engine/sh2d.hpp"
+#include "engine/sh2d/kernels.hpp"
 
 // The vectorisable kernels are compiled twice, for AVX2 (four doubles per instruction) and for the
 // baseline x86-64 (two), and the loader picks the one the CPU supports.
@@ -22,31 +26,10 @@
 
 namespace runout::engine::sh2d_detail {
 
-// std::max and std::min by value (the same selects): the kernels take them of locals, and a
-// reference to a local in an OpenMP simd loop keeps the compiler from vectorising it.
-inline double vmax(double a, double b) { return a < b ? b : a; }
-inline double vmin(double a, double b) { return b < a ? b : a; }
-
 // A box of cells [i0, i1) x [j0, j1).
 struct CellBox {
   int i0, i1, j0, j1;
   bool empty() const { return i1 <= i0 || j1 <= j0; }
-};
-
-struct Face {
-  double f0, f1, f2;
-};
-
-// The basal friction a kernel computes, a template parameter (no branch in the loops): a constant mu
-// with or without Voellmy's drag, or mu(h, Fr) with or without the start/stop term
-// (engine/friction/law.hpp).
-enum class Basal { coulomb, voellmy, flow, hysteresis };
-constexpr bool is_flow(Basal b) { return b == Basal::flow || b == Basal::hysteresis; }
-
-// A reconstructed state on one side of a face, in face coordinates: depth, normal and tangential
-// velocity, and the pressure coefficients Pi_nn, Pi_nt of that side's cell.
-struct FaceState {
-  double H, un, ut, Pnn, Pnt;
 };
 
 // Work space of one tile's step, private to the thread computing it. A tile's step runs the whole
@@ -83,6 +66,31 @@ struct TileWork {
   std::size_t at(int i, int j) const { return std::size_t(j - bj0) * bw + (i - bi0); }
   std::size_t fx(int i, int j) const { return std::size_t(j - bj0) * (bw + 1) + (i - bi0); }
   std::size_t fy(int i, int j) const { return std::size_t(j - bj0) * bw + (i - bi0); }
+};
+
+// Where the predictor writes a run of cells of the box, from box index q on.
+struct PredictorOut {
+  double *sHx, *sux, *svx, *sHy, *suy, *svy, *Hp, *Up, *Vp, *Pxx, *Pxy, *Pyy, *Ps, *held;
+  RUNOUT_KERNEL PredictorOut(TileWork& w, std::size_t q)
+      : sHx(&w.sHx[q]), sux(&w.sux[q]), svx(&w.svx[q]), sHy(&w.sHy[q]), suy(&w.suy[q]), svy(&w.svy[q]), Hp(&w.Hp[q]),
+        Up(&w.Up[q]), Vp(&w.Vp[q]), Pxx(&w.Pxx[q]), Pxy(&w.Pxy[q]), Pyy(&w.Pyy[q]), Ps(&w.Ps[q]), held(&w.held[q]) {}
+  RUNOUT_KERNEL void put(std::ptrdiff_t t, const Slopes& s, const Predicted& p, double pxx, double pxy, double pyy,
+                         double ps) const {
+    sHx[t] = s.Hx;
+    sux[t] = s.ux;
+    svx[t] = s.vx;
+    sHy[t] = s.Hy;
+    suy[t] = s.uy;
+    svy[t] = s.vy;
+    Hp[t] = p.Hp;
+    Up[t] = p.Up;
+    Vp[t] = p.Vp;
+    Pxx[t] = pxx;
+    Pxy[t] = pxy;
+    Pyy[t] = pyy;
+    Ps[t] = ps;
+    held[t] = p.held;
+  }
 };
 
 class Solver {
@@ -131,37 +139,11 @@ class Solver {
     pyy = a * ddy * ddy + b * ddx * ddx;
   }
 
-  // The normal reaction keeps the flow on the surface and always includes Q: it turns the velocity
-  // in curved terrain without loss of energy. The option `curvature` only decides whether the
-  // centrifugal part raises the basal friction (as in eq. 3.48), as in the 1D solver.
-  double normal_g(std::size_t k, double U, double V) const {
-    const double Q = std::min(qcap_, U * U * geo_.hxx[k] + 2 * U * V * geo_.hxy[k] + V * V * geo_.hyy[k]);
-    return std::max(0.0, g_ + Q);
-  }
-  // Coulomb resistance per horizontal area (magnitude of the basal friction force, 3D):
-  // mu N / cos(theta) with N / rho = h c (g + Q)_+ = H c^2 (g + Q)_+; gn = (g + Q)_+.
-  double resistance(std::size_t k, double H, double gn, double mu) const {
-    const double load = cfg_.curvature ? gn : g_;
-    return H * mu * geo_.c[k] * load;
-  }
-  // The friction coefficient of cell k at depth H and velocity (U, V) with normal load gn: mu_, or
-  // mu(h, Fr) with h = H c, the 3D speed and g_n = c (g + Q)_+ (c g without curvature), the load of
-  // resistance(), so that Fr = |u| / sqrt(g_n h) uses the friction's own normal stress.
-  template <Basal B>
-  double basal_mu(std::size_t k, double H, double U, double V, double gn) const {
-    if constexpr (is_flow(B)) {
-      const double c = geo_.c[k], load = cfg_.curvature ? gn : g_;
-      return flow_mu<B == Basal::hysteresis>(fr_, H * c, m3(k, U, V), c * load);
-    } else {
-      return mu_;
-    }
-  }
+  // The constants of a step the point kernels read.
+  StepConstants constants() const { return StepConstants{g_, qcap_, cfg_.dry_depth, cfg_.curvature ? 1.0 : 0.0, fr_}; }
   // sqrt(Pxx)/dx + sqrt(Pyy)/dy: the gravity-wave part of the CFL rate, per sqrt(H).
   double wave_factor(double pxx, double pyy) const { return std::sqrt(pxx) / t_.dx + std::sqrt(pyy) / t_.dy; }
-  double m3(std::size_t k, double MU, double MV) const {
-    const double w = geo_.bx[k] * MU + geo_.by[k] * MV;
-    return std::sqrt(MU * MU + MV * MV + w * w);
-  }
+  double m3(std::size_t k, double MU, double MV) const { return speed3(geo_.bx[k], geo_.by[k], MU, MV); }
 
   // A step's parts (solver.cpp): its length, one step of every active tile, the guard on the state.
   double next_dt(double t_end) const;
@@ -193,9 +175,12 @@ class Solver {
   template <Basal B>
   void update_cells(int tt, TileWork& w, const CellBox& c, double t, double dt);
   template <Basal B>
-  void update_cell(TileWork& w, int i, int j, int i0, double t, double dt, double& out);
+  void update_cell(TileWork& w, int i, int j, int i0, double t1, double dt, double& out);
   template <Basal B>
-  void update_row(TileWork& w, int j, int ia, int ib, int i0, double dt);
+  void update_row(TileWork& w, int j, int ia, int ib, int i0, double t1, double dt);
+  template <Basal B, bool Row = false>
+  void update_run(TileWork& w, int j, int ia, int ib, int i0, double t1, double dt, double sw, double se, double ss,
+                  double sn, double smu, double swt);
 
   const Terrain2D& t_;
   const Sh2dConfig& cfg_;
