@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "engine/vof/bc/boundary.hpp"
+#include "engine/vof/config.hpp"
 #include "engine/vof/fields.hpp"
 #include "engine/vof/fv/ops.hpp"
 #include "engine/vof/hydrostatics.hpp"

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "engine/vof/fields.hpp"
-#include "engine/vof/solver.hpp"
+#include "engine/vof/config.hpp"
 
 namespace runout::engine::vof {
 

@@ -8,6 +8,7 @@
 // a closed domain the level fixed at its highest cell.
 #include "engine/vof/active_region.hpp"
 #include "engine/vof/bc/boundary.hpp"
+#include "engine/vof/config.hpp"
 #include "engine/vof/fields.hpp"
 #include "engine/vof/fv/fv_matrix.hpp"
 #include "engine/vof/linear/petsc.hpp"

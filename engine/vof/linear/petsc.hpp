@@ -9,7 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/vof/solver.hpp"
+#include "engine/vof/config.hpp"
+#include "engine/vof/state.hpp"
 
 namespace runout::engine::vof {
 

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "engine/vof/error.hpp"
 #include "engine/vof/linear/petsc.hpp"
 
 namespace runout::engine::vof {
