@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "engine/vof/fv/grad.hpp"
 #include "engine/vof/fv/parallel.hpp"
 
 namespace runout::engine::vof {
@@ -230,20 +231,12 @@ void PressureEqn::correct_flux_and_velocity(Fields& F, const MomentumEqn& UEqn, 
 // weight's gradient there).
 void PressureEqn::pressure_gradient(const Fields& F, const CellField<double>& p, CellField<Vec>& out) const {
   const Hydrostatics& hs = bc_ctx_.hydrostatics;
-  const CellFaces& cf = region_.cell_faces();
-  parallel_each(region_.cells, [&](int c) {
-    Vec sum{};
-    for (int f : cf[c]) {
-      if (open_[f] != 0 || !internal(m_, f)) {  // an opening out of c, or a wall: p carried to the face
-        const double pf = p[c] + F.rho[c] * (hs.ghf(f) - hs.gh(c));
-        sum = open_[f] != 0 ? sum + (double(open_[f]) * pf) * m_.Sf[f] : sum + pf * m_.Sf[f];
-      } else {
-        const double pf = interpolate(m_, f, p);
-        sum = m_.owner[f] == c ? sum + pf * m_.Sf[f] : sum - pf * m_.Sf[f];
-      }
-    }
-    out[c] = (1.0 / m_.volume[c]) * sum;
-  });
+  const auto face_p = [&](int f, int c) {
+    // An opening out of c, or a wall: p carried to the face.
+    if (open_[f] != 0 || !internal(m_, f)) return carried_hydrostatically(p[c], F.rho[c], hs.gh(c), hs.ghf(f));
+    return interpolate(m_, f, p);
+  };
+  grad(m_, region_.cell_faces(), region_.cells, face_p, out);
 }
 
 // The face force's non-orthogonal part from the latest pressure, -rAf (non_orth . grad(p)_f -
