@@ -26,34 +26,36 @@ PressureEqn::PressureEqn(const Mesh& m, const VofConfig& cfg, const BcContext& b
 
 void PressureEqn::make_system() { solver_.make_system(region_.n_active, region_.pressure_nonzeros()); }
 
-int PressureEqn::correct(Fields& F, const MomentumEqn& UEqn, bool initial, bool reuse, bool final, double t) {
-  solver_.set_tolerance(final);
+int PressureEqn::correct(Fields& F, const MomentumEqn& UEqn, CorrectorPass pass, double t) {
+  solver_.set_tolerance(pass.final);
   const bool closed = !bcs_.has_opening() && region_.whole_mesh();  // no opening anywhere: the level is free
   // The consistent coupling (VofConfig::consistent): the pressure equation and the correction take
   // 1/(A - H1); the part of the last pressure's force that 1/A would have carried, (1/A -
   // 1/(A - H1)) F_old, stays in the predicted flux and velocity (SIMPLEC).
-  const bool cons = cfg_.consistent && !initial;
+  const bool cons = cfg_.consistent && !pass.initial;
   const Coupling k{cons, cons ? UEqn.rAtUf : UEqn.rAUf, UEqn};
   // Within a step 1/A, the density and the active region do not change (reuse), and with them
   // neither which faces are openings, the Laplacian coefficients, the buoyancy fluxes nor the
   // outside pressures: those are set by the step's first call. Every call forms the predicted flux
   // from the correctors' H/A.
   const int n_non_orth = std::max(0, cfg_.n_non_orthogonal_correctors);
-  if (!reuse) {
+  if (!pass.reuse) {
     laplacian_coefficients(F, k);
   }
   // The non-orthogonal correctors solve again with the correction from the latest pressure, the
   // matrix kept; the flux takes the last correction (interFoam's nNonOrthogonalCorrectors loop).
   int its = 0;
-  for (int pass = 0; pass <= n_non_orth; ++pass) {
+  for (int non_orth = 0; non_orth <= n_non_orth; ++non_orth) {
     if (n_non_orth > 0) pressure_correction(F, k);
-    predicted_flux(UEqn, initial, k);
-    assemble(F, reuse || pass > 0);
-    its += solver_.solve(initial, reuse || pass > 0, closed, diag_rows_.empty() ? 0.0 : diag_rows_[0], t);
+    predicted_flux(UEqn, pass.initial, k);
+    const bool reuse = pass.reuse || non_orth > 0;
+    assemble(F, reuse);
+    const double diag0 = diag_rows_.empty() ? 0.0 : diag_rows_[0];
+    its += solver_.solve({.initial = pass.initial, .reuse = reuse, .closed = closed, .diag0 = diag0}, t);
     solver_.solution(x_rows_);
     for (int r = 0; r < region_.n_active; ++r) F.p_rgh[region_.cells[r]] = x_rows_[r];
   }
-  correct_flux_and_velocity(F, UEqn, initial, k);
+  correct_flux_and_velocity(F, UEqn, pass.initial, k);
   for (int c : region_.cells) F.p[c] = F.p_rgh[c] + F.rho[c] * bc_ctx_.hydrostatics.gh(c);
   if (closed) fix_level(F);
   return its;
