@@ -7,8 +7,9 @@
 #include <functional>
 #include <vector>
 
-#include "engine/vof/fields.hpp"
 #include "engine/vof/config.hpp"
+#include "engine/vof/fields.hpp"
+#include "engine/vof/fv/ops.hpp"
 
 namespace runout::engine::vof {
 
@@ -81,9 +82,10 @@ class Hydrostatics {
   }
   /// face_force's non-orthogonal part, -(Mesh::non_orth . grad(p)_f - rho_f Mesh::non_orth . g) /
   /// |Sf|, from the cells' Gauss gradient of the current pressure p (on boundary faces the cell's p
-  /// carried hydrostatically to the face), limited by VofConfig::non_orthogonal_limiter against the orthogonal part. The same as
-  /// the non-orthogonal parts of -ghf snGrad(rho) - snGrad(p_rgh), but from p, which is continuous
-  /// across the interface where p_rgh jumps by (rho1 - rho2) g.(x - x_ref) (docs/design/vof.md).
+  /// carried hydrostatically to the face), limited by VofConfig::non_orthogonal_limiter against the
+  /// orthogonal part. The same as the non-orthogonal parts of -ghf snGrad(rho) - snGrad(p_rgh), but
+  /// from p, which is continuous across the interface where p_rgh jumps by (rho1 - rho2)
+  /// g.(x - x_ref) (docs/design/vof.md).
   /// On the listed faces (internal ones; the others skipped), from the gradient in `cells`, which
   /// must hold both sides of every listed face (the active region's faces and halo). Nothing
   /// without non-orthogonal correctors.

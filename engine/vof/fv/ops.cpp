@@ -8,7 +8,9 @@ void gauss_gradient_hydrostatic(const Mesh& m, const CellFaces& cell_faces, cons
                                 const CellField<double>& rho, const CellField<double>& gh, const FaceField<double>& ghf,
                                 CellField<Vec>& out) {
   if (out.size() != std::size_t(m.cells())) out.assign(std::size_t(m.cells()), Vec{});
-  const auto face_p = [&](int f, int c) { return internal(m, f) ? interpolate(m, f, p) : carried_hydrostatically(p[c], rho[c], gh[c], ghf[f]); };
+  const auto face_p = [&](int f, int c) {
+    return internal(m, f) ? interpolate(m, f, p) : carried_hydrostatically(p[c], rho[c], gh[c], ghf[f]);
+  };
   grad(m, cell_faces, cells, face_p, out);
 }
 
