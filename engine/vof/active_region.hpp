@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "engine/vof/bc/boundary.hpp"
+#include "engine/vof/config.hpp"
 #include "engine/vof/fields.hpp"
 #include "engine/vof/fv/ops.hpp"
 #include "engine/vof/hydrostatics.hpp"
@@ -36,6 +37,10 @@ class ActiveRegion {
   bool whole_mesh() const { return n_active == m_.cells(); }
   bool active(int c) const { return index[c] >= 0; }
   const CellFaces& cell_faces() const { return cell_faces_; }
+  /// The test "face f is one of `faces`", for grad() over the region's faces.
+  auto face_in_region() const {
+    return [this](int f) { return face_in[f] != 0; };
+  }
 
   CellField<int> index;     ///< per cell: its row in the pressure system, -1 outside the region
   std::vector<int> cells;   ///< the region

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/vof/fv/grad.hpp"
 #include "engine/vof/fv/parallel.hpp"
 
 namespace runout::engine::vof {
@@ -65,16 +66,8 @@ void AlphaEqn::settling_fluxes(const Fields& F) {
 
 // The interface normal per cell: the Gauss gradient of alpha.
 void AlphaEqn::interface_normal(const Fields& F) {
-  const CellFaces& cf = region_.cell_faces();
-  parallel_each(region_.halo, [&](int c) {
-    Vec sum{};
-    for (int f : cf[c]) {
-      if (!region_.face_in[f]) continue;
-      const double af = internal(m_, f) ? interpolate(m_, f, F.alpha) : bcs_[f].alpha(bc_ctx_, f);
-      sum = m_.owner[f] == c ? sum + af * m_.Sf[f] : sum - af * m_.Sf[f];
-    }
-    grad_alpha_[c] = (1.0 / m_.volume[c]) * sum;
-  });
+  const auto face_alpha = [&](int f, int) { return internal(m_, f) ? interpolate(m_, f, F.alpha) : bcs_[f].alpha(bc_ctx_, f); };
+  grad(m_, region_.cell_faces(), region_.halo, face_alpha, grad_alpha_, region_.face_in_region());
 }
 
 // Per face the upwind flux FL and the antidiffusive flux AF (central value plus compression, less

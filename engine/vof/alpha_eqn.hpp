@@ -8,6 +8,7 @@
 // sub-cycles as keep its Courant number at most 0.5.
 #include "engine/vof/active_region.hpp"
 #include "engine/vof/bc/boundary.hpp"
+#include "engine/vof/config.hpp"
 #include "engine/vof/fields.hpp"
 
 namespace runout::engine::vof {

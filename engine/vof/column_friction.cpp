@@ -5,9 +5,9 @@
 #include <string>
 
 #include "engine/vof/active_region.hpp"
+#include "engine/vof/error.hpp"
 #include "engine/vof/fields.hpp"
 #include "engine/vof/hydrostatics.hpp"
-#include "engine/vof/solver.hpp"
 
 namespace runout::engine::vof {
 

@@ -1,5 +1,6 @@
 #include "engine/vof/hydrostatics.hpp"
 
+#include "engine/vof/fv/grad.hpp"
 #include "engine/vof/fv/ops.hpp"
 #include "engine/vof/fv/parallel.hpp"
 

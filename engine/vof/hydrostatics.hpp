@@ -7,8 +7,9 @@
 #include <functional>
 #include <vector>
 
+#include "engine/vof/config.hpp"
 #include "engine/vof/fields.hpp"
-#include "engine/vof/solver.hpp"
+#include "engine/vof/fv/ops.hpp"
 
 namespace runout::engine::vof {
 
@@ -59,7 +60,7 @@ class Hydrostatics {
   // cell filling by 0.1 in a step 2 m from the origin of a 50 deg chute, where the bed pressure is
   // about 100 Pa).
   double wall_pressure(int f, int o) const {
-    return fields_.p[o] + fields_.rho[o] * (ghf_[f] - gh_[o]) - coulomb_level(ghf_[f]);
+    return carried_hydrostatically(fields_.p[o], fields_.rho[o], gh_[o], ghf_[f]) - coulomb_level(ghf_[f]);
   }
   // The confining pressure of the Coulomb viscosity in cell c: p less coulomb_level().
   double confining_pressure(int c) const { return fields_.p[c] - coulomb_level(gh_[c]); }
@@ -80,10 +81,11 @@ class Hydrostatics {
     return -ghf_[f] * (fields_.rho[nb] - fields_.rho[o]) * dl - (fields_.p_rgh[nb] - fields_.p_rgh[o]) * dl;
   }
   /// face_force's non-orthogonal part, -(Mesh::non_orth . grad(p)_f - rho_f Mesh::non_orth . g) /
-  /// |Sf|, from the cells' Gauss gradient of the current pressure p (the cell's own value on boundary
-  /// faces), limited by VofConfig::non_orthogonal_limiter against the orthogonal part. The same as
-  /// the non-orthogonal parts of -ghf snGrad(rho) - snGrad(p_rgh), but from p, which is continuous
-  /// across the interface where p_rgh jumps by (rho1 - rho2) g.(x - x_ref) (docs/design/vof.md).
+  /// |Sf|, from the cells' Gauss gradient of the current pressure p (on boundary faces the cell's p
+  /// carried hydrostatically to the face), limited by VofConfig::non_orthogonal_limiter against the
+  /// orthogonal part. The same as the non-orthogonal parts of -ghf snGrad(rho) - snGrad(p_rgh), but
+  /// from p, which is continuous across the interface where p_rgh jumps by (rho1 - rho2)
+  /// g.(x - x_ref) (docs/design/vof.md).
   /// On the listed faces (internal ones; the others skipped), from the gradient in `cells`, which
   /// must hold both sides of every listed face (the active region's faces and halo). Nothing
   /// without non-orthogonal correctors.

@@ -4,7 +4,7 @@
 // viscosity nu1 and the air's, and the mass flux from the granular and the total volume flux.
 #include <algorithm>
 
-#include "engine/vof/solver.hpp"
+#include "engine/vof/config.hpp"
 
 namespace runout::engine::vof {
 

@@ -1,5 +1,6 @@
 #include "engine/vof/momentum_eqn.hpp"
 
+#include "engine/vof/fv/grad.hpp"
 #include "engine/vof/fv/parallel.hpp"
 
 #include <algorithm>
@@ -63,27 +64,9 @@ Vec MomentumEqn::rA_difference_apply(int c, const Vec& v) const {
 void MomentumEqn::setup_predictor() { solver_.setup(cfg_.momentum_rtol); }
 
 void MomentumEqn::velocity_gradient(Fields& F) const {
-  auto& G = F.gradU;
-  const CellFaces& cf = region_.cell_faces();
   // Per cell of the halo over its faces of the region (the outer cells' other faces carry nothing).
-  parallel_each(region_.halo, [&](int c) {
-    Tensor g{};
-    for (int f : cf[c]) {
-      if (!region_.face_in[f]) continue;
-      const Vec S = m_.Sf[f];
-      const Vec Uf = internal(m_, f) ? interpolate(m_, f, F.U) : bcs_[f].velocity(bc_ctx_, f);
-      const bool own = m_.owner[f] == c;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-          const double v = comp(S, i) * comp(Uf, j);
-          if (own) g.g[i][j] += v;
-          else g.g[i][j] -= v;
-        }
-    }
-    for (auto& row : g.g)
-      for (double& v : row) v /= m_.volume[c];
-    G[c] = g;
-  });
+  const auto face_U = [&](int f, int) { return internal(m_, f) ? interpolate(m_, f, F.U) : bcs_[f].velocity(bc_ctx_, f); };
+  grad(m_, region_.cell_faces(), region_.halo, face_U, F.gradU, region_.face_in_region());
 }
 
 void MomentumEqn::update_viscosity(Fields& F) const {

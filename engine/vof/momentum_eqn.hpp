@@ -9,6 +9,7 @@
 #include "engine/vof/active_region.hpp"
 #include "engine/vof/bc/boundary.hpp"
 #include "engine/vof/column_friction.hpp"
+#include "engine/vof/config.hpp"
 #include "engine/vof/fields.hpp"
 #include "engine/vof/fv/fv_matrix.hpp"
 #include "engine/vof/linear/petsc.hpp"

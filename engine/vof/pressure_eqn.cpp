@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "engine/vof/fv/grad.hpp"
 #include "engine/vof/fv/parallel.hpp"
 
 namespace runout::engine::vof {
@@ -25,34 +26,36 @@ PressureEqn::PressureEqn(const Mesh& m, const VofConfig& cfg, const BcContext& b
 
 void PressureEqn::make_system() { solver_.make_system(region_.n_active, region_.pressure_nonzeros()); }
 
-int PressureEqn::correct(Fields& F, const MomentumEqn& UEqn, bool initial, bool reuse, bool final, double t) {
-  solver_.set_tolerance(final);
+int PressureEqn::correct(Fields& F, const MomentumEqn& UEqn, CorrectorPass pass, double t) {
+  solver_.set_tolerance(pass.final);
   const bool closed = !bcs_.has_opening() && region_.whole_mesh();  // no opening anywhere: the level is free
   // The consistent coupling (VofConfig::consistent): the pressure equation and the correction take
   // 1/(A - H1); the part of the last pressure's force that 1/A would have carried, (1/A -
   // 1/(A - H1)) F_old, stays in the predicted flux and velocity (SIMPLEC).
-  const bool cons = cfg_.consistent && !initial;
+  const bool cons = cfg_.consistent && !pass.initial;
   const Coupling k{cons, cons ? UEqn.rAtUf : UEqn.rAUf, UEqn};
   // Within a step 1/A, the density and the active region do not change (reuse), and with them
   // neither which faces are openings, the Laplacian coefficients, the buoyancy fluxes nor the
   // outside pressures: those are set by the step's first call. Every call forms the predicted flux
   // from the correctors' H/A.
   const int n_non_orth = std::max(0, cfg_.n_non_orthogonal_correctors);
-  if (!reuse) {
+  if (!pass.reuse) {
     laplacian_coefficients(F, k);
   }
   // The non-orthogonal correctors solve again with the correction from the latest pressure, the
   // matrix kept; the flux takes the last correction (interFoam's nNonOrthogonalCorrectors loop).
   int its = 0;
-  for (int pass = 0; pass <= n_non_orth; ++pass) {
+  for (int non_orth = 0; non_orth <= n_non_orth; ++non_orth) {
     if (n_non_orth > 0) pressure_correction(F, k);
-    predicted_flux(UEqn, initial, k);
-    assemble(F, reuse || pass > 0);
-    its += solver_.solve(initial, reuse || pass > 0, closed, diag_rows_.empty() ? 0.0 : diag_rows_[0], t);
+    predicted_flux(UEqn, pass.initial, k);
+    const bool reuse = pass.reuse || non_orth > 0;
+    assemble(F, reuse);
+    const double diag0 = diag_rows_.empty() ? 0.0 : diag_rows_[0];
+    its += solver_.solve({.initial = pass.initial, .reuse = reuse, .closed = closed, .diag0 = diag0}, t);
     solver_.solution(x_rows_);
     for (int r = 0; r < region_.n_active; ++r) F.p_rgh[region_.cells[r]] = x_rows_[r];
   }
-  correct_flux_and_velocity(F, UEqn, initial, k);
+  correct_flux_and_velocity(F, UEqn, pass.initial, k);
   for (int c : region_.cells) F.p[c] = F.p_rgh[c] + F.rho[c] * bc_ctx_.hydrostatics.gh(c);
   if (closed) fix_level(F);
   return its;
@@ -230,20 +233,12 @@ void PressureEqn::correct_flux_and_velocity(Fields& F, const MomentumEqn& UEqn, 
 // weight's gradient there).
 void PressureEqn::pressure_gradient(const Fields& F, const CellField<double>& p, CellField<Vec>& out) const {
   const Hydrostatics& hs = bc_ctx_.hydrostatics;
-  const CellFaces& cf = region_.cell_faces();
-  parallel_each(region_.cells, [&](int c) {
-    Vec sum{};
-    for (int f : cf[c]) {
-      if (open_[f] != 0 || !internal(m_, f)) {  // an opening out of c, or a wall: p carried to the face
-        const double pf = p[c] + F.rho[c] * (hs.ghf(f) - hs.gh(c));
-        sum = open_[f] != 0 ? sum + (double(open_[f]) * pf) * m_.Sf[f] : sum + pf * m_.Sf[f];
-      } else {
-        const double pf = interpolate(m_, f, p);
-        sum = m_.owner[f] == c ? sum + pf * m_.Sf[f] : sum - pf * m_.Sf[f];
-      }
-    }
-    out[c] = (1.0 / m_.volume[c]) * sum;
-  });
+  const auto face_p = [&](int f, int c) {
+    // An opening out of c, or a wall: p carried to the face.
+    if (open_[f] != 0 || !internal(m_, f)) return carried_hydrostatically(p[c], F.rho[c], hs.gh(c), hs.ghf(f));
+    return interpolate(m_, f, p);
+  };
+  grad(m_, region_.cell_faces(), region_.cells, face_p, out);
 }
 
 // The face force's non-orthogonal part from the latest pressure, -rAf (non_orth . grad(p)_f -

@@ -8,6 +8,7 @@
 // a closed domain the level fixed at its highest cell.
 #include "engine/vof/active_region.hpp"
 #include "engine/vof/bc/boundary.hpp"
+#include "engine/vof/config.hpp"
 #include "engine/vof/fields.hpp"
 #include "engine/vof/fv/fv_matrix.hpp"
 #include "engine/vof/linear/petsc.hpp"
@@ -15,17 +16,24 @@
 
 namespace runout::engine::vof {
 
+/// Which corrector PressureEqn::correct() runs, by name at the call.
+struct CorrectorPass {
+  bool initial = false;  ///< the initial hydrostatic solve (no velocity)
+  /// A later corrector of the step (1/A, the density and the region unchanged: the matrix and its
+  /// coefficients are kept).
+  bool reuse = false;
+  bool final = false;  ///< the step's last corrector (its tolerance)
+};
+
 class PressureEqn {
  public:
   PressureEqn(const Mesh& m, const VofConfig& cfg, const BcContext& bc_ctx, const Boundaries& bcs, const ActiveRegion& region,
               const Reconstruction& reconstruct, PressureSolver& solver);
   /// (Re)create the pressure system for the current active region.
   void make_system();
-  /// One corrector: solve for p_rgh and correct the fluxes and velocities. initial: the initial
-  /// hydrostatic solve (no velocity); reuse: a later corrector of the step (1/A, the density and
-  /// the region unchanged: the matrix and its coefficients are kept); final: the step's last (its
-  /// tolerance). Returns the iterations.
-  int correct(Fields& F, const MomentumEqn& UEqn, bool initial, bool reuse, bool final, double t);
+  /// One corrector (CorrectorPass): solve for p_rgh and correct the fluxes and velocities. Returns
+  /// the iterations.
+  int correct(Fields& F, const MomentumEqn& UEqn, CorrectorPass pass, double t);
 
  private:
   struct Coupling {  // the coefficients of this corrector: 1/A (PISO) or 1/(A - H1) (SIMPLEC)

@@ -149,7 +149,7 @@ void VofSolver::Impl::initial_pressure(double t) {
   region.clear();
   region.update(true);
   pEqn.make_system();
-  pEqn.correct(F, UEqn, true, false, true, t);
+  pEqn.correct(F, UEqn, {.initial = true, .final = true}, t);
   std::fill(F.phi.begin(), F.phi.end(), 0.0);
   bool inflow = false;
   for (int f = m.n_internal; f < m.faces(); ++f)
@@ -160,7 +160,7 @@ void VofSolver::Impl::initial_pressure(double t) {
   if (inflow && bcs.has_opening()) {
     const auto p_rgh = F.p_rgh, p = F.p;
     hydrostatics.zero();
-    pEqn.correct(F, UEqn, true, false, true, t);
+    pEqn.correct(F, UEqn, {.initial = true, .final = true}, t);
     F.p_rgh = p_rgh;
     F.p = p;
     update_gravity(t);
@@ -316,7 +316,7 @@ StepStats VofSolver::step(double t_limit) {
       if (cfg_.consistent && k > 0) I.hydrostatics.update_non_orthogonal_force(I.cell_faces, I.region.faces, I.region.halo);
       const auto tp = clk::now();
       const bool final = outer + 1 == n_outer && k + 1 == n_corr;
-      st.pressure_iterations += I.pEqn.correct(F, I.UEqn, false, k > 0, final, t_);  // p_rgh, phi, U
+      st.pressure_iterations += I.pEqn.correct(F, I.UEqn, {.reuse = k > 0, .final = final}, t_);  // p_rgh, phi, U
       t_p += std::chrono::duration<double>(clk::now() - tp).count();
     }
   }

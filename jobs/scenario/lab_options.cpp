@@ -1,12 +1,12 @@
 // The option table of the VOF laboratory block `lab` (options.hpp) and its materials. The mapping
 // into the engine's VofConfig lives in the lab driver (jobs/drivers/vof_lab/config.cpp), which
 // `maps_to` names; the choices of the engine's options come from its name tables
-// (engine/vof/solver.hpp), the boundary kinds are checked against its registry by a test
+// (engine/vof/config.hpp), the boundary kinds are checked against its registry by a test
 // (LabOptions.BoundaryKindsAreTheEngineRegistrys).
 #include <string>
 #include <vector>
 
-#include "engine/vof/solver.hpp"
+#include "engine/vof/config.hpp"
 #include "jobs/scenario/options.hpp"
 
 namespace runout::jobs {

@@ -1,5 +1,7 @@
 #include "engine/vof/bc/boundary.hpp"
 
+#include "engine/vof/error.hpp"
+
 namespace runout::engine::vof {
 
 void BoundaryCondition::momentum(const BcContext&, int, const Vec&, double&, Vec&) const {}

@@ -22,7 +22,7 @@
 #include "engine/vof/hydrostatics.hpp"
 #include "engine/vof/mixture.hpp"
 #include "engine/vof/models/granular_viscosity.hpp"
-#include "engine/vof/solver.hpp"
+#include "engine/vof/config.hpp"
 
 namespace runout::engine::vof {
 

@@ -2,6 +2,7 @@
 // fixed from the start and its cells are always computed. Its shear as a wall's with the inflow's
 // velocity and phase fraction.
 #include "engine/vof/bc/boundary.hpp"
+#include "engine/vof/error.hpp"
 
 namespace runout::engine::vof {
 

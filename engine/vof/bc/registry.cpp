@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "engine/vof/bc/boundary.hpp"
+#include "engine/vof/error.hpp"
 
 namespace runout::engine::vof {
 

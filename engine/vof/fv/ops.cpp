@@ -1,6 +1,6 @@
 #include "engine/vof/fv/ops.hpp"
 
-#include "engine/vof/fv/parallel.hpp"
+#include "engine/vof/fv/grad.hpp"
 
 namespace runout::engine::vof {
 
@@ -8,18 +8,10 @@ void gauss_gradient_hydrostatic(const Mesh& m, const CellFaces& cell_faces, cons
                                 const CellField<double>& rho, const CellField<double>& gh, const FaceField<double>& ghf,
                                 CellField<Vec>& out) {
   if (out.size() != std::size_t(m.cells())) out.assign(std::size_t(m.cells()), Vec{});
-  parallel_each(cells, [&](int c) {
-    Vec sum{};
-    for (int f : cell_faces[c]) {
-      if (internal(m, f)) {
-        const double pf = interpolate(m, f, p);
-        sum = m.owner[f] == c ? sum + pf * m.Sf[f] : sum - pf * m.Sf[f];
-      } else {
-        sum = sum + (p[c] + rho[c] * (ghf[f] - gh[c])) * m.Sf[f];
-      }
-    }
-    out[c] = (1.0 / m.volume[c]) * sum;
-  });
+  const auto face_p = [&](int f, int c) {
+    return internal(m, f) ? interpolate(m, f, p) : carried_hydrostatically(p[c], rho[c], gh[c], ghf[f]);
+  };
+  grad(m, cell_faces, cells, face_p, out);
 }
 
 void CellFaces::build(const Mesh& m) {

@@ -1,7 +1,8 @@
 #pragma once
 // The finite-volume operators the VOF equations are written with (OpenFOAM's fvc): face
-// interpolation, the velocity-gradient tensor and the strain rate, the cells' faces, and the
-// reconstruction of a cell vector from face values.
+// interpolation, the velocity-gradient tensor and the strain rate, the cells' faces, a pressure
+// carried hydrostatically to a face, and the reconstruction of a cell vector from face values (the
+// Gauss gradient in grad.hpp).
 #include <array>
 #include <cmath>
 #include <span>
@@ -60,13 +61,9 @@ struct CellFaces {
   }
 };
 
-/// fvc::grad(p), Gauss linear, for a pressure p whose boundary faces take the cell's value carried
-/// hydrostatically, p + rho (ghf - gh) (gh = g.x at the cell centres, ghf at the face centres):
-/// into out[c] for the listed cells only (each from its own faces, so any subset and any order
-/// give the same values).
-void gauss_gradient_hydrostatic(const Mesh& m, const CellFaces& cell_faces, const std::vector<int>& cells, const CellField<double>& p,
-                                const CellField<double>& rho, const CellField<double>& gh, const FaceField<double>& ghf,
-                                CellField<Vec>& out);
+/// A pressure p carried hydrostatically from cell c to face f, p + rho (ghf - gh) (gh = g.x at the
+/// cell centres, ghf at the face centres): the face value of p where p_rgh has zero gradient.
+inline double carried_hydrostatically(double p_c, double rho_c, double gh_c, double ghf_f) { return p_c + rho_c * (ghf_f - gh_c); }
 
 /// fvc::reconstruct: the cell vector whose face projections best match face values q, from the sum
 /// of q Sf over the cell's faces (the inverse of sum Sf Sf / |Sf| per cell).

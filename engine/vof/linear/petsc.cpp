@@ -6,6 +6,8 @@
 #include <chrono>
 #include <mutex>
 
+#include "engine/vof/error.hpp"
+
 namespace runout::engine::vof {
 
 void petsc_check(PetscErrorCode e, const char* what) {

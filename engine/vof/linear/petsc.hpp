@@ -9,7 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/vof/solver.hpp"
+#include "engine/vof/config.hpp"
+#include "engine/vof/state.hpp"
 
 namespace runout::engine::vof {
 
@@ -74,9 +75,15 @@ class PressureSolver {
   /// The diagonal (unless reuse), the right-hand side and the initial guess of every row; then the
   /// matrix assembled (unless reuse).
   void set_rows(const std::vector<double>& diag, const std::vector<double>& rhs, const std::vector<double>& x0, bool reuse);
-  /// Solve (initial: the initial hydrostatic solve, three passes; closed: a closed domain, the
-  /// correction fixed to zero in row 0 with diagonal diag0). Returns the iterations.
-  int solve(bool initial, bool reuse, bool closed, double diag0, double t);
+  /// What solve() solves, by name at the call.
+  struct Solve {
+    bool initial = false;  ///< the initial hydrostatic solve: three passes
+    bool reuse = false;    ///< the matrix of the solve before (a later corrector or non-orthogonal pass)
+    bool closed = false;   ///< a closed domain: the correction fixed to zero in row 0, with diagonal diag0
+    double diag0 = 0;
+  };
+  /// Solve at time t (for the error message). Returns the iterations.
+  int solve(const Solve& s, double t);
   /// The solution, row by row.
   void solution(std::vector<double>& x) const;
   /// Add s to every row of the solution (a closed domain's level).

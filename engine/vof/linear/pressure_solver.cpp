@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "engine/vof/error.hpp"
 #include "engine/vof/linear/petsc.hpp"
 
 namespace runout::engine::vof {
@@ -117,23 +118,23 @@ void PressureSolver::timed_solve(Mat Ap) {
   ksp_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t_ksp).count();
 }
 
-int PressureSolver::solve(bool initial, bool reuse, bool closed, double diag0, double t) {
+int PressureSolver::solve(const Solve& s, double t) {
   PetscInt its = 0;
-  for (int pass = 0; pass < (initial ? 3 : 1); ++pass) {
+  for (int pass = 0; pass < (s.initial ? 3 : 1); ++pass) {
     petsc_check(MatMult(A_, x_, r_), "MatMult");
     petsc_check(VecAYPX(r_, -1.0, b_), "VecAYPX");  // r = b - A x
     petsc_check(VecSet(dx_, 0.0), "VecSet");
-    const bool same = (reuse || pass > 0) && !system_fresh_;  // passes of the initial solve share the matrix too
+    const bool same = (s.reuse || pass > 0) && !system_fresh_;  // passes of the initial solve share the matrix too
     // The preconditioner is rebuilt every pressure_pc_refresh steps (GAMG: the coarse operators
     // from the current matrix, with the prolongators of the solver's first build) and made anew
     // whenever the active region changes; in between, the last one preconditions the new matrix
     // (still symmetric positive definite).
     bool keep_pc = same;
     // (Counted per step: the outer correctors after a step's first keep it.)
-    if (!same && !initial && !system_fresh_) keep_pc = later_outer || ++steps_since_pc_ < std::max(1, cfg_.pressure_pc_refresh);
+    if (!same && !s.initial && !system_fresh_) keep_pc = later_outer || ++steps_since_pc_ < std::max(1, cfg_.pressure_pc_refresh);
     if (!keep_pc) steps_since_pc_ = 0;
     Mat Ap = A_;
-    if (closed) {
+    if (s.closed) {
       // A closed domain: the correction is fixed to zero in row 0 (its row and column replaced by
       // the diagonal), which leaves a nonsingular system with the same solution up to the
       // constant that the pressure level takes care of.
@@ -141,7 +142,7 @@ int PressureSolver::solve(bool initial, bool reuse, bool closed, double diag0, d
         if (Apin_) petsc_check(MatCopy(A_, Apin_, SAME_NONZERO_PATTERN), "MatCopy");
         else petsc_check(MatDuplicate(A_, MAT_COPY_VALUES, &Apin_), "MatDuplicate");
         const PetscInt row0 = 0;
-        petsc_check(MatZeroRowsColumns(Apin_, 1, &row0, diag0, dx_, r_), "MatZeroRowsColumns");
+        petsc_check(MatZeroRowsColumns(Apin_, 1, &row0, s.diag0, dx_, r_), "MatZeroRowsColumns");
       } else {
         petsc_check(VecSetValue(r_, 0, 0.0, INSERT_VALUES), "VecSetValue");  // dx_0 = 0
         VecAssemblyBegin(r_);

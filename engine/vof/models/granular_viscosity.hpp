@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/vof/solver.hpp"
+#include "engine/vof/config.hpp"
 
 namespace runout::engine::vof {
 

@@ -20,7 +20,8 @@
 #include <cmath>
 #include <string>
 
-#include "engine/vof/solver.hpp"
+#include "engine/vof/config.hpp"
+#include "engine/vof/error.hpp"
 
 namespace runout::engine::vof {
 

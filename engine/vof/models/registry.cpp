@@ -3,6 +3,7 @@
 #include <array>
 #include <string_view>
 
+#include "engine/vof/error.hpp"
 #include "engine/vof/models/granular_viscosity.hpp"
 
 namespace runout::engine::vof {
