@@ -129,7 +129,7 @@ v1::Scenario parse_scenario_json(const std::string& json) {
 
 void apply_material_rheology(const v1::Material& m, engine::vof::VofConfig& c) {
   c.rho1 = m.density_kg_m3();
-  c.rheology = m.rheology();  // a granular viscosity's name (check_terrain_vof)
+  c.rheology = m.rheology().empty() ? "coulomb" : m.rheology();  // a granular viscosity's name (check_terrain_vof)
   c.phi_deg = m.internal_friction_deg();
   take_mu_i_fields(m, c.mu_i);
 }

@@ -181,3 +181,54 @@ TEST(FlowFriction2d, AgreesWithThe1dEngineOnAPlane) {
     }
   }
 }
+
+// A new friction law is one header (a FrictionLaw: name, caption, equation, parameter rows, the
+// coefficients of law.hpp's family and the checks) plus its line in registry.hpp's table; the kernels
+// need nothing else. This example law, a Coulomb angle with Voellmy's drag, is defined here and
+// given to both engines directly: it computes Voellmy's bits, and its check names its parameter.
+namespace {
+
+constexpr FrictionLaw kExampleLaw{
+    "example_coulomb_drag",
+    "Coulomb with drag",
+    "tau_b = tan(delta) N + rho g |u|^2 / xi (an example law of the unit tests)",
+    {{{"bed_friction_deg", "delta", "δ", "°", "bed friction angle"}, {"voellmy_xi", "xi", "ξ", "m/s²", "turbulent-friction coefficient"}}},
+    [](const FrictionParams& p) { return BasalFriction{std::tan(p.delta), 1.0 / p.xi}; },
+    [](const FrictionParams& p) -> const char* { return p.xi > 0 ? "" : "example law: xi must be > 0 m/s^2"; }};
+
+}  // namespace
+
+TEST(FrictionLaws, AnExampleLawRunsInBothEnginesWithoutChangesToTheKernels) {
+  Material example;
+  example.rheology = &kExampleLaw;
+  example.delta = 20 * kDeg;
+  example.xi = 500;
+  Material voellmy;
+  voellmy.rheology = &friction::voellmy;
+  voellmy.mu = std::tan(20 * kDeg);
+  voellmy.xi = 500;
+  // 2D: a blob down a hillside.
+  const auto t = hillside(60, 40, 5.0, 30, 0.3);
+  Sh2dConfig c2;
+  c2.time.t_end = 8;
+  c2.tile = 16;
+  c2.material = example;
+  const auto a = run_sh2d(t, c2, state_from_normal_depth(t, blob(t, 12, 20, 6, 2.0)));
+  c2.material = voellmy;
+  const auto b = run_sh2d(t, c2, state_from_normal_depth(t, blob(t, 12, 20, 6, 2.0)));
+  ASSERT_GT(a.diag.steps, 10);
+  EXPECT_EQ(a.diag.steps, b.diag.steps);
+  EXPECT_EQ(a.state.H, b.state.H);
+  EXPECT_EQ(a.hazard.max_speed, b.hazard.max_speed);
+  // 1D: the uniform chute.
+  const auto a1 = chute_1d(example, 35, 0.5, 2.0), b1 = chute_1d(voellmy, 35, 0.5, 2.0);
+  EXPECT_EQ(a1.state.m, b1.state.m);
+  // Its check runs with every material's.
+  example.xi = 0;
+  try {
+    example.validate();
+    FAIL() << "xi = 0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("example law: xi"), std::string::npos) << e.what();
+  }
+}
