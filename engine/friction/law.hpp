@@ -13,9 +13,11 @@
 // a bounded impulse (apply_friction) and the second implicitly (turbulent_factor); which form of mu
 // a kernel computes is a template parameter (MuForm), so a constant mu costs nothing more.
 //
-// A new law: one header beside coulomb.hpp (a FrictionLaw with its equation, parameters,
-// coefficients and checks) and one line in registry.hpp; a law outside the family above also needs
-// its term in the kernels (engine/sh1d.cpp, engine/sh2d/step.cpp and update.cpp).
+// A new law: one header beside coulomb.hpp (a FrictionLaw with its name, the caption the maps print,
+// its equation, its parameter rows with their map labels and units, its coefficients and checks) and
+// one line in registry.hpp (tests/unit/test_flow_friction.cpp runs an example law that is not in the
+// table through both engines); a law outside the family above also needs
+// its term in the kernels (engine/sh1d.cpp, engine/sh2d/kernels.hpp).
 #include <array>
 #include <cmath>
 #include <limits>
