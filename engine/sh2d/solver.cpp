@@ -356,6 +356,10 @@ double Solver::next_dt(double t_end) const {
 double Solver::step_all(double dt) {
   const double t = t_now_;
   const int na = int(active_.size());
+  while (work_.size() < std::size_t(omp_get_max_threads())) {  // more threads than when the solver was built
+    work_.emplace_back();
+    work_.back().reserve(T_);
+  }
   long ncells = 0;  // the cells computed: those of the active tiles within reach of material
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : ncells)
   for (int a = 0; a < na; ++a) ncells += step_tile(active_[a], t, dt, work_[omp_get_thread_num()]);

@@ -3,7 +3,8 @@
 // whose `prepare` builds the run (terrain or laboratory geometry, mesh, initial or restored state)
 // and returns it as an EngineRun: the engine the one loop steps (engine/stepping.hpp), the loop's
 // schedule, the hooks that keep hazard maps, monitors, frames and checkpoints, and the results at
-// the end. A new engine or set-up is one file with its EngineRun plus one row in engines.cpp.
+// the end. A new engine or set-up is one file with its EngineRun, its prepare_* below and one row in
+// engines.cpp; the scenario's resolution names the row (ResolvedScenario::engine).
 #include <memory>
 #include <string>
 #include <string_view>

@@ -5,6 +5,7 @@
 #include "jobs/drivers/hazard_outputs.hpp"
 
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -111,11 +112,24 @@ std::string friction_line(const engine::FrictionLaw& law, const v1::Material& m)
     const std::string u(unit);
     line += ", " + std::string(label) + " = " + num(v) + (u.empty() ? "" : u.rfind("°", 0) == 0 ? u : " " + u);
   };
+  auto value = [&](std::string_view field, double& v) {
+    const auto* f = d->FindFieldByName(std::string(field));
+    if (!f || f->cpp_type() != google::protobuf::FieldDescriptor::CPPTYPE_DOUBLE) return false;
+    v = refl->GetDouble(m, f);
+    return !f->has_presence() || refl->HasField(m, f);
+  };
   for (const auto& p : law.parameters) {
     if (p.field.empty()) break;
-    const auto* f = d->FindFieldByName(std::string(p.field));
-    if (!f || f->cpp_type() != google::protobuf::FieldDescriptor::CPPTYPE_DOUBLE || (f->has_presence() && !refl->HasField(m, f))) continue;
-    add(p.label, p.unit, refl->GetDouble(m, f));
+    double v = 0;
+    if (!value(p.field, v)) {  // unset: what the row says it means, another parameter's value or a number
+      const std::string_view means = p.unset.substr(0, p.unset.find(','));
+      const auto other = std::find_if(law.parameters.begin(), law.parameters.end(), [&](const auto& q) { return q.symbol == means; });
+      char* end = nullptr;
+      const std::string text(means);
+      if (other != law.parameters.end() && !other->field.empty()) (void)value(other->field, v);
+      else if (v = std::strtod(text.c_str(), &end); text.empty() || *end != '\0') continue;
+    }
+    add(p.label, p.unit, v);
   }
   if (m.has_internal_friction_deg()) add("φ", "°", m.internal_friction_deg());
   return line;

@@ -1,6 +1,5 @@
 #pragma once
-// What the VOF engine's run drivers (laboratory and terrain) share: PETSc's turn and its options,
-// the schedule of frames and checkpoints, and the progress report after a step.
+// What the VOF engine's set-ups (laboratory and terrain) share: PETSc's turn and its options.
 #include <mutex>
 #include <string>
 
@@ -16,12 +15,5 @@ std::mutex& petsc_turn();
 /// PETSc's options database as the run used it (PETSC_OPTIONS and the engine's defaults); empty
 /// before PETSc started.
 std::string petsc_options();
-
-/// The first multiple of `interval` after time t (frames and checkpoints after a restart).
-double next_multiple(double interval, double t);
-
-/// Every opt.progress_every steps, the step to opt.progress (material volume, fastest material,
-/// the active region's share of `cells`); false when the hook asks the run to stop.
-bool report_step(const RunOptions& opt, const engine::vof::StepStats& st, long steps, int cells);
 
 }  // namespace runout::jobs

@@ -265,15 +265,15 @@ void check_material(const v1::Material& m, const engine::Material& mat) {
 void check_terrain_vof(const v1::Scenario& s) {
   const auto& m = s.material();
   // The friction laws the 3D engine has a granular viscosity of the same name for.
-  std::string laws;
-  bool found = false;
+  std::vector<std::string> laws;
   for (const auto* law : engine::kFrictionLaws)
     for (const auto& v : engine::vof::kGranularViscosityNames)
-      if (law->name == v) {
-        laws += (laws.empty() ? "\"" : ", \"") + std::string(v) + "\"";
-        found = found || v == m.rheology();
-      }
-  if (!found) bad("material.rheology", "the 3D engine takes " + laws + " (got \"" + m.rheology() + "\")");
+      if (law->name == v) laws.push_back("\"" + std::string(v) + "\"");
+  if (std::find(laws.begin(), laws.end(), "\"" + m.rheology() + "\"") == laws.end()) {
+    std::string list;
+    for (std::size_t k = 0; k < laws.size(); ++k) list += (k == 0 ? "" : k + 1 == laws.size() ? " or " : ", ") + laws[k];
+    bad("material.rheology", "the 3D engine takes " + list + " (got \"" + m.rheology() + "\")");
+  }
   if (m.rheology() == "coulomb" && !m.has_internal_friction_deg())
     bad("material.internal_friction_deg", "needed by the 3D engine's Coulomb viscosity");
   if (m.rheology() == "mu_i" && m.has_mu_s() && m.has_mu_2() && m.has_mu_i0() && m.has_grain_diameter_m() && m.has_grain_density_kg_m3()) {

@@ -1,5 +1,6 @@
 // Terrain: the terrain pipeline (DEM preparation, reprojection, releases, the area of interest) and
 // the depth-averaged run driver on synthetic inputs made here with GDAL.
+#include "jobs/drivers/hazard_maps.hpp"
 #include "jobs/drivers/hazard_outputs.hpp"
 #include "tests/support/run_helpers.hpp"
 
@@ -603,4 +604,40 @@ TEST(Terrain, GridOverTheMemoryBudgetIsRefused) {
   } catch (const terrain::TerrainError& e) {
     EXPECT_NE(std::string(e.what()).find("exceeds the memory budget"), std::string::npos) << e.what();
   }
+}
+
+// The maps' parameter block names the friction law and its parameters from the law's own rows
+// (engine/friction): caption, labels, units; an unset parameter as what its row says it means.
+TEST(Terrain, MapParametersNameTheFrictionLawFromItsRows) {
+  auto s = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/tests/data/arelen-30m.json");
+  const auto g = terrain::prepare_grid(s.dem);
+  auto line = [&](const engine::FrictionLaw& law) {
+    s.config.material.rheology = &law;
+    s.scenario.mutable_material()->set_rheology(std::string(law.name));
+    for (const auto& p : jobs::map_parameters(s, g, 1000))
+      if (p.rfind("friction: ", 0) == 0) return p;
+    return std::string();
+  };
+  auto* m = s.scenario.mutable_material();
+  m->set_bed_friction_deg(15);
+  m->clear_internal_friction_deg();
+  EXPECT_EQ(line(engine::friction::coulomb), "friction: Coulomb, δ = 15°");
+  m->set_internal_friction_deg(32);
+  EXPECT_EQ(line(engine::friction::coulomb), "friction: Coulomb, δ = 15°, φ = 32°");
+  m->clear_internal_friction_deg();
+  m->set_voellmy_mu(0.2);
+  m->set_voellmy_xi(1000);
+  EXPECT_EQ(line(engine::friction::voellmy), "friction: Voellmy, μ = 0.2, ξ = 1000 m/s²");
+  m->set_bed_friction_1_deg(20);
+  m->set_bed_friction_2_deg(32);
+  m->set_pf_beta(0.136);
+  m->set_pf_length_m(0.5);
+  // δ₃ unset means δ₁, γ unset means 0.
+  EXPECT_EQ(line(engine::friction::pouliquen_forterre), "friction: Pouliquen–Forterre, δ₁ = 20°, δ₂ = 32°, δ₃ = 20°, β = 0.136, L = 0.5 m, γ = 0");
+  m->set_mu_s(0.38);
+  m->set_mu_2(0.64);
+  m->set_mu_i0(0.279);
+  m->set_grain_diameter_m(0.005);
+  m->set_grain_density_kg_m3(2500);
+  EXPECT_EQ(line(engine::friction::mu_i), "friction: μ(I), μs = 0.38, μ₂ = 0.64, I₀ = 0.279, d = 0.005 m, ρs = 2500 kg/m³");
 }
