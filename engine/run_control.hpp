@@ -19,11 +19,20 @@ inline std::string_view to_string(StopReason r) {
   return "?";
 }
 
-/// Progress as reported to the caller every `progress_every` steps.
-struct Progress {
-  double t = 0, dt = 0, mass = 0, max_speed = 0, kinetic_energy = 0, active_fraction = 0;
+/// What one step did, in the figures the run loop (engine/stepping.hpp) and the progress report need.
+struct StepReport {
+  double t = 0, dt = 0;        ///< the time reached, the step's length [s]
+  const char* dt_limit = "";   ///< what bounded the step (an engine's own words; "" when it does not say)
+  double mass = 0;             ///< volume of material [m^3]
+  double kinetic_energy = 0;   ///< of the material, per unit density [m^5/s^2] (the stop rule's figure)
+  double max_speed = 0;        ///< fastest flowing material [m/s]
+  double active_fraction = 0;  ///< the share of the cells the step computed
+};
+
+/// Progress as reported to the caller every `progress_every` steps: the last step's report and the
+/// steps so far.
+struct Progress : StepReport {
   long step = 0;
-  const char* dt_limit = "";  ///< what set dt (the VOF engine: engine::vof::StepStats::dt_limit)
 };
 /// Returns false to cancel the run (it then stops cleanly at the end of the step).
 using ProgressHook = std::function<bool(const Progress&)>;

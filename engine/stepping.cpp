@@ -6,9 +6,10 @@
 
 namespace runout::engine {
 
-double next_multiple(double interval, double t) { return interval * (std::floor(t / interval + 1e-9) + 1); }
-
 namespace {
+
+// The first multiple of `interval` after time t.
+double next_multiple(double interval, double t) { return interval * (std::floor(t / interval + 1e-9) + 1); }
 
 // The frames' schedule: a frame at t, and the next regular one after it.
 struct Frames {
@@ -25,14 +26,8 @@ struct Frames {
 
 Progress progress_of(const StepReport& r, long steps) {
   Progress p;
-  p.t = r.t;
-  p.dt = r.dt;
-  p.mass = r.mass;
-  p.max_speed = r.max_speed;
-  p.kinetic_energy = r.kinetic_energy;
-  p.active_fraction = r.active_fraction;
+  static_cast<StepReport&>(p) = r;
   p.step = steps;
-  p.dt_limit = r.dt_limit;
   return p;
 }
 
@@ -52,7 +47,10 @@ StopReason run_steps(SteppingEngine& e, const LoopSchedule& s, LoopState& st, co
   bool go = true;
   if (!continued) {
     if (frames.on()) frames.write(e.time());
-  } else if (settled(e.kinetic_energy())) {
+  } else if (frames.on() && st.next_frame <= e.time()) {
+    st.next_frame = next_multiple(s.frame_interval, e.time());
+  }
+  if (continued && settled(e.kinetic_energy())) {
     stop = StopReason::kinetic_energy;
     go = false;
   }

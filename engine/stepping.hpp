@@ -12,16 +12,6 @@
 
 namespace runout::engine {
 
-/// What one step did, in the figures the loop and the progress report need.
-struct StepReport {
-  double t = 0, dt = 0;        ///< the time reached, the step's length [s]
-  const char* dt_limit = "";   ///< what bounded the step (an engine's own words; "" when it does not say)
-  double mass = 0;             ///< volume of material [m^3]
-  double kinetic_energy = 0;   ///< of the material, per unit density [m^5/s^2] (the stop rule's figure)
-  double max_speed = 0;        ///< fastest flowing material [m/s]
-  double active_fraction = 0;  ///< the share of the cells the step computed
-};
-
 /// An engine as the loop sees it. Implementations: engine::Sh2dEngine (depth-averaged),
 /// engine::vof::VofStepping (3D); tests drive toy engines through the same loop.
 class SteppingEngine {
@@ -51,7 +41,9 @@ struct LoopSchedule {
 /// continued run stops, writes frames and reports as the uninterrupted one.
 struct LoopState {
   double kinetic_energy_peak = 0;
-  double next_frame = 0;   ///< the time of the next regular frame
+  /// The time of the next regular frame; a continued run whose checkpoint does not carry it (not
+  /// after the checkpoint's time) takes the first multiple of the interval after that time.
+  double next_frame = 0;
   double last_frame = -1;  ///< the time of the last frame written (-1: none)
 };
 
@@ -66,9 +58,6 @@ struct LoopHooks {
 
 /// The frames' and checkpoints' times are met within this [s] (sums of steps do not hit them exactly).
 inline constexpr double kTimeTolerance = 1e-12;
-
-/// The first multiple of `interval` after time t.
-double next_multiple(double interval, double t);
 
 /// Steps `engine` from its time to the schedule's end or until a stop rule or the progress hook
 /// stops it. `continued`: the engine and `state` were restored from a checkpoint (no frame at the

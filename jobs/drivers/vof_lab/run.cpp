@@ -122,7 +122,6 @@ LabRun::LabRun(const ResolvedScenario& r, const std::string& out_dir, const RunO
   if (continued) {
     fig_.restore(restart, opt.restart_path);
     mon_->restore(restart, opt.restart_path);
-    loop.next_frame = engine::next_multiple(L_.write_interval_s(), restart.state.t);  // the next regular frame
   }
   step_ = std::make_unique<vof::VofStepping>(*s_, fig_.steps);
 }

@@ -166,7 +166,6 @@ TerrainRun::TerrainRun(const ResolvedScenario& r, const std::string& out_dir, co
                                                continued ? opt.restart_path + ".fields.h5" : std::string(), restart.state.t);
   if (continued) {
     restore(restart, opt.restart_path);
-    if (write_every > 0) loop.next_frame = engine::next_multiple(write_every, restart.state.t);
   } else {
     hazard_->update(0, *s_);
   }
