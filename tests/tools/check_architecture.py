@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Checks docs/design/architecture.md's "may use" column against the code: every #include of another
 room's header, and every CMake link line between runout's libraries, must name a room the table lets
-that room use. Prints each violation (file:line, room, used room) and exits 1 when there is one.
+that room use; and every target that uses a header whose functions another target builds must link
+that target itself (link completeness). Prints each violation (file:line, room, used room) and exits 1 when there is one.
 Run from the repository root: python3 tests/tools/check_architecture.py"""
 import re
 import sys
@@ -102,10 +103,50 @@ def main():
                 target = libs.get(dep)
                 if target in rooms and not allowed(room, target, rooms):
                     bad.append(f"{cm.relative_to(ROOT)}: {lib} ({room}) links {dep} ({target}), not in its 'may use'")
+    bad += link_completeness()
     for b in bad:
         print(b)
     print(f"architecture: {len(rooms)} rooms, {len(bad)} use(s) outside the table")
     return 1 if bad else 0
+
+
+def cmake_targets():
+    """runout's production targets (libraries and programs outside tests/ and bench/): name ->
+    (its source files, relative to the root; the runout_* targets it links)."""
+    targets = {}
+    for cm in ROOT.rglob("CMakeLists.txt"):
+        rel = cm.parent.relative_to(ROOT)
+        if str(rel).startswith(("build", "tests", "bench")):
+            continue
+        text = re.sub(r"#[^\n]*", "", cm.read_text())
+        for m in re.finditer(r"add_(?:library|executable)\((runout\w*)\s([^)]*)\)", text):
+            srcs = [str(rel / f) if str(rel) != "." else f for f in m.group(2).split() if f.endswith(".cpp")]
+            targets[m.group(1)] = (srcs, set())
+        for m in re.finditer(r"target_link_libraries\((runout\w*)([^)]*)\)", text):
+            if m.group(1) in targets:
+                targets[m.group(1)][1].update(re.findall(r"\brunout_\w+", m.group(2)))
+    return targets
+
+
+def link_completeness():
+    """Every target that includes a header whose functions another target compiles (foo.hpp where
+    that target builds foo.cpp) names that target on its own link line. Without it the program
+    links only because some other library happens to bring it, and the table above says nothing
+    true about the link lines."""
+    targets = cmake_targets()
+    owner = {src: name for name, (srcs, _) in targets.items() for src in srcs}
+    bad = []
+    for name, (srcs, links) in sorted(targets.items()):
+        files = set(srcs) | {s[:-4] + ".hpp" for s in srcs if (ROOT / (s[:-4] + ".hpp")).is_file()}
+        for f in sorted(files):
+            for n, line in enumerate((ROOT / f).read_text(errors="replace").splitlines(), 1):
+                m = re.match(r'\s*#include\s+"([^"]+)\.hpp"', line)
+                if not m:
+                    continue
+                dep = owner.get(m.group(1) + ".cpp")
+                if dep and dep != name and dep not in links:
+                    bad.append(f"{f}:{n}: {name} uses {m.group(1)}.hpp, built by {dep}, which it does not link")
+    return bad
 
 
 if __name__ == "__main__":
