@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "engine/vof/fv/fv_matrix.hpp"
+#include "engine/vof/stats.hpp"
 #include "engine/vof/fv/ops.hpp"
 
 namespace runout::engine::vof {
@@ -32,14 +33,6 @@ struct MeshColumns {
   std::vector<int> cells;        ///< bottom up
   std::vector<Tensor> curvature; ///< per column; empty: a plane bed
   int columns() const { return int(bed_face.size()); }
-};
-
-/// What the bed carried at the last momentum build, summed over the columns with material [N]:
-/// the weight's bed-normal part, the centripetal load, the bed faces' pressure times their area,
-/// and the load the friction took (per column the largest of the first two summed and the third).
-struct BedLoad {
-  double weight_normal = 0, centripetal = 0, face_pressure = 0, friction_load = 0;
-  int columns = 0;  ///< columns with material
 };
 
 struct ColumnFrictionConfig {

@@ -203,6 +203,10 @@ VofSolver::VofSolver(Mesh mesh, VofConfig cfg) : mesh_(std::move(mesh)), cfg_(st
 
 VofSolver::~VofSolver() = default;
 
+std::unique_ptr<VofBackend> make_vof_backend(Mesh mesh, VofConfig cfg) {
+  return std::make_unique<VofSolver>(std::move(mesh), std::move(cfg));
+}
+
 const std::vector<double>& VofSolver::alpha() const { return impl_->F.alpha; }
 const std::vector<Vec>& VofSolver::velocity() const { return impl_->F.U; }
 const std::vector<double>& VofSolver::pressure() const { return impl_->F.p; }

@@ -39,28 +39,12 @@
 #include "engine/vof/config.hpp"
 #include "engine/vof/error.hpp"
 #include "engine/vof/mesh.hpp"
+#include "engine/vof/backend.hpp"
 #include "engine/vof/state.hpp"
 
 namespace runout::engine::vof {
 
-/// Per-step solver statistics.
-struct StepStats {
-  double t = 0, dt = 0, co = 0, alpha_co = 0, air_co = 0;  ///< Courant numbers: material, interface, air
-  /// What set dt: the Courant number in the "material", at the "interface" or in the "air", the
-  /// step's "growth" limit (20 % a step), the "largest step" or the "end time".
-  const char* dt_limit = "";
-  int pressure_iterations = 0;  ///< summed over the correctors (and outer correctors)
-  int momentum_iterations = 0;  ///< of the predictor, both components (summed over outer correctors)
-  double seconds_pressure = 0, seconds_total = 0;  ///< the pressure correctors (assembly, solve, flux update); the step
-  double seconds_pressure_solve = 0;  ///< of seconds_pressure, the time in PETSc's KSPSolve (preconditioner set-up included)
-  double alpha_min = 0, alpha_max = 0;
-  double granular_volume = 0;   ///< sum alpha V [m3]
-  double max_speed = 0;         ///< in cells with alpha > 0.5
-  double divergence = 0;        ///< max |sum of face fluxes| / V over cells [1/s]
-  int active_cells = 0;         ///< cells in the active region (the pressure system's size)
-};
-
-class VofSolver {
+class VofSolver final : public VofBackend {
  public:
   VofSolver(Mesh mesh, VofConfig cfg);
   ~VofSolver();
@@ -68,28 +52,28 @@ class VofSolver {
   VofSolver& operator=(const VofSolver&) = delete;
 
   /// Initial state: alpha per cell (velocity zero unless set); computes the hydrostatic pressure.
-  void initialise(const std::vector<double>& alpha, const std::vector<Vec>& U = {});
+  void initialise(const std::vector<double>& alpha, const std::vector<Vec>& U = {}) override;
   /// The state for a checkpoint; taking it changes nothing in the run.
-  VofState state() const;
+  VofState state() const override;
   /// Continue from a checkpoint (in place of initialise()); sizes must match the mesh.
-  void restore(const VofState& st);
+  void restore(const VofState& st) override;
   /// One time step of the length chosen by the Courant control, never past t_limit.
-  StepStats step(double t_limit = 1e300);
+  StepStats step(double t_limit = 1e300) override;
   /// Step until `t_end` through the run loop (engine/stepping.hpp); `hook` is called after every
   /// step and may return false to stop.
   void run(double t_end, const std::function<bool(const StepStats&)>& hook = {});
 
-  const Mesh& mesh() const { return mesh_; }
-  double time() const { return t_; }
-  const std::vector<double>& alpha() const;
-  const std::vector<Vec>& velocity() const;
-  const std::vector<double>& pressure() const;   ///< full pressure p [Pa]
-  const std::vector<double>& viscosity() const;  ///< granular-phase nu [m2/s]
-  const std::vector<double>& face_flux() const;
+  const Mesh& mesh() const override { return mesh_; }
+  double time() const override { return t_; }
+  const std::vector<double>& alpha() const override;
+  const std::vector<Vec>& velocity() const override;
+  const std::vector<double>& pressure() const override;   ///< full pressure p [Pa]
+  const std::vector<double>& viscosity() const override;  ///< granular-phase nu [m2/s]
+  const std::vector<double>& face_flux() const override;
   /// Granular volume flux per face [m3/s] over the last step (alpha times the face flux, limited).
-  const std::vector<double>& granular_flux() const;
+  const std::vector<double>& granular_flux() const override;
   /// What the bed carried at the last momentum build (VofConfig::column_friction; zero without it).
-  const BedLoad& bed_load() const;
+  const BedLoad& bed_load() const override;
 
  private:
   struct Impl;  // the fields, the equations and their solvers (engine/vof/solver.cpp)

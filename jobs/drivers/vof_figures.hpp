@@ -4,7 +4,7 @@
 // travel with a checkpoint, so that a continued run's record is the uninterrupted run's.
 #include <string>
 
-#include "engine/vof/solver.hpp"
+#include "engine/vof/backend.hpp"
 #include "jobs/formats/checkpoint.hpp"
 #include "runout/v1/run_record.pb.h"
 

@@ -3,7 +3,7 @@
 #include <mutex>
 #include <string>
 
-#include "engine/vof/solver.hpp"
+#include "engine/vof/backend.hpp"
 #include "jobs/drivers/run.hpp"
 
 namespace runout::jobs {

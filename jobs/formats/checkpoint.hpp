@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/vof/solver.hpp"
+#include "engine/vof/backend.hpp"
 
 namespace runout::jobs {
 

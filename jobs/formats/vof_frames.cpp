@@ -96,7 +96,7 @@ VofFrameWriter::~VofFrameWriter() {
   if (file_ >= 0) H5Fclose(file_);
 }
 
-void VofFrameWriter::write(double t, const vof::VofSolver& s) {
+void VofFrameWriter::write(double t, const vof::VofBackend& s) {
   const auto n = g_.cell.size();
   std::vector<float> a(n, NAN), ux(n, NAN), uy(n, NAN), uz(n, NAN), p(n, NAN), nu(n, NAN);
   for (std::size_t q = 0; q < n; ++q) {

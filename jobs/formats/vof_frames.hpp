@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "engine/vof/solver.hpp"
+#include "engine/vof/backend.hpp"
 
 namespace runout::jobs {
 
@@ -43,7 +43,7 @@ class VofFrameWriter {
   VofFrameWriter& operator=(const VofFrameWriter&) = delete;
 
   /// Append the solver's state as frame at time t.
-  void write(double t, const engine::vof::VofSolver& s);
+  void write(double t, const engine::vof::VofBackend& s);
   /// Close fields.h5 (copied to dir when written elsewhere) and write fields.xmf. Returns the
   /// number of frames.
   int finish();

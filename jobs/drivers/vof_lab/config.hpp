@@ -4,7 +4,9 @@
 // conditions of the listed sides. This file is the one place where an option's value becomes an
 // engine setting; an unknown value is a ScenarioError naming the valid ones (an empty string is the
 // option's default).
-#include "engine/vof/solver.hpp"
+#include "engine/vof/backend.hpp"
+#include "engine/vof/column_friction.hpp"
+#include "engine/vof/error.hpp"
 #include "runout/v1/scenario.pb.h"
 
 namespace runout::jobs::vof_lab {

@@ -16,7 +16,7 @@ namespace vof = engine::vof;
 namespace {
 
 // 3D: the flow depth per column (x, z); -1 where an obstacle not covered by flow stands.
-std::vector<double> plan_depth(const vof::VofSolver& s, const LabGrid& g, double& dmax) {
+std::vector<double> plan_depth(const vof::VofBackend& s, const LabGrid& g, double& dmax) {
   std::vector<double> depth(std::size_t(g.nx) * g.nz, -1);
   dmax = 1e-9;
   for (int k = 0; k < g.nz; ++k)
@@ -50,7 +50,7 @@ void write_png(const std::string& path, int W, int H, std::vector<unsigned char>
 // Plane set-ups: the x-y section, material (alpha > 0.5) coloured by speed (blue slow ... red fast),
 // air white. 3D: the plan view (x along, z across), flow depth coloured from blue (thin) to red
 // (the deepest), obstacles grey.
-void write_state_figure(const std::string& path, const vof::VofSolver& s, const LabGrid& g, double vmax) {
+void write_state_figure(const std::string& path, const vof::VofBackend& s, const LabGrid& g, double vmax) {
   const int nrow = g.three_d ? g.nz : g.ny;
   const int sc = std::max(1, 600 / std::max(g.nx, 1));
   const int W = g.nx * sc, H = nrow * sc;
@@ -97,7 +97,7 @@ std::string figure_title(const ResolvedScenario& r, const LabGrid& g, double t) 
 }
 
 void write_section_comparison(const std::string& path, const std::string& title, const v1::Lab& L, const LabSetup& su,
-                              const vof::VofSolver& s, const Deposit& dep, const LabMonitors& mon) {
+                              const vof::VofBackend& s, const Deposit& dep, const LabMonitors& mon) {
   const auto& g = su.g;
   figures::SectionFigure fig;
   fig.title = title;

@@ -3,7 +3,7 @@
 // and the curved chute's bed (B8).
 #include <google/protobuf/repeated_field.h>
 
-#include "engine/vof/solver.hpp"
+#include "engine/vof/backend.hpp"
 #include "jobs/formats/vof_frames.hpp"
 #include "runout/v1/scenario.pb.h"
 

@@ -32,7 +32,7 @@ OutflowMonitor::OutflowMonitor(const LabSetup& su, double end_time) : per_width_
       for (int f = p.start; f < p.start + p.size; ++f) faces_.push_back(f);
 }
 
-void OutflowMonitor::sample(double, const vof::VofSolver& s) {
+void OutflowMonitor::sample(double, const vof::VofBackend& s) {
   double sum = 0;
   for (int f : faces_) sum += s.granular_flux()[std::size_t(f)];
   q.push_back(1000 * sum * per_width_);
@@ -57,7 +57,7 @@ GateMonitor::GateMonitor(const LabSetup& su, const v1::Lab& L)
       faces_.push_back(f);
 }
 
-void GateMonitor::sample(double, const vof::VofSolver& s) {
+void GateMonitor::sample(double, const vof::VofBackend& s) {
   const auto& m = su_.m;
   const auto& g = su_.g;
   double qg = 0;
@@ -87,7 +87,7 @@ void GateMonitor::write(v1::Monitors& rec, const std::vector<double>& t) const {
 
 // ---- moving share ----
 
-void MovingShareMonitor::sample(double t, const vof::VofSolver& s) {
+void MovingShareMonitor::sample(double t, const vof::VofBackend& s) {
   double mat = 0, moving = 0;
   const auto n = s.alpha().size();
   for (std::size_t k = 0; k < n; ++k)
@@ -113,7 +113,7 @@ ShockMonitor::ShockMonitor(const LabSetup& su, const v1::Lab& L)
     if (lb.kind() == "inflow") inflow_speed_ = std::max(inflow_speed_, lb.inflow_u0() + 0.5 * lb.inflow_dudy() * lb.inflow_height());
 }
 
-void ShockMonitor::sample(double, const vof::VofSolver& s) {
+void ShockMonitor::sample(double, const vof::VofBackend& s) {
   if (!end_wall_) return;
   const auto& g = su_.g;
   int i = g.nx - 1;
@@ -158,7 +158,7 @@ SurfaceAngleMonitor::SurfaceAngleMonitor(const LabSetup& su, const v1::Lab& L, d
       period_(L.rotation_period_s()),
       every_(every) {}
 
-void SurfaceAngleMonitor::sample(double t, const vof::VofSolver& s) {
+void SurfaceAngleMonitor::sample(double t, const vof::VofBackend& s) {
   if (!rotating_) return;
   const auto& m = su_.m;
   double n = 0, mx = 0, my = 0, sxx = 0, sxy = 0, syy = 0;
@@ -193,7 +193,7 @@ void SurfaceAngleMonitor::sample(double t, const vof::VofSolver& s) {
 // turning gravity): along the surface line's normal into the sand, the deepest sand cell within 2 cm
 // of the normal through the points' centroid that moves faster than 10 % of the fastest there and
 // 5 mm/s, plus half a cell (the reference method's measure, validation.md B1).
-double SurfaceAngleMonitor::flowing_layer(const vof::VofSolver& s, double mx, double my, double dir) const {
+double SurfaceAngleMonitor::flowing_layer(const vof::VofBackend& s, double mx, double my, double dir) const {
   const auto& m = su_.m;
   double nx = -std::sin(dir), ny = std::cos(dir), sgn = 0;
   for (int c = 0; c < m.cells(); ++c) {
@@ -271,7 +271,7 @@ LabMonitors::LabMonitors(const LabSetup& su, const v1::Lab& L, double t_start)
 
 std::vector<Monitor*> LabMonitors::all() { return {&surface, &outflow, &gate, &moving, &shock}; }
 
-void LabMonitors::after_step(double time, const vof::VofSolver& s) {
+void LabMonitors::after_step(double time, const vof::VofBackend& s) {
   if (time < next_ - 1e-12) return;
   for (Monitor* m : all()) m->sample(time, s);
   t.push_back(time);

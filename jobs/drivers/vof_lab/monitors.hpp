@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "engine/vof/solver.hpp"
+#include "engine/vof/backend.hpp"
 #include "jobs/drivers/vof_lab/setup.hpp"
 #include "jobs/formats/checkpoint.hpp"
 #include "jobs/drivers/vof_figures.hpp"
@@ -25,7 +25,7 @@ double median_between(const std::vector<double>& t, const std::vector<double>& v
 class Monitor {
  public:
   virtual ~Monitor() = default;
-  virtual void sample(double t, const engine::vof::VofSolver& s) = 0;
+  virtual void sample(double t, const engine::vof::VofBackend& s) = 0;
   /// Its figures, from its series and their sample times `t`.
   virtual void write(v1::Monitors& rec, const std::vector<double>& t) const = 0;
   /// Its series by checkpoint name (present in every checkpoint, empty where it does not apply).
@@ -37,7 +37,7 @@ class Monitor {
 class OutflowMonitor : public Monitor {
  public:
   OutflowMonitor(const LabSetup& su, double end_time);
-  void sample(double t, const engine::vof::VofSolver& s) override;
+  void sample(double t, const engine::vof::VofBackend& s) override;
   void write(v1::Monitors& rec, const std::vector<double>& t) const override;
   std::vector<std::pair<const char*, std::vector<double>*>> series() override { return {{"outflow", &q}}; }
   std::vector<double> q;
@@ -52,7 +52,7 @@ class OutflowMonitor : public Monitor {
 class GateMonitor : public Monitor {
  public:
   GateMonitor(const LabSetup& su, const v1::Lab& L);
-  void sample(double t, const engine::vof::VofSolver& s) override;
+  void sample(double t, const engine::vof::VofBackend& s) override;
   void write(v1::Monitors& rec, const std::vector<double>& t) const override;
   std::vector<std::pair<const char*, std::vector<double>*>> series() override { return {{"gate_flux", &flux}, {"gate_strain_rate", &strain}}; }
   bool has_gate() const { return !faces_.empty(); }
@@ -68,7 +68,7 @@ class GateMonitor : public Monitor {
 /// The share of the material (alpha > 0.5) moving faster than 1 cm/s, and when it first reached 99 %.
 class MovingShareMonitor : public Monitor {
  public:
-  void sample(double t, const engine::vof::VofSolver& s) override;
+  void sample(double t, const engine::vof::VofBackend& s) override;
   void write(v1::Monitors& rec, const std::vector<double>& t) const override;
   std::vector<std::pair<const char*, std::vector<double>*>> series() override { return {{"moving_share", &share}}; }
   std::vector<double> share;
@@ -84,7 +84,7 @@ class ShockMonitor : public Monitor {
  public:
   ShockMonitor(const LabSetup& su, const v1::Lab& L);
   bool enabled() const { return end_wall_; }
-  void sample(double t, const engine::vof::VofSolver& s) override;
+  void sample(double t, const engine::vof::VofBackend& s) override;
   void write(v1::Monitors& rec, const std::vector<double>& t) const override;
   std::vector<std::pair<const char*, std::vector<double>*>> series() override { return {{"shock", &x}}; }
   std::vector<double> x;
@@ -102,7 +102,7 @@ class SurfaceAngleMonitor : public Monitor {
  public:
   SurfaceAngleMonitor(const LabSetup& su, const v1::Lab& L, double every);
   bool enabled() const { return rotating_; }
-  void sample(double t, const engine::vof::VofSolver& s) override;
+  void sample(double t, const engine::vof::VofBackend& s) override;
   void write(v1::Monitors& rec, const std::vector<double>& t) const override;
   std::vector<std::pair<const char*, std::vector<double>*>> series() override {
     return {{"surface_angle", &angle}, {"flowing_layer", &layer}};
@@ -110,7 +110,7 @@ class SurfaceAngleMonitor : public Monitor {
   std::vector<double> angle, layer;
 
  private:
-  double flowing_layer(const engine::vof::VofSolver& s, double mx, double my, double dir) const;
+  double flowing_layer(const engine::vof::VofBackend& s, double mx, double my, double dir) const;
   const LabSetup& su_;
   bool rotating_;
   engine::vof::Vec centre_;
@@ -122,7 +122,7 @@ class LabMonitors {
  public:
   LabMonitors(const LabSetup& su, const v1::Lab& L, double t_start);
   /// Sample when the next sample is due.
-  void after_step(double t, const engine::vof::VofSolver& s);
+  void after_step(double t, const engine::vof::VofBackend& s);
   void save(VofCheckpoint& cp);
   /// Throws ScenarioError naming `path` when the checkpoint lacks a series or the monitor times.
   void restore(const VofCheckpoint& cp, const std::string& path);

@@ -22,7 +22,7 @@ void write_mesh(const LabSetup& su, v1::RunRecord& rec) {
   if (g.three_d) me->set_dz_m(g.dz);
 }
 
-Deposit deposit(const LabSetup& su, const vof::VofSolver& s) {
+Deposit deposit(const LabSetup& su, const vof::VofBackend& s) {
   const auto& g = su.g;
   const double dx = g.dx, dy = g.dy;
   Deposit d;
@@ -74,7 +74,7 @@ void write_deposit(const Deposit& d, const LabSetup& su, int frames, v1::RunReco
 }
 
 // Cells blocked by an obstacle are skipped: on a ramp the column starts at the ramp's surface.
-void write_stations(const v1::Lab& L, const LabSetup& su, const vof::VofSolver& s, v1::RunRecord& rec) {
+void write_stations(const v1::Lab& L, const LabSetup& su, const vof::VofBackend& s, v1::RunRecord& rec) {
   const auto& g = su.g;
   const double dy = g.dy;
   for (int q = 0; q < L.stations_x_size(); ++q) {
@@ -113,7 +113,7 @@ void write_stations(const v1::Lab& L, const LabSetup& su, const vof::VofSolver& 
 namespace {
 
 // The flow depth per column (x, z) and the depth-averaged velocity along the bed and across it.
-void depth_map(const v1::Lab& L, const LabSetup& su, const vof::VofSolver& s, std::vector<double>& d, std::vector<char>& blocked_col,
+void depth_map(const v1::Lab& L, const LabSetup& su, const vof::VofBackend& s, std::vector<double>& d, std::vector<char>& blocked_col,
                figures::PlanFigure& plan) {
   const auto& g = su.g;
   const ChuteBed chute_bed(L);  // used on a curved chute only
@@ -181,7 +181,7 @@ void shadows(const v1::Lab& L, const LabGrid& g, const std::vector<double>& d, c
 // The curved chute (validation.md B8): where the deposit lies along the arc length (on the chute,
 // in the bend, on the run-out), its extent, its half-width on the chute and on the run-out (z from
 // lab.z_min, the symmetry plane of a half chute), its highest point and centroid.
-void curved_chute(const v1::Lab& L, const LabSetup& su, const vof::VofSolver& s, const std::vector<double>& d, const figures::PlanFigure& plan,
+void curved_chute(const v1::Lab& L, const LabSetup& su, const vof::VofBackend& s, const std::vector<double>& d, const figures::PlanFigure& plan,
                   v1::CurvedChute& rec) {
   const auto& g = su.g;
   const double s1 = L.chute().bend_start_m(), s2 = L.chute().bend_end_m();
@@ -217,7 +217,7 @@ void curved_chute(const v1::Lab& L, const LabSetup& su, const vof::VofSolver& s,
 
 // The undisturbed depth (median over the wetted columns of the first quarter of the chute), the
 // deepest column and its ratio to it, and the obstacles' shadows.
-void write_chute(const v1::Lab& L, const LabSetup& su, const vof::VofSolver& s, figures::PlanFigure& plan, v1::RunRecord& rec) {
+void write_chute(const v1::Lab& L, const LabSetup& su, const vof::VofBackend& s, figures::PlanFigure& plan, v1::RunRecord& rec) {
   const auto& g = su.g;
   std::vector<double> d, upstream;
   std::vector<char> blocked_col;

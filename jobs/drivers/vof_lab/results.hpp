@@ -5,7 +5,7 @@
 // and the solver's final state.
 #include <vector>
 
-#include "engine/vof/solver.hpp"
+#include "engine/vof/backend.hpp"
 #include "jobs/drivers/vof_lab/setup.hpp"
 #include "jobs/figures/lab_figure.hpp"
 #include "runout/v1/run_record.pb.h"
@@ -23,17 +23,17 @@ struct Deposit {
   int imax = 0;           ///< the right end of the highest plateau
   double upper_angle = 0, mean_angle = 0;  ///< [deg]
 };
-Deposit deposit(const LabSetup& su, const engine::vof::VofSolver& s);
+Deposit deposit(const LabSetup& su, const engine::vof::VofBackend& s);
 
 /// results.front_x_m ... volume figures and frames.
 void write_deposit(const Deposit& d, const LabSetup& su, int frames, v1::RunRecord& rec);
 
 /// The stations of lab.stations_x (centre line in 3D): depth, depth-averaged, surface and basal
 /// velocity along x, the basal speed, the strain rate du/dy and the profile.
-void write_stations(const v1::Lab& L, const LabSetup& su, const engine::vof::VofSolver& s, v1::RunRecord& rec);
+void write_stations(const v1::Lab& L, const LabSetup& su, const engine::vof::VofBackend& s, v1::RunRecord& rec);
 
 /// 3D set-ups (validation.md B7, B8): the record's chute (and curved_chute) and the plan figure's
 /// depth and velocity map.
-void write_chute(const v1::Lab& L, const LabSetup& su, const engine::vof::VofSolver& s, figures::PlanFigure& plan, v1::RunRecord& rec);
+void write_chute(const v1::Lab& L, const LabSetup& su, const engine::vof::VofBackend& s, figures::PlanFigure& plan, v1::RunRecord& rec);
 
 }  // namespace runout::jobs::vof_lab

@@ -85,7 +85,7 @@ class LabRun final : public EngineRun {
   std::string out_dir_;
   const RunOptions& opt_;
   LabSetup su_;
-  std::unique_ptr<vof::VofSolver> s_;
+  std::unique_ptr<vof::VofBackend> s_;
   std::string state_hash_;
   double continued_from_ = 0;
   std::unique_ptr<VofFrameWriter> frames_;
@@ -97,7 +97,7 @@ class LabRun final : public EngineRun {
 LabRun::LabRun(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt)
     : r_(r), L_(r.scenario.lab()), out_dir_(out_dir), opt_(opt) {
   build_setup(L_, su_);
-  s_ = std::make_unique<vof::VofSolver>(su_.m, su_.config);
+  s_ = vof::make_vof_backend(su_.m, su_.config);
   state_hash_ = lab_state_hash(r);
   continued = !opt.restart_path.empty();
   VofCheckpoint restart;
@@ -154,7 +154,7 @@ engine::LoopHooks LabRun::hooks() {
 
 RunSummary LabRun::finish(engine::StopReason stop, const RunTimes& times) {
   const LabGrid& g = su_.g;
-  const vof::VofSolver& s = *s_;
+  const vof::VofBackend& s = *s_;
   RunSummary sum;
   sum.nx = g.nx;
   sum.ny = g.ny * g.nz;

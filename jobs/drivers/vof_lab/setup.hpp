@@ -4,7 +4,7 @@
 // conditions (config.hpp) and the initial fill.
 #include <vector>
 
-#include "engine/vof/solver.hpp"
+#include "engine/vof/backend.hpp"
 #include "jobs/drivers/vof_lab/config.hpp"
 #include "jobs/drivers/vof_lab/geometry.hpp"
 

@@ -2,7 +2,7 @@
 // The 3D engine's configuration for a run on the DEM: the scenario's material, the `vof` block's
 // settings and the conditions of the terrain mesh's patches. This file is the one place where a
 // terrain option's value becomes an engine setting.
-#include "engine/vof/solver.hpp"
+#include "engine/vof/backend.hpp"
 #include "jobs/scenario/scenario.hpp"
 
 namespace runout::jobs::vof_terrain {

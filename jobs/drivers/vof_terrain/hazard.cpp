@@ -25,7 +25,7 @@ ColumnHazard::ColumnHazard(const Columns& cols, const vof::Mesh& m, std::vector<
   deepest_.resize(tracked_.size());
 }
 
-ColumnHazard::Column ColumnHazard::column(std::size_t gc, const vof::VofSolver& s) const {
+ColumnHazard::Column ColumnHazard::column(std::size_t gc, const vof::VofBackend& s) const {
   Column out;
   const auto& a = s.alpha();
   const auto& u = s.velocity();
@@ -59,7 +59,7 @@ ColumnHazard::Column ColumnHazard::column(std::size_t gc, const vof::VofSolver& 
   return out;
 }
 
-Profile ColumnHazard::profile(std::size_t col, const vof::VofSolver& s) const {
+Profile ColumnHazard::profile(std::size_t col, const vof::VofBackend& s) const {
   Profile p;
   for (int j = 0; j < cols_.layers; ++j) {
     const int c = cols_.cell(col, j);
@@ -70,7 +70,7 @@ Profile ColumnHazard::profile(std::size_t col, const vof::VofSolver& s) const {
   return p;
 }
 
-void ColumnHazard::update(double t, const vof::VofSolver& s) {
+void ColumnHazard::update(double t, const vof::VofBackend& s) {
   const std::size_t n = cols_.grid_cells();
   for (std::size_t col = 0; col < n; ++col) {
     const Column c = column(col, s);  // zero where no column of the cell is meshed
@@ -93,13 +93,13 @@ void ColumnHazard::update(double t, const vof::VofSolver& s) {
   }
 }
 
-std::vector<double> ColumnHazard::depth(const vof::VofSolver& s) const {
+std::vector<double> ColumnHazard::depth(const vof::VofBackend& s) const {
   std::vector<double> d(cols_.grid_cells(), 0.0);
   for (std::size_t col = 0; col < d.size(); ++col) d[col] = column(col, s).depth;
   return d;
 }
 
-void ColumnHazard::finish(const vof::VofSolver& s) { hz_.final_depth = depth(s); }
+void ColumnHazard::finish(const vof::VofBackend& s) { hz_.final_depth = depth(s); }
 
 void ColumnHazard::save(VofCheckpoint& cp) const {
   cp.series["max_depth"] = hz_.max_depth;

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "engine/sh2d.hpp"
-#include "engine/vof/solver.hpp"
+#include "engine/vof/backend.hpp"
 #include "jobs/formats/checkpoint.hpp"
 #include "jobs/drivers/vof_terrain/mesh.hpp"
 
@@ -42,11 +42,11 @@ class ColumnHazard {
 
   /// After each step (and at t = 0): the running maxima, arrival times and the tracked columns'
   /// profiles at their deepest.
-  void update(double t, const engine::vof::VofSolver& s);
+  void update(double t, const engine::vof::VofBackend& s);
   /// The normal depth per grid cell now.
-  std::vector<double> depth(const engine::vof::VofSolver& s) const;
+  std::vector<double> depth(const engine::vof::VofBackend& s) const;
   /// The final depth (the deposit) from the solver's state at the end.
-  void finish(const engine::vof::VofSolver& s);
+  void finish(const engine::vof::VofBackend& s);
 
   const engine::HazardMaps& maps() const { return hz_; }
   const std::vector<double>& max_surface_speed() const { return max_surface_; }
@@ -63,8 +63,8 @@ class ColumnHazard {
   struct Column {
     double depth = 0, speed = 0, surface_speed = 0, ground_stress = 0;
   };
-  Column column(std::size_t gc, const engine::vof::VofSolver& s) const;
-  Profile profile(std::size_t col, const engine::vof::VofSolver& s) const;
+  Column column(std::size_t gc, const engine::vof::VofBackend& s) const;
+  Profile profile(std::size_t col, const engine::vof::VofBackend& s) const;
 
   const Columns& cols_;
   const engine::vof::Mesh& m_;

@@ -118,7 +118,7 @@ class TerrainRun final : public EngineRun {
   std::string out_dir_;
   const RunOptions& opt_;
   TerrainSetup su_;
-  std::unique_ptr<vof::VofSolver> s_;
+  std::unique_ptr<vof::VofBackend> s_;
   std::string state_hash_;
   double continued_from_ = std::numeric_limits<double>::quiet_NaN();
   std::unique_ptr<ColumnHazard> hazard_;
@@ -132,7 +132,7 @@ class TerrainRun final : public EngineRun {
 
 TerrainRun::TerrainRun(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt) : r_(r), out_dir_(out_dir), opt_(opt) {
   build_terrain_setup(r, su_);
-  s_ = std::make_unique<vof::VofSolver>(su_.mesh, terrain_config(r, bed_columns(su_.columns, su_.mesh, su_.grid)));
+  s_ = vof::make_vof_backend(su_.mesh, terrain_config(r, bed_columns(su_.columns, su_.mesh, su_.grid)));
   continued = !opt.restart_path.empty();
   state_hash_ = continued || !opt.checkpoint_path.empty() ? terrain_state_hash(r) : std::string();
   VofCheckpoint restart;
@@ -246,7 +246,7 @@ std::vector<std::string> TerrainRun::corridor_notes() const {
 }
 
 RunSummary TerrainRun::finish(engine::StopReason stop, const RunTimes& times) {
-  const vof::VofSolver& s = *s_;
+  const vof::VofBackend& s = *s_;
   RunSummary sum = summary_of_setup(r_, su_);
   sum.seconds_prepare = times.prepare;
   sum.seconds_run = times.run;
