@@ -10,7 +10,7 @@
 
 #include "engine/limiters.hpp"
 #include "engine/sh2d.hpp"
-#include "engine/vof/models/granular_viscosity.hpp"
+#include "engine/vof/models/registry.hpp"
 
 using namespace runout::engine;
 
@@ -35,7 +35,7 @@ BENCHMARK(BM_Limiter)->Arg(0)->Arg(1)->Arg(2);
 void BM_GranularViscosity(benchmark::State& state) {
   vof::VofConfig c;
   c.rho1 = 1470;
-  c.rheology = std::string(vof::kGranularViscosityNames[std::size_t(state.range(0))]);
+  c.rheology = std::string(vof::kGranularViscosityModels[std::size_t(state.range(0))]->name);
   const auto model = vof::make_granular_viscosity(c);
   std::vector<double> p(4096), sr(4096);
   for (std::size_t k = 0; k < p.size(); ++k) {

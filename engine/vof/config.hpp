@@ -2,7 +2,7 @@
 // The VOF engine's configuration (VofConfig) and what it is made of: the boundary conditions per
 // patch (Bc, PatchBc), the numerical choices (Transpose, CoulombPressure, Convection,
 // WallViscosity) with the name tables scenarios take them by, and the names of the boundary
-// conditions and granular viscosity models. The equations, models, boundary conditions and solvers
+// conditions. The equations, models, boundary conditions and solvers
 // of engine/vof take their settings from here; solver.hpp (VofSolver) includes it.
 #include <array>
 #include <functional>
@@ -69,22 +69,17 @@ inline constexpr NameTable<WallViscosity, 2> kWallViscosityNames{{{"face", WallV
 /// momentum predictor (true; VofConfig::consistent and momentum_predictor).
 inline constexpr NameTable<bool, 2> kPressureCouplingNames{{{"piso", false}, {"consistent", true}}};
 
-/// The granular viscosity models' names (VofConfig::rheology), as models/registry.cpp has them (a
-/// test keeps the two the same): for the scenario's checks, which do not link the solver.
-inline constexpr std::array<std::string_view, 3> kGranularViscosityNames{"coulomb", "mu_i", "mu_i_unregularised"};
-
-/// The boundary conditions' and the granular viscosity models' names (PatchBc::type,
-/// VofConfig::rheology).
+/// The boundary conditions' names (PatchBc::type). The granular viscosity models' rows (names,
+/// parameters, checks): models/registry.hpp.
 std::vector<std::string> boundary_condition_names();
-std::vector<std::string> granular_viscosity_names();
 
 struct VofConfig {
   double rho1 = 936.17;        ///< granular bulk density [kg/m3]
   double rho2 = 1.0;           ///< air [kg/m3]
   double nu2 = 1.48e-5;        ///< air kinematic viscosity [m2/s]
-  double phi_deg = 32;         ///< internal friction angle of the granular phase
-  std::string rheology = "coulomb";  ///< the granular phase's viscosity model, by name
-  /// The mu(I) rheology (rheology "mu_i", models/mu_i.cpp): mu = mu_s + (mu_2 - mu_s) / (I_0 / I + 1),
+  double phi_deg = 32;         ///< internal friction angle of the granular phase (the Coulomb viscosity)
+  std::string rheology = "coulomb";  ///< the granular phase's viscosity model, by name (models/registry.hpp)
+  /// The mu(I) rheology (rheology "mu_i", models/mu_i.hpp): mu = mu_s + (mu_2 - mu_s) / (I_0 / I + 1),
   /// I = d |strain rate| / sqrt(p / rho_s). Defaults: the glass beads of Jop, Forterre & Pouliquen
   /// (2006): mu_s = tan 20.9 deg, mu_2 = tan 32.76 deg, I_0 = 0.279, d = 0.5 mm, rho_s = 2450 kg/m3.
   struct MuI {

@@ -23,7 +23,6 @@ namespace runout::engine::vof {
 namespace {
 
 void check_config(const VofConfig& c) {
-  if (!(c.phi_deg > 0 && c.phi_deg < 90)) throw VofError("phi_deg must lie in (0, 90)");
   if (!(c.side_walls.width >= 0 && c.side_walls.tan_delta >= 0 && c.side_walls.creep_speed > 0))
     throw VofError("side_walls: the width and the friction must be >= 0, the creep speed > 0");
   if (!(c.column_friction.tan_delta >= 0 && c.column_friction.creep_speed > 0))

@@ -10,6 +10,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "engine/vof/bc/conditions.hpp"
+#include "engine/vof/models/registry.hpp"
 #include "jobs/figures/hazard_map.hpp"
 #include "jobs/figures/pen.hpp"
 #include "jobs/figures/profile_plot.hpp"
@@ -102,37 +104,70 @@ void write_path_outputs(const ResolvedScenario& s, const products::PathProfile& 
 
 namespace {
 
+// A line of the parameter block, "what: caption, label = value unit, ...", with the material's
+// values read by their field names.
+class ParameterLine {
+ public:
+  ParameterLine(std::string_view what, std::string_view caption, const v1::Material& m)
+      : line_(std::string(what) + ": " + std::string(caption)), m_(m) {}
+  void add(std::string_view label, std::string_view unit, double v) {
+    const std::string u(unit == "deg" ? "°" : unit == "kg/m3" ? "kg/m³" : unit);
+    line_ += ", " + std::string(label) + " = " + num(v) + (u.empty() ? "" : u.rfind("°", 0) == 0 ? u : " " + u);
+  }
+  /// The field's value in `v`; false when it is unset (or not a number).
+  bool value(std::string_view field, double& v) const {
+    const auto* f = m_.GetDescriptor()->FindFieldByName(std::string(field));
+    if (!f || f->cpp_type() != google::protobuf::FieldDescriptor::CPPTYPE_DOUBLE) return false;
+    v = m_.GetReflection()->GetDouble(m_, f);
+    return !f->has_presence() || m_.GetReflection()->HasField(m_, f);
+  }
+  const std::string& text() const { return line_; }
+
+ private:
+  std::string line_;
+  const v1::Material& m_;
+};
+
 // The friction law's line of the parameter block, from the law's own rows (engine/friction): its
 // caption and each parameter the scenario sets, with the internal friction angle where given.
 std::string friction_line(const engine::FrictionLaw& law, const v1::Material& m) {
-  std::string line = "friction: " + std::string(law.caption);
-  const auto* d = m.GetDescriptor();
-  const auto* refl = m.GetReflection();
-  auto add = [&](std::string_view label, std::string_view unit, double v) {
-    const std::string u(unit);
-    line += ", " + std::string(label) + " = " + num(v) + (u.empty() ? "" : u.rfind("°", 0) == 0 ? u : " " + u);
-  };
-  auto value = [&](std::string_view field, double& v) {
-    const auto* f = d->FindFieldByName(std::string(field));
-    if (!f || f->cpp_type() != google::protobuf::FieldDescriptor::CPPTYPE_DOUBLE) return false;
-    v = refl->GetDouble(m, f);
-    return !f->has_presence() || refl->HasField(m, f);
-  };
+  ParameterLine line("friction", law.caption, m);
   for (const auto& p : law.parameters) {
     if (p.field.empty()) break;
     double v = 0;
-    if (!value(p.field, v)) {  // unset: what the row says it means, another parameter's value or a number
+    if (!line.value(p.field, v)) {  // unset: what the row says it means, another parameter's value or a number
       const std::string_view means = p.unset.substr(0, p.unset.find(','));
       const auto other = std::find_if(law.parameters.begin(), law.parameters.end(), [&](const auto& q) { return q.symbol == means; });
       char* end = nullptr;
       const std::string text(means);
-      if (other != law.parameters.end() && !other->field.empty()) (void)value(other->field, v);
+      if (other != law.parameters.end() && !other->field.empty()) (void)line.value(other->field, v);
       else if (v = std::strtod(text.c_str(), &end); text.empty() || *end != '\0') continue;
     }
-    add(p.label, p.unit, v);
+    line.add(p.label, p.unit, v);
   }
-  if (m.has_internal_friction_deg()) add("φ", "°", m.internal_friction_deg());
-  return line;
+  double phi = 0;
+  if (line.value("internal_friction_deg", phi)) line.add("φ", "°", phi);
+  return line.text();
+}
+
+// The 3D engine's granular viscosity and bed, from their rows (engine/vof/models, engine/vof/bc):
+// the model's caption and each parameter's value in the material; the bed's condition and, where
+// it takes one, its friction angle.
+std::vector<std::string> viscosity_lines(const v1::Material& m, const std::string& bed_name) {
+  const auto* model = engine::vof::find_granular_viscosity(m.rheology());
+  std::string type = bed_name;
+  std::replace(type.begin(), type.end(), '-', '_');
+  const auto* bc = engine::vof::find_boundary_condition(type);
+  if (!model || !bc) return {};
+  ParameterLine line("granular viscosity", model->caption, m);
+  for (const auto& p : model->parameters) {
+    double v = 0;
+    if (!p.field.empty() && line.value(p.material_name(), v)) line.add(p.label, p.unit, v);
+  }
+  ParameterLine bed("bed", bc->caption, m);
+  double delta = 0;
+  if (bc->bed_friction && bed.value("bed_friction_deg", delta)) bed.add("δ", "°", delta);
+  return {line.text(), bed.text()};
 }
 
 }  // namespace
@@ -141,7 +176,10 @@ std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain
   const auto& m = s.scenario.material();
   std::vector<std::string> p;
   p.push_back("engine: " + std::string(engine_row(s.engine).caption));
-  p.push_back(friction_line(*s.config.material.rheology, m));
+  if (s.engine == kVofTerrainEngine)
+    for (auto& line : viscosity_lines(m, s.scenario.vof().bed())) p.push_back(std::move(line));
+  else
+    p.push_back(friction_line(*s.config.material.rheology, m));
   p.push_back("density: " + num(m.density_kg_m3()) + " kg/m³");
   p.push_back("release: " + num(std::round(release_volume_m3)) + " m³ in " + std::to_string(s.releases.size()) +
               (s.releases.size() == 1 ? " release" : " releases"));

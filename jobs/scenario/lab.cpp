@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "jobs/scenario/mu_i_fields.hpp"
+#include "jobs/scenario/model_fields.hpp"
 #include "jobs/scenario/options.hpp"
 #include "jobs/scenario/scenario.hpp"
 #include "jobs/scenario/scenario_impl.hpp"
@@ -74,18 +74,13 @@ void check_boundaries(const v1::Lab& l, bool three_d) {
   }
 }
 
-// mu(I): the checks between its fields (each one's range is the option table's) and the
-// regularisation's join, which the model makes when it is built.
+// The granular viscosity model with the lab block's parameters: each in its row's range and the
+// model's own checks (engine/vof/models; for mu(I) the join of its branches).
 void check_rheology(const v1::Lab& l) {
-  if (l.rheology().empty() || l.rheology() == "coulomb") return;
   engine::vof::VofConfig c;
   c.rho1 = lab_material(l.material()).rho;
   apply_lab_rheology(l, c);
-  const auto& m = c.mu_i;
-  if (m.mu_2 < m.mu_s) bad("lab.mu_2", "must be at least lab.mu_s (" + num(m.mu_s) + "), got " + num(m.mu_2));
-  if (m.grain_density < c.rho1)
-    bad("lab.grain_density_kg_m3", "must be at least the material's density " + num(c.rho1) + " kg/m3, got " + num(m.grain_density));
-  check_mu_i_law(c, c.rheology == "mu_i", "lab.mu_2");
+  check_model(c, ModelBlock::lab);
 }
 
 }  // namespace
@@ -96,13 +91,9 @@ void apply_lab_rheology(const v1::Lab& l, engine::vof::VofConfig& c) {
     c.side_walls.tan_delta = std::tan(radians(l.side_wall_friction_deg()));
   }
   if (!l.rheology().empty()) c.rheology = l.rheology();
-  const LabMaterial& mat = lab_material(l.material());  // mu(I)'s defaults: the material's (options.hpp)
-  c.mu_i.mu_s = std::tan(radians(mat.repose_deg));
-  c.mu_i.mu_2 = std::tan(radians(mat.repose_deg + LabMaterial::kMuIRise));
-  c.mu_i.i0 = LabMaterial::kMuII0;
-  c.mu_i.grain_diameter = mat.grain_diameter;
-  c.mu_i.grain_density = mat.grain_density;
-  take_mu_i_fields(l, c.mu_i);
+  // The models' parameters: the lab material's (options.hpp), then those the block gives.
+  for (const auto& [field, value] : lab_model_defaults(lab_material(l.material()))) set_model_parameter(field, value, c);
+  take_model_fields(l, ModelBlock::lab, c);
 }
 
 ResolvedScenario resolve_lab(v1::Scenario s) {

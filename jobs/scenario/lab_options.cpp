@@ -1,13 +1,18 @@
 // The option table of the VOF laboratory block `lab` (options.hpp) and its materials. The mapping
 // into the engine's VofConfig lives in the lab driver (jobs/drivers/vof_lab/config.cpp), which
 // `maps_to` names; the choices of the engine's options come from its name tables
-// (engine/vof/config.hpp), the boundary kinds are checked against its registry by a test
-// (LabOptions.BoundaryKindsAreTheEngineRegistrys).
+// (engine/vof/config.hpp), the boundary kinds and the granular viscosities from their rows
+// (engine/vof/bc/conditions.hpp, engine/vof/models/registry.hpp).
+#include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "engine/vof/bc/conditions.hpp"
 #include "engine/vof/config.hpp"
+#include "jobs/scenario/model_fields.hpp"
 #include "jobs/scenario/options.hpp"
+#include "jobs/scenario/scenario_impl.hpp"
 
 namespace runout::jobs {
 
@@ -20,6 +25,17 @@ constexpr double kExt = 1e4;   // |coordinate| of the lab block [m]
 constexpr double kTime = 1e4;  // lab times [s]
 const Range kCoord{-kExt, kExt};
 const Range kLength{0, kExt};
+
+}  // namespace
+
+std::vector<std::string> condition_names(bool bed) {
+  std::vector<std::string> out;
+  for (const auto* r : engine::vof::boundary_conditions())
+    if (!bed || r->bed) out.push_back(engine::vof::scenario_spelling(r->name));
+  return out;
+}
+
+namespace {
 
 std::vector<std::string> material_names() {
   std::vector<std::string> out;
@@ -44,6 +60,14 @@ const std::vector<LabMaterial>& lab_materials() {
       {"fine-sand", 1855, 54.5, 54.5, "the rotating box's fine sand (its side walls raise the effective phi)", 37, 0.175e-3, 2650},
   };
   return m;
+}
+
+std::vector<std::pair<std::string, double>> lab_model_defaults(const LabMaterial& m) {
+  return {{"phi_deg", m.phi_deg},
+          {"mu_s", std::tan(radians(m.repose_deg))},
+          {"mu_2", std::tan(radians(m.repose_deg + LabMaterial::kMuIRise))},
+          {"grain_diameter_m", m.grain_diameter},
+          {"grain_density_kg_m3", m.grain_density}};
 }
 
 namespace {
@@ -73,9 +97,8 @@ OptionTable lab_geometry_options() {
       coord("lab.fill[].cap_z", "3D: the cap's centre"),
       {"lab.boundaries[].side", T::choice, U::required, "", {}, {"bottom", "top", "left", "right", "back", "front", "obstacle"}, "",
        "the side (back, front: 3D); a side not listed is a wall", "VofConfig::bc"},
-      {"lab.boundaries[].kind", T::choice, U::required, "", {},
-       {"wall", "coulomb-slip", "coulomb-friction", "atmosphere", "outflow", "inflow", "symmetry"}, "",
-       "the boundary condition (engine/vof/bc)", "VofConfig::bc[side].kind"},
+      {"lab.boundaries[].kind", T::choice, U::required, "", {}, condition_names(false), "",
+       "the boundary condition (engine/vof/bc; the section below)", "VofConfig::bc[side].kind"},
       coord("lab.boundaries[].from", "the part of the side this applies to (along it); default all"),
       coord("lab.boundaries[].to", "the part of the side this applies to (along it); default all"),
       {"lab.boundaries[].inflow_u0", T::number, U::as_given, "", Range{-100, 100}, {}, "m/s", "inflow: velocity along x at the bottom",
@@ -91,8 +114,6 @@ OptionTable lab_run_options() {
   return {
       {"lab.material", T::choice, U::fill, "pvc", {}, material_names(), "", "the granular material (the table below)",
        "VofConfig::rho1, phi_deg; coulomb-slip delta"},
-      {"lab.phi_deg", T::number, U::as_given, "", Range{0, 80, true, true}, {}, "deg", "internal friction angle instead of the material's",
-       "VofConfig::phi_deg"},
       {"lab.bed_friction_deg", T::number, U::as_given, "", Range{0, 80, false, true}, {}, "deg",
        "bed friction angle of coulomb-slip sides instead of the material's", "coulomb-slip delta"},
       {"lab.end_time_s", T::number, U::fill, "1", Range{0, kTime, true}, {}, "s", "the simulated time", "run control"},
@@ -155,17 +176,6 @@ OptionTable lab_model_options() {
        "the pressure solve's preconditioner: PETSc's GAMG, hypre's BoomerAMG or ILU(0)", "VofConfig::pressure_pc"},
       {"lab.wall_viscosity", T::choice, U::keep, "face", {}, names_of(engine::vof::kWallViscosityNames), "",
        "viscosity on walls and inflows: evaluated on the face (as OpenFOAM) or the cell's", "VofConfig::wall_viscosity"},
-      {"lab.rheology", T::choice, U::keep, "coulomb", {}, std::vector<std::string>(engine::vof::kGranularViscosityNames.begin(), engine::vof::kGranularViscosityNames.end()), "",
-       "the granular viscosity: Coulomb (tan(phi) p) or mu(I), regularised at low I or not", "VofConfig::rheology"},
-      {"lab.mu_s", T::number, U::as_given, "", Range{0, 5, true}, {}, "", "mu(I): static friction coefficient mu_s (default: the material's, tan(angle of repose))",
-       "VofConfig::mu_i.mu_s"},
-      {"lab.mu_2", T::number, U::as_given, "", Range{0, 5, true}, {}, "",
-       "mu(I): limiting friction coefficient mu_2 >= mu_s (default: the material's, tan(angle of repose + 11.86 deg))", "VofConfig::mu_i.mu_2"},
-      {"lab.mu_i0", T::number, U::as_given, "", Range{0, 10, true}, {}, "", "mu(I): I_0 (default 0.279)", "VofConfig::mu_i.i0"},
-      {"lab.grain_diameter_m", T::number, U::as_given, "", Range{0, 0.1, true}, {}, "m", "mu(I): grain diameter d (default: the material's)",
-       "VofConfig::mu_i.grain_diameter"},
-      {"lab.grain_density_kg_m3", T::number, U::as_given, "", Range{100, 20000}, {}, "kg/m3",
-       "mu(I): grain density rho_s, at least the material's density (default: the material's)", "VofConfig::mu_i.grain_density"},
       {"lab.bed_normal_stress", T::choice, U::keep, "pressure", {}, {"pressure", "column"}, "",
        "the normal load of the bottom's coulomb-friction parts: the face's pressure, or the weight of the material in the cells "
        "above each bed face (the column found by walking the mesh away from the face), as on the DEM; plane beds only, other "
@@ -186,6 +196,9 @@ const OptionTable& lab_options() {
     OptionTable v;
     for (auto* part : {lab_geometry_options, lab_run_options, lab_model_options})
       for (auto& o : part()) v.push_back(std::move(o));
+    std::vector<std::string> from_material;  // the models' parameters whose default is the lab material's
+    for (const auto& [field, value] : lab_model_defaults(lab_materials().front())) from_material.push_back(field);
+    for (auto& o : lab_model_parameter_options(from_material)) v.push_back(std::move(o));
     return v;
   }();
   return t;

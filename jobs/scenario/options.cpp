@@ -117,13 +117,6 @@ void check_choice(const Option& o, const std::string& label, const std::string& 
   if (!is_choice(o, v)) bad(label, "unknown '" + v + "' (valid: " + join_names(o.choices) + ")");
 }
 
-// Integers as lo..hi (every whole number between), numbers as intervals.
-std::string range_text(const Range& r, OptionType type) {
-  if (type == OptionType::integer && std::isfinite(r.lo) && std::isfinite(r.hi))
-    return std::to_string((long long)r.lo) + ".." + std::to_string((long long)r.hi);
-  return (r.lo_open ? "(" : "[") + num(r.lo) + ", " + num(r.hi) + (r.hi_open || std::isinf(r.hi) ? ")" : "]");
-}
-
 void check(const Option& o, const Location& l) {
   const auto* refl = l.msg->GetReflection();
   if (o.type == OptionType::choice) {
@@ -141,6 +134,13 @@ void check(const Option& o, const Location& l) {
 }
 
 }  // namespace
+
+// Integers as lo..hi (every whole number between), numbers as intervals.
+std::string range_text(const Range& r, OptionType type) {
+  if (type == OptionType::integer && std::isfinite(r.lo) && std::isfinite(r.hi))
+    return std::to_string((long long)r.lo) + ".." + std::to_string((long long)r.hi);
+  return (r.lo_open ? "(" : "[") + num(r.lo) + ", " + num(r.hi) + (r.hi_open || std::isinf(r.hi) ? ")" : "]");
+}
 
 std::string join_names(const std::vector<std::string>& names) {
   std::string s;

@@ -15,6 +15,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "engine/names.hpp"
@@ -83,13 +84,19 @@ struct LabMaterial {
   std::string doc;
   /// mu(I)'s parameters (lab.rheology "mu_i"): the measured angle of repose as mu_s = tan(repose),
   /// mu_2 = tan(repose + kMuIRise) (the rise of the glass beads of Jop et al. 2006, 20.9 to 32.76
-  /// deg: not measured for these materials), I_0 0.279 (the beads'), the measured mean grain
-  /// diameter [m] and grain density [kg/m^3].
+  /// deg: not measured for these materials), the measured mean grain diameter [m] and grain
+  /// density [kg/m^3]; I_0 is the engine's (the beads', 0.279).
   double repose_deg, grain_diameter, grain_density;
   static constexpr double kMuIRise = 32.76 - 20.9;
-  static constexpr double kMuII0 = 0.279;
 };
 const std::vector<LabMaterial>& lab_materials();
+/// The boundary conditions' names as scenarios spell them (engine/vof/bc/conditions.hpp's rows);
+/// `bed`: those that may be the ground of the 3D engine on the DEM.
+std::vector<std::string> condition_names(bool bed);
+/// The granular viscosity models' parameters a lab material gives, by the rows' lab field
+/// (engine/vof/models): lab.phi_deg, and mu(I)'s from the angle of repose, grain diameter and
+/// density. The lab block's defaults of those fields.
+std::vector<std::pair<std::string, double>> lab_model_defaults(const LabMaterial& m);
 /// The material called `name` ("" is the default, pvc); an unknown name is a ScenarioError listing
 /// the valid ones. For the lab driver's mapping into VofConfig.
 const LabMaterial& lab_material(const std::string& name);
@@ -108,6 +115,8 @@ std::string option_table_markdown(const OptionTable& table);
 /// The reference page of every table (Markdown), as committed in docs/user/scenario-reference.md.
 std::string scenario_reference_markdown();
 
+/// A range as the messages and the reference write it: "[0, 5)", integers "1..20".
+std::string range_text(const Range& r, OptionType type);
 /// "a, b, c"
 std::string join_names(const std::vector<std::string>& names);
 /// The names of an engine's name table, as an option's choices.

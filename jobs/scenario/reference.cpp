@@ -4,6 +4,9 @@
 #include <string>
 
 #include "engine/friction/registry.hpp"
+#include "engine/vof/bc/conditions.hpp"
+#include "engine/vof/models/registry.hpp"
+#include "jobs/scenario/model_fields.hpp"
 #include "jobs/scenario/options.hpp"
 #include "jobs/scenario/scenario_impl.hpp"
 
@@ -21,6 +24,32 @@ std::string friction_laws_markdown() {
                                                 std::string(p.doc) + (p.unset.empty() ? "" : "; unset: " + std::string(p.unset)) + ")");
     s += "| `" + std::string(law->name) + "` | " + std::string(law->equation) + " | " + needs + " |\n";
   }
+  return s;
+}
+
+// The 3D engine's granular viscosity models from their rows (engine/vof/models/registry.hpp).
+std::string granular_viscosities_markdown() {
+  std::string s = "| `rheology` | Granular viscosity | Parameters: lab block, material block (default; valid; unit) |\n|---|---|---|\n";
+  for (const auto* m : engine::vof::granular_viscosity_models()) {
+    std::string params;
+    for (const auto& p : m->parameters) {
+      if (p.field.empty()) break;
+      params += (params.empty() ? "" : "; ") + ("`" + model_field(p, ModelBlock::lab) + "`, `" + model_field(p, ModelBlock::material) + "` (" +
+                                                 std::string(p.symbol) + ", " + std::string(p.doc) + "; engine default " +
+                                                 num(p.default_value()) + "; " + range_text(Range{p.lo, p.hi, p.lo_open, p.hi_open}, OptionType::number) +
+                                                 (p.unit.empty() ? "" : " " + std::string(p.unit)) + ")");
+    }
+    s += "| `" + std::string(m->name) + "` | " + std::string(m->caption) + ": " + std::string(m->equation) + " | " + params + " |\n";
+  }
+  return s;
+}
+
+// The 3D engine's boundary conditions from their rows (engine/vof/bc/conditions.hpp).
+std::string boundary_conditions_markdown() {
+  std::string s = "| `kind` | Boundary condition | `vof.bed` |\n|---|---|---|\n";
+  for (const auto* r : engine::vof::boundary_conditions())
+    s += "| `" + engine::vof::scenario_spelling(r->name) + "` | " + std::string(r->caption) + ": " + std::string(r->doc) + " | " +
+         (r->bed ? (r->bed_friction ? "yes, with `material.bed_friction_deg`" : "yes") : "-") + " |\n";
   return s;
 }
 
@@ -74,15 +103,35 @@ derivations and reference values for glass beads.
 ## 3D engine on the DEM (`engine` "vof" without `lab`)
 
 The DEM, area of interest, grid, releases, material, `numerics.end_time_s`,
-`numerics.stop_fraction` and outputs are the depth-averaged engine's fields above; the material must
-be `coulomb` with `internal_friction_deg` (the Coulomb viscosity) and `bed_friction_deg`. The other
-`numerics` fields do not apply. docs/design/vof.md, "Meshes over terrain", describes the mesh.
+`numerics.stop_fraction` and outputs are the depth-averaged engine's fields above; `material.rheology`
+must name a friction law that is also a granular viscosity below, with every parameter of its
+material block given, and `bed_friction_deg` (the bed). The other `numerics` fields do not apply.
+docs/design/vof.md, "Meshes over terrain", describes the mesh.
 
 )" + option_table_markdown(terrain_vof_options()) +
          R"(
 ## VOF laboratory (`engine` "vof", block `lab`)
 
 )" + option_table_markdown(lab_options()) +
+         R"(
+### Granular viscosities
+
+The 3D engine's granular phase takes its viscosity from one of these models (`engine/vof/models/`,
+one header per model): the laboratory block by `lab.rheology`, the 3D engine on the DEM by
+`material.rheology`. A parameter the laboratory block leaves unset is the lab material's where the
+table below gives it, else the engine's default; on the DEM every parameter is needed.
+p is the pressure, rho the granular phase's density, \|strain rate\| = sqrt(2 D:D).
+
+)" + granular_viscosities_markdown() +
+         R"(
+### Boundary conditions
+
+The sides of a laboratory set-up (`lab.boundaries[].kind`) and the ground of the 3D engine on the
+DEM (`vof.bed`) take one of these conditions (`engine/vof/bc/`, one file per condition); a
+coulomb-slip or coulomb-friction side of a laboratory set-up takes the material's bed friction
+angle (`lab.bed_friction_deg`).
+
+)" + boundary_conditions_markdown() +
          R"(
 ### Lab materials
 

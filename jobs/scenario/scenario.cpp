@@ -8,7 +8,7 @@
 #include "jobs/digest/sha256.hpp"
 #include "jobs/scenario/json_shape.hpp"
 #include "jobs/scenario/text_limits.hpp"
-#include "jobs/scenario/mu_i_fields.hpp"
+#include "jobs/scenario/model_fields.hpp"
 #include "jobs/scenario/options.hpp"
 #include "jobs/scenario/scenario_impl.hpp"
 
@@ -130,8 +130,7 @@ v1::Scenario parse_scenario_json(const std::string& json) {
 void apply_material_rheology(const v1::Material& m, engine::vof::VofConfig& c) {
   c.rho1 = m.density_kg_m3();
   c.rheology = m.rheology().empty() ? "coulomb" : m.rheology();  // a granular viscosity's name (check_terrain_vof)
-  c.phi_deg = m.internal_friction_deg();
-  take_mu_i_fields(m, c.mu_i);
+  take_model_fields(m, ModelBlock::material, c);
 }
 
 ResolvedScenario load_scenario(const std::string& path) {
@@ -259,28 +258,29 @@ void check_material(const v1::Material& m, const engine::Material& mat) {
   }
 }
 
-// The 3D engine on the DEM: the Coulomb viscosity (with the internal friction angle) or mu(I) (with
-// the parameters the depth-averaged mu_i law takes too, checked by check_material; here their
-// join), and the bed's friction angle.
+// The 3D engine on the DEM: a friction law it has a granular viscosity of the same name for
+// (engine/vof/models), with every parameter of that model's rows given in the material (the rows'
+// ranges and the model's checks: check_model), and the bed's friction angle.
 void check_terrain_vof(const v1::Scenario& s) {
   const auto& m = s.material();
-  // The friction laws the 3D engine has a granular viscosity of the same name for.
-  std::vector<std::string> laws;
+  std::vector<std::string> laws;  // the friction laws the 3D engine has a granular viscosity of the same name for
   for (const auto* law : engine::kFrictionLaws)
-    for (const auto& v : engine::vof::kGranularViscosityNames)
-      if (law->name == v) laws.push_back("\"" + std::string(v) + "\"");
-  if (std::find(laws.begin(), laws.end(), "\"" + m.rheology() + "\"") == laws.end()) {
+    if (engine::vof::find_granular_viscosity(law->name)) laws.push_back("\"" + std::string(law->name) + "\"");
+  const auto* model = engine::vof::find_granular_viscosity(m.rheology());
+  if (!model || std::find(laws.begin(), laws.end(), "\"" + m.rheology() + "\"") == laws.end()) {
     std::string list;
     for (std::size_t k = 0; k < laws.size(); ++k) list += (k == 0 ? "" : k + 1 == laws.size() ? " or " : ", ") + laws[k];
     bad("material.rheology", "the 3D engine takes " + list + " (got \"" + m.rheology() + "\")");
   }
-  if (m.rheology() == "coulomb" && !m.has_internal_friction_deg())
-    bad("material.internal_friction_deg", "needed by the 3D engine's Coulomb viscosity");
-  if (m.rheology() == "mu_i" && m.has_mu_s() && m.has_mu_2() && m.has_mu_i0() && m.has_grain_diameter_m() && m.has_grain_density_kg_m3()) {
-    engine::vof::VofConfig c;
-    apply_material_rheology(m, c);
-    check_mu_i_law(c, true, "material.mu_2");
+  const auto* refl = m.GetReflection();
+  for (const auto& p : model->parameters) {
+    if (p.field.empty()) break;
+    const auto* f = m.GetDescriptor()->FindFieldByName(std::string(p.material_name()));
+    if (!f || !refl->HasField(m, f)) bad(model_field(p, ModelBlock::material), "needed by the 3D engine's " + std::string(model->caption));
   }
+  engine::vof::VofConfig c;
+  apply_material_rheology(m, c);
+  check_model(c, ModelBlock::material);
   if (!m.has_bed_friction_deg()) bad("material.bed_friction_deg", "needed by the 3D engine's bed condition");
   const auto& me = s.mesh();
   if (me.has_first_layer_m() && me.has_band_height_m() && !(me.band_height_m() > me.first_layer_m()))

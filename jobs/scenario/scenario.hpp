@@ -123,11 +123,12 @@ ResolvedScenario load_scenario(const std::string& path);
 ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base_dir);
 
 /// The laboratory block's granular rheology into the engine's configuration: lab.rheology, the
-/// mu(I) parameters (those not set are the material's, LabMaterial) and the side walls' friction of
-/// a plane set-up.
+/// granular viscosity models' parameters (by their rows, engine/vof/models/registry.hpp; those not
+/// set are the lab material's, lab_model_defaults) and the side walls' friction of a plane set-up.
 void apply_lab_rheology(const v1::Lab& lab, engine::vof::VofConfig& c);
 /// The material block into the 3D engine's configuration on the DEM: its density, the granular
-/// rheology ("coulomb" with internal_friction_deg, or "mu_i" with its parameters).
+/// viscosity model of material.rheology's name and the parameters the material gives (by the
+/// models' rows: internal_friction_deg, mu(I)'s fields).
 void apply_material_rheology(const v1::Material& m, engine::vof::VofConfig& c);
 
 }  // namespace runout::jobs

@@ -50,8 +50,10 @@ const OptionTable& terrain_vof_options() {
        "run control", "none"},
       {"vof.max_courant", T::number, U::fill, "0.2", Range{0.01, 1}, {}, "", "the time step's Courant number in the material",
        "VofConfig::max_co, max_alpha_co"},
-      {"vof.bed", T::choice, U::fill, "coulomb-friction", {}, {"coulomb-friction", "coulomb-slip", "wall"}, "",
-       "the ground: Coulomb friction with material.bed_friction_deg as a force, as a slip wall, or stick", "VofConfig::bc[ground]"},
+      {"vof.bed", T::choice, U::fill, "coulomb-friction", {}, condition_names(true), "",
+       "the ground's boundary condition (the section \"Boundary conditions\" below); those with the bed friction take "
+       "material.bed_friction_deg",
+       "VofConfig::bc[ground]"},
       {"vof.outer_correctors", T::integer, U::fill, "3", Range{1, 20}, {}, "", "outer correctors per step (PIMPLE's nOuterCorrectors)",
        "VofConfig::n_outer_correctors"},
       {"vof.non_orthogonal_correctors", T::integer, U::fill, "1", Range{0, 5}, {}, "",

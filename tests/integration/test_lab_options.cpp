@@ -365,7 +365,7 @@ TEST(Scenarios, LabRheologyIsValidatedAndReachesTheRun) {
       "fill": [{"x_max": 0.5, "y_max": 0.5}], "rheology": "mu_i")";
   auto with = [&](const std::string& more) { return jobs::parse_scenario_json(head + more + "}}"); };
   EXPECT_NO_THROW(jobs::resolve_scenario(with(R"(, "mu_s": 0.5, "mu_2": 0.9, "mu_i0": 0.3, "grain_diameter_m": 0.001)"), "."));
-  expect_resolve_error(with(R"(, "mu_s": 0.6, "mu_2": 0.5)"), {"lab.mu_2", "at least lab.mu_s"});
+  expect_resolve_error(with(R"(, "mu_s": 0.6, "mu_2": 0.5)"), {"lab.mu_2", "at least mu_s"});
   expect_resolve_error(with(R"(, "grain_density_kg_m3": 500)"), {"lab.grain_density_kg_m3", "material's density"});
   expect_resolve_error(with(R"(, "mu_s": 0.381863, "mu_2": 0.382)"), {"lab.mu_2", "too small"});
   for (const auto& m : jobs::lab_materials()) {  // the defaults: the material's (options.hpp LabMaterial)

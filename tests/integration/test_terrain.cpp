@@ -641,3 +641,32 @@ TEST(Terrain, MapParametersNameTheFrictionLawFromItsRows) {
   m->set_grain_density_kg_m3(2500);
   EXPECT_EQ(line(engine::friction::mu_i), "friction: μ(I), μs = 0.38, μ₂ = 0.64, I₀ = 0.279, d = 0.005 m, ρs = 2500 kg/m³");
 }
+
+// The 3D engine's maps name its granular viscosity and its bed from their rows (engine/vof/models,
+// engine/vof/bc): the model's caption with its parameters, the bed's condition with the friction
+// angle where it takes one.
+TEST(Terrain, MapParametersOfThe3DEngineNameItsViscosityAndBedFromTheirRows) {
+  auto s = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/tests/data/arelen-30m.json");
+  const auto g = terrain::prepare_grid(s.dem);
+  s.engine = jobs::kVofTerrainEngine;
+  auto lines = [&] {
+    std::string out;
+    for (const auto& p : jobs::map_parameters(s, g, 1000))
+      if (p.rfind("granular viscosity: ", 0) == 0 || p.rfind("bed: ", 0) == 0 || p.rfind("friction: ", 0) == 0) out += p + "\n";
+    return out;
+  };
+  auto* m = s.scenario.mutable_material();
+  m->set_rheology("coulomb");
+  m->set_bed_friction_deg(15);
+  m->set_internal_friction_deg(32);
+  s.scenario.mutable_vof()->set_bed("coulomb-friction");
+  EXPECT_EQ(lines(), "granular viscosity: Coulomb viscosity, φ = 32°\nbed: Coulomb friction, δ = 15°\n");
+  s.scenario.mutable_vof()->set_bed("wall");
+  m->set_rheology("mu_i");
+  m->set_mu_s(0.38);
+  m->set_mu_2(0.64);
+  m->set_mu_i0(0.279);
+  m->set_grain_diameter_m(0.005);
+  m->set_grain_density_kg_m3(2500);
+  EXPECT_EQ(lines(), "granular viscosity: μ(I) viscosity, μs = 0.38, μ₂ = 0.64, I₀ = 0.279, d = 0.005 m, ρs = 2500 kg/m³\nbed: stick wall\n");
+}

@@ -8,7 +8,7 @@
 #include "engine/vof/fv/fv_matrix.hpp"
 #include "engine/vof/fv/ops.hpp"
 #include "engine/vof/mixture.hpp"
-#include "engine/vof/models/granular_viscosity.hpp"
+#include "engine/vof/models/registry.hpp"
 #include "engine/vof/models/mu_i_law.hpp"
 #include "engine/vof/solver.hpp"
 
@@ -132,8 +132,13 @@ TEST(VofFv, CoulombViscosityByName) {
   EXPECT_EQ(nu->nu(1000, 0.0), c.nu_max);  // at rest: the clip
   EXPECT_EQ(nu->nu(-1000, 1.0), c.nu_min);
   EXPECT_EQ(granular_viscosity_names(), (std::vector<std::string>{"coulomb", "mu_i", "mu_i_unregularised"}));
-  EXPECT_EQ(granular_viscosity_names(),
-            std::vector<std::string>(kGranularViscosityNames.begin(), kGranularViscosityNames.end()));  // the scenario's list
+  c.phi_deg = 90;  // the row's check, before the model is made
+  try {
+    (void)make_granular_viscosity(c);
+    ADD_FAILURE() << "phi = 90 deg accepted";
+  } catch (const VofError& e) {
+    EXPECT_NE(std::string(e.what()).find("rheology coulomb: phi_deg must lie in (0, 90)"), std::string::npos) << e.what();
+  }
 }
 
 // mu(I) through the viscosity: nu rho1 |strain rate| / p is mu(I) at I = d |strain rate| / sqrt(p / rho_s).
@@ -193,7 +198,7 @@ TEST(VofFv, MuIParametersAreChecked) {
   bad([](VofConfig& c) { c.mu_i.mu_s = 0; }, "mu_s must be > 0");
   bad([](VofConfig& c) { c.mu_i.i0 = -1; }, "I_0 must be > 0");
   bad([](VofConfig& c) { c.mu_i.grain_diameter = 0; }, "grain diameter");
-  bad([](VofConfig& c) { c.mu_i.grain_density = 1000; }, "grain density must be at least the bulk density");
+  bad([](VofConfig& c) { c.mu_i.grain_density = 1000; }, "grain_density_kg_m3 must be at least the material's density");
   bad([](VofConfig& c) { c.mu_i.mu_2 = c.mu_i.mu_s + 1e-3; }, "too small for alpha");
   bad([](VofConfig& c) { c.mu_i.alpha = -1; }, "alpha must be > 0");
   bad([](VofConfig& c) { c.mu_i.alpha = 1.9, c.mu_i.mu_s = 0.625, c.mu_i.mu_2 = 0.961; }, "too small for alpha");
@@ -244,7 +249,7 @@ TEST(VofFv, BoundaryConditionsByName) {
     const std::string what = e.what();
     EXPECT_NE(what.find("patch 'top'"), std::string::npos) << what;
     EXPECT_NE(what.find("'sky'"), std::string::npos) << what;
-    EXPECT_NE(what.find("valid: wall, coulomb_slip, atmosphere"), std::string::npos) << what;
+    EXPECT_NE(what.find("valid: wall, coulomb_slip, coulomb_friction, atmosphere"), std::string::npos) << what;
   }
 }
 

@@ -11,7 +11,8 @@
 //   opening()        whether the face opens to the still air outside: the pressure equation fixes
 //                    p_rgh there, it sets the reference level and joins the air reservoir;
 //   seeds_active_region() whether the cell next to it is always computed (material enters there).
-// A new kind: one file in bc/ with its class and factory, and one entry in bc/registry.cpp.
+// A new kind: one file in bc/ with its class and factory, its row in bc/conditions.hpp (name,
+// caption, what it does) and its factory's line in bc/registry.cpp.
 #include <map>
 #include <memory>
 #include <optional>
@@ -60,6 +61,13 @@ class BoundaryCondition {
 /// The condition `patch`'s PatchBc names (PatchBc::type, or its kind); throws VofError for an
 /// unknown name (listing the valid ones) or an incomplete PatchBc.
 std::unique_ptr<BoundaryCondition> make_boundary_condition(const std::string& patch, const PatchBc& bc);
+
+struct BoundaryConditionRow;
+using MakeBc = std::unique_ptr<BoundaryCondition> (*)(const std::string& patch, const PatchBc& bc);
+/// Adds a condition outside the tables (a test's example, a program's own condition): its row to
+/// the rows every reader sees (bc/conditions.hpp) and its factory here; call it before the rows are
+/// read (at start-up). Returns true; a name already taken is a VofError.
+bool add_boundary_condition(const BoundaryConditionRow& row, MakeBc make);
 
 // Shared by the wall-like conditions.
 

@@ -2,7 +2,7 @@
 // The mu(I) law of the granular phase (Jop, Forterre & Pouliquen 2006): the shear stress is
 // mu(I) p along the strain rate, with the inertial number I = d |strain rate| / sqrt(p / rho_s) and
 //   mu(I) = mu_s + (mu_2 - mu_s) / (I_0 / I + 1),
-// (models/mu_i.cpp makes it the viscosity nu = mu(I) p / (rho1 |strain rate|)). Header-only and free
+// (models/mu_i.hpp makes it the viscosity nu = mu(I) p / (rho1 |strain rate|)). Header-only and free
 // of the solver's libraries, so that a scenario's parameters are checked where it is resolved.
 //
 // "mu_i" takes Barker & Gray (2017)'s partial regularisation. The law above makes the equations
