@@ -1,4 +1,5 @@
-// The granular viscosity model VofConfig::rheology names, from the rows of registry.hpp.
+// make_granular_viscosity (granular_viscosity.hpp): the model VofConfig::rheology names, from the rows of
+// registry.hpp.
 #include "engine/vof/models/registry.hpp"
 
 namespace runout::engine::vof {
