@@ -59,6 +59,18 @@ void expect_same_vof_outputs(const std::string& a, const std::string& b) {
   EXPECT_EQ(vof_record(a), vof_record(b));
 }
 
+// The run stopped after `stop_step` steps through the progress hook (as SIGTERM and Ctrl-C stop it),
+// its checkpoint written to `cp` there (and every `every` s before, if given).
+jobs::RunSummary run_cut(const jobs::ResolvedScenario& r, const fs::path& dir, const fs::path& cp, long stop_step,
+                         double every = 0) {
+  jobs::RunOptions cut;
+  cut.checkpoint_path = cp;
+  if (every > 0) cut.checkpoint_interval_s = every;
+  cut.progress_every = 1;
+  cut.progress = [stop_step](const engine::Progress& p) { return p.step < stop_step; };
+  return jobs::run_scenario(r, dir, cut);
+}
+
 // A VOF scenario run in every way a run can go: without checkpoints; with checkpoints every
 // `every` s; stopped after `stop_step` steps through the progress hook (as SIGTERM and Ctrl-C stop
 // it), its checkpoint written there, and continued from it (writing its own checkpoints to the same
@@ -77,12 +89,7 @@ void expect_exact_vof_continuation(const jobs::ResolvedScenario& r, double every
   EXPECT_EQ(jobs::run_scenario(r, d / "checked", checked).steps, whole.steps);
   ASSERT_TRUE(fs::exists(d / "every.h5"));
   expect_same_vof_outputs(d / "whole", d / "checked");
-  jobs::RunOptions cut;
-  cut.checkpoint_path = d / "cut.h5";
-  cut.checkpoint_interval_s = every;
-  cut.progress_every = 1;
-  cut.progress = [stop_step](const engine::Progress& p) { return p.step < stop_step; };
-  const auto part = jobs::run_scenario(r, d / "part", cut);
+  const auto part = run_cut(r, d / "part", d / "cut.h5", stop_step, every);
   ASSERT_EQ(part.stop, "cancelled");
   ASSERT_EQ(part.steps, stop_step);
   jobs::RunOptions cont;
@@ -180,11 +187,7 @@ TEST(Scenarios, TerrainVofRunContinuedFromItsCheckpointIsTheUninterruptedRun) {
   ASSERT_EQ(whole.stop, "end-time");
   const long stop_step = whole.steps / 2;
   ASSERT_GT(stop_step, 10);
-  jobs::RunOptions cut;
-  cut.checkpoint_path = d / "cut.h5";
-  cut.progress_every = 1;
-  cut.progress = [stop_step](const engine::Progress& p) { return p.step < stop_step; };
-  const auto part = jobs::run_scenario(r, d / "part", cut);
+  const auto part = run_cut(r, d / "part", d / "cut.h5", stop_step);
   ASSERT_EQ(part.stop, "cancelled");
   ASSERT_EQ(part.steps, stop_step);
   jobs::RunOptions cont;
