@@ -1,6 +1,6 @@
 // Work-precision and throughput benchmark of the depth-averaged solvers (docs/design/performance.md).
 //
-//   runout_bench_sh [--quick] [--repeat N] [--throughput-only] [--friction LAW]
+//   runout_bench_sh [--quick] [--repeat N] [--throughput-only] [--friction LAW] [--resistance]
 //
 // 1. Work-precision: cases A1 (1D and 2D) and A3 (2D) at four resolutions for each limiter:
 //    error, wall time, cell-updates per second.
@@ -10,6 +10,9 @@
 // Figures are medians over --repeat runs (default 5), all measured in this one process.
 // --throughput-only skips part 1 (for quick before/after comparisons of the 2D step). --friction
 // runs parts 2 and 3 with another basal friction (friction_material: coulomb by default).
+// --resistance puts the whole grid in a resistance area (drag c = 0.01 and detrainment K = 5 Pa, the
+// band from 0 so that the drag acts and the detrainment is evaluated everywhere; the kernels are
+// branch-free, so the cost does not depend on where either applies).
 #include <omp.h>
 
 #include <algorithm>
@@ -73,9 +76,16 @@ bool friction_material(const std::string& law, Material& m) {
   return true;
 }
 
-StepCost measure(const Terrain2D& t, const Sh2dState& init, const Material& material, long steps, int repeat) {
+StepCost measure(const Terrain2D& t, const Sh2dState& init, const Material& material, long steps, int repeat,
+                 bool resistance) {
   Sh2dConfig cfg;
   cfg.material = material;
+  if (resistance) {
+    cfg.resistance.c.assign(t.cells(), 0.01);
+    cfg.resistance.k_det.assign(t.cells(), 5.0);
+    cfg.resistance.speed_min = cfg.resistance.depth_min = 0;
+    cfg.resistance.speed_max = cfg.resistance.depth_max = 1e9;
+  }
   cfg.time.t_end = 1e9;
   cfg.time.max_steps = steps;
   std::vector<double> per_step, rate;
@@ -115,7 +125,7 @@ void work_precision(bool quick) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool quick = false, throughput_only = false;
+  bool quick = false, throughput_only = false, resistance = false;
   int repeat = 5;
   std::string law = "coulomb";
   Material material;
@@ -128,8 +138,10 @@ int main(int argc, char** argv) {
       repeat = std::max(1, std::atoi(argv[++k]));
     } else if (!std::strcmp(argv[k], "--friction") && k + 1 < argc) {
       law = argv[++k];
+    } else if (!std::strcmp(argv[k], "--resistance")) {
+      resistance = true;
     } else {
-      std::fprintf(stderr, "usage: runout_bench_sh [--quick] [--repeat N] [--throughput-only] [--friction LAW]\n");
+      std::fprintf(stderr, "usage: runout_bench_sh [--quick] [--repeat N] [--throughput-only] [--friction LAW] [--resistance]\n");
       return 2;
     }
   }
@@ -159,9 +171,10 @@ int main(int argc, char** argv) {
     }
   const auto part = state_from_normal_depth(t, h);
   const long steps = quick ? 20 : 60;
-  const auto full = measure(t, wet, material, steps, repeat);
-  const auto small = measure(t, part, material, steps * 4, repeat);
-  std::printf("\n## Throughput (%d x %d grid, %ld steps, friction %s)\n\n", n, n, full.steps, law.c_str());
+  const auto full = measure(t, wet, material, steps, repeat, resistance);
+  const auto small = measure(t, part, material, steps * 4, repeat, resistance);
+  std::printf("\n## Throughput (%d x %d grid, %ld steps, friction %s%s)\n\n", n, n, full.steps, law.c_str(),
+              resistance ? ", a resistance area everywhere" : "");
   std::printf("| run | ever wet | mean active | ms/step | Mcell-updates/s (of active cells) | grid cells/s |\n");
   std::printf("|---|---:|---:|---:|---:|---:|\n");
   std::printf("| fully wet | %.1f %% | %.1f %% | %.2f | %.1f | %.1f M |\n", 100 * full.ever_wet, 100 * full.active_fraction,

@@ -114,6 +114,8 @@ struct Sh2dCheckpoint {
   /// released so far [m^3].
   std::vector<double> secondary_time;
   double volume_secondary = 0;
+  /// With resistance areas: the depth detrained per cell so far (as H) and per tile the volume.
+  std::vector<double> detrained, tile_detrained;
 };
 /// Called with a checkpoint at the end of the first step at or after each multiple of
 /// `checkpoint_interval` (steps are never shortened for it) and when the progress hook cancels the
@@ -128,6 +130,23 @@ struct SecondaryRelease {
   std::string name;
   std::vector<std::size_t> cells;  ///< cell indices (i + nx j)
   std::vector<double> depth;       ///< normal depth per cell of `cells` [m], > 0
+};
+
+/// Resistance areas (forest, other obstacles on the ground), as AvaFrame's com1DFA models them
+/// (its resistance model `default`, AvaFrame 1.13 and later; parameter values there marked as not yet
+/// calibrated): a drag per bed area of c rho |u| u, which adds c to Voellmy's g / xi in the implicit
+/// drag (engine/rheology.hpp turbulent_factor), and, with detrainment, the drag only where the normal
+/// depth and the speed both lie in [depth_min, depth_max] and [speed_min, speed_max], and below either
+/// minimum the detrainment of Feistl et al. (2014), dh/dt = -K / (rho |u|) of normal thickness, the
+/// detrained material left on the ground with its momentum taken out of the flow. Per cell: c (0
+/// outside every area) and K [Pa] (0: none). Only with a constant mu (Coulomb or Voellmy).
+struct ResistanceAreas {
+  std::vector<double> c;      ///< per cell, [-]; empty: no resistance areas
+  std::vector<double> k_det;  ///< per cell [Pa]; empty or 0: no detrainment there
+  bool detrainment = true;    ///< false: the drag wherever c > 0, no detrainment
+  double speed_min = 6, speed_max = 40;    ///< [m/s] (com1DFA's forestVMin, forestVMax)
+  double depth_min = 0.6, depth_max = 10;  ///< normal depth [m] (forestThMin, forestThMax)
+  bool empty() const { return c.empty(); }
 };
 
 struct Sh2dConfig {
@@ -161,6 +180,7 @@ struct Sh2dConfig {
   double checkpoint_interval = 0;   ///< [s] of simulated time; 0: checkpoints only when cancelled
   CheckpointHook checkpoint;        ///< optional
   std::vector<SecondaryRelease> secondary;  ///< released when the flow reaches them
+  ResistanceAreas resistance;               ///< none by default
 };
 
 /// Solver state: H = h / cos(theta) and the horizontal momentum H U, H V per horizontal area.
@@ -177,6 +197,7 @@ struct Sh2dDiagnostics {
   double volume_secondary = 0;                  ///< added by the secondary releases [m^3]
   std::vector<double> secondary_time;           ///< per secondary release: when released [s], NaN: never
   double volume_outflow = 0;                    ///< left through outflow boundaries [m^3]
+  double volume_detrained = 0;                  ///< left behind in resistance areas (ResistanceAreas) [m^3]
   double kinetic_energy_peak = 0;               ///< per unit density [m^5/s^2]
   /// Mass-averaged horizontal distance travelled: (1/V0) * integral over time and area of H |U| [m]
   /// (only with Sh2dConfig::track_travel).
@@ -189,10 +210,10 @@ struct Sh2dDiagnostics {
   double mean_active_fraction = 0, max_active_fraction = 0;
   double wall_seconds = 0;  ///< whole run, set-up included
   double loop_seconds = 0;  ///< time loop only
-  /// Relative volume error: |final + outflow - initial - secondary| / (initial + secondary).
+  /// Relative volume error: |final + outflow + detrained - initial - secondary| / (initial + secondary).
   double volume_error() const {
     const double in = volume_initial + volume_secondary;
-    return in > 0 ? std::abs(volume_final + volume_outflow - in) / in : 0.0;
+    return in > 0 ? std::abs(volume_final + volume_outflow + volume_detrained - in) / in : 0.0;
   }
 };
 
@@ -200,6 +221,8 @@ struct Sh2dResult {
   Sh2dState state;
   HazardMaps hazard;
   Sh2dDiagnostics diag;
+  /// Normal thickness left behind per cell by detrainment in resistance areas [m] (empty without).
+  std::vector<double> detrained;
 };
 
 /// Surface geometry derived from the terrain once per run (exposed for tests and output conversion).

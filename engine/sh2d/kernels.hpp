@@ -38,9 +38,17 @@ struct FaceState {
 
 // The basal friction a kernel computes, a template parameter (no branch in the loops): a constant mu
 // with or without Voellmy's drag, or mu(h, Fr) with or without the start/stop term
-// (engine/friction/law.hpp).
-enum class Basal { coulomb, voellmy, flow, hysteresis };
+// (engine/friction/law.hpp); `resisted`: a constant mu with Voellmy's drag (1/xi may be 0) and, per
+// cell, the drag and the detrainment of resistance areas (Sh2dConfig::resistance).
+enum class Basal { coulomb, voellmy, flow, hysteresis, resisted };
 constexpr bool is_flow(Basal b) { return b == Basal::flow || b == Basal::hysteresis; }
+
+// Where a resistance area's drag and detrainment act (engine/sh2d.hpp ResistanceAreas): the band of
+// normal depth and speed of the drag, detrain = 1 where detrainment is on (below either minimum),
+// else 0 (the drag everywhere), and 1 / the flow's density.
+struct ResistanceRule {
+  double speed_min, speed_max, depth_min, depth_max, detrain, inv_density;
+};
 
 // The constants of one step the kernels read: gravity g, the cap of the centrifugal term qcap, the
 // dry depth, curv = 1 where the centrifugal part raises the friction's load (option `curvature`),
@@ -48,6 +56,7 @@ constexpr bool is_flow(Basal b) { return b == Basal::flow || b == Basal::hystere
 struct StepConstants {
   double g, qcap, dry, curv;
   BasalFriction fr;
+  ResistanceRule res{};  // Basal::resisted only
 };
 
 // ---- Surface and load ------------------------------------------------------------------------
@@ -106,6 +115,18 @@ RUNOUT_KERNEL bool stopped(double m3, double impulse) { return m3 <= impulse; }
 // speed is 0. The depth is bounded away from 0 so that a dry cell's factor stays finite.
 RUNOUT_KERNEL double drag_factor(double speed, double h, double gxd) { return turbulent_factor(speed, vmax(h, 1e-300), gxd); }
 
+// The weight of a resistance area's drag at normal depth h and speed: 1 inside the band of both (or
+// everywhere without detrainment), else 0. As 0/1 weights: the selects stay branch-free.
+RUNOUT_KERNEL double drag_weight(const ResistanceRule& r, double h, double speed) {
+  const bool band = h >= r.depth_min && h <= r.depth_max && speed >= r.speed_min && speed <= r.speed_max;
+  return r.detrain == 0.0 || band ? 1.0 : 0.0;
+}
+// Whether a resistance area detrains at normal depth h and speed: detrainment on and slower than
+// the band or thinner than it.
+RUNOUT_KERNEL bool detrains(const ResistanceRule& r, double h, double speed) {
+  return r.detrain != 0.0 && (h < r.depth_min || speed < r.speed_min);
+}
+
 // ---- Reconstruction and predictor --------------------------------------------------------------
 
 struct Slopes {
@@ -138,11 +159,13 @@ struct Predicted {
 // primitive form, pressure coefficients Pxx, Pxy, Pyy frozen in the cell; hx = dt / (2 dx),
 // hy = dt / (2 dy)); where a predicted face depth would be negative it falls back to first order and
 // zeroes s. Then friction over the half step with the load and mu of the state at t (mu from
-// basal_mu, the start/stop law's parts smu, sw), and Voellmy's drag implicitly (B).
+// basal_mu, the start/stop law's parts smu, sw), and Voellmy's drag implicitly (B), with a resistance
+// area's drag coefficient cres (Basal::resisted) in its band at the state at t.
 template <Basal B>
 RUNOUT_KERNEL Predicted predict(const StepConstants& k, double H, double U, double V, double HU, double HV, Slopes& s,
                                 double Pxx, double Pxy, double Pyy, double c, double bx, double by, double hxx, double hxy,
-                                double hyy, double hx, double hy, double dt, double gxd, double smu, double sw) {
+                                double hyy, double hx, double hy, double dt, double gxd, double smu, double sw,
+                                double cres = 0) {
   const double gn = normal_load(U, V, hxx, hxy, hyy, k.g, k.qcap);
   const double acc = -c * c * gn;  // gravity + normal reaction per unit volume
   const bool wet = H > k.dry;
@@ -166,6 +189,10 @@ RUNOUT_KERNEL Predicted predict(const StepConstants& k, double H, double U, doub
   const bool rest = stopped(M3, imp);
   double f = friction_factor(M3, imp);
   if constexpr (B == Basal::voellmy) f *= drag_factor(vmax(M3 - imp, 0.0), H * c, gxd);
+  if constexpr (B == Basal::resisted) {
+    const double gr = gxd + 0.5 * dt * cres * drag_weight(k.res, H * c, speed3(bx, by, U, V));
+    f *= drag_factor(vmax(M3 - imp, 0.0), H * c, gr);
+  }
   const double held = std::abs(HU) + std::abs(HV) == 0.0 ? (rest ? 1.0 : 0.0) : 0.0;
   return Predicted{Hp, rest ? 0.0 : Up * f, rest ? 0.0 : Vp * f, held};
 }
@@ -235,16 +262,21 @@ RUNOUT_KERNEL double flux_update(double Q0, double lx, double ly, double fw, dou
 // A cell's new state: depth, momentum, velocity (zero where dry) and surface speed after friction.
 struct NewState {
   double H, MU, MV, U, V, sp;
+  double det;  // depth detrained in the step (Basal::resisted), as H
 };
 
 // The sources and friction of a cell whose depth H and momentum (MU, MV) are the flux update's:
 // gravity and the normal reaction at the half step (Hp, Up, Vp; midpoint rule), then the friction
 // at the half step as a bounded impulse that never reverses u, its load and mu from the half-step
-// state, then Voellmy's drag implicitly in the speed (gxd = dt g / xi). Dry cells keep no momentum.
+// state, then Voellmy's drag implicitly in the speed (gxd = dt g / xi). Basal::resisted: a resistance
+// area's drag (coefficient cres, in its band at the half step) joins Voellmy's, and where the area
+// detrains (kdet, Pa) the flow leaves dh = dt K / (rho |u|) of normal thickness per step behind
+// (Feistl et al. 2014, as AvaFrame's com1DFA), dt K / (rho |u| c) of H, at most all of it, with its
+// momentum. Dry cells keep no momentum.
 template <Basal B>
 RUNOUT_KERNEL NewState update_sources(const StepConstants& k, double H, double MU, double MV, double Hp, double Up,
                                       double Vp, double c, double bx, double by, double hxx, double hxy, double hyy,
-                                      double dt, double gxd, double smu, double sw) {
+                                      double dt, double gxd, double smu, double sw, double cres = 0, double kdet = 0) {
   H = H < 0 ? 0.0 : H;  // round-off only: the limiter bounds the outflow by the content
   const double gn = normal_load(Up, Vp, hxx, hxy, hyy, k.g, k.qcap);
   const double drive = -Hp * c * c * gn;
@@ -257,16 +289,29 @@ RUNOUT_KERNEL NewState update_sources(const StepConstants& k, double H, double M
   const double f = friction_factor(M3, imp);
   MU = rest ? 0.0 : MU * f;
   MV = rest ? 0.0 : MV * f;
-  const double inv = 1.0 / H;
+  double inv = 1.0 / H;
   double sp = vmax(M3 - imp, 0.0) * inv;  // surface speed after Coulomb friction
-  if constexpr (B == Basal::voellmy) {
-    const double ft = turbulent_factor(sp, H * c, gxd);
+  if constexpr (B == Basal::voellmy || B == Basal::resisted) {
+    double g = gxd;
+    if constexpr (B == Basal::resisted) g += dt * cres * drag_weight(k.res, Hp * c, speed3(bx, by, Up, Vp));
+    const double ft = turbulent_factor(sp, H * c, g);
     MU *= ft;
     MV *= ft;
     sp *= ft;
   }
+  double det = 0;
+  if constexpr (B == Basal::resisted) {
+    const double up = speed3(bx, by, Up, Vp);
+    const double dH = dt * kdet * k.res.inv_density / (vmax(up, 1e-6) * c);
+    det = kdet > 0 && detrains(k.res, Hp * c, up) ? vmin(dH, H) : 0.0;
+    const double keep = H > 0 ? (H - det) * inv : 0.0;
+    H = H - det;
+    MU *= keep;
+    MV *= keep;
+    inv = 1.0 / H;
+  }
   const bool wet = H > k.dry;
-  return NewState{H, wet ? MU : 0.0, wet ? MV : 0.0, wet ? MU * inv : 0.0, wet ? MV * inv : 0.0, wet ? sp : 0.0};
+  return NewState{H, wet ? MU : 0.0, wet ? MV : 0.0, wet ? MU * inv : 0.0, wet ? MV * inv : 0.0, wet ? sp : 0.0, det};
 }
 
 // A cell's terms of the hazard maps and the tile's sums from its new state: normal depth, impact

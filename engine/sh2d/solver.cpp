@@ -15,6 +15,19 @@ namespace runout::engine {
 namespace sh2d_detail {
 namespace {
 
+void validate_resistance(const Terrain2D& t, const Sh2dConfig& cfg) {
+  auto bad = [](const std::string& m) { throw std::invalid_argument("2D solver: resistance areas: " + m); };
+  const ResistanceAreas& r = cfg.resistance;
+  if (r.empty()) return;
+  if (r.c.size() != t.cells() || (!r.k_det.empty() && r.k_det.size() != t.cells())) bad("field sizes differ from the grid");
+  for (std::size_t k = 0; k < r.c.size(); ++k)
+    if (!(r.c[k] >= 0 && std::isfinite(r.c[k])) || (!r.k_det.empty() && !(r.k_det[k] >= 0 && std::isfinite(r.k_det[k]))))
+      bad("drag coefficient and detrainment must be finite and >= 0 (cell " + std::to_string(k) + ")");
+  if (!(r.speed_min >= 0 && r.speed_min <= r.speed_max && r.depth_min >= 0 && r.depth_min <= r.depth_max))
+    bad("the band needs 0 <= speed_min <= speed_max and 0 <= depth_min <= depth_max");
+  if (cfg.material.friction().flow) bad("need a constant mu (Coulomb or Voellmy), not a flow-dependent friction law");
+}
+
 void validate(const Terrain2D& t, const Sh2dConfig& cfg, const Sh2dState& s) {
   auto bad = [](const std::string& m) { throw std::invalid_argument("2D solver: " + m); };
   if (t.nx < 1 || t.ny < 1) bad("terrain grid is empty");
@@ -44,6 +57,7 @@ void validate(const Terrain2D& t, const Sh2dConfig& cfg, const Sh2dState& s) {
       if (!t.outside.empty() && t.outside[a.cells[q]]) bad("secondary release '" + a.name + "': a cell lies outside the domain");
     }
   }
+  validate_resistance(t, cfg);
   cfg.material.validate();
 }
 
@@ -65,6 +79,15 @@ Solver::Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
     case MuForm::hysteresis: basal_ = Basal::hysteresis; break;
   }
   if (fr_.flow && ixi_ > 0) throw std::logic_error("2D solver: the kernels of mu(h, Fr) have no turbulent drag (1/xi = 0)");
+  if (!cfg.resistance.empty()) {  // a constant mu (validate): Voellmy's kernels with the areas' terms
+    const ResistanceAreas& r = cfg.resistance;
+    basal_ = Basal::resisted;
+    cres_ = r.c;
+    kdet_ = r.k_det.empty() ? std::vector<double>(n_, 0.0) : r.k_det;
+    res_ = ResistanceRule{r.speed_min, r.speed_max, r.depth_min, r.depth_max, r.detrainment ? 1.0 : 0.0,
+                          1.0 / cfg.material.density};
+    det_.assign(n_, 0.0);
+  }
   kap_ = cfg.material.earth_pressure == EarthPressure::active_passive;
   if (kap_) {
     const double d = std::atan(mu_), phi = cfg.material.phi;
@@ -113,6 +136,7 @@ Solver::Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
   tile_speed_.assign(ntiles_, 0);
   tile_rate_.assign(ntiles_, 0);
   tile_out_.assign(ntiles_, 0);
+  tile_det_.assign(ntiles_, 0);
   tile_travel_.assign(ntiles_, 0);
   tile_limited_.assign(ntiles_, 0);
   tile_wet_.assign(ntiles_, 0);
@@ -274,6 +298,10 @@ Sh2dCheckpoint Solver::checkpoint(const LoopState& loop) const {
   cp.last_snapshot = loop.last_frame;
   cp.secondary_time = secondary_time_;
   cp.volume_secondary = volume_secondary_;
+  if (basal_ == Basal::resisted) {
+    cp.detrained = det_;
+    cp.tile_detrained = tile_det_;
+  }
   return cp;
 }
 
@@ -292,6 +320,9 @@ void Solver::restore(const Sh2dCheckpoint& cp) {
     bad("is damaged (a tile field has the wrong size)");
   if (!(std::isfinite(cp.t) && cp.t >= 0) || cp.steps < 0) bad("is damaged (time or step count)");
   if (cp.secondary_time.size() != cfg_.secondary.size()) bad("was taken with other secondary releases");
+  if ((basal_ == Basal::resisted) != !cp.detrained.empty() ||
+      (!cp.detrained.empty() && (!cells(cp.detrained) || cp.tile_detrained.size() != nt)))
+    bad("was taken with other resistance areas");
   // Both time levels hold the state: the level a step writes is never read before it is written,
   // and inactive tiles hold the same in both (see rebuild_active).
   cur_ = 0;
@@ -323,6 +354,10 @@ void Solver::restore(const Sh2dCheckpoint& cp) {
   max_active_fraction_ = cp.max_active_fraction;
   secondary_time_ = cp.secondary_time;
   volume_secondary_ = cp.volume_secondary;
+  if (basal_ == Basal::resisted) {
+    det_ = cp.detrained;
+    tile_det_ = cp.tile_detrained;
+  }
 }
 
 double Solver::sum_tiles(const std::vector<double>& v) const {
@@ -407,6 +442,11 @@ Sh2dResult Solver::finish(StopReason stop, const LoopState& loop) {
   d.max_active_fraction = max_active_fraction_;
   d.volume_final = sum_tiles(tile_mass_) * cell_area;
   d.volume_outflow = sum_tiles(tile_out_);
+  d.volume_detrained = sum_tiles(tile_det_) * cell_area;
+  if (basal_ == Basal::resisted) {  // as normal thickness
+    res.detrained.resize(n_);
+    for (std::size_t k = 0; k < n_; ++k) res.detrained[k] = det_[k] * geo_.c[k];
+  }
   d.mean_travel = d.volume_initial > 0 ? sum_tiles(tile_travel_) * cell_area / d.volume_initial : 0.0;
   for (int tt = 0; tt < ntiles_; ++tt) d.positivity_limited += tile_limited_[tt];
   d.mean_active_fraction = steps_ > 0 ? active_sum_ / double(steps_) : 0.0;

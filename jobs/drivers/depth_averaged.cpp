@@ -43,6 +43,7 @@ void write_record(const std::string& path, const ResolvedScenario& s, const terr
   mb->set_volume_outflow_m3(d.volume_outflow);
   mb->set_relative_error(d.volume_error());
   mb->set_volume_secondary_m3(d.volume_secondary);
+  mb->set_volume_detrained_m3(d.volume_detrained);
   for (std::size_t a = 0; a < secondary.size(); ++a) {
     auto* sr = rec.mutable_release()->add_secondary();
     sr->set_name(secondary[a].name);
@@ -73,6 +74,26 @@ void write_record(const std::string& path, const ResolvedScenario& s, const terr
   for (const auto& f : sum.files) rec.add_outputs(f);
   rec.add_outputs("run.json");
   write_run_record(path, rec);
+}
+
+// The resistance areas as the engine takes them: the scenario's band and switch, and per cell the
+// drag coefficient and detrainment K of the areas whose polygons hold the cell's centre (the largest
+// where areas overlap; 0 elsewhere and outside the domain). No areas: none.
+engine::ResistanceAreas resistance_areas(const terrain::Grid& g, const ResolvedScenario& s) {
+  engine::ResistanceAreas r = s.config.resistance;
+  if (s.resistance.empty()) return r;
+  r.c.assign(g.cells(), 0.0);
+  r.k_det.assign(g.cells(), 0.0);
+  for (std::size_t a = 0; a < s.resistance.size(); ++a) {
+    const auto& area = s.resistance[a];
+    const auto in = terrain::rasterize_polygons(g, area.path, area.crs, "resistance.areas[" + std::to_string(a) + "].path");
+    for (std::size_t k = 0; k < in.size(); ++k)
+      if (in[k]) {
+        r.c[k] = std::max(r.c[k], area.c);
+        r.k_det[k] = std::max(r.k_det[k], area.k_det);
+      }
+  }
+  return r;
 }
 
 // The secondary release areas as the engine takes them: the cells of each and their depths.
@@ -173,6 +194,7 @@ DepthAveragedRun::DepthAveragedRun(const ResolvedScenario& s, const std::string&
   cfg_ = s.config;
   secondary_ = terrain::secondary_release_areas(grid_, s.dem, s.releases);
   cfg_.secondary = engine_secondary(secondary_);
+  cfg_.resistance = resistance_areas(grid_, s);
 
   // Checkpoints: the solver's whole state between two steps, with the scenario's hash; the time
   // series so far lies beside it (CHECKPOINT.timeseries.h5), so that a continued run's outputs are
@@ -240,6 +262,11 @@ RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& tim
   // Outputs.
   const auto t2 = std::chrono::steady_clock::now();
   const auto outputs = write_hazard_outputs(s_, grid_, h0_, res.hazard, output_inputs_, out_dir_, sum);
+  if (!res.detrained.empty()) {
+    terrain::write_cog((fs::path(out_dir_) / "detrained_depth.tif").string(), grid_, res.detrained,
+                       terrain::BandInfo{"normal thickness left behind in resistance areas (detrainment)", "m"});
+    sum.files.push_back("detrained_depth.tif");
+  }
   if (series_) {
     // QGIS styles for the frames' GeoTIFFs: the depth and speed maps' classes, on any band chosen.
     figures::write_qml_ramp((fs::path(out_dir_) / "timeseries_depth.qml").string(), figures::hazard_palette("max_depth"));

@@ -191,6 +191,18 @@ void resolve_inputs(const v1::Scenario& s, const std::string& base, ResolvedScen
     r.observed_outline = path_in(base, s.observations().outline_path(), "observations.outline_path");
     add_vector(r.observed_outline, "observations.outline_path", r);
   }
+  const auto& rs = s.resistance();
+  for (int a = 0; a < rs.areas_size(); ++a) {
+    const auto& ar = rs.areas(a);
+    const std::string field = "resistance.areas[" + std::to_string(a) + "]";
+    ResistanceAreaSettings q;
+    q.path = path_in(base, ar.path(), field + ".path");
+    add_vector(q.path, field + ".path", r);
+    q.crs = ar.crs();
+    q.c = ar.has_drag_coefficient() ? ar.drag_coefficient() : rs.has_drag_coefficient() ? rs.drag_coefficient() : 0.01;
+    q.k_det = ar.has_detrainment_k_pa() ? ar.detrainment_k_pa() : rs.has_detrainment_k_pa() ? rs.detrainment_k_pa() : 5.0;
+    r.resistance.push_back(q);
+  }
   if (!s.mesh().corridor_path().empty()) {
     r.corridor_path = path_in(base, s.mesh().corridor_path(), "mesh.corridor_path");
     add_vector(r.corridor_path, "mesh.corridor_path", r);
@@ -295,6 +307,22 @@ void check_terrain_vof(const v1::Scenario& s) {
   for (int k = 0; k < s.releases_size(); ++k)
     if (s.releases(k).secondary())
       bad("releases[" + std::to_string(k) + "].secondary", "the 3D engine takes no secondary releases (the depth-averaged engine does)");
+  if (s.resistance().ByteSizeLong() > 0)
+    bad("resistance", "the 3D engine takes no resistance areas (the depth-averaged engine does)");
+}
+
+// Resistance areas: at least one area, a band whose minima lie below its maxima, and a friction law
+// with a constant mu (the areas' drag joins Voellmy's in the kernels).
+void check_resistance(const v1::Scenario& s, const ResolvedScenario& r) {
+  if (s.resistance().ByteSizeLong() == 0) return;  // none given (or only defaults, which the options cleared)
+  const auto& band = r.config.resistance;  // the options' values, defaults filled in
+  const engine::Material& mat = r.config.material;
+  if (s.resistance().areas_size() == 0) bad("resistance.areas", "at least one area (polygons)");
+  if (band.speed_min > band.speed_max) bad("resistance.speed_min_m_s", "must not exceed resistance.speed_max_m_s");
+  if (band.depth_min > band.depth_max) bad("resistance.depth_min_m", "must not exceed resistance.depth_max_m");
+  if (mat.friction().flow)
+    bad("resistance", "needs a friction law with a constant mu (material.rheology coulomb or voellmy), not " +
+                          std::string(mat.rheology->name));
 }
 
 }  // namespace
@@ -309,6 +337,7 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   // The option tables fill the defaults and check every field's range or choices; the checks
   // between fields and the input files follow.
   apply_option_rules(depth_averaged_options(), s);
+  if (s.has_resistance() && s.resistance().ByteSizeLong() == 0) s.clear_resistance();  // only its defaults: none
   if (vof) {
     const double write_given = s.vof().write_interval_s();
     apply_option_rules(terrain_vof_options(), s);
@@ -321,6 +350,7 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   map_options(depth_averaged_options(), s, r);
   if (vof) check_terrain_vof(s);  // first: the 3D engine takes one friction law
   check_material(s.material(), r.config.material);
+  if (!vof) check_resistance(s, r);
   const double t_end = s.numerics().end_time_s();
   check_output_interval("outputs.timeseries_interval_s", s.outputs().timeseries_interval_s(), "numerics.end_time_s", t_end, true);
   if (vof) {

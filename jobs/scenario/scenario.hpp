@@ -40,6 +40,13 @@ inline constexpr std::string_view kDepthAveragedEngine = "depth-averaged";
 inline constexpr std::string_view kVofLabEngine = "vof-lab";
 inline constexpr std::string_view kVofTerrainEngine = "vof-terrain";
 
+/// A resistance area (scenario `resistance.areas[]`), resolved: its polygons, their CRS, its drag
+/// coefficient and detrainment K (the engine's ResistanceAreas per cell once rasterised).
+struct ResistanceAreaSettings {
+  std::string path, crs;
+  double c = 0.01, k_det = 5;
+};
+
 struct ResolvedScenario {
   v1::Scenario scenario;  ///< as given, with the defaults filled in
   std::string source;     ///< the file it came from (empty when given as a message)
@@ -52,6 +59,7 @@ struct ResolvedScenario {
   std::vector<ZoneThreshold> pressure_zones = {{"blue", 3}, {"red", 30}};
   std::string observed_outline, observed_crs;  ///< observations: polygons of the observed runout, their CRS
   PathSettings path;
+  std::vector<ResistanceAreaSettings> resistance;  ///< none: no resistance areas
   std::string corridor_path;  ///< mesh.corridor_path (3D engine on the DEM), resolved; empty: none
   bool maps = true;  ///< outputs.maps: the report maps (PNG, PDF)
   std::vector<std::string> input_files;  ///< for hashing

@@ -181,3 +181,84 @@ TEST(DepthAveraged, CheckpointOfAnotherScenarioIsRefused) {
   expect_refused(r, d / "missing.h5", "no such file");
   expect_refused(r, d / "a/run.json", "not an HDF5 file");
 }
+
+// A forest on the run-out (a polygon file, scenario `resistance`): the flow stops shorter than
+// without it, the forest keeps what it detrained (detrained_depth.tif, run.json's
+// mass_balance.volume_detrained_m3), and the volume balance holds to round-off.
+TEST(DepthAveraged, ForestShortensTheRunoutAndKeepsWhatItDetrained) {
+  TempDir d;
+  make_dem(d / "dem.tif", 120, 20.0, 35);
+  make_polygons(d / "rel.geojson", {square(500200, 5201000, 300)}, "EPSG:32632");
+  // The forest covers the flat run-out (from x = 1500 m; the slope ends at 1440 m) across the grid.
+  make_polygons(d / "forest.geojson", {{{501500, 5200000}, {502400, 5200000}, {502400, 5202400}, {501500, 5202400}, {501500, 5200000}}},
+                "EPSG:32632");
+  auto sc = base_scenario(d / "dem.tif", d / "rel.geojson");
+  sc.mutable_numerics()->set_end_time_s(150);
+  fs::create_directories(d / "open");
+  const auto open = jobs::run_scenario(jobs::resolve_scenario(sc, d.p.string()), d / "open");
+  // The band widened to the whole flow (the default band lets a fast, thin avalanche pass): the drag
+  // acts while it flows, and where it slows below 6 m/s the forest detrains it.
+  auto* rs = sc.mutable_resistance();
+  rs->add_areas()->set_path("forest.geojson");
+  rs->set_speed_max_m_s(200);
+  rs->set_depth_min_m(0);
+  fs::create_directories(d / "forest");
+  const auto forest = jobs::run_scenario(jobs::resolve_scenario(sc, d.p.string()), d / "forest");
+  EXPECT_LT(forest.runout_m, open.runout_m - 40) << forest.runout_m << " against " << open.runout_m;
+  const auto rec = run_record(d / "forest/run.json");
+  const auto& mb = rec.mass_balance();
+  EXPECT_GT(mb.volume_detrained_m3(), 0.05 * mb.volume_initial_m3());
+  EXPECT_LT(mb.relative_error(), 1e-12);
+  EXPECT_NEAR(mb.volume_final_m3() + mb.volume_outflow_m3() + mb.volume_detrained_m3(), mb.volume_initial_m3(),
+              1e-9 * mb.volume_initial_m3());
+  EXPECT_TRUE(fs::exists(d / "forest/detrained_depth.tif"));
+  EXPECT_FALSE(fs::exists(d / "open/detrained_depth.tif"));
+  EXPECT_EQ(run_record(d / "open/run.json").mass_balance().volume_detrained_m3(), 0.0);
+  // The raster holds the detrained thickness: its volume is run.json's.
+  GDALDatasetUniquePtr ds(GDALDataset::Open((d / "forest/detrained_depth.tif").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(ds);
+  std::vector<double> v(std::size_t(forest.nx) * forest.ny);
+  ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, forest.nx, forest.ny, v.data(), forest.nx, forest.ny, GDT_Float64, 0, 0),
+            CE_None);
+  double on_ground = 0;
+  for (double x : v)
+    if (x > 0) on_ground += x * forest.dx * forest.dx;  // normal thickness on a flat run-out
+  EXPECT_NEAR(on_ground / mb.volume_detrained_m3(), 1.0, 0.02) << on_ground << " against " << mb.volume_detrained_m3();
+}
+
+// Resistance areas are refused by name where they cannot work: no areas, an inverted band, a
+// flow-dependent friction law, the 3D engine.
+TEST(DepthAveraged, ResistanceAreasAreRefusedWhereTheyCannotWork) {
+  TempDir d;
+  make_dem(d / "dem.tif", 40, 20.0, 30);
+  make_polygons(d / "rel.geojson", {square(500200, 5200400, 200)}, "EPSG:32632");
+  auto sc = base_scenario(d / "dem.tif", d / "rel.geojson");
+  auto with = [&](auto change) {
+    auto s = sc;
+    s.mutable_resistance()->add_areas()->set_path(d / "rel.geojson");
+    change(s);
+    return s;
+  };
+  auto s0 = sc;
+  s0.mutable_resistance()->set_drag_coefficient(0.02);
+  expect_resolve_error(s0, {"resistance.areas", "at least one"});
+  expect_resolve_error(with([](v1::Scenario& s) { s.mutable_resistance()->set_speed_min_m_s(50); }),
+                       {"resistance.speed_min_m_s", "speed_max"});
+  expect_resolve_error(with([](v1::Scenario& s) { s.mutable_resistance()->set_drag_coefficient(-1); }),
+                       {"resistance.drag_coefficient"});
+  expect_resolve_error(with([](v1::Scenario& s) {
+                         auto* m = s.mutable_material();
+                         m->set_rheology("mu_i");
+                         m->set_mu_s(0.38);
+                         m->set_mu_2(0.64);
+                         m->set_mu_i0(0.28);
+                         m->set_grain_diameter_m(0.0005);
+                         m->set_grain_density_kg_m3(2450);
+                       }),
+                       {"resistance", "constant mu"});
+  expect_resolve_error(with([](v1::Scenario& s) {
+                         s.set_engine("vof");
+                         s.mutable_material()->set_internal_friction_deg(30);
+                       }),
+                       {"resistance", "3D engine"});
+}

@@ -98,6 +98,8 @@ inline void expect_same(const Sh2dResult& a, const Sh2dResult& b) {
   EXPECT_EQ(a.diag.mean_active_fraction, b.diag.mean_active_fraction);
   EXPECT_EQ(a.diag.max_active_fraction, b.diag.max_active_fraction);
   EXPECT_EQ(a.diag.mean_travel, b.diag.mean_travel);
+  EXPECT_EQ(a.diag.volume_detrained, b.diag.volume_detrained);
+  EXPECT_EQ(a.detrained, b.detrained);
 }
 
 }  // namespace runout::test_support::depth_averaged
