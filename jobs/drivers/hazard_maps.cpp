@@ -32,6 +32,7 @@ figures::HazardMap map_base(const ResolvedScenario& s, const terrain::Grid& grid
                             const MapOverlay& overlay, const RunSummary& sum) {
   figures::HazardMap base;
   base.release = h0;
+  base.resistance = overlay.resistance;
   base.max_depth = hz.max_depth;
   base.outline_threshold = s.outline_threshold;
   base.parameters = map_parameters(s, grid, sum.release_volume_m3);
@@ -74,6 +75,14 @@ OutputInputs read_output_inputs(const ResolvedScenario& s, const terrain::Grid& 
     in.observed = terrain::rasterize_polygons(grid, s.observed_outline, s.observed_crs, "observations.outline_path");
     if (std::find(in.observed.begin(), in.observed.end(), 1) == in.observed.end())
       throw terrain::TerrainError("observations.outline_path: '" + s.observed_outline + "' covers no cell of the domain");
+  }
+  for (std::size_t a = 0; a < s.resistance.size(); ++a) {  // each area must lie on the domain
+    const std::string field = "resistance.areas[" + std::to_string(a) + "].path";
+    const auto cells = terrain::rasterize_polygons(grid, s.resistance[a].path, s.resistance[a].crs, field);
+    if (std::find(cells.begin(), cells.end(), 1) == cells.end())
+      throw terrain::TerrainError(field + ": '" + s.resistance[a].path + "' covers no cell of the domain");
+    in.resistance.resize(cells.size(), 0);
+    for (std::size_t k = 0; k < cells.size(); ++k) in.resistance[k] |= cells[k];
   }
   return in;
 }

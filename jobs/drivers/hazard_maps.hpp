@@ -32,6 +32,7 @@ struct OutputInputs {
   std::vector<PlacedPoint> points;
   products::Line path;
   std::vector<std::uint8_t> observed;
+  std::vector<std::uint8_t> resistance;  ///< cells of any resistance area (scenario `resistance`); empty: none
 };
 /// Throws TerrainError naming the field (a point outside the domain, a line or outline that cannot be
 /// read, an outline that covers no cell of the domain).
@@ -43,6 +44,7 @@ std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain
 /// What every map of a run draws besides its quantity.
 struct MapOverlay {
   std::vector<PlacedPoint> points;
+  std::vector<std::uint8_t> resistance;  ///< cells of resistance areas, outlined
   products::Line path;
   std::vector<figures::MapPoint> path_marks;
 };

@@ -227,7 +227,7 @@ TEST(DepthAveraged, ForestShortensTheRunoutAndKeepsWhatItDetrained) {
 }
 
 // Resistance areas are refused by name where they cannot work: no areas, an inverted band, a
-// flow-dependent friction law, the 3D engine.
+// negative coefficient, an area away from the domain, a flow-dependent friction law, the 3D engine.
 TEST(DepthAveraged, ResistanceAreasAreRefusedWhereTheyCannotWork) {
   TempDir d;
   make_dem(d / "dem.tif", 40, 20.0, 30);
@@ -256,6 +256,11 @@ TEST(DepthAveraged, ResistanceAreasAreRefusedWhereTheyCannotWork) {
                          m->set_grain_density_kg_m3(2450);
                        }),
                        {"resistance", "constant mu"});
+  // An area away from the domain: refused before the run.
+  make_polygons(d / "far.geojson", {square(600000, 5300000, 100)}, "EPSG:32632");
+  auto far = sc;
+  far.mutable_resistance()->add_areas()->set_path("far.geojson");
+  expect_error(far, d, "resistance.areas[0].path");
   expect_resolve_error(with([](v1::Scenario& s) {
                          s.set_engine("vof");
                          s.mutable_material()->set_internal_friction_deg(30);

@@ -334,3 +334,40 @@ TEST(HazardProducts, PathAnalysisHasKnownAnswers) {
   set.threshold = 2;
   EXPECT_FALSE(jobs::products::analyse_path(g, line, {depth, speed, pressure, release}, set).runout);
 }
+
+// Resistance areas (forest) are outlined on the maps in green and named in the legend: the same map
+// with an area shows green pixels along its edges that the map without it has not.
+TEST(HazardProducts, MapsOutlineTheResistanceAreas) {
+  TempDir d;
+  const auto g = tilted_grid();
+  figures::HazardMap m;
+  m.title = "forest";
+  m.palette = figures::hazard_palette("max_depth");
+  m.values.assign(g.cells(), NAN);
+  auto greens = [&](const std::string& png_path, const figures::MapLayout& lay) {
+    GDALDatasetUniquePtr png(GDALDataset::Open(png_path.c_str(), GDAL_OF_RASTER));
+    EXPECT_TRUE(png);
+    if (!png) return 0L;
+    const int w = png->GetRasterXSize(), h = png->GetRasterYSize();
+    std::vector<std::uint8_t> rgb[3];
+    for (int b = 0; b < 3; ++b) {
+      rgb[b].resize(std::size_t(w) * h);
+      EXPECT_EQ(png->GetRasterBand(b + 1)->RasterIO(GF_Read, 0, 0, w, h, rgb[b].data(), w, h, GDT_Byte, 0, 0), CE_None);
+    }
+    long n = 0;
+    for (int y = int(lay.map_y); y < int(lay.map_y + g.ny * lay.cell_px) && y < h; ++y)
+      for (int x = int(lay.map_x); x < int(lay.map_x + g.nx * lay.cell_px) && x < w; ++x) {
+        const std::size_t k = std::size_t(y) * w + x;
+        n += rgb[1][k] > rgb[0][k] + 50 && rgb[1][k] > rgb[2][k] + 50;
+      }
+    return n;
+  };
+  const auto plain = figures::draw_hazard_map(d / "plain.png", "", g, m);
+  m.resistance.assign(g.cells(), 0);
+  for (int j = 20; j < 50; ++j)
+    for (int i = 20; i < 60; ++i) m.resistance[std::size_t(j) * g.nx + i] = 1;
+  const auto forest = figures::draw_hazard_map(d / "forest.png", "", g, m);
+  const long edge_px = long(2 * (30 + 40) * forest.cell_px);  // the area's perimeter in pixels
+  EXPECT_EQ(greens(d / "plain.png", plain), 0);
+  EXPECT_GT(greens(d / "forest.png", forest), edge_px / 3);  // a dashed line, 1.6 px wide
+}
