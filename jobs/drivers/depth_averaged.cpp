@@ -249,6 +249,7 @@ RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& tim
   sum.volume_initial = d.volume_initial;
   sum.volume_final = d.volume_final;
   sum.volume_outflow = d.volume_outflow;
+  sum.volume_detrained = d.volume_detrained;
   sum.volume_error = d.volume_error();
   sum.t = d.t;
   sum.steps = d.steps;

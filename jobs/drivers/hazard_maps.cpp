@@ -179,6 +179,25 @@ std::vector<std::string> viscosity_lines(const v1::Material& m, const std::strin
   return {line.text(), bed.text()};
 }
 
+// The resistance areas on the maps: how many, their drag coefficient and detrainment (the range where
+// areas differ), and the band, or "drag everywhere" without detrainment.
+std::string resistance_line(const ResolvedScenario& s) {
+  auto range = [&](auto get) {
+    double lo = get(s.resistance[0]), hi = lo;
+    for (const auto& a : s.resistance) {
+      lo = std::min(lo, get(a));
+      hi = std::max(hi, get(a));
+    }
+    return lo == hi ? num(lo) : num(lo) + "–" + num(hi);
+  };
+  const auto& b = s.config.resistance;
+  std::string line = "resistance: " + std::to_string(s.resistance.size()) + (s.resistance.size() == 1 ? " area" : " areas") +
+                     ", c = " + range([](const ResistanceAreaSettings& a) { return a.c; });
+  if (!b.detrainment) return line + ", drag everywhere, no detrainment";
+  return line + ", K = " + range([](const ResistanceAreaSettings& a) { return a.k_det; }) + " Pa, drag at " + num(b.depth_min) + "–" +
+         num(b.depth_max) + " m and " + num(b.speed_min) + "–" + num(b.speed_max) + " m/s";
+}
+
 }  // namespace
 
 std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain::Grid& grid, double release_volume_m3) {
@@ -190,6 +209,7 @@ std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain
   else
     p.push_back(friction_line(*s.config.material.rheology, m));
   p.push_back("density: " + num(m.density_kg_m3()) + " kg/m³");
+  if (!s.resistance.empty()) p.push_back(resistance_line(s));
   p.push_back("release: " + num(std::round(release_volume_m3)) + " m³ in " + std::to_string(s.releases.size()) +
               (s.releases.size() == 1 ? " release" : " releases"));
   p.push_back("grid: " + num(grid.dx) + " m, " + std::to_string(grid.nx) + " × " + std::to_string(grid.ny) + " cells, " + grid.crs_name);

@@ -27,6 +27,8 @@ void for_each_input_path(v1::Scenario& s, F f) {
   if (s.has_observations()) each("observations.outline_path", s.mutable_observations()->mutable_outline_path());
   if (s.has_path()) each("path.line_path", s.mutable_path()->mutable_line_path());
   if (s.has_mesh()) each("mesh.corridor_path", s.mutable_mesh()->mutable_corridor_path());
+  for (int k = 0; k < s.resistance().areas_size(); ++k)
+    each("resistance.areas[" + std::to_string(k) + "].path", s.mutable_resistance()->mutable_areas(k)->mutable_path());
 }
 
 /// Every input path of `s` made absolute against `base_dir` (the scenario file's folder).

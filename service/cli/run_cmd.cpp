@@ -47,8 +47,10 @@ void print_summary(const jobs::RunSummary& sum, bool vof, const fs::path& dest) 
   std::printf("run         %ld steps to t = %.1f s (stop: %s), %.2f s wall (prepare %.2f, solve %.2f, write %.2f)\n",
               sum.steps, sum.t, sum.stop.c_str(), sum.seconds_prepare + sum.seconds_run + sum.seconds_write,
               sum.seconds_prepare, sum.seconds_run, sum.seconds_write);
-  std::printf("volume      %.6g m3 initial, %.6g m3 final, %.6g m3 left the grid (error %.1e)\n", sum.volume_initial,
-              sum.volume_final, sum.volume_outflow, sum.volume_error);
+  std::printf("volume      %.6g m3 initial, %.6g m3 final, %.6g m3 left the grid", sum.volume_initial, sum.volume_final,
+              sum.volume_outflow);
+  if (sum.volume_detrained > 0) std::printf(", %.6g m3 left in resistance areas", sum.volume_detrained);
+  std::printf(" (error %.1e)\n", sum.volume_error);
   std::printf("hazard      affected area %.0f m2, runout %.0f m from the release centroid, max speed %.1f m/s, max depth %.2f m\n",
               sum.affected_area_m2, sum.runout_m, sum.max_speed, sum.max_depth);
   std::printf("results in  %s:", dest.string().c_str());

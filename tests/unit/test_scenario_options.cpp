@@ -16,6 +16,7 @@
 #include "engine/limiters.hpp"
 #include "engine/rheology.hpp"
 #include "engine/sh2d.hpp"
+#include "jobs/scenario/inputs.hpp"
 #include "jobs/scenario/options.hpp"
 #include "jobs/scenario/scenario.hpp"
 
@@ -79,6 +80,19 @@ std::pair<Message*, const FieldDescriptor*> field_at(Message& m, const std::stri
   return field_at(*next, path.substr(dot + 1));
 }
 
+// As field_at, adding the first element of a list of blocks where there is none.
+std::pair<Message*, const FieldDescriptor*> field_made(Message& m, const std::string& path) {
+  const auto dot = path.find('.');
+  std::string seg = path.substr(0, dot);
+  const bool each = seg.size() > 2 && seg.compare(seg.size() - 2, 2, "[]") == 0;
+  if (each) seg.resize(seg.size() - 2);
+  const auto* f = m.GetDescriptor()->FindFieldByName(seg);
+  if (dot == std::string::npos) return {&m, f};
+  const auto* r = m.GetReflection();
+  auto* next = !each ? r->MutableMessage(&m, f) : r->FieldSize(m, f) > 0 ? r->MutableRepeatedMessage(&m, f, 0) : r->AddMessage(&m, f);
+  return field_made(*next, path.substr(dot + 1));
+}
+
 // The base scenario and its folder of an option's table.
 std::pair<v1::Scenario, std::string> base_of(const jobs::OptionTable* t) {
   if (t == &jobs::lab_options()) return {b10(), kLabDir};
@@ -92,6 +106,25 @@ std::pair<v1::Scenario, std::string> base_of(const jobs::OptionTable* t) {
 }
 
 }  // namespace
+
+// Every option that names an input file is in the list of input fields (jobs/scenario/inputs.hpp)
+// that the service's client uploads and an ensemble makes absolute: one missing there would reach
+// the server as a path on the client's machine.
+TEST(ScenarioOptions, EveryInputFileFieldIsInTheInputList) {
+  int paths = 0;
+  for (const auto* t : tables())
+    for (const auto& o : *t) {
+      if (o.type != jobs::OptionType::path) continue;
+      ++paths;
+      v1::Scenario s;
+      auto [m, f] = field_made(s, o.path);
+      m->GetReflection()->SetString(m, f, "marker.file");
+      int seen = 0;
+      jobs::for_each_input_path(s, [&](const std::string&, std::string* p) { seen += *p == "marker.file"; });
+      EXPECT_EQ(seen, 1) << o.path;
+    }
+  EXPECT_GE(paths, 8);
+}
 
 TEST(ScenarioOptions, EveryFieldIsDeclaredOnceInOneTable) {
   std::set<std::string> fields, declared;
