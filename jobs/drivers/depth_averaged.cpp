@@ -77,22 +77,20 @@ void write_record(const std::string& path, const ResolvedScenario& s, const terr
 }
 
 // The resistance areas as the engine takes them: the scenario's band and switch, and per cell the
-// drag coefficient and detrainment K of the areas whose polygons hold the cell's centre (the largest
-// where areas overlap; 0 elsewhere and outside the domain). No areas: none.
-engine::ResistanceAreas resistance_areas(const terrain::Grid& g, const ResolvedScenario& s) {
+// drag coefficient and detrainment K of the areas whose polygons hold the cell's centre (`cells`,
+// one mask per area, read_output_inputs; the largest where areas overlap; 0 elsewhere and outside
+// the domain). No areas: none.
+engine::ResistanceAreas resistance_areas(const ResolvedScenario& s, const std::vector<std::vector<std::uint8_t>>& cells) {
   engine::ResistanceAreas r = s.config.resistance;
   if (s.resistance.empty()) return r;
-  r.c.assign(g.cells(), 0.0);
-  r.k_det.assign(g.cells(), 0.0);
-  for (std::size_t a = 0; a < s.resistance.size(); ++a) {
-    const auto& area = s.resistance[a];
-    const auto in = terrain::rasterize_polygons(g, area.path, area.crs, "resistance.areas[" + std::to_string(a) + "].path");
-    for (std::size_t k = 0; k < in.size(); ++k)
-      if (in[k]) {
-        r.c[k] = std::max(r.c[k], area.c);
-        r.k_det[k] = std::max(r.k_det[k], area.k_det);
+  r.c.assign(cells.front().size(), 0.0);
+  r.k_det.assign(cells.front().size(), 0.0);
+  for (std::size_t a = 0; a < s.resistance.size(); ++a)
+    for (std::size_t k = 0; k < cells[a].size(); ++k)
+      if (cells[a][k]) {
+        r.c[k] = std::max(r.c[k], s.resistance[a].c);
+        r.k_det[k] = std::max(r.k_det[k], s.resistance[a].k_det);
       }
-  }
   return r;
 }
 
@@ -194,7 +192,7 @@ DepthAveragedRun::DepthAveragedRun(const ResolvedScenario& s, const std::string&
   cfg_ = s.config;
   secondary_ = terrain::secondary_release_areas(grid_, s.dem, s.releases);
   cfg_.secondary = engine_secondary(secondary_);
-  cfg_.resistance = resistance_areas(grid_, s);
+  cfg_.resistance = resistance_areas(s, output_inputs_.resistance_areas);
 
   // Checkpoints: the solver's whole state between two steps, with the scenario's hash; the time
   // series so far lies beside it (CHECKPOINT.timeseries.h5), so that a continued run's outputs are

@@ -335,7 +335,7 @@ TEST(HazardProducts, PathAnalysisHasKnownAnswers) {
   EXPECT_FALSE(jobs::products::analyse_path(g, line, {depth, speed, pressure, release}, set).runout);
 }
 
-// Resistance areas (forest) are outlined on the maps in green and named in the legend: the same map
+// Resistance areas (forest) are outlined on the maps in green: the same map
 // with an area shows green pixels along its edges that the map without it has not.
 TEST(HazardProducts, MapsOutlineTheResistanceAreas) {
   TempDir d;
