@@ -291,9 +291,10 @@ RUNOUT_KERNEL NewState update_sources(const StepConstants& k, double H, double M
   MV = rest ? 0.0 : MV * f;
   double inv = 1.0 / H;
   double sp = vmax(M3 - imp, 0.0) * inv;  // surface speed after Coulomb friction
+  const double up = B == Basal::resisted ? speed3(bx, by, Up, Vp) : 0.0;  // the areas' band and rate read it
   if constexpr (B == Basal::voellmy || B == Basal::resisted) {
     double g = gxd;
-    if constexpr (B == Basal::resisted) g += dt * cres * drag_weight(k.res, Hp * c, speed3(bx, by, Up, Vp));
+    if constexpr (B == Basal::resisted) g += dt * cres * drag_weight(k.res, Hp * c, up);
     const double ft = turbulent_factor(sp, H * c, g);
     MU *= ft;
     MV *= ft;
@@ -301,7 +302,6 @@ RUNOUT_KERNEL NewState update_sources(const StepConstants& k, double H, double M
   }
   double det = 0;
   if constexpr (B == Basal::resisted) {
-    const double up = speed3(bx, by, Up, Vp);
     const double dH = dt * kdet * k.res.inv_density / (vmax(up, 1e-6) * c);
     det = kdet > 0 && detrains(k.res, Hp * c, up) ? vmin(dH, H) : 0.0;
     const double keep = H > 0 ? (H - det) * inv : 0.0;

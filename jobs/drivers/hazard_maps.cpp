@@ -81,8 +81,6 @@ OutputInputs read_output_inputs(const ResolvedScenario& s, const terrain::Grid& 
     const auto cells = terrain::rasterize_polygons(grid, s.resistance[a].path, s.resistance[a].crs, field);
     if (std::find(cells.begin(), cells.end(), 1) == cells.end())
       throw terrain::TerrainError(field + ": '" + s.resistance[a].path + "' covers no cell of the domain");
-    in.resistance.resize(cells.size(), 0);
-    for (std::size_t k = 0; k < cells.size(); ++k) in.resistance[k] |= cells[k];
     in.resistance_areas.push_back(cells);
   }
   return in;

@@ -32,10 +32,8 @@ struct OutputInputs {
   std::vector<PlacedPoint> points;
   products::Line path;
   std::vector<std::uint8_t> observed;
-  /// Per resistance area (scenario `resistance.areas[]`), its cells; and the cells of any of them
-  /// (empty: no areas).
+  /// Per resistance area (scenario `resistance.areas[]`), its cells (empty: no areas).
   std::vector<std::vector<std::uint8_t>> resistance_areas;
-  std::vector<std::uint8_t> resistance;
 };
 /// Throws TerrainError naming the field (a point outside the domain, a line or outline that cannot be
 /// read, an outline that covers no cell of the domain).

@@ -134,7 +134,10 @@ HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Gri
   MapOverlay overlay;
   overlay.points = in.points;
   overlay.path = in.path;
-  overlay.resistance = in.resistance;
+  for (const auto& cells : in.resistance_areas) {  // the cells of any area
+    overlay.resistance.resize(cells.size(), 0);
+    for (std::size_t k = 0; k < cells.size(); ++k) overlay.resistance[k] |= cells[k];
+  }
   res.path_source = s.path.line_path.empty() ? "steepest descent from the release's centroid" : s.path.line_path;
   if (overlay.path.size() >= 2) {
     res.path = products::analyse_path(grid, overlay.path, {raster("max_depth"), raster("max_speed"), pressure_kpa, h0}, s.path);

@@ -199,8 +199,10 @@ void resolve_inputs(const v1::Scenario& s, const std::string& base, ResolvedScen
     q.path = path_in(base, ar.path(), field + ".path");
     add_vector(q.path, field + ".path", r);
     q.crs = ar.crs();
-    q.c = ar.has_drag_coefficient() ? ar.drag_coefficient() : rs.has_drag_coefficient() ? rs.drag_coefficient() : 0.01;
-    q.k_det = ar.has_detrainment_k_pa() ? ar.detrainment_k_pa() : rs.has_detrainment_k_pa() ? rs.detrainment_k_pa() : 5.0;
+    if (ar.has_drag_coefficient()) q.c = ar.drag_coefficient();  // else the block's, else the default
+    else if (rs.has_drag_coefficient()) q.c = rs.drag_coefficient();
+    if (ar.has_detrainment_k_pa()) q.k_det = ar.detrainment_k_pa();
+    else if (rs.has_detrainment_k_pa()) q.k_det = rs.detrainment_k_pa();
     r.resistance.push_back(q);
   }
   if (!s.mesh().corridor_path().empty()) {
