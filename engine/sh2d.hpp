@@ -116,6 +116,8 @@ struct Sh2dCheckpoint {
   double volume_secondary = 0;
   /// With resistance areas: the depth detrained per cell so far (as H) and per tile the volume.
   std::vector<double> detrained, tile_detrained;
+  /// With an erodible cover: the cover left per cell (as flow H) and per tile the volume entrained.
+  std::vector<double> cover, tile_entrained;
 };
 /// Called with a checkpoint at the end of the first step at or after each multiple of
 /// `checkpoint_interval` (steps are never shortened for it) and when the progress hook cancels the
@@ -147,6 +149,23 @@ struct ResistanceAreas {
   double speed_min = 6, speed_max = 40;    ///< [m/s] (com1DFA's forestVMin, forestVMax)
   double depth_min = 0.6, depth_max = 10;  ///< normal depth [m] (forestThMin, forestThMax)
   bool empty() const { return c.empty(); }
+};
+
+/// An erodible snow cover (entrainment), as AvaFrame's com1DFA models it (its theory page, equations
+/// "erosion" and "ploughing"; defaults entEroEnergy = 5000 J/kg, rhoEnt = 100 kg/m^3): where the flow passes over the
+/// cover it erodes mass at dm/dt = tau_b |u| / e_b per bed area (basal erosion: tau_b the basal shear
+/// stress of the friction law, Coulomb and Voellmy's drag, |u| the speed, e_b the specific erosion
+/// energy), or, with `ploughing`, the flow takes up the whole cover of a cell where it first flows
+/// there (front entrainment: com1DFA's choice with e_b = 0, here on the grid in one step). The
+/// eroded mass joins the flow at rest (the momentum is kept, the speed drops) at the flow's density:
+/// a volume of cover q / rho_flow per bed area of q = rho_cover d of mass. Per cell: the cover's normal
+/// depth d [m] (0: none) and density [kg/m^3]. Only with a constant mu (Coulomb or Voellmy).
+struct ErodibleCover {
+  std::vector<double> depth;    ///< normal depth per cell [m]; empty: no cover
+  std::vector<double> density;  ///< per cell [kg/m^3] (com1DFA's rhoEnt: 100)
+  double erosion_energy = 5000;  ///< e_b [J/kg] (com1DFA's entEroEnergy)
+  bool ploughing = false;        ///< true: front entrainment instead of basal erosion
+  bool empty() const { return depth.empty(); }
 };
 
 struct Sh2dConfig {
@@ -181,6 +200,7 @@ struct Sh2dConfig {
   CheckpointHook checkpoint;        ///< optional
   std::vector<SecondaryRelease> secondary;  ///< released when the flow reaches them
   ResistanceAreas resistance;               ///< none by default
+  ErodibleCover cover;                      ///< none by default
 };
 
 /// Solver state: H = h / cos(theta) and the horizontal momentum H U, H V per horizontal area.
@@ -198,6 +218,8 @@ struct Sh2dDiagnostics {
   std::vector<double> secondary_time;           ///< per secondary release: when released [s], NaN: never
   double volume_outflow = 0;                    ///< left through outflow boundaries [m^3]
   double volume_detrained = 0;                  ///< left behind in resistance areas (ResistanceAreas) [m^3]
+  /// Taken up from the erodible cover (ErodibleCover), as flow volume at the flow's density [m^3].
+  double volume_entrained = 0;
   double kinetic_energy_peak = 0;               ///< per unit density [m^5/s^2]
   /// Mass-averaged horizontal distance travelled: (1/V0) * integral over time and area of H |U| [m]
   /// (only with Sh2dConfig::track_travel).
@@ -210,9 +232,10 @@ struct Sh2dDiagnostics {
   double mean_active_fraction = 0, max_active_fraction = 0;
   double wall_seconds = 0;  ///< whole run, set-up included
   double loop_seconds = 0;  ///< time loop only
-  /// Relative volume error: |final + outflow + detrained - initial - secondary| / (initial + secondary).
+  /// Relative volume error: |final + outflow + detrained - initial - secondary - entrained| /
+  /// (initial + secondary + entrained).
   double volume_error() const {
-    const double in = volume_initial + volume_secondary;
+    const double in = volume_initial + volume_secondary + volume_entrained;
     return in > 0 ? std::abs(volume_final + volume_outflow + volume_detrained - in) / in : 0.0;
   }
 };
@@ -223,6 +246,8 @@ struct Sh2dResult {
   Sh2dDiagnostics diag;
   /// Normal thickness left behind per cell by detrainment in resistance areas [m] (empty without).
   std::vector<double> detrained;
+  /// The erodible cover left per cell, as its own normal depth [m] (empty without a cover).
+  std::vector<double> cover;
 };
 
 /// Surface geometry derived from the terrain once per run (exposed for tests and output conversion).

@@ -38,16 +38,20 @@ struct FaceState {
 
 // The basal friction a kernel computes, a template parameter (no branch in the loops): a constant mu
 // with or without Voellmy's drag, or mu(h, Fr) with or without the start/stop term
-// (engine/friction/law.hpp); `resisted`: a constant mu with Voellmy's drag (1/xi may be 0) and, per
-// cell, the drag and the detrainment of resistance areas (Sh2dConfig::resistance).
-enum class Basal { coulomb, voellmy, flow, hysteresis, resisted };
+// (engine/friction/law.hpp); `ground`: a constant mu with Voellmy's drag (1/xi may be 0) and, per
+// cell, what lies on the ground: the drag and the detrainment of resistance areas
+// (Sh2dConfig::resistance) and the erodible cover (Sh2dConfig::cover).
+enum class Basal { coulomb, voellmy, flow, hysteresis, ground };
 constexpr bool is_flow(Basal b) { return b == Basal::flow || b == Basal::hysteresis; }
 
-// Where a resistance area's drag and detrainment act (engine/sh2d.hpp ResistanceAreas): the band of
-// normal depth and speed of the drag, detrain = 1 where detrainment is on (below either minimum),
-// else 0 (the drag everywhere), and 1 / the flow's density.
-struct ResistanceRule {
+// What the ground's terms read (engine/sh2d.hpp ResistanceAreas, ErodibleCover): where a resistance
+// area's drag and detrainment act (the band of normal depth and speed of the drag, detrain = 1 where
+// detrainment is on (below either minimum), else 0 (the drag everywhere)), 1 / the flow's density;
+// the cover's erosion: 1 / e_b (0 while ploughing), plough = 1 for front entrainment, else 0, and the
+// flowing depth at which a cell ploughs its cover.
+struct GroundRule {
   double speed_min, speed_max, depth_min, depth_max, detrain, inv_density;
+  double inv_eb, plough, flowing;
 };
 
 // The constants of one step the kernels read: gravity g, the cap of the centrifugal term qcap, the
@@ -56,7 +60,7 @@ struct ResistanceRule {
 struct StepConstants {
   double g, qcap, dry, curv;
   BasalFriction fr;
-  ResistanceRule res{};  // Basal::resisted only
+  GroundRule ground{};  // Basal::ground only
 };
 
 // ---- Surface and load ------------------------------------------------------------------------
@@ -117,14 +121,24 @@ RUNOUT_KERNEL double drag_factor(double speed, double h, double gxd) { return tu
 
 // The weight of a resistance area's drag at normal depth h and speed: 1 inside the band of both (or
 // everywhere without detrainment), else 0. As 0/1 weights: the selects stay branch-free.
-RUNOUT_KERNEL double drag_weight(const ResistanceRule& r, double h, double speed) {
+RUNOUT_KERNEL double drag_weight(const GroundRule& r, double h, double speed) {
   const bool band = h >= r.depth_min && h <= r.depth_max && speed >= r.speed_min && speed <= r.speed_max;
   return r.detrain == 0.0 || band ? 1.0 : 0.0;
 }
 // Whether a resistance area detrains at normal depth h and speed: detrainment on and slower than
 // the band or thinner than it.
-RUNOUT_KERNEL bool detrains(const ResistanceRule& r, double h, double speed) {
+RUNOUT_KERNEL bool detrains(const GroundRule& r, double h, double speed) {
   return r.detrain != 0.0 && (h < r.depth_min || speed < r.speed_min);
+}
+
+// The depth (as H of flow) a cell takes up from its erodible cover cov (as H) in one step: basal
+// erosion tau_b |u| dt / (rho e_b) per horizontal area (tau_dt = tau_b dt / rho per horizontal area,
+// speed the 3D speed), at most the cover; or, ploughing, the whole cover where the normal depth h
+// flows.
+RUNOUT_KERNEL double ground_entrainment(const GroundRule& r, double tau_dt, double speed, double h, double cov) {
+  const double eroded = vmin(tau_dt * speed * r.inv_eb, cov);
+  const double ploughed = h > r.flowing ? cov : 0.0;
+  return r.plough != 0.0 ? ploughed : eroded;
 }
 
 // ---- Reconstruction and predictor --------------------------------------------------------------
@@ -160,7 +174,7 @@ struct Predicted {
 // hy = dt / (2 dy)); where a predicted face depth would be negative it falls back to first order and
 // zeroes s. Then friction over the half step with the load and mu of the state at t (mu from
 // basal_mu, the start/stop law's parts smu, sw), and Voellmy's drag implicitly (B), with a resistance
-// area's drag coefficient cres (Basal::resisted) in its band at the state at t.
+// area's drag coefficient cres (Basal::ground) in its band at the state at t.
 template <Basal B>
 RUNOUT_KERNEL Predicted predict(const StepConstants& k, double H, double U, double V, double HU, double HV, Slopes& s,
                                 double Pxx, double Pxy, double Pyy, double c, double bx, double by, double hxx, double hxy,
@@ -189,8 +203,8 @@ RUNOUT_KERNEL Predicted predict(const StepConstants& k, double H, double U, doub
   const bool rest = stopped(M3, imp);
   double f = friction_factor(M3, imp);
   if constexpr (B == Basal::voellmy) f *= drag_factor(vmax(M3 - imp, 0.0), H * c, gxd);
-  if constexpr (B == Basal::resisted) {
-    const double gr = gxd + 0.5 * dt * cres * drag_weight(k.res, H * c, speed3(bx, by, U, V));
+  if constexpr (B == Basal::ground) {
+    const double gr = gxd + 0.5 * dt * cres * drag_weight(k.ground, H * c, speed3(bx, by, U, V));
     f *= drag_factor(vmax(M3 - imp, 0.0), H * c, gr);
   }
   const double held = std::abs(HU) + std::abs(HV) == 0.0 ? (rest ? 1.0 : 0.0) : 0.0;
@@ -262,21 +276,23 @@ RUNOUT_KERNEL double flux_update(double Q0, double lx, double ly, double fw, dou
 // A cell's new state: depth, momentum, velocity (zero where dry) and surface speed after friction.
 struct NewState {
   double H, MU, MV, U, V, sp;
-  double det;  // depth detrained in the step (Basal::resisted), as H
+  double det, ent;  // depth detrained and entrained in the step (Basal::ground), as H
 };
 
 // The sources and friction of a cell whose depth H and momentum (MU, MV) are the flux update's:
 // gravity and the normal reaction at the half step (Hp, Up, Vp; midpoint rule), then the friction
 // at the half step as a bounded impulse that never reverses u, its load and mu from the half-step
-// state, then Voellmy's drag implicitly in the speed (gxd = dt g / xi). Basal::resisted: a resistance
+// state, then Voellmy's drag implicitly in the speed (gxd = dt g / xi). Basal::ground: a resistance
 // area's drag (coefficient cres, in its band at the half step) joins Voellmy's, and where the area
 // detrains (kdet, Pa) the flow leaves dh = dt K / (rho |u|) of normal thickness per step behind
 // (Feistl et al. 2014, as AvaFrame's com1DFA), dt K / (rho |u| c) of H, at most all of it, with its
-// momentum. Dry cells keep no momentum.
+// momentum. Then the erodible cover (cov, as H of flow) is eroded (ground_entrainment). Dry cells keep
+// no momentum.
 template <Basal B>
 RUNOUT_KERNEL NewState update_sources(const StepConstants& k, double H, double MU, double MV, double Hp, double Up,
                                       double Vp, double c, double bx, double by, double hxx, double hxy, double hyy,
-                                      double dt, double gxd, double smu, double sw, double cres = 0, double kdet = 0) {
+                                      double dt, double gxd, double smu, double sw, double cres = 0, double kdet = 0,
+                                      double cov = 0) {
   H = H < 0 ? 0.0 : H;  // round-off only: the limiter bounds the outflow by the content
   const double gn = normal_load(Up, Vp, hxx, hxy, hyy, k.g, k.qcap);
   const double drive = -Hp * c * c * gn;
@@ -291,27 +307,34 @@ RUNOUT_KERNEL NewState update_sources(const StepConstants& k, double H, double M
   MV = rest ? 0.0 : MV * f;
   double inv = 1.0 / H;
   double sp = vmax(M3 - imp, 0.0) * inv;  // surface speed after Coulomb friction
-  const double up = B == Basal::resisted ? speed3(bx, by, Up, Vp) : 0.0;  // the areas' band and rate read it
-  if constexpr (B == Basal::voellmy || B == Basal::resisted) {
+  const double up = B == Basal::ground ? speed3(bx, by, Up, Vp) : 0.0;  // the ground's terms read it
+  if constexpr (B == Basal::voellmy || B == Basal::ground) {
     double g = gxd;
-    if constexpr (B == Basal::resisted) g += dt * cres * drag_weight(k.res, Hp * c, up);
+    if constexpr (B == Basal::ground) g += dt * cres * drag_weight(k.ground, Hp * c, up);
     const double ft = turbulent_factor(sp, H * c, g);
     MU *= ft;
     MV *= ft;
     sp *= ft;
   }
-  double det = 0;
-  if constexpr (B == Basal::resisted) {
-    const double dH = dt * kdet * k.res.inv_density / (vmax(up, 1e-6) * c);
-    det = kdet > 0 && detrains(k.res, Hp * c, up) ? vmin(dH, H) : 0.0;
-    const double keep = H > 0 ? (H - det) * inv : 0.0;
+  double det = 0, ent = 0;
+  if constexpr (B == Basal::ground) {
+    const double dH = dt * kdet * k.ground.inv_density / (vmax(up, 1e-6) * c);
+    det = kdet > 0 && detrains(k.ground, Hp * c, up) ? vmin(dH, H) : 0.0;
+    const double keep = det > 0 ? (H - det) * inv : 1.0;  // exactly 1 where nothing detrains
     H = H - det;
     MU *= keep;
     MV *= keep;
+    // The cover's erosion at the half step: tau_b dt / rho per horizontal area is Coulomb's impulse
+    // plus Voellmy's drag g |u|^2 / xi per bed area (gxd = dt g / xi) over c.
+    const double tau_dt = imp + gxd * up * up / c;
+    ent = ground_entrainment(k.ground, tau_dt, up, Hp * c, cov);
+    sp = ent > 0 ? sp * H / (H + ent) : sp;  // taken up at rest: the momentum is kept
+    H = H + ent;
     inv = 1.0 / H;
   }
   const bool wet = H > k.dry;
-  return NewState{H, wet ? MU : 0.0, wet ? MV : 0.0, wet ? MU * inv : 0.0, wet ? MV * inv : 0.0, wet ? sp : 0.0, det};
+  return NewState{H,   wet ? MU : 0.0, wet ? MV : 0.0, wet ? MU * inv : 0.0, wet ? MV * inv : 0.0, wet ? sp : 0.0,
+                  det, ent};
 }
 
 // A cell's terms of the hazard maps and the tile's sums from its new state: normal depth, impact

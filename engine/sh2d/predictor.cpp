@@ -45,7 +45,7 @@ void Solver::predictor(TileWork& w, double dt) const {
     case Basal::voellmy: predictor_cells<lim, Basal::voellmy>(w, dt); break;
     case Basal::flow: predictor_cells<lim, Basal::flow>(w, dt); break;
     case Basal::hysteresis: predictor_cells<lim, Basal::hysteresis>(w, dt); break;
-    case Basal::resisted: predictor_cells<lim, Basal::resisted>(w, dt); break;
+    case Basal::ground: predictor_cells<lim, Basal::ground>(w, dt); break;
   }
 }
 template void Solver::predictor<Limiter::minmod>(TileWork&, double) const;
@@ -94,7 +94,7 @@ void Solver::predictor_cells(TileWork& w, double dt) const {
         smu = p.mu;
         sw = start_weight(p.q);
       }
-      const double cres = B == Basal::resisted ? cres_[k] : 0.0;
+      const double cres = B == Basal::ground ? cres_[k] : 0.0;
       const Predicted p = predict<B>(K, H, U, V, HUs[k], HVs[k], s, Pxx, Pxy, Pyy, c, bx, by, hxx, hxy, hyy, hx, hy,
                                      dt, gxd, smu, sw, cres);
       PredictorOut{w, w.at(i, j)}.put(0, s, p, Pxx, Pxy, Pyy, Ps);
@@ -120,7 +120,7 @@ RUNOUT_SIMD_CLONES void Solver::predictor_row(TileWork& w, int j, int ia, int ib
   const double hx = 0.5 * dt / t_.dx, hy = 0.5 * dt / t_.dy, gxd = 0.5 * dt * g_ * ixi_;
   const StepConstants K = constants();
   const double *__restrict rmu = w.row_mu.data(), *__restrict rwt = w.row_w.data();  // start_terms'
-  const double* __restrict cr = B == Basal::resisted ? cres_.data() : nullptr;    // the areas' drag
+  const double* __restrict cr = B == Basal::ground ? cres_.data() : nullptr;    // the areas' drag
   const std::ptrdiff_t N = nx_;
   const int n = ib - ia;
 #pragma omp simd
@@ -128,7 +128,7 @@ RUNOUT_SIMD_CLONES void Solver::predictor_row(TileWork& w, int j, int ia, int ib
     const std::ptrdiff_t k = std::ptrdiff_t(k0) + t;
     Slopes s = limited_slopes<lim>(Hs, Us, Vs, k, -1, 1, -N, N, true, true, K.dry);
     double cres = 0;
-    if constexpr (B == Basal::resisted) cres = cr[k];
+    if constexpr (B == Basal::ground) cres = cr[k];
     const Predicted p = predict<B>(K, Hs[k], Us[k], Vs[k], HUs[k], HVs[k], s, Pxx[k], Pxy[k], Pyy[k], cc[k], bx[k],
                                    by[k], hxx[k], hxy[k], hyy[k], hx, hy, dt, gxd, rmu[t], rwt[t], cres);
     out.put(t, s, p, Pxx[k], Pxy[k], Pyy[k], Ps[k]);

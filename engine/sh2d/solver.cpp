@@ -28,6 +28,19 @@ void validate_resistance(const Terrain2D& t, const Sh2dConfig& cfg) {
   if (cfg.material.friction().flow) bad("need a constant mu (Coulomb or Voellmy), not a flow-dependent friction law");
 }
 
+void validate_cover(const Terrain2D& t, const Sh2dConfig& cfg) {
+  auto bad = [](const std::string& m) { throw std::invalid_argument("2D solver: erodible cover: " + m); };
+  const ErodibleCover& e = cfg.cover;
+  if (e.empty()) return;
+  if (e.depth.size() != t.cells() || e.density.size() != t.cells()) bad("field sizes differ from the grid");
+  for (std::size_t k = 0; k < e.depth.size(); ++k)
+    if (!(e.depth[k] >= 0 && std::isfinite(e.depth[k])) || !(e.density[k] > 0 && std::isfinite(e.density[k])))
+      bad("depth must be finite and >= 0 and density finite and > 0 (cell " + std::to_string(k) + ")");
+  if (!e.ploughing && !(e.erosion_energy > 0 && std::isfinite(e.erosion_energy)))
+    bad("the erosion energy e_b must be finite and > 0 (or ploughing)");
+  if (cfg.material.friction().flow) bad("need a constant mu (Coulomb or Voellmy), not a flow-dependent friction law");
+}
+
 void validate(const Terrain2D& t, const Sh2dConfig& cfg, const Sh2dState& s) {
   auto bad = [](const std::string& m) { throw std::invalid_argument("2D solver: " + m); };
   if (t.nx < 1 || t.ny < 1) bad("terrain grid is empty");
@@ -58,6 +71,7 @@ void validate(const Terrain2D& t, const Sh2dConfig& cfg, const Sh2dState& s) {
     }
   }
   validate_resistance(t, cfg);
+  validate_cover(t, cfg);
   cfg.material.validate();
 }
 
@@ -79,14 +93,19 @@ Solver::Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
     case MuForm::hysteresis: basal_ = Basal::hysteresis; break;
   }
   if (fr_.flow && ixi_ > 0) throw std::logic_error("2D solver: the kernels of mu(h, Fr) have no turbulent drag (1/xi = 0)");
-  if (!cfg.resistance.empty()) {  // a constant mu (validate): Voellmy's kernels with the areas' terms
+  if (!cfg.resistance.empty() || !cfg.cover.empty()) {  // a constant mu (validate): Voellmy's kernels with the ground's
     const ResistanceAreas& r = cfg.resistance;
-    basal_ = Basal::resisted;
-    cres_ = r.c;
+    const ErodibleCover& e = cfg.cover;
+    basal_ = Basal::ground;
+    cres_ = r.empty() ? std::vector<double>(n_, 0.0) : r.c;
     kdet_ = r.k_det.empty() ? std::vector<double>(n_, 0.0) : r.k_det;
-    res_ = ResistanceRule{r.speed_min, r.speed_max, r.depth_min, r.depth_max, r.detrainment ? 1.0 : 0.0,
-                          1.0 / cfg.material.density};
+    const double rho = cfg.material.density;
+    ground_ = GroundRule{r.speed_min, r.speed_max, r.depth_min, r.depth_max, r.detrainment ? 1.0 : 0.0, 1.0 / rho,
+                         e.ploughing ? 0.0 : 1.0 / e.erosion_energy, e.ploughing ? 1.0 : 0.0, cfg.flow_threshold};
     det_.assign(n_, 0.0);
+    cover_.assign(n_, 0.0);  // the cover's mass per bed area rho_c d as flow volume per horizontal area
+    if (!e.empty())
+      for (std::size_t k = 0; k < n_; ++k) cover_[k] = e.density[k] * e.depth[k] / (rho * geo_.c[k]);
   }
   kap_ = cfg.material.earth_pressure == EarthPressure::active_passive;
   if (kap_) {
@@ -137,6 +156,7 @@ Solver::Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
   tile_rate_.assign(ntiles_, 0);
   tile_out_.assign(ntiles_, 0);
   tile_det_.assign(ntiles_, 0);
+  tile_ent_.assign(ntiles_, 0);
   tile_travel_.assign(ntiles_, 0);
   tile_limited_.assign(ntiles_, 0);
   tile_wet_.assign(ntiles_, 0);
@@ -298,9 +318,13 @@ Sh2dCheckpoint Solver::checkpoint(const LoopState& loop) const {
   cp.last_snapshot = loop.last_frame;
   cp.secondary_time = secondary_time_;
   cp.volume_secondary = volume_secondary_;
-  if (basal_ == Basal::resisted) {
+  if (basal_ == Basal::ground) {
     cp.detrained = det_;
     cp.tile_detrained = tile_det_;
+  }
+  if (!cfg_.cover.empty()) {
+    cp.cover = cover_;
+    cp.tile_entrained = tile_ent_;
   }
   return cp;
 }
@@ -320,9 +344,11 @@ void Solver::restore(const Sh2dCheckpoint& cp) {
     bad("is damaged (a tile field has the wrong size)");
   if (!(std::isfinite(cp.t) && cp.t >= 0) || cp.steps < 0) bad("is damaged (time or step count)");
   if (cp.secondary_time.size() != cfg_.secondary.size()) bad("was taken with other secondary releases");
-  if ((basal_ == Basal::resisted) != !cp.detrained.empty() ||
+  if ((basal_ == Basal::ground) != !cp.detrained.empty() ||
       (!cp.detrained.empty() && (!cells(cp.detrained) || cp.tile_detrained.size() != nt)))
     bad("was taken with other resistance areas");
+  if (cfg_.cover.empty() != cp.cover.empty() || (!cp.cover.empty() && (!cells(cp.cover) || cp.tile_entrained.size() != nt)))
+    bad("was taken with another erodible cover");
   // Both time levels hold the state: the level a step writes is never read before it is written,
   // and inactive tiles hold the same in both (see rebuild_active).
   cur_ = 0;
@@ -354,9 +380,13 @@ void Solver::restore(const Sh2dCheckpoint& cp) {
   max_active_fraction_ = cp.max_active_fraction;
   secondary_time_ = cp.secondary_time;
   volume_secondary_ = cp.volume_secondary;
-  if (basal_ == Basal::resisted) {
+  if (basal_ == Basal::ground) {
     det_ = cp.detrained;
     tile_det_ = cp.tile_detrained;
+  }
+  if (!cfg_.cover.empty()) {
+    cover_ = cp.cover;
+    tile_ent_ = cp.tile_entrained;
   }
 }
 
@@ -443,9 +473,15 @@ Sh2dResult Solver::finish(StopReason stop, const LoopState& loop) {
   d.volume_final = sum_tiles(tile_mass_) * cell_area;
   d.volume_outflow = sum_tiles(tile_out_);
   d.volume_detrained = sum_tiles(tile_det_) * cell_area;
-  if (basal_ == Basal::resisted) {  // as normal thickness
+  d.volume_entrained = sum_tiles(tile_ent_) * cell_area;
+  if (!cfg_.resistance.empty()) {  // as normal thickness
     res.detrained.resize(n_);
     for (std::size_t k = 0; k < n_; ++k) res.detrained[k] = det_[k] * geo_.c[k];
+  }
+  if (!cfg_.cover.empty()) {  // the cover's own normal depth
+    res.cover.resize(n_);
+    for (std::size_t k = 0; k < n_; ++k)
+      res.cover[k] = cover_[k] * cfg_.material.density * geo_.c[k] / cfg_.cover.density[k];
   }
   d.mean_travel = d.volume_initial > 0 ? sum_tiles(tile_travel_) * cell_area / d.volume_initial : 0.0;
   for (int tt = 0; tt < ntiles_; ++tt) d.positivity_limited += tile_limited_[tt];

@@ -50,7 +50,7 @@ struct TileWork {
   // (else 0), CFL rate; written by the update's cell kernels, summed in cell order afterwards. And
   // the row kernel's normal depth and pressure of a flowing cell (else 0), for the hazard maps.
   std::vector<double> cell_ke, cell_speed, cell_rate, cell_h, cell_pressure;
-  std::vector<double> cell_det;  // the depth detrained (Basal::resisted)
+  std::vector<double> cell_det, cell_ent;  // the depth detrained and entrained (Basal::ground)
   // One row's friction coefficients without the start/stop term and that term's weights (start_terms).
   std::vector<double> row_mu, row_w;
   Face fxf(std::size_t k) const { return Face{Fx0[k], Fx1[k], Fx2[k]}; }
@@ -61,7 +61,7 @@ struct TileWork {
     held.assign(n, 0.0);
     for (auto* v : {&Fx0, &Fx1, &Fx2}) v->assign(std::size_t(T + 5) * (T + 4), 0.0);
     for (auto* v : {&Fy0, &Fy1, &Fy2}) v->assign(std::size_t(T + 4) * (T + 5), 0.0);
-    for (auto* v : {&cell_ke, &cell_speed, &cell_rate, &cell_h, &cell_pressure, &cell_det}) v->assign(std::size_t(T), 0.0);
+    for (auto* v : {&cell_ke, &cell_speed, &cell_rate, &cell_h, &cell_pressure, &cell_det, &cell_ent}) v->assign(std::size_t(T), 0.0);
     for (auto* v : {&row_mu, &row_w}) v->assign(std::size_t(T + 4), 0.0);
   }
   std::size_t at(int i, int j) const { return std::size_t(j - bj0) * bw + (i - bi0); }
@@ -142,7 +142,7 @@ class Solver {
 
   // The constants of a step the point kernels read.
   StepConstants constants() const {
-    return StepConstants{g_, qcap_, cfg_.dry_depth, cfg_.curvature ? 1.0 : 0.0, fr_, res_};
+    return StepConstants{g_, qcap_, cfg_.dry_depth, cfg_.curvature ? 1.0 : 0.0, fr_, ground_};
   }
   // sqrt(Pxx)/dx + sqrt(Pyy)/dy: the gravity-wave part of the CFL rate, per sqrt(H).
   double wave_factor(double pxx, double pyy) const { return std::sqrt(pxx) / t_.dx + std::sqrt(pyy) / t_.dy; }
@@ -204,10 +204,13 @@ class Solver {
   std::vector<double> Pxx_, Pxy_, Pyy_;  // pressure coefficients for K = 1 (also the start values)
   std::vector<double> Ps_;                // wave_factor of those
   std::vector<double> tile_mass_, tile_ke_, tile_speed_, tile_rate_, tile_out_, tile_travel_;
-  // Resistance areas (Basal::resisted): the drag coefficient and detrainment per cell, their rule, the
+  // Resistance areas (Basal::ground): the drag coefficient and detrainment per cell, their rule, the
   // depth detrained per cell so far (as H) and per tile the volume as H summed (times the cell area).
   std::vector<double> cres_, kdet_, det_, tile_det_;
-  ResistanceRule res_{};
+  // The erodible cover (Basal::ground): what is left per cell (as H of flow: the flow volume it would
+  // make per horizontal area) and per tile the volume taken up (as H summed).
+  std::vector<double> cover_, tile_ent_;
+  GroundRule ground_{};
   std::vector<long> tile_limited_;
   std::vector<std::uint8_t> tile_wet_, active_flag_;
   std::vector<int> active_;

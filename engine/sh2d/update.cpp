@@ -107,9 +107,11 @@ RUNOUT_KERNEL void Solver::update_run(TileWork& w, int j, int ia, int ib, int i0
   double *__restrict oke = &w.cell_ke[ia - i0], *__restrict osp = &w.cell_speed[ia - i0];
   double *__restrict ort = &w.cell_rate[ia - i0], *__restrict oh = &w.cell_h[ia - i0];
   double *__restrict opr = &w.cell_pressure[ia - i0], *__restrict odet = &w.cell_det[ia - i0];
-  const double* __restrict cr = B == Basal::resisted ? &cres_[k0] : nullptr;  // the areas' drag and
-  const double* __restrict kd = B == Basal::resisted ? &kdet_[k0] : nullptr;  // detrainment
-  double* __restrict det = B == Basal::resisted ? &det_[k0] : nullptr;
+  const double* __restrict cr = B == Basal::ground ? &cres_[k0] : nullptr;  // the areas' drag and
+  const double* __restrict kd = B == Basal::ground ? &kdet_[k0] : nullptr;  // detrainment
+  double* __restrict det = B == Basal::ground ? &det_[k0] : nullptr;
+  double* __restrict cov = B == Basal::ground ? &cover_[k0] : nullptr;  // the erodible cover
+  double* __restrict oent = &w.cell_ent[ia - i0];
   const double lx = dt / t_.dx, ly = dt / t_.dy, dx = t_.dx, dy = t_.dy, gxd = dt * g_ * ixi_;
   const double thr = cfg_.flow_threshold, rho = cfg_.material.density;
   const StepConstants K = constants();
@@ -131,16 +133,19 @@ RUNOUT_KERNEL void Solver::update_run(TileWork& w, int j, int ia, int ib, int i0
     const double H = flux_update(H0[m], lx, ly, Fx0[m], Fx0[m + 1], Fy0[m], Fy0[m + bw], sw, se, ss, sn);
     const double MU = flux_update(HU0[m], lx, ly, Fx1[m], Fx1[m + 1], Fy1[m], Fy1[m + bw], sw, se, ss, sn);
     const double MV = flux_update(HV0[m], lx, ly, Fx2[m], Fx2[m + 1], Fy2[m], Fy2[m + bw], sw, se, ss, sn);
-    double cres = 0, kdet = 0;
-    if constexpr (B == Basal::resisted) {
+    double cres = 0, kdet = 0, cv = 0;
+    if constexpr (B == Basal::ground) {
       cres = cr[m];
       kdet = kd[m];
+      cv = cov[m];
     }
     const NewState s = update_sources<B>(K, H, MU, MV, Hp[m], Up[m], Vp[m], cc[m], bx[m], by[m], hxx[m], hxy[m],
-                                         hyy[m], dt, gxd, smu, swt, cres, kdet);
-    if constexpr (B == Basal::resisted) {
+                                         hyy[m], dt, gxd, smu, swt, cres, kdet, cv);
+    if constexpr (B == Basal::ground) {
       det[m] += s.det;
       odet[m] = s.det;
+      cov[m] = cv - s.ent;
+      oent[m] = s.ent;
     }
     H1[m] = s.H;
     HU1[m] = s.MU;
@@ -174,7 +179,7 @@ void Solver::update(int tt, TileWork& w, const CellBox& c, double t, double dt) 
     case Basal::voellmy: update_cells<Basal::voellmy>(tt, w, c, t, dt); break;
     case Basal::flow: update_cells<Basal::flow>(tt, w, c, t, dt); break;
     case Basal::hysteresis: update_cells<Basal::hysteresis>(tt, w, c, t, dt); break;
-    case Basal::resisted: update_cells<Basal::resisted>(tt, w, c, t, dt); break;
+    case Basal::ground: update_cells<Basal::ground>(tt, w, c, t, dt); break;
   }
 }
 
@@ -182,7 +187,7 @@ template <Basal B>
 void Solver::update_cells(int tt, TileWork& w, const CellBox& c, double t, double dt) {
   const int i0 = c.i0, i1 = c.i1, j0 = c.j0, j1 = c.j1;
   const auto &H1 = H_[1 - cur_], &HU1 = HU_[1 - cur_], &HV1 = HV_[1 - cur_];
-  double out = 0, travel = 0, mass = 0, ke = 0, top = 0, rate = 0, detrained = 0;
+  double out = 0, travel = 0, mass = 0, ke = 0, top = 0, rate = 0, detrained = 0, entrained = 0;
   bool wet = false;
   for (int j = j0; j < j1; ++j) {
     // The row's cells: the row kernel for runs of cells away from the domain's edges and from cells
@@ -202,7 +207,7 @@ void Solver::update_cells(int tt, TileWork& w, const CellBox& c, double t, doubl
         continue;
       }
       if (w.has_outside && outside(i, j)) {  // never holds material (both buffers stay 0)
-        w.cell_ke[i - i0] = w.cell_speed[i - i0] = w.cell_rate[i - i0] = w.cell_det[i - i0] = 0.0;
+        w.cell_ke[i - i0] = w.cell_speed[i - i0] = w.cell_rate[i - i0] = w.cell_det[i - i0] = w.cell_ent[i - i0] = 0.0;
         continue;
       }
       update_cell<B>(w, i, j, i0, t + dt, dt, out);
@@ -222,11 +227,15 @@ void Solver::update_cells(int tt, TileWork& w, const CellBox& c, double t, doubl
       rate = sh2d_detail::vmax(rate, w.cell_rate[m]);
       wet = wet || h1[m] > act;
     }
-    if constexpr (B == Basal::resisted)
-      for (int m = 0; m < n; ++m) detrained += w.cell_det[m];
+    if constexpr (B == Basal::ground)
+      for (int m = 0; m < n; ++m) {
+        detrained += w.cell_det[m];
+        entrained += w.cell_ent[m];
+      }
   }
   tile_out_[tt] += out;
   tile_det_[tt] += detrained;
+  tile_ent_[tt] += entrained;
   tile_travel_[tt] += travel;
   tile_mass_[tt] = mass;
   tile_ke_[tt] = ke;

@@ -22,8 +22,8 @@ using h5::put_attr_string;
 // The scalars, by position in the dataset "scalars" (their names are in its attribute "names").
 constexpr const char* kScalarNames =
     "nx,ny,tile,t,steps,volume_initial,kinetic_energy_peak,cell_updates,active_fraction_sum,max_active_fraction,"
-    "next_snapshot,last_snapshot,timeseries_frames,volume_secondary,secondary_areas,resistance_areas";
-constexpr std::size_t kScalars = 16;
+    "next_snapshot,last_snapshot,timeseries_frames,volume_secondary,secondary_areas,resistance_areas,erodible_cover";
+constexpr std::size_t kScalars = 17;
 
 struct File {
   hid_t id = -1;
@@ -79,7 +79,8 @@ void write_sh_checkpoint(const std::string& path, const std::string& scenario_ha
       const std::vector<double> sc = {double(s.nx), double(s.ny), double(s.tile), s.t, double(s.steps), s.volume_initial,
                                       s.kinetic_energy_peak, s.cell_updates, s.active_fraction_sum, s.max_active_fraction,
                                       s.next_snapshot, s.last_snapshot, double(timeseries_frames), s.volume_secondary,
-                                      double(s.secondary_time.size()), s.detrained.empty() ? 0.0 : 1.0};
+                                      double(s.secondary_time.size()), s.detrained.empty() ? 0.0 : 1.0,
+                                      s.cover.empty() ? 0.0 : 1.0};
       put(f.id, "scalars", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, sc.data(), sc.size());
       hid_t ds = H5Dopen2(f.id, "scalars", H5P_DEFAULT);
       put_attr_string(ds, "names", kScalarNames);
@@ -101,6 +102,10 @@ void write_sh_checkpoint(const std::string& path, const std::string& scenario_ha
       if (!s.detrained.empty()) {  // resistance areas: the depth detrained so far, per cell and per tile
         put(f.id, "detrained", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, s.detrained.data(), s.detrained.size(), rows);
         put(f.id, "tile_detrained", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, s.tile_detrained.data(), s.tile_detrained.size());
+      }
+      if (!s.cover.empty()) {  // an erodible cover: what is left of it per cell, and per tile the volume taken up
+        put(f.id, "cover", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, s.cover.data(), s.cover.size(), rows);
+        put(f.id, "tile_entrained", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, s.tile_entrained.data(), s.tile_entrained.size());
       }
     } catch (...) {
       H5Fclose(f.id);
@@ -171,6 +176,10 @@ ShCheckpoint read_sh_checkpoint(const std::string& path) {
   if (sc[15] != 0) {
     s.detrained = get<double>(f.id, "detrained", H5T_NATIVE_DOUBLE, n, path);
     s.tile_detrained = get<double>(f.id, "tile_detrained", H5T_NATIVE_DOUBLE, nt, path);
+  }
+  if (sc[16] != 0) {
+    s.cover = get<double>(f.id, "cover", H5T_NATIVE_DOUBLE, n, path);
+    s.tile_entrained = get<double>(f.id, "tile_entrained", H5T_NATIVE_DOUBLE, nt, path);
   }
   return cp;
 }

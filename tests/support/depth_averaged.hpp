@@ -100,6 +100,8 @@ inline void expect_same(const Sh2dResult& a, const Sh2dResult& b) {
   EXPECT_EQ(a.diag.mean_travel, b.diag.mean_travel);
   EXPECT_EQ(a.diag.volume_detrained, b.diag.volume_detrained);
   EXPECT_EQ(a.detrained, b.detrained);
+  EXPECT_EQ(a.diag.volume_entrained, b.diag.volume_entrained);
+  EXPECT_EQ(a.cover, b.cover);
 }
 
 }  // namespace runout::test_support::depth_averaged
