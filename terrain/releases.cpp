@@ -309,12 +309,12 @@ std::unique_ptr<OGRGeometry> polygon_on_grid(const OGRGeometry* g0, OGRCoordinat
 // The thickness raster at the cells' centres, resampled bilinearly by GDAL's warper (PROJ for the
 // CRS), row 0 south; 0 where it has no data. Values below 0 or above 500 m are refused.
 std::vector<double> raster_thickness(const Grid& g, const ReleaseRequest& rq, const OGRSpatialReference& dst) {
-  const std::string what = "release thickness raster '" + rq.thickness_raster + "'";
+  const std::string what = rq.kind + " thickness raster '" + rq.thickness_raster + "'";
   GDALDatasetUniquePtr src(GDALDataset::Open(rq.thickness_raster.c_str(), GDAL_OF_RASTER));
   if (!src) throw TerrainError(what + ": cannot read it as a raster" + gdal_message());
   const OGRSpatialReference* own = src->GetSpatialRef();
   const OGRSpatialReference s =
-      input_crs(own, rq.crs, what, what + " has no CRS and none is given: set the release's crs (e.g. \"EPSG:2056\")");
+      input_crs(own, rq.crs, what, what + " has no CRS and none is given: set the " + rq.kind + "'s crs (e.g. \"EPSG:2056\")");
   transform(s, dst, what);  // refuses a local CRS against a georeferenced one
   std::vector<std::string> args = {"-r", "bilinear", "-dstnodata", "-99999", "-wo", "INIT_DEST=NO_DATA"};
   if (s.IsLocal()) {
@@ -352,17 +352,17 @@ std::vector<double> raster_thickness(const Grid& g, const ReleaseRequest& rq, co
 void release_polygons(const ReleaseRequest& rq, const OGRSpatialReference& dst, const CellFill& fill, ReleaseReport& rep,
                       std::vector<ReleaseArea>* areas = nullptr) {
   GDALDatasetUniquePtr ds(GDALDataset::Open(rq.path.c_str(), GDAL_OF_VECTOR));
-  if (!ds) throw TerrainError("release '" + rq.path + "': cannot read it as a vector file" + gdal_message());
+  if (!ds) throw TerrainError(rq.kind + " '" + rq.path + "': cannot read it as a vector file" + gdal_message());
   const bool raster = !rq.thickness_raster.empty();
   const Grid& g = fill.lat.g;
   int n = 0;
   for (auto* layer : ds->GetLayers()) {
-    const std::string file = "release '" + rq.path + "'";
-    const auto src = input_crs(layer->GetSpatialRef(), rq.crs, file, file + " has no CRS and none is given: set the release's crs (e.g. \"EPSG:2056\")");
+    const std::string file = rq.kind + " '" + rq.path + "'";
+    const auto src = input_crs(layer->GetSpatialRef(), rq.crs, file, file + " has no CRS and none is given: set the " + rq.kind + "'s crs (e.g. \"EPSG:2056\")");
     auto ct = transform(src, dst, file);
     for (auto& f : layer) {
       ++n;
-      const std::string what = "release polygon " + std::to_string(n) + " of '" + rq.path + "'";
+      const std::string what = rq.kind + " polygon " + std::to_string(n) + " of '" + rq.path + "'";
       bool repaired = false;
       const auto geom = polygon_on_grid(f->GetGeometryRef(), ct.get(), g, what, repaired);
       if (repaired) rep.notes.push_back(what + ": invalid geometry (e.g. self-intersecting) repaired with GEOS MakeValid");
@@ -393,7 +393,7 @@ void release_polygons(const ReleaseRequest& rq, const OGRSpatialReference& dst, 
       ++rep.polygons;
     }
   }
-  if (n == 0) throw TerrainError("release '" + rq.path + "': no polygon in the file");
+  if (n == 0) throw TerrainError(rq.kind + " '" + rq.path + "': no polygon in the file");
 }
 
 // A release given by its thickness raster alone (no polygons).
@@ -476,7 +476,7 @@ std::vector<double> rasterize_releases(const Grid& g, const DemRequest& dem, con
   for (const auto& rq : releases) {
     if (rq.secondary) continue;
     if (!rq.path.empty()) release_polygons(rq, dst, fill, rep);
-    else release_raster(rq, dst, fill, "release thickness raster '" + rq.thickness_raster + "'");
+    else release_raster(rq, dst, fill, rq.kind + " thickness raster '" + rq.thickness_raster + "'");
   }
   for (std::size_t k = 0; k < h.size(); ++k)
     if (h[k] > 0) {

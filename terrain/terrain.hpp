@@ -82,6 +82,9 @@ struct ReleaseRequest {
   std::string min_slope_attribute, max_slope_attribute;
   bool secondary = false;  ///< released when the flow reaches it (each polygon an area of its own)
   double thickness_factor = 1;  ///< every thickness (given, attribute, raster) times this
+  /// What the thickness is of, for messages (e.g. "release", or "entrainment.areas[0]" for an erodible
+  /// cover, which is read with the releases' rules).
+  std::string kind = "release";
 };
 
 struct ReleaseReport {

@@ -44,6 +44,7 @@ void write_record(const std::string& path, const ResolvedScenario& s, const terr
   mb->set_relative_error(d.volume_error());
   mb->set_volume_secondary_m3(d.volume_secondary);
   mb->set_volume_detrained_m3(d.volume_detrained);
+  mb->set_volume_entrained_m3(d.volume_entrained);
   for (std::size_t a = 0; a < secondary.size(); ++a) {
     auto* sr = rec.mutable_release()->add_secondary();
     sr->set_name(secondary[a].name);
@@ -92,6 +93,22 @@ engine::ResistanceAreas resistance_areas(const ResolvedScenario& s, const std::v
         r.k_det[k] = std::max(r.k_det[k], s.resistance[a].k_det);
       }
   return r;
+}
+
+// The erodible cover as the engine takes it: the scenario's law and erosion energy, and per cell the
+// thickest area's thickness and density (`depth`, one field per area, read_output_inputs). None: none.
+engine::ErodibleCover erodible_cover(const ResolvedScenario& s, const std::vector<std::vector<double>>& depth) {
+  engine::ErodibleCover e = s.config.cover;
+  if (s.cover.empty()) return e;
+  e.depth.assign(depth.front().size(), 0.0);
+  e.density.assign(depth.front().size(), s.cover.front().density);
+  for (std::size_t a = 0; a < s.cover.size(); ++a)
+    for (std::size_t k = 0; k < depth[a].size(); ++k)
+      if (depth[a][k] > e.depth[k]) {
+        e.depth[k] = depth[a][k];
+        e.density[k] = s.cover[a].density;
+      }
+  return e;
 }
 
 // The secondary release areas as the engine takes them: the cells of each and their depths.
@@ -193,6 +210,7 @@ DepthAveragedRun::DepthAveragedRun(const ResolvedScenario& s, const std::string&
   secondary_ = terrain::secondary_release_areas(grid_, s.dem, s.releases);
   cfg_.secondary = engine_secondary(secondary_);
   cfg_.resistance = resistance_areas(s, output_inputs_.resistance_areas);
+  cfg_.cover = erodible_cover(s, output_inputs_.cover_areas);
 
   // Checkpoints: the solver's whole state between two steps, with the scenario's hash; the time
   // series so far lies beside it (CHECKPOINT.timeseries.h5), so that a continued run's outputs are
@@ -248,6 +266,7 @@ RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& tim
   sum.volume_final = d.volume_final;
   sum.volume_outflow = d.volume_outflow;
   sum.volume_detrained = d.volume_detrained;
+  sum.volume_entrained = d.volume_entrained;
   sum.volume_error = d.volume_error();
   sum.t = d.t;
   sum.steps = d.steps;
@@ -265,6 +284,11 @@ RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& tim
     terrain::write_cog((fs::path(out_dir_) / "detrained_depth.tif").string(), grid_, res.detrained,
                        terrain::BandInfo{"normal thickness left behind in resistance areas (detrainment)", "m"});
     sum.files.push_back("detrained_depth.tif");
+  }
+  if (!res.cover.empty()) {
+    terrain::write_cog((fs::path(out_dir_) / "cover_depth.tif").string(), grid_, terrain::masked_outside(grid_, res.cover),
+                       terrain::BandInfo{"erodible cover left at the end (normal thickness)", "m"});
+    sum.files.push_back("cover_depth.tif");
   }
   if (series_) {
     // QGIS styles for the frames' GeoTIFFs: the depth and speed maps' classes, on any band chosen.

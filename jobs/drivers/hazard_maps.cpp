@@ -33,6 +33,7 @@ figures::HazardMap map_base(const ResolvedScenario& s, const terrain::Grid& grid
   figures::HazardMap base;
   base.release = h0;
   base.resistance = overlay.resistance;
+  base.cover = overlay.cover;
   base.max_depth = hz.max_depth;
   base.outline_threshold = s.outline_threshold;
   base.parameters = map_parameters(s, grid, sum.release_volume_m3);
@@ -83,6 +84,9 @@ OutputInputs read_output_inputs(const ResolvedScenario& s, const terrain::Grid& 
       throw terrain::TerrainError(field + ": '" + s.resistance[a].path + "' covers no cell of the domain");
     in.resistance_areas.push_back(cells);
   }
+  // Each area of cover, read with the releases' rules (an area on no cell of the domain is refused,
+  // naming its field).
+  for (const auto& c : s.cover) in.cover_areas.push_back(terrain::rasterize_releases(grid, s.dem, {c.release}));
   return in;
 }
 
@@ -197,6 +201,19 @@ std::string resistance_line(const ResolvedScenario& s) {
          num(b.depth_max) + " m and " + num(b.speed_min) + "–" + num(b.speed_max) + " m/s";
 }
 
+// The erodible cover on the maps: how many areas, the law (with e_b) and the cover's density.
+std::string cover_line(const ResolvedScenario& s) {
+  double lo = s.cover[0].density, hi = lo;
+  for (const auto& a : s.cover) {
+    lo = std::min(lo, a.density);
+    hi = std::max(hi, a.density);
+  }
+  const auto& e = s.config.cover;
+  return "entrainment: " + std::to_string(s.cover.size()) + (s.cover.size() == 1 ? " area" : " areas") +
+         (e.ploughing ? ", ploughing" : ", erosion e_b = " + num(e.erosion_energy) + " J/kg") + ", cover " +
+         (lo == hi ? num(lo) : num(lo) + "–" + num(hi)) + " kg/m³";
+}
+
 }  // namespace
 
 std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain::Grid& grid, double release_volume_m3) {
@@ -209,6 +226,7 @@ std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain
     p.push_back(friction_line(*s.config.material.rheology, m));
   p.push_back("density: " + num(m.density_kg_m3()) + " kg/m³");
   if (!s.resistance.empty()) p.push_back(resistance_line(s));
+  if (!s.cover.empty()) p.push_back(cover_line(s));
   p.push_back("release: " + num(std::round(release_volume_m3)) + " m³ in " + std::to_string(s.releases.size()) +
               (s.releases.size() == 1 ? " release" : " releases"));
   p.push_back("grid: " + num(grid.dx) + " m, " + std::to_string(grid.nx) + " × " + std::to_string(grid.ny) + " cells, " + grid.crs_name);

@@ -34,6 +34,8 @@ struct OutputInputs {
   std::vector<std::uint8_t> observed;
   /// Per resistance area (scenario `resistance.areas[]`), its cells (empty: no areas).
   std::vector<std::vector<std::uint8_t>> resistance_areas;
+  /// Per area of erodible cover (scenario `entrainment.areas[]`), its normal thickness per cell.
+  std::vector<std::vector<double>> cover_areas;
 };
 /// Throws TerrainError naming the field (a point outside the domain, a line or outline that cannot be
 /// read, an outline that covers no cell of the domain).
@@ -46,6 +48,7 @@ std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain
 struct MapOverlay {
   std::vector<PlacedPoint> points;
   std::vector<std::uint8_t> resistance;  ///< cells of resistance areas, outlined
+  std::vector<std::uint8_t> cover;       ///< cells of erodible cover, outlined
   products::Line path;
   std::vector<figures::MapPoint> path_marks;
 };

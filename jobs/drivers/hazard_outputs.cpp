@@ -138,6 +138,10 @@ HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Gri
     overlay.resistance.resize(cells.size(), 0);
     for (std::size_t k = 0; k < cells.size(); ++k) overlay.resistance[k] |= cells[k];
   }
+  for (const auto& d : in.cover_areas) {  // the cells of any area of cover
+    overlay.cover.resize(d.size(), 0);
+    for (std::size_t k = 0; k < d.size(); ++k) overlay.cover[k] |= d[k] > 0;
+  }
   res.path_source = s.path.line_path.empty() ? "steepest descent from the release's centroid" : s.path.line_path;
   if (overlay.path.size() >= 2) {
     res.path = products::analyse_path(grid, overlay.path, {raster("max_depth"), raster("max_speed"), pressure_kpa, h0}, s.path);

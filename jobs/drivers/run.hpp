@@ -43,6 +43,7 @@ struct RunSummary {
   double affected_area_m2 = 0, runout_m = 0, max_speed = 0, max_depth = 0;
   double volume_initial = 0, volume_final = 0, volume_outflow = 0, volume_error = 0;
   double volume_detrained = 0;  ///< depth-averaged: left behind in resistance areas
+  double volume_entrained = 0;  ///< depth-averaged: taken up from the erodible cover (flow volume)
   double t = 0;
   long steps = 0;
   std::string stop;

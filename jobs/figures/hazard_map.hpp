@@ -30,6 +30,7 @@ struct HazardMap {
   std::vector<double> values;           ///< per cell (row 0 south); NaN or below the first class: not coloured
   std::vector<double> release;          ///< release thickness per cell (> 0: released)
   std::vector<std::uint8_t> resistance;  ///< cells of resistance areas (forest), outlined; empty: none
+  std::vector<std::uint8_t> cover;       ///< cells of erodible cover (entrainment), outlined; empty: none
   std::vector<double> max_depth;        ///< for the outline
   double outline_threshold = 0.1;       ///< [m]
   std::vector<ClassBoundaries> boundaries;

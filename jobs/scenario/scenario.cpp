@@ -211,6 +211,39 @@ void resolve_inputs(const v1::Scenario& s, const std::string& base, ResolvedScen
   }
 }
 
+// The erodible cover's areas: each read as a release is (polygons with a thickness or a thickness
+// attribute, or a thickness raster, any CRS), with its density.
+void resolve_cover(const v1::Scenario& s, const std::string& base, ResolvedScenario& r) {
+  const auto& e = s.entrainment();
+  for (int a = 0; a < e.areas_size(); ++a) {
+    const auto& ar = e.areas(a);
+    const std::string f = "entrainment.areas[" + std::to_string(a) + "]";
+    CoverAreaSettings c;
+    terrain::ReleaseRequest& q = c.release;
+    q.kind = f;
+    if (ar.path().empty() && ar.thickness_raster().empty()) bad(f + ".path", "missing (cover polygons, or a thickness_raster)");
+    if (!ar.path().empty()) {
+      q.path = path_in(base, ar.path(), f + ".path");
+      add_vector(q.path, f + ".path", r);
+    }
+    q.has_thickness = ar.has_thickness_m();
+    q.thickness = ar.thickness_m();
+    q.thickness_attribute = ar.thickness_attribute();
+    if (!ar.thickness_raster().empty()) {
+      q.thickness_raster = path_in(base, ar.thickness_raster(), f + ".thickness_raster");
+      add_raster(q.thickness_raster, f + ".thickness_raster", r);
+      if (q.has_thickness || !q.thickness_attribute.empty())
+        bad(f + ".thickness_raster", "gives the thickness: leave thickness_m and thickness_attribute unset");
+    } else if (!q.has_thickness && q.thickness_attribute.empty()) {
+      bad(f, "needs thickness_m, thickness_attribute or thickness_raster");
+    }
+    q.vertical = ar.thickness_measured() == "vertical";
+    q.crs = ar.crs();
+    c.density = ar.has_density_kg_m3() ? ar.density_kg_m3() : e.has_density_kg_m3() ? e.density_kg_m3() : 100.0;
+    r.cover.push_back(c);
+  }
+}
+
 void resolve_releases(const v1::Scenario& s, const std::string& base, ResolvedScenario& r) {
   if (s.releases().empty()) bad("releases", "at least one release is needed");
   for (int k = 0; k < s.releases_size(); ++k) {
@@ -311,6 +344,19 @@ void check_terrain_vof(const v1::Scenario& s) {
       bad("releases[" + std::to_string(k) + "].secondary", "the 3D engine takes no secondary releases (the depth-averaged engine does)");
   if (s.resistance().ByteSizeLong() > 0)
     bad("resistance", "the 3D engine takes no resistance areas (the depth-averaged engine does)");
+  if (s.entrainment().ByteSizeLong() > 0)
+    bad("entrainment", "the 3D engine takes no erodible cover (the depth-averaged engine does)");
+}
+
+// The erodible cover: at least one area, and a friction law with a constant mu (the kernels of the
+// ground's terms take Coulomb's and Voellmy's basal shear stress).
+void check_cover(const v1::Scenario& s, const ResolvedScenario& r) {
+  if (s.entrainment().ByteSizeLong() == 0) return;  // none given (or only defaults, which the options cleared)
+  if (s.entrainment().areas_size() == 0) bad("entrainment.areas", "at least one area (polygons or a thickness raster)");
+  const engine::Material& mat = r.config.material;
+  if (mat.friction().flow)
+    bad("entrainment", "needs a friction law with a constant mu (material.rheology coulomb or voellmy), not " +
+                           std::string(mat.rheology->name));
 }
 
 // Resistance areas: at least one area, a band whose minima lie below its maxima, and a friction law
@@ -340,6 +386,7 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   // between fields and the input files follow.
   apply_option_rules(depth_averaged_options(), s);
   if (s.has_resistance() && s.resistance().ByteSizeLong() == 0) s.clear_resistance();  // only its defaults: none
+  if (s.has_entrainment() && s.entrainment().ByteSizeLong() == 0) s.clear_entrainment();
   if (vof) {
     const double write_given = s.vof().write_interval_s();
     apply_option_rules(terrain_vof_options(), s);
@@ -348,11 +395,13 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   ResolvedScenario r;
   resolve_inputs(s, base, r);
   resolve_releases(s, base, r);
+  resolve_cover(s, base, r);
   map_options(scenario_options(), s, r);
   map_options(depth_averaged_options(), s, r);
   if (vof) check_terrain_vof(s);  // first: the 3D engine takes one friction law
   check_material(s.material(), r.config.material);
   if (!vof) check_resistance(s, r);
+  if (!vof) check_cover(s, r);
   const double t_end = s.numerics().end_time_s();
   check_output_interval("outputs.timeseries_interval_s", s.outputs().timeseries_interval_s(), "numerics.end_time_s", t_end, true);
   if (vof) {
@@ -399,6 +448,13 @@ std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version,
   if (s.has_observations()) s.mutable_observations()->clear_outline_path();
   if (s.has_path()) s.mutable_path()->clear_line_path();
   if (s.has_mesh()) s.mutable_mesh()->clear_corridor_path();
+  if (s.has_resistance())
+    for (auto& a : *s.mutable_resistance()->mutable_areas()) a.clear_path();
+  if (s.has_entrainment())
+    for (auto& a : *s.mutable_entrainment()->mutable_areas()) {
+      a.clear_path();
+      a.clear_thickness_raster();
+    }
   // A block left empty (its kept defaults cleared) is the block not given.
   if (s.has_path() && s.path().ByteSizeLong() == 0) s.clear_path();
   if (s.has_observations() && s.observations().ByteSizeLong() == 0) s.clear_observations();

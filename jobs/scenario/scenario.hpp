@@ -47,6 +47,13 @@ struct ResistanceAreaSettings {
   double c = 0.01, k_det = 5;
 };
 
+/// An area of erodible cover (scenario `entrainment.areas[]`), resolved: its thickness read with the
+/// releases' rules (`release.kind` names the field in messages) and its density.
+struct CoverAreaSettings {
+  terrain::ReleaseRequest release;
+  double density = 100;  ///< [kg/m^3]
+};
+
 struct ResolvedScenario {
   v1::Scenario scenario;  ///< as given, with the defaults filled in
   std::string source;     ///< the file it came from (empty when given as a message)
@@ -60,6 +67,7 @@ struct ResolvedScenario {
   std::string observed_outline, observed_crs;  ///< observations: polygons of the observed runout, their CRS
   PathSettings path;
   std::vector<ResistanceAreaSettings> resistance;  ///< none: no resistance areas
+  std::vector<CoverAreaSettings> cover;            ///< entrainment.areas[]; none: no erodible cover
   std::string corridor_path;  ///< mesh.corridor_path (3D engine on the DEM), resolved; empty: none
   bool maps = true;  ///< outputs.maps: the report maps (PNG, PDF)
   std::vector<std::string> input_files;  ///< for hashing

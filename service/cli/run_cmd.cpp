@@ -50,6 +50,7 @@ void print_summary(const jobs::RunSummary& sum, bool vof, const fs::path& dest) 
   std::printf("volume      %.6g m3 initial, %.6g m3 final, %.6g m3 left the grid", sum.volume_initial, sum.volume_final,
               sum.volume_outflow);
   if (sum.volume_detrained > 0) std::printf(", %.6g m3 left in resistance areas", sum.volume_detrained);
+  if (sum.volume_entrained > 0) std::printf(", %.6g m3 entrained", sum.volume_entrained);
   std::printf(" (error %.1e)\n", sum.volume_error);
   std::printf("hazard      affected area %.0f m2, runout %.0f m from the release centroid, max speed %.1f m/s, max depth %.2f m\n",
               sum.affected_area_m2, sum.runout_m, sum.max_speed, sum.max_depth);

@@ -226,6 +226,109 @@ TEST(DepthAveraged, ForestShortensTheRunoutAndKeepsWhatItDetrained) {
   EXPECT_NEAR(on_ground / mb.volume_detrained_m3(), 1.0, 0.02) << on_ground << " against " << mb.volume_detrained_m3();
 }
 
+// An erodible cover on the run-out (polygons with a thickness attribute, scenario `entrainment`): the
+// flow takes part of it up, run.json's mass balance counts it (released + entrained = final + left
+// the grid, to round-off), and cover_depth.tif holds what is left: the cover it lost, at the cover's
+// density, is the entrained volume at the flow's.
+TEST(DepthAveraged, EntrainmentTakesUpCoverAndCountsItInTheMassBalance) {
+  TempDir d;
+  make_dem(d / "dem.tif", 120, 20.0, 35);
+  make_polygons(d / "rel.geojson", {square(500200, 5201000, 300)}, "EPSG:32632");
+  // The cover lies on the flat run-out (from x = 1500 m; the slope ends at 1440 m), 0.4 m thick.
+  make_polygons(d / "cover.geojson", {{{501500, 5200000}, {502400, 5200000}, {502400, 5202400}, {501500, 5202400}, {501500, 5200000}}},
+                "EPSG:32632", R"(,"thickness":0.4)");
+  auto sc = base_scenario(d / "dem.tif", d / "rel.geojson");
+  sc.mutable_numerics()->set_end_time_s(150);
+  fs::create_directories(d / "bare");
+  jobs::run_scenario(jobs::resolve_scenario(sc, d.p.string()), d / "bare");
+  auto* e = sc.mutable_entrainment();
+  auto* a = e->add_areas();
+  a->set_path("cover.geojson");
+  a->set_thickness_attribute("thickness");
+  fs::create_directories(d / "cover");
+  const auto run = jobs::run_scenario(jobs::resolve_scenario(sc, d.p.string()), d / "cover");
+  const auto rec = run_record(d / "cover/run.json");
+  const auto& mb = rec.mass_balance();
+  EXPECT_GT(mb.volume_entrained_m3(), 0.01 * mb.volume_initial_m3());
+  EXPECT_LT(mb.relative_error(), 1e-12);
+  EXPECT_NEAR(mb.volume_final_m3() + mb.volume_outflow_m3(), mb.volume_initial_m3() + mb.volume_entrained_m3(),
+              1e-9 * mb.volume_initial_m3());
+  EXPECT_EQ(run_record(d / "bare/run.json").mass_balance().volume_entrained_m3(), 0.0);
+  EXPECT_FALSE(fs::exists(d / "bare/cover_depth.tif"));
+  GDALDatasetUniquePtr ds(GDALDataset::Open((d / "cover/cover_depth.tif").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(ds);
+  std::vector<double> v(std::size_t(run.nx) * run.ny);
+  ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, run.nx, run.ny, v.data(), run.nx, run.ny, GDT_Float64, 0, 0), CE_None);
+  double gt[6];
+  ASSERT_EQ(ds->GetGeoTransform(gt), CE_None);
+  // The cover taken: its cells (centres east of 501500 m) on the run-out, which falls 2 % to the
+  // north: the volume of a normal thickness t there is t dx^2 / cos(theta).
+  const double cos_theta = 1 / std::sqrt(1 + 0.02 * 0.02);
+  double lost = 0;
+  long covered = 0;
+  for (int r = 0; r < run.ny; ++r)
+    for (int i = 0; i < run.nx; ++i) {
+      const double x = v[std::size_t(r) * run.nx + i];
+      if (gt[0] + (i + 0.5) * gt[1] < 501500) {
+        ASSERT_EQ(x, 0.0);
+        continue;
+      }
+      lost += (0.4 - x) * run.dx * run.dx / cos_theta;
+      covered += x > 0;
+    }
+  EXPECT_GT(covered, 100);
+  // To the Float32 raster and the slope of the grid (a cubic resampling of the Float32 DEM).
+  EXPECT_NEAR(lost * 100.0 / 300.0 / mb.volume_entrained_m3(), 1.0, 5e-5) << lost;
+  // The maps outline the cover and name it in the parameter block.
+  EXPECT_TRUE(fs::exists(d / "cover/map_max_depth.png"));
+}
+
+// An erodible cover is refused by name where it cannot work: no areas, no thickness, an area away
+// from the domain, a flow-dependent friction law, the 3D engine.
+TEST(DepthAveraged, ErodibleCoverIsRefusedWhereItCannotWork) {
+  TempDir d;
+  make_dem(d / "dem.tif", 40, 20.0, 30);
+  make_polygons(d / "rel.geojson", {square(500200, 5200400, 200)}, "EPSG:32632");
+  auto sc = base_scenario(d / "dem.tif", d / "rel.geojson");
+  auto with = [&](auto change) {
+    auto s = sc;
+    auto* a = s.mutable_entrainment()->add_areas();
+    a->set_path(d / "rel.geojson");
+    a->set_thickness_m(0.3);
+    change(s);
+    return s;
+  };
+  auto s0 = sc;
+  s0.mutable_entrainment()->set_erosion_energy_j_kg(3000);
+  expect_resolve_error(s0, {"entrainment.areas", "at least one"});
+  expect_resolve_error(with([](v1::Scenario& s) { s.mutable_entrainment()->mutable_areas(0)->clear_thickness_m(); }),
+                       {"entrainment.areas[0]", "thickness"});
+  expect_resolve_error(with([](v1::Scenario& s) { s.mutable_entrainment()->set_law("plough"); }), {"entrainment.law"});
+  expect_resolve_error(with([](v1::Scenario& s) { s.mutable_entrainment()->set_erosion_energy_j_kg(-5); }),
+                       {"entrainment.erosion_energy_j_kg"});
+  expect_resolve_error(with([](v1::Scenario& s) {
+                         auto* m = s.mutable_material();
+                         m->set_rheology("mu_i");
+                         m->set_mu_s(0.38);
+                         m->set_mu_2(0.64);
+                         m->set_mu_i0(0.28);
+                         m->set_grain_diameter_m(0.0005);
+                         m->set_grain_density_kg_m3(2450);
+                       }),
+                       {"entrainment", "constant mu"});
+  make_polygons(d / "far.geojson", {square(600000, 5300000, 100)}, "EPSG:32632");
+  auto far = sc;
+  auto* fa = far.mutable_entrainment()->add_areas();
+  fa->set_path("far.geojson");
+  fa->set_thickness_m(0.3);
+  expect_error(far, d, "entrainment.areas[0]");
+  expect_resolve_error(with([](v1::Scenario& s) {
+                         s.set_engine("vof");
+                         s.mutable_material()->set_internal_friction_deg(30);
+                       }),
+                       {"entrainment", "3D engine"});
+}
+
 // Resistance areas are refused by name where they cannot work: no areas, an inverted band, a
 // negative coefficient, an area away from the domain, a flow-dependent friction law, the 3D engine.
 TEST(DepthAveraged, ResistanceAreasAreRefusedWhereTheyCannotWork) {
