@@ -335,39 +335,59 @@ TEST(HazardProducts, PathAnalysisHasKnownAnswers) {
   EXPECT_FALSE(jobs::products::analyse_path(g, line, {depth, speed, pressure, release}, set).runout);
 }
 
-// Resistance areas (forest) are outlined on the maps in green: the same map
-// with an area shows green pixels along its edges that the map without it has not.
-TEST(HazardProducts, MapsOutlineTheResistanceAreas) {
+namespace {
+
+// The pixels of a map's frame (the grid's cells) whose colour satisfies `pred(r, g, b)`.
+template <class Pred>
+long map_pixels(const std::string& png_path, const figures::MapLayout& lay, const terrain::Grid& g, Pred pred) {
+  GDALDatasetUniquePtr png(GDALDataset::Open(png_path.c_str(), GDAL_OF_RASTER));
+  EXPECT_TRUE(png);
+  if (!png) return 0L;
+  const int w = png->GetRasterXSize(), h = png->GetRasterYSize();
+  std::vector<std::uint8_t> rgb[3];
+  for (int b = 0; b < 3; ++b) {
+    rgb[b].resize(std::size_t(w) * h);
+    EXPECT_EQ(png->GetRasterBand(b + 1)->RasterIO(GF_Read, 0, 0, w, h, rgb[b].data(), w, h, GDT_Byte, 0, 0), CE_None);
+  }
+  long n = 0;
+  for (int y = int(lay.map_y); y < int(lay.map_y + g.ny * lay.cell_px) && y < h; ++y)
+    for (int x = int(lay.map_x); x < int(lay.map_x + g.nx * lay.cell_px) && x < w; ++x) {
+      const std::size_t k = std::size_t(y) * w + x;
+      n += pred(int(rgb[0][k]), int(rgb[1][k]), int(rgb[2][k]));
+    }
+  return n;
+}
+
+// A block of cells (i in [20, 60), j in [20, 50)) as a mask.
+std::vector<std::uint8_t> block_mask(const terrain::Grid& g) {
+  std::vector<std::uint8_t> m(g.cells(), 0);
+  for (int j = 20; j < 50; ++j)
+    for (int i = 20; i < 60; ++i) m[std::size_t(j) * g.nx + i] = 1;
+  return m;
+}
+
+}  // namespace
+
+// Resistance areas (forest) are outlined on the maps in green and the erodible cover in blue: the
+// same map with an area shows pixels of its colour along its edges that the map without it has not.
+TEST(HazardProducts, MapsOutlineTheResistanceAreasAndTheCover) {
   TempDir d;
   const auto g = tilted_grid();
   figures::HazardMap m;
   m.title = "forest";
   m.palette = figures::hazard_palette("max_depth");
   m.values.assign(g.cells(), NAN);
-  auto greens = [&](const std::string& png_path, const figures::MapLayout& lay) {
-    GDALDatasetUniquePtr png(GDALDataset::Open(png_path.c_str(), GDAL_OF_RASTER));
-    EXPECT_TRUE(png);
-    if (!png) return 0L;
-    const int w = png->GetRasterXSize(), h = png->GetRasterYSize();
-    std::vector<std::uint8_t> rgb[3];
-    for (int b = 0; b < 3; ++b) {
-      rgb[b].resize(std::size_t(w) * h);
-      EXPECT_EQ(png->GetRasterBand(b + 1)->RasterIO(GF_Read, 0, 0, w, h, rgb[b].data(), w, h, GDT_Byte, 0, 0), CE_None);
-    }
-    long n = 0;
-    for (int y = int(lay.map_y); y < int(lay.map_y + g.ny * lay.cell_px) && y < h; ++y)
-      for (int x = int(lay.map_x); x < int(lay.map_x + g.nx * lay.cell_px) && x < w; ++x) {
-        const std::size_t k = std::size_t(y) * w + x;
-        n += rgb[1][k] > rgb[0][k] + 50 && rgb[1][k] > rgb[2][k] + 50;
-      }
-    return n;
-  };
+  auto green = [](int r, int gr, int b) { return gr > r + 50 && gr > b + 50; };
+  auto blue = [](int r, int gr, int b) { return b > r + 100 && gr > r + 80 && b > gr + 20; };
   const auto plain = figures::draw_hazard_map(d / "plain.png", "", g, m);
-  m.resistance.assign(g.cells(), 0);
-  for (int j = 20; j < 50; ++j)
-    for (int i = 20; i < 60; ++i) m.resistance[std::size_t(j) * g.nx + i] = 1;
+  m.resistance = block_mask(g);
   const auto forest = figures::draw_hazard_map(d / "forest.png", "", g, m);
   const long edge_px = long(2 * (30 + 40) * forest.cell_px);  // the area's perimeter in pixels
-  EXPECT_EQ(greens(d / "plain.png", plain), 0);
-  EXPECT_GT(greens(d / "forest.png", forest), edge_px / 3);  // a dashed line, 1.6 px wide
+  EXPECT_EQ(map_pixels(d / "plain.png", plain, g, green), 0);
+  EXPECT_GT(map_pixels(d / "forest.png", forest, g, green), edge_px / 3);  // a dashed line, 1.6 px wide
+  m.resistance.clear();
+  m.cover = block_mask(g);
+  const auto cover = figures::draw_hazard_map(d / "cover.png", "", g, m);
+  EXPECT_EQ(map_pixels(d / "plain.png", plain, g, blue), 0);
+  EXPECT_GT(map_pixels(d / "cover.png", cover, g, blue), edge_px / 3);
 }
