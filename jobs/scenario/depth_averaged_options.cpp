@@ -131,6 +131,24 @@ OptionTable output_options() {
       {"path.beta_deg", T::number, U::keep, "10", Range{0, 90, true, true}, {}, "deg",
        "the beta point: where the path's slope first falls below this", "ResolvedScenario::path", "",
        [](const S& s, R& r) { r.path.beta_deg = s.path().has_beta_deg() ? s.path().beta_deg() : 10.0; }},
+      {"outputs.maps", T::flag, U::keep, "true", {}, {}, "",
+       "the report maps (map_*.png and .pdf); false: rasters, vectors and run.json only (ensemble members)", "ResolvedScenario::maps", "",
+       [](const S& s, R& r) { r.maps = !s.outputs().has_maps() || s.outputs().maps(); }},
+      {"outputs.points_of_interest[].name", T::text, U::required, "", {}, {}, "",
+       "a named point (a farmhouse): drawn on the maps, its maxima and zone in run.json", "run record, maps"},
+      {"outputs.points_of_interest[].x", T::number, U::as_given, "", Range{}, {}, "", "easting, or longitude in a geographic CRS",
+       "run record, maps"},
+      {"outputs.points_of_interest[].y", T::number, U::as_given, "", Range{}, {}, "", "northing, or latitude", "run record, maps"},
+      {"outputs.points_of_interest[].crs", T::text, U::as_given, "", {}, {}, "", "the point's CRS (\"EPSG:4326\"); default the grid's",
+       "run record, maps"},
+  };
+}
+
+// The `variations` block (an ensemble, jobs/ensemble): checked here field by field; what the values
+// make (members, the aggregate's settings) is jobs/ensemble/variations.cpp's.
+// What lies on the ground: resistance areas (forest) and the erodible cover (entrainment).
+OptionTable ground_options() {
+  return {
       {"resistance.areas[].path", T::path, U::required, "", {}, {}, "",
        "polygons of a resistance area (forest) in any CRS: the cells whose centres lie inside", "ResolvedScenario::resistance"},
       {"resistance.areas[].crs", T::text, U::as_given, "", {}, {}, "", "the polygons' CRS when the file has none",
@@ -188,21 +206,9 @@ OptionTable output_options() {
        }},
       {"entrainment.density_kg_m3", T::number, U::keep, "100", Range{1, 1000}, {}, "kg/m^3",
        "the cover's density for the areas that give none (com1DFA's rhoEnt)", "ErodibleCover::density"},
-      {"outputs.maps", T::flag, U::keep, "true", {}, {}, "",
-       "the report maps (map_*.png and .pdf); false: rasters, vectors and run.json only (ensemble members)", "ResolvedScenario::maps", "",
-       [](const S& s, R& r) { r.maps = !s.outputs().has_maps() || s.outputs().maps(); }},
-      {"outputs.points_of_interest[].name", T::text, U::required, "", {}, {}, "",
-       "a named point (a farmhouse): drawn on the maps, its maxima and zone in run.json", "run record, maps"},
-      {"outputs.points_of_interest[].x", T::number, U::as_given, "", Range{}, {}, "", "easting, or longitude in a geographic CRS",
-       "run record, maps"},
-      {"outputs.points_of_interest[].y", T::number, U::as_given, "", Range{}, {}, "", "northing, or latitude", "run record, maps"},
-      {"outputs.points_of_interest[].crs", T::text, U::as_given, "", {}, {}, "", "the point's CRS (\"EPSG:4326\"); default the grid's",
-       "run record, maps"},
   };
 }
 
-// The `variations` block (an ensemble, jobs/ensemble): checked here field by field; what the values
-// make (members, the aggregate's settings) is jobs/ensemble/variations.cpp's.
 OptionTable variation_options() {
   const Range positive{0, kMaxDepthThreshold * 1e3, true};
   return {
@@ -405,7 +411,7 @@ OptionTable numerics_options() {
 const OptionTable& depth_averaged_options() {
   static const OptionTable t = [] {
     OptionTable v;
-    for (auto* part : {terrain_options, material_options, numerics_options, output_options, variation_options})
+    for (auto* part : {terrain_options, material_options, numerics_options, output_options, ground_options, variation_options})
       for (auto& o : part()) v.push_back(std::move(o));
     return v;
   }();

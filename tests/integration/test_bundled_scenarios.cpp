@@ -92,6 +92,38 @@ TEST(Scenarios, InDenArelenReachesTheValleyFloor) {
   EXPECT_GT(v, 0.01f);
 }
 
+// In den Arelen with an illustrative erodible cover (a thickness raster in EPSG:2056, resampled onto
+// the UTM grid) and a forest polygon: the flow takes up cover along the track and the volume balance
+// counts it; cover_depth.tif holds the cover left (at most the 0.4 m laid, less where the flow passed),
+// the maps outline both.
+TEST(Scenarios, InDenArelenTakesUpTheCoverAndMeetsTheForest) {
+  const auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/in-den-arelen-ground.json");
+  TempDir d;
+  const auto sum = jobs::run_scenario(r, d.p.string());
+  EXPECT_LT(sum.volume_error, 1e-12);
+  EXPECT_GT(sum.volume_entrained, 0.02 * sum.volume_initial);
+  check_outputs(d, sum, "WGS 84 / UTM zone 32N");
+  for (const char* f : {"cover_depth.tif", "detrained_depth.tif", "map_max_pressure.png"}) EXPECT_TRUE(fs::exists(d / f)) << f;
+  const auto rec = run_record(d / "run.json");
+  EXPECT_NEAR(rec.mass_balance().volume_entrained_m3(), sum.volume_entrained, 1e-9 * sum.volume_entrained);
+  GDALDatasetUniquePtr ds(GDALDataset::Open((d / "cover_depth.tif").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(ds);
+  std::vector<float> v(std::size_t(sum.nx) * sum.ny);
+  ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, sum.nx, sum.ny, v.data(), sum.nx, sum.ny, GDT_Float32, 0, 0), CE_None);
+  int has_nodata = 0;
+  const double nodata = ds->GetRasterBand(1)->GetNoDataValue(&has_nodata);
+  long laid = 0;
+  for (float x : v) {
+    if (!std::isfinite(x) || (has_nodata && x == float(nodata))) continue;
+    EXPECT_GE(x, 0.0f);
+    // The thickness is carried as the volume of the DEM's finer samples (as a release's is), so a
+    // cell's normal depth may exceed the raster's 0.4 m by the slope's variation within it.
+    EXPECT_LE(x, 0.41f);
+    laid += x > 0.395f;
+  }
+  EXPECT_GT(laid, 20);  // cover the flow did not reach
+}
+
 TEST(Scenarios, WolfsgrubenRunsInTheDemCrs) {
   auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/wolfsgruben.json");
   r.dem.resolution = 20;  // coarser than the DEM's 5 m, to stay fast

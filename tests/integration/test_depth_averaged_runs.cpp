@@ -306,15 +306,7 @@ TEST(DepthAveraged, ErodibleCoverIsRefusedWhereItCannotWork) {
   expect_resolve_error(with([](v1::Scenario& s) { s.mutable_entrainment()->set_law("plough"); }), {"entrainment.law"});
   expect_resolve_error(with([](v1::Scenario& s) { s.mutable_entrainment()->set_erosion_energy_j_kg(-5); }),
                        {"entrainment.erosion_energy_j_kg"});
-  expect_resolve_error(with([](v1::Scenario& s) {
-                         auto* m = s.mutable_material();
-                         m->set_rheology("mu_i");
-                         m->set_mu_s(0.38);
-                         m->set_mu_2(0.64);
-                         m->set_mu_i0(0.28);
-                         m->set_grain_diameter_m(0.0005);
-                         m->set_grain_density_kg_m3(2450);
-                       }),
+  expect_resolve_error(with([](v1::Scenario& s) { set_mu_i(s.mutable_material()); }),
                        {"entrainment", "constant mu"});
   make_polygons(d / "far.geojson", {square(600000, 5300000, 100)}, "EPSG:32632");
   auto far = sc;
@@ -349,15 +341,7 @@ TEST(DepthAveraged, ResistanceAreasAreRefusedWhereTheyCannotWork) {
                        {"resistance.speed_min_m_s", "speed_max"});
   expect_resolve_error(with([](v1::Scenario& s) { s.mutable_resistance()->set_drag_coefficient(-1); }),
                        {"resistance.drag_coefficient"});
-  expect_resolve_error(with([](v1::Scenario& s) {
-                         auto* m = s.mutable_material();
-                         m->set_rheology("mu_i");
-                         m->set_mu_s(0.38);
-                         m->set_mu_2(0.64);
-                         m->set_mu_i0(0.28);
-                         m->set_grain_diameter_m(0.0005);
-                         m->set_grain_density_kg_m3(2450);
-                       }),
+  expect_resolve_error(with([](v1::Scenario& s) { set_mu_i(s.mutable_material()); }),
                        {"resistance", "constant mu"});
   // An area away from the domain: refused before the run.
   make_polygons(d / "far.geojson", {square(600000, 5300000, 100)}, "EPSG:32632");

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "engine/sh2d.hpp"
@@ -102,6 +104,37 @@ inline void expect_same(const Sh2dResult& a, const Sh2dResult& b) {
   EXPECT_EQ(a.detrained, b.detrained);
   EXPECT_EQ(a.diag.volume_entrained, b.diag.volume_entrained);
   EXPECT_EQ(a.cover, b.cover);
+}
+
+// The engine refuses `cfg` with std::invalid_argument whose message holds `needle`.
+inline void expect_refused(const Terrain2D& t, const Sh2dConfig& cfg, const Sh2dState& init, const std::string& needle) {
+  try {
+    run_sh2d(t, cfg, init);
+    ADD_FAILURE() << "accepted: " << needle;
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+// A run with checkpoints, cancelled at about half of `plain`'s steps, continues from its last
+// checkpoint to `plain`'s bits; and a checkpoint of the run without the feature under test (`strip`
+// removes it from a configuration) does not continue the run with it.
+template <class Strip>
+void expect_continuation(const Terrain2D& t, const Sh2dConfig& cfg, const Sh2dState& init, const Sh2dResult& plain, Strip strip) {
+  auto cut = cfg;
+  Sh2dCheckpoint taken;
+  const long at = plain.diag.steps / 2 + 1;
+  cut.time.progress_every = 1;
+  cut.time.progress = [&](const Progress& p) { return p.step < at; };
+  cut.checkpoint = [&](const Sh2dCheckpoint& cp) { taken = cp; };
+  ASSERT_EQ(run_sh2d(t, cut, init).diag.stop, StopReason::cancelled);
+  expect_same(plain, run_sh2d(t, cfg, taken));
+  auto bare = cut;
+  strip(bare);
+  Sh2dCheckpoint other;
+  bare.checkpoint = [&](const Sh2dCheckpoint& cp) { other = cp; };
+  run_sh2d(t, bare, init);
+  EXPECT_THROW(run_sh2d(t, cfg, other), std::invalid_argument);
 }
 
 }  // namespace runout::test_support::depth_averaged

@@ -83,6 +83,16 @@ inline std::vector<std::pair<double, double>> square(double x0, double y0, doubl
   return {{x0, y0}, {x0 + a, y0}, {x0 + a, y0 + a}, {x0, y0 + a}, {x0, y0}};
 }
 
+// mu(I) for glass beads in a scenario's material (a flow-dependent friction law).
+inline void set_mu_i(v1::Material* m) {
+  m->set_rheology("mu_i");
+  m->set_mu_s(0.38);
+  m->set_mu_2(0.64);
+  m->set_mu_i0(0.28);
+  m->set_grain_diameter_m(0.0005);
+  m->set_grain_density_kg_m3(2450);
+}
+
 inline v1::Scenario base_scenario(const std::string& dem, const std::string& release, double res = 20) {
   v1::Scenario s;
   s.mutable_dem()->set_path(dem);

@@ -136,35 +136,13 @@ TEST(Sh2dResistance, ContinuedRunIsTheUninterruptedRun) {
   const auto plain = run_sh2d(t, cfg, init);
   ASSERT_GT(plain.diag.volume_detrained, 0);
   EXPECT_LT(plain.diag.volume_error(), 1e-12);
-  auto cut = cfg;
-  Sh2dCheckpoint taken;
-  const long at = plain.diag.steps / 2 + 1;
-  cut.time.progress_every = 1;
-  cut.time.progress = [&](const Progress& p) { return p.step < at; };
-  cut.checkpoint = [&](const Sh2dCheckpoint& cp) { taken = cp; };
-  ASSERT_EQ(run_sh2d(t, cut, init).diag.stop, StopReason::cancelled);
-  ASSERT_FALSE(taken.detrained.empty());
-  expect_same(plain, run_sh2d(t, cfg, taken));
-  // A checkpoint of a run without the areas does not continue one with them.
-  auto bare = cut;
-  bare.resistance = {};
-  Sh2dCheckpoint other;
-  bare.checkpoint = [&](const Sh2dCheckpoint& cp) { other = cp; };
-  run_sh2d(t, bare, init);
-  EXPECT_THROW(run_sh2d(t, cfg, other), std::invalid_argument);
+  expect_continuation(t, cfg, init, plain, [](Sh2dConfig& c) { c.resistance = {}; });
 }
 
 // Bad areas are refused by name: sizes, negative coefficients, an inverted band, a flow-dependent law.
 TEST(Sh2dResistance, BadAreasAreRefused) {
   UniformFlow f(1.0, 5.0, 1.0);
-  auto expect_bad = [&](const Sh2dConfig& cfg, const std::string& needle) {
-    try {
-      run_sh2d(f.t, cfg, f.init);
-      ADD_FAILURE() << "accepted: " << needle;
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-    }
-  };
+  auto expect_bad = [&](const Sh2dConfig& cfg, const std::string& needle) { expect_refused(f.t, cfg, f.init, needle); };
   auto c = f.cfg;
   c.resistance.c.assign(3, 0.01);
   expect_bad(c, "resistance areas: field sizes");
