@@ -318,7 +318,7 @@ Sh2dCheckpoint Solver::checkpoint(const LoopState& loop) const {
   cp.last_snapshot = loop.last_frame;
   cp.secondary_time = secondary_time_;
   cp.volume_secondary = volume_secondary_;
-  if (basal_ == Basal::ground) {
+  if (!cfg_.resistance.empty()) {
     cp.detrained = det_;
     cp.tile_detrained = tile_det_;
   }
@@ -344,7 +344,7 @@ void Solver::restore(const Sh2dCheckpoint& cp) {
     bad("is damaged (a tile field has the wrong size)");
   if (!(std::isfinite(cp.t) && cp.t >= 0) || cp.steps < 0) bad("is damaged (time or step count)");
   if (cp.secondary_time.size() != cfg_.secondary.size()) bad("was taken with other secondary releases");
-  if ((basal_ == Basal::ground) != !cp.detrained.empty() ||
+  if (cfg_.resistance.empty() != cp.detrained.empty() ||
       (!cp.detrained.empty() && (!cells(cp.detrained) || cp.tile_detrained.size() != nt)))
     bad("was taken with other resistance areas");
   if (cfg_.cover.empty() != cp.cover.empty() || (!cp.cover.empty() && (!cells(cp.cover) || cp.tile_entrained.size() != nt)))
@@ -380,7 +380,7 @@ void Solver::restore(const Sh2dCheckpoint& cp) {
   max_active_fraction_ = cp.max_active_fraction;
   secondary_time_ = cp.secondary_time;
   volume_secondary_ = cp.volume_secondary;
-  if (basal_ == Basal::ground) {
+  if (!cfg_.resistance.empty()) {
     det_ = cp.detrained;
     tile_det_ = cp.tile_detrained;
   }

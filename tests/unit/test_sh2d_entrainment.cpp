@@ -147,7 +147,8 @@ TEST(Sh2dEntrainment, AnEmptyCoverChangesNothing) {
 }
 
 // A Voellmy avalanche over a cover, with checkpoints and cancelled at an arbitrary step: continued, it
-// computes the bits of the uninterrupted run, the cover left included.
+// computes the bits of the uninterrupted run, the cover left included; a checkpoint without the cover
+// (or without the forest, where there is one) does not continue it.
 TEST(Sh2dEntrainment, ContinuedRunIsTheUninterruptedRun) {
   auto t = hillside(100, 40, 5.0, 30, 0.0);
   Sh2dConfig cfg;
@@ -165,6 +166,10 @@ TEST(Sh2dEntrainment, ContinuedRunIsTheUninterruptedRun) {
   ASSERT_GT(plain.diag.volume_entrained, 0);
   EXPECT_LT(plain.diag.volume_error(), 1e-12);
   expect_continuation(t, cfg, init, plain, [](Sh2dConfig& c) { c.cover = {}; });
+  // With a forest too, the same; and a checkpoint of the run with the cover alone does not continue it.
+  auto forest = cfg;
+  forest.resistance.c.assign(t.cells(), 0.01);
+  expect_continuation(t, forest, init, run_sh2d(t, forest, init), [](Sh2dConfig& c) { c.resistance = {}; });
 }
 
 // A bad cover is refused by name: sizes, a negative depth, a zero density, no erosion energy, a
