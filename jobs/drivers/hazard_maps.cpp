@@ -182,17 +182,21 @@ std::vector<std::string> viscosity_lines(const v1::Material& m, const std::strin
   return {line.text(), bed.text()};
 }
 
+// "v" where every item's get(item) is v, else "lo–hi" (items not empty).
+template <class Items, class Get>
+std::string value_range(const Items& items, Get get) {
+  double lo = get(items.front()), hi = lo;
+  for (const auto& a : items) {
+    lo = std::min(lo, get(a));
+    hi = std::max(hi, get(a));
+  }
+  return lo == hi ? num(lo) : num(lo) + "–" + num(hi);
+}
+
 // The resistance areas on the maps: how many, their drag coefficient and detrainment (the range where
 // areas differ), and the band, or "drag everywhere" without detrainment.
 std::string resistance_line(const ResolvedScenario& s) {
-  auto range = [&](auto get) {
-    double lo = get(s.resistance[0]), hi = lo;
-    for (const auto& a : s.resistance) {
-      lo = std::min(lo, get(a));
-      hi = std::max(hi, get(a));
-    }
-    return lo == hi ? num(lo) : num(lo) + "–" + num(hi);
-  };
+  auto range = [&](auto get) { return value_range(s.resistance, get); };
   const auto& b = s.config.resistance;
   std::string line = "resistance: " + std::to_string(s.resistance.size()) + (s.resistance.size() == 1 ? " area" : " areas") +
                      ", c = " + range([](const ResistanceAreaSettings& a) { return a.c; });
@@ -203,15 +207,10 @@ std::string resistance_line(const ResolvedScenario& s) {
 
 // The erodible cover on the maps: how many areas, the law (with e_b) and the cover's density.
 std::string cover_line(const ResolvedScenario& s) {
-  double lo = s.cover[0].density, hi = lo;
-  for (const auto& a : s.cover) {
-    lo = std::min(lo, a.density);
-    hi = std::max(hi, a.density);
-  }
   const auto& e = s.config.cover;
   return "entrainment: " + std::to_string(s.cover.size()) + (s.cover.size() == 1 ? " area" : " areas") +
          (e.ploughing ? ", ploughing" : ", erosion e_b = " + num(e.erosion_energy) + " J/kg") + ", cover " +
-         (lo == hi ? num(lo) : num(lo) + "–" + num(hi)) + " kg/m³";
+         value_range(s.cover, [](const CoverAreaSettings& a) { return a.density; }) + " kg/m³";
 }
 
 }  // namespace

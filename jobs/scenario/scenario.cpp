@@ -211,34 +211,43 @@ void resolve_inputs(const v1::Scenario& s, const std::string& base, ResolvedScen
   }
 }
 
-// The erodible cover's areas: each read as a release is (polygons with a thickness or a thickness
-// attribute, or a thickness raster, any CRS), with its density.
+// The thickness of a release or an area of cover (the messages Release and CoverArea share these
+// fields): polygons with a thickness or a thickness attribute, or a thickness raster, any CRS. `f`
+// names the entry in messages, `what` what its polygons are.
+template <class M>
+terrain::ReleaseRequest resolve_thickness(const M& m, const std::string& f, const char* what, const std::string& base,
+                                          ResolvedScenario& r) {
+  terrain::ReleaseRequest q;
+  if (m.path().empty() && m.thickness_raster().empty()) bad(f + ".path", std::string("missing (") + what + " polygons, or a thickness_raster)");
+  if (!m.path().empty()) {
+    q.path = path_in(base, m.path(), f + ".path");
+    add_vector(q.path, f + ".path", r);
+  }
+  q.has_thickness = m.has_thickness_m();
+  q.thickness = m.thickness_m();
+  q.thickness_attribute = m.thickness_attribute();
+  if (!m.thickness_raster().empty()) {
+    q.thickness_raster = path_in(base, m.thickness_raster(), f + ".thickness_raster");
+    add_raster(q.thickness_raster, f + ".thickness_raster", r);
+    if (q.has_thickness || !q.thickness_attribute.empty())
+      bad(f + ".thickness_raster", "gives the thickness: leave thickness_m and thickness_attribute unset");
+  } else if (!q.has_thickness && q.thickness_attribute.empty()) {
+    bad(f, "needs thickness_m, thickness_attribute or thickness_raster");
+  }
+  q.vertical = m.thickness_measured() == "vertical";
+  q.crs = m.crs();
+  return q;
+}
+
+// The erodible cover's areas: each read as a release is, with its density.
 void resolve_cover(const v1::Scenario& s, const std::string& base, ResolvedScenario& r) {
   const auto& e = s.entrainment();
   for (int a = 0; a < e.areas_size(); ++a) {
     const auto& ar = e.areas(a);
     const std::string f = "entrainment.areas[" + std::to_string(a) + "]";
     CoverAreaSettings c;
-    terrain::ReleaseRequest& q = c.release;
-    q.kind = f;
-    if (ar.path().empty() && ar.thickness_raster().empty()) bad(f + ".path", "missing (cover polygons, or a thickness_raster)");
-    if (!ar.path().empty()) {
-      q.path = path_in(base, ar.path(), f + ".path");
-      add_vector(q.path, f + ".path", r);
-    }
-    q.has_thickness = ar.has_thickness_m();
-    q.thickness = ar.thickness_m();
-    q.thickness_attribute = ar.thickness_attribute();
-    if (!ar.thickness_raster().empty()) {
-      q.thickness_raster = path_in(base, ar.thickness_raster(), f + ".thickness_raster");
-      add_raster(q.thickness_raster, f + ".thickness_raster", r);
-      if (q.has_thickness || !q.thickness_attribute.empty())
-        bad(f + ".thickness_raster", "gives the thickness: leave thickness_m and thickness_attribute unset");
-    } else if (!q.has_thickness && q.thickness_attribute.empty()) {
-      bad(f, "needs thickness_m, thickness_attribute or thickness_raster");
-    }
-    q.vertical = ar.thickness_measured() == "vertical";
-    q.crs = ar.crs();
+    c.release = resolve_thickness(ar, f, "cover", base, r);
+    c.release.kind = f;
     c.density = ar.has_density_kg_m3() ? ar.density_kg_m3() : e.has_density_kg_m3() ? e.density_kg_m3() : 100.0;
     r.cover.push_back(c);
   }
@@ -249,32 +258,14 @@ void resolve_releases(const v1::Scenario& s, const std::string& base, ResolvedSc
   for (int k = 0; k < s.releases_size(); ++k) {
     const auto& rl = s.releases(k);
     const std::string f = "releases[" + std::to_string(k) + "]";
-    terrain::ReleaseRequest q;
-    if (rl.path().empty() && rl.thickness_raster().empty()) bad(f + ".path", "missing (release polygons, or a thickness_raster)");
-    if (!rl.path().empty()) {
-      q.path = path_in(base, rl.path(), f + ".path");
-      add_vector(q.path, f + ".path", r);
-    }
-    q.has_thickness = rl.has_thickness_m();
-    q.thickness = rl.thickness_m();
-    q.thickness_attribute = rl.thickness_attribute();
-    if (!rl.thickness_raster().empty()) {
-      q.thickness_raster = path_in(base, rl.thickness_raster(), f + ".thickness_raster");
-      add_raster(q.thickness_raster, f + ".thickness_raster", r);
-      if (q.has_thickness || !q.thickness_attribute.empty())
-        bad(f + ".thickness_raster", "gives the thickness: leave thickness_m and thickness_attribute unset");
-      if (q.path.empty() && (!rl.min_slope_attribute().empty() || !rl.max_slope_attribute().empty()))
-        bad(f, "slope-window attributes need polygons (path); give min_slope_deg and max_slope_deg");
-    } else if (!q.has_thickness && q.thickness_attribute.empty()) {
-      bad(f, "needs thickness_m, thickness_attribute or thickness_raster");
-    }
-    q.vertical = rl.thickness_measured() == "vertical";
+    terrain::ReleaseRequest q = resolve_thickness(rl, f, "release", base, r);
+    if (!q.thickness_raster.empty() && q.path.empty() && (!rl.min_slope_attribute().empty() || !rl.max_slope_attribute().empty()))
+      bad(f, "slope-window attributes need polygons (path); give min_slope_deg and max_slope_deg");
     q.has_min_slope = rl.has_min_slope_deg();
     q.min_slope = rl.min_slope_deg();
     q.has_max_slope = rl.has_max_slope_deg();
     q.max_slope = rl.max_slope_deg();
     if (q.has_min_slope && q.has_max_slope && !(q.min_slope < q.max_slope)) bad(f, "min_slope_deg must be below max_slope_deg");
-    q.crs = rl.crs();
     q.min_slope_attribute = rl.min_slope_attribute();
     q.max_slope_attribute = rl.max_slope_attribute();
     q.secondary = rl.secondary();
