@@ -1,6 +1,6 @@
 // Work-precision and throughput benchmark of the depth-averaged solvers (docs/design/performance.md).
 //
-//   runout_bench_sh [--quick] [--repeat N] [--throughput-only] [--friction LAW] [--resistance]
+//   runout_bench_sh [--quick] [--repeat N] [--throughput-only] [--friction LAW] [--resistance] [--entrainment]
 //
 // 1. Work-precision: cases A1 (1D and 2D) and A3 (2D) at four resolutions for each limiter:
 //    error, wall time, cell-updates per second.
@@ -12,7 +12,9 @@
 // runs parts 2 and 3 with another basal friction (friction_material: coulomb by default).
 // --resistance puts the whole grid in a resistance area (drag c = 0.01 and detrainment K = 5 Pa, the
 // band from 0 so that the drag acts and the detrainment is evaluated everywhere; the kernels are
-// branch-free, so the cost does not depend on where either applies).
+// branch-free, so the cost does not depend on where either applies). --entrainment lays an erodible
+// cover of 5 m (density 100 kg/m^3, e_b = 5000 J/kg: basal erosion) over the whole grid, more than the
+// steps erode, so that the erosion acts in every wet cell.
 #include <omp.h>
 
 #include <algorithm>
@@ -77,9 +79,13 @@ bool friction_material(const std::string& law, Material& m) {
 }
 
 StepCost measure(const Terrain2D& t, const Sh2dState& init, const Material& material, long steps, int repeat,
-                 bool resistance) {
+                 bool resistance, bool entrainment) {
   Sh2dConfig cfg;
   cfg.material = material;
+  if (entrainment) {
+    cfg.cover.depth.assign(t.cells(), 5.0);
+    cfg.cover.density.assign(t.cells(), 100.0);
+  }
   if (resistance) {
     cfg.resistance.c.assign(t.cells(), 0.01);
     cfg.resistance.k_det.assign(t.cells(), 5.0);
@@ -125,7 +131,7 @@ void work_precision(bool quick) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool quick = false, throughput_only = false, resistance = false;
+  bool quick = false, throughput_only = false, resistance = false, entrainment = false;
   int repeat = 5;
   std::string law = "coulomb";
   Material material;
@@ -140,8 +146,11 @@ int main(int argc, char** argv) {
       law = argv[++k];
     } else if (!std::strcmp(argv[k], "--resistance")) {
       resistance = true;
+    } else if (!std::strcmp(argv[k], "--entrainment")) {
+      entrainment = true;
     } else {
-      std::fprintf(stderr, "usage: runout_bench_sh [--quick] [--repeat N] [--throughput-only] [--friction LAW] [--resistance]\n");
+      std::fprintf(stderr,
+                   "usage: runout_bench_sh [--quick] [--repeat N] [--throughput-only] [--friction LAW] [--resistance] [--entrainment]\n");
       return 2;
     }
   }
@@ -171,10 +180,10 @@ int main(int argc, char** argv) {
     }
   const auto part = state_from_normal_depth(t, h);
   const long steps = quick ? 20 : 60;
-  const auto full = measure(t, wet, material, steps, repeat, resistance);
-  const auto small = measure(t, part, material, steps * 4, repeat, resistance);
-  std::printf("\n## Throughput (%d x %d grid, %ld steps, friction %s%s)\n\n", n, n, full.steps, law.c_str(),
-              resistance ? ", a resistance area everywhere" : "");
+  const auto full = measure(t, wet, material, steps, repeat, resistance, entrainment);
+  const auto small = measure(t, part, material, steps * 4, repeat, resistance, entrainment);
+  std::printf("\n## Throughput (%d x %d grid, %ld steps, friction %s%s%s)\n\n", n, n, full.steps, law.c_str(),
+              resistance ? ", a resistance area everywhere" : "", entrainment ? ", an erodible cover everywhere" : "");
   std::printf("| run | ever wet | mean active | ms/step | Mcell-updates/s (of active cells) | grid cells/s |\n");
   std::printf("|---|---:|---:|---:|---:|---:|\n");
   std::printf("| fully wet | %.1f %% | %.1f %% | %.2f | %.1f | %.1f M |\n", 100 * full.ever_wet, 100 * full.active_fraction,
