@@ -41,6 +41,7 @@
 // neighbours, are computed in a step (CFL <= 0.5 moves material less than one cell per step).
 // OpenMP runs over the active tiles; every reduction is done per tile and summed in tile order,
 // so results are bitwise identical for any thread count.
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -118,6 +119,8 @@ struct Sh2dCheckpoint {
   std::vector<double> detrained, tile_detrained;
   /// With an erodible cover: the cover left per cell (as flow H) and per tile the volume entrained.
   std::vector<double> cover, tile_entrained;
+  /// Per flux gauge: the net volume that left its cells to its right and to its left so far [m^3].
+  std::vector<double> gauge_right, gauge_left;
 };
 /// Called with a checkpoint at the end of the first step at or after each multiple of
 /// `checkpoint_interval` (steps are never shortened for it) and when the progress hook cancels the
@@ -168,6 +171,18 @@ struct ErodibleCover {
   bool empty() const { return depth.empty(); }
 };
 
+/// A flux gauge: a line across the flow (a dam's crest), the cells it passes through, and for each of
+/// them which of its faces (west, east, south, north) lead to the line's right (+1) or left (-1),
+/// 0 for faces to another cell of the gauge or off the grid. The scheme's own face fluxes (the mass
+/// fluxes the update applies, draining factors included) out of the gauge's cells through those faces
+/// are summed each step: the volume that left the crest to its right and to its left, exactly as the
+/// volume balance moves it.
+struct FluxGauge {
+  std::string name;
+  std::vector<std::size_t> cells;               ///< cell indices (i + nx j), each in one gauge at most
+  std::vector<std::array<std::int8_t, 4>> sides;  ///< per cell: W, E, S, N
+};
+
 struct Sh2dConfig {
   Material material;
   Limiter limiter = Limiter::minmod;
@@ -201,6 +216,7 @@ struct Sh2dConfig {
   std::vector<SecondaryRelease> secondary;  ///< released when the flow reaches them
   ResistanceAreas resistance;               ///< none by default
   ErodibleCover cover;                      ///< none by default
+  std::vector<FluxGauge> gauges;            ///< none by default
 };
 
 /// Solver state: H = h / cos(theta) and the horizontal momentum H U, H V per horizontal area.
@@ -248,6 +264,9 @@ struct Sh2dResult {
   std::vector<double> detrained;
   /// The erodible cover left per cell, as its own normal depth [m] (empty without a cover).
   std::vector<double> cover;
+  /// Per flux gauge (Sh2dConfig::gauges): the net volume that left its cells to its right and to its
+  /// left [m^3] (negative: more came in from that side).
+  std::vector<double> gauge_right, gauge_left;
 };
 
 /// Surface geometry derived from the terrain once per run (exposed for tests and output conversion).

@@ -3,7 +3,9 @@
 #include <cpl_conv.h>
 #include <cpl_error.h>
 
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <mutex>
 #include <sstream>
 
@@ -113,6 +115,36 @@ GDALDatasetUniquePtr mem_raster(const Grid& g, GDALDataType type) {
   ds->SetGeoTransform(gt);
   ds->SetProjection(g.crs_wkt.c_str());
   return ds;
+}
+
+// A feature's numeric attribute; errors name `what` and list the attributes there are.
+double field_value(OGRFeature& f, const std::string& attr, const std::string& what) {
+  const int idx = f.GetFieldIndex(attr.c_str());
+  if (idx < 0) {
+    std::string names;
+    for (int k = 0; k < f.GetFieldCount(); ++k) names += (k ? ", " : "") + std::string(f.GetFieldDefnRef(k)->GetNameRef());
+    throw TerrainError(what + ": no attribute '" + attr + "' (attributes: " + (names.empty() ? "none" : names) + ")");
+  }
+  if (!f.IsFieldSetAndNotNull(idx)) throw TerrainError(what + ": attribute '" + attr + "' is empty");
+  const OGRFieldType type = f.GetFieldDefnRef(idx)->GetType();
+  if (type == OFTString) {  // GDAL reads a text that is not a number as 0
+    const std::string text = f.GetFieldAsString(idx);
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    while (end && *end && std::isspace(static_cast<unsigned char>(*end))) ++end;
+    if (text.empty() || end == text.c_str() || *end) throw TerrainError(what + ": attribute '" + attr + "' is not a number: '" + text + "'");
+    return v;
+  }
+  if (type != OFTInteger && type != OFTInteger64 && type != OFTReal)
+    throw TerrainError(what + ": attribute '" + attr + "' is not a number (" + OGRFieldDefn::GetFieldTypeName(type) + ")");
+  return f.GetFieldAsDouble(idx);
+}
+
+OGRSpatialReference grid_crs(const Grid& g) {
+  OGRSpatialReference dst;
+  dst.importFromWkt(g.crs_wkt.c_str());
+  dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  return dst;
 }
 
 }  // namespace runout::terrain::detail

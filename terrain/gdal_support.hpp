@@ -27,6 +27,8 @@ OGRSpatialReference srs_from(const std::string& text, const std::string& what);
 OGRSpatialReference input_crs(const OGRSpatialReference* own, const std::string& given, const std::string& given_what,
                               const std::string& no_crs);
 OGRSpatialReference wgs84();
+/// The grid's CRS, x first (easting, or longitude).
+OGRSpatialReference grid_crs(const Grid& g);
 std::string wkt(const OGRSpatialReference& s);
 /// "EPSG:32632", the CRS's name, or "local metres".
 std::string crs_name(const OGRSpatialReference& s);
@@ -45,6 +47,9 @@ double slope_spacing(const DemRequest& req, const Grid& g);
 /// (widened to whole cells and to at least 3 x 3); cells without data take the elevation of the
 /// nearest data.
 Grid dem_surface(const DemRequest& req, const Grid& g, double res, double x0, double y0, double x1, double y1);
+/// The number in attribute `attr` of feature `f` (a text that reads as a number counts); errors name
+/// `what` and list the attributes the feature has.
+double field_value(OGRFeature& f, const std::string& attr, const std::string& what);
 /// A one-band in-memory raster on the grid (north-up, the grid's CRS).
 GDALDatasetUniquePtr mem_raster(const Grid& g, GDALDataType type);
 /// The rows of a raster, north first (GDAL's order), from `value(k)` of cell k (row 0 south).

@@ -26,27 +26,6 @@ namespace {
 
 using namespace detail;
 
-double field_value(OGRFeature& f, const std::string& attr, const std::string& what) {
-  const int idx = f.GetFieldIndex(attr.c_str());
-  if (idx < 0) {
-    std::string names;
-    for (int k = 0; k < f.GetFieldCount(); ++k) names += (k ? ", " : "") + std::string(f.GetFieldDefnRef(k)->GetNameRef());
-    throw TerrainError(what + ": no attribute '" + attr + "' (attributes: " + (names.empty() ? "none" : names) + ")");
-  }
-  if (!f.IsFieldSetAndNotNull(idx)) throw TerrainError(what + ": attribute '" + attr + "' is empty");
-  const OGRFieldType type = f.GetFieldDefnRef(idx)->GetType();
-  if (type == OFTString) {  // GDAL reads a text that is not a number as 0
-    const std::string text = f.GetFieldAsString(idx);
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
-    while (end && *end && std::isspace(static_cast<unsigned char>(*end))) ++end;
-    if (text.empty() || end == text.c_str() || *end) throw TerrainError(what + ": attribute '" + attr + "' is not a number: '" + text + "'");
-    return v;
-  }
-  if (type != OFTInteger && type != OFTInteger64 && type != OFTReal)
-    throw TerrainError(what + ": attribute '" + attr + "' is not a number (" + OGRFieldDefn::GetFieldTypeName(type) + ")");
-  return f.GetFieldAsDouble(idx);
-}
 
 // The release is evaluated on a lattice of samples finer than the grid: each cell divided into
 // n x n squares. A square counts with the fraction of it that the polygon covers (the exact area of
@@ -401,13 +380,6 @@ void release_raster(const ReleaseRequest& rq, const OGRSpatialReference& dst, co
   const auto c = cells_of(fill.lat.g, raster_thickness(fill.lat.g, rq, dst));
   const double smin = rq.has_min_slope ? rq.min_slope : 0.0, smax = rq.has_max_slope ? rq.max_slope : 90.0;
   fill(what, rq.vertical, smin, smax, nullptr, &rq, dst, 0, rq.thickness_factor, c[0], c[1], c[2], c[3]);
-}
-
-OGRSpatialReference grid_crs(const Grid& g) {
-  OGRSpatialReference dst;
-  dst.importFromWkt(g.crs_wkt.c_str());
-  dst.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  return dst;
 }
 
 }  // namespace

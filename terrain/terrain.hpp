@@ -4,6 +4,7 @@
 // centre by default), reprojection and resampling with GDAL's warper (PROJ underneath), clipping to
 // the area of interest, release polygons rasterised onto the grid with thickness and slope windows,
 // and the raster/vector outputs. Errors are `TerrainError` with a message that names the input.
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <stdexcept>
@@ -112,6 +113,36 @@ std::vector<ReleaseArea> secondary_release_areas(const Grid& g, const DemRequest
 /// (releases.cpp, Lattice), so that the released volume does not depend on the grid.
 std::vector<double> rasterize_releases(const Grid& g, const DemRequest& dem, const std::vector<ReleaseRequest>& releases,
                                        ReleaseReport* report = nullptr);
+
+/// A dam or wall (scenario `dams[]`): crest lines, or footprints (polygons), with a height above the
+/// ground (for every feature, or per feature from an attribute).
+struct DamRequest {
+  std::string field;  ///< for messages, e.g. "dams[0]"
+  std::string path, crs;
+  bool has_height = false;
+  double height = 0;            ///< [m]
+  std::string height_attribute;
+};
+
+/// A dam as the depth-averaged engine sees it: the terrain raised by its height on the cells the
+/// geometry touches (every cell a crest line passes through, every cell a footprint covers or its
+/// outline passes through), grown by one cell in the four directions, so that a flow crossing it
+/// passes at least three raised cells (no wall thinner than the grid, however thin the geometry);
+/// and for crest lines, the flux gauge across the crest (engine FluxGauge): the cells the lines pass
+/// through and which of their faces lead to the lines' right (+1) or left (-1): the side of the
+/// neighbour's centre seen along the line's right-hand normal in the cell.
+struct DamCells {
+  std::vector<double> raise;  ///< per cell, the height added [m] (0 off the dam)
+  std::vector<std::size_t> crest;  ///< crest lines: the cells they pass through
+  std::vector<std::array<std::int8_t, 4>> sides;  ///< per crest cell: its W, E, S, N faces' side
+  int features = 0;
+  bool lines = false;        ///< crest lines (else footprints)
+  double length_m = 0;       ///< crest lines: their length on the grid
+  long cells = 0;            ///< raised cells
+};
+/// Throws TerrainError naming rq.field (unreadable file, no CRS, a geometry neither line nor polygon,
+/// lines mixed with polygons, a height missing or outside (0, 100] m, a dam on no cell of the domain).
+DamCells rasterize_dam(const Grid& g, const DamRequest& rq);
 
 /// What a raster band says about itself (GDAL's band description, unit type and metadata): QGIS
 /// shows the description as the band's name and the unit beside its values.

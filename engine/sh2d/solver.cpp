@@ -70,6 +70,14 @@ void validate(const Terrain2D& t, const Sh2dConfig& cfg, const Sh2dState& s) {
       if (!t.outside.empty() && t.outside[a.cells[q]]) bad("secondary release '" + a.name + "': a cell lies outside the domain");
     }
   }
+  std::vector<std::uint8_t> taken(cfg.gauges.empty() ? 0 : t.cells(), 0);
+  for (const auto& g : cfg.gauges) {
+    if (g.cells.size() != g.sides.size()) bad("flux gauge '" + g.name + "': cells and sides differ in number");
+    for (std::size_t k : g.cells) {
+      if (k >= t.cells()) bad("flux gauge '" + g.name + "': a cell lies outside the grid");
+      if (taken[k]++) bad("flux gauge '" + g.name + "': a cell belongs to two gauges (crest lines of two dams cross)");
+    }
+  }
   validate_resistance(t, cfg);
   validate_cover(t, cfg);
   cfg.material.validate();
@@ -172,6 +180,17 @@ Solver::Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
   for (int tt = 0; tt < ntiles_; ++tt) fill_whole(tt);
   rebuild_active();
   secondary_time_.assign(cfg.secondary.size(), nan);
+  gauge_right_.assign(cfg.gauges.size(), 0.0);
+  gauge_left_.assign(cfg.gauges.size(), 0.0);
+  if (!cfg.gauges.empty()) gauge_slot_.assign(n_, -1);
+  for (std::size_t a = 0; a < cfg.gauges.size(); ++a)
+    for (std::size_t q = 0; q < cfg.gauges[a].cells.size(); ++q) {
+      gauge_slot_[cfg.gauges[a].cells[q]] = int(slot_gauge_.size());
+      slot_gauge_.push_back(int(a));
+      slot_sides_.push_back(cfg.gauges[a].sides[q]);
+    }
+  slot_right_.assign(slot_gauge_.size(), 0.0);
+  slot_left_.assign(slot_gauge_.size(), 0.0);
   volume_initial_ = sum_tiles(tile_mass_) * (t_.dx * t_.dy);
   work_.resize(std::size_t(omp_get_max_threads()));
   for (auto& w : work_) w.reserve(T_);
@@ -318,6 +337,8 @@ Sh2dCheckpoint Solver::checkpoint(const LoopState& loop) const {
   cp.last_snapshot = loop.last_frame;
   cp.secondary_time = secondary_time_;
   cp.volume_secondary = volume_secondary_;
+  cp.gauge_right = gauge_right_;
+  cp.gauge_left = gauge_left_;
   if (!cfg_.resistance.empty()) {
     cp.detrained = det_;
     cp.tile_detrained = tile_det_;
@@ -344,6 +365,8 @@ void Solver::restore(const Sh2dCheckpoint& cp) {
     bad("is damaged (a tile field has the wrong size)");
   if (!(std::isfinite(cp.t) && cp.t >= 0) || cp.steps < 0) bad("is damaged (time or step count)");
   if (cp.secondary_time.size() != cfg_.secondary.size()) bad("was taken with other secondary releases");
+  if (cp.gauge_right.size() != cfg_.gauges.size() || cp.gauge_left.size() != cfg_.gauges.size())
+    bad("was taken with other dams (flux gauges)");
   if (cfg_.resistance.empty() != cp.detrained.empty() ||
       (!cp.detrained.empty() && (!cells(cp.detrained) || cp.tile_detrained.size() != nt)))
     bad("was taken with other resistance areas");
@@ -380,6 +403,8 @@ void Solver::restore(const Sh2dCheckpoint& cp) {
   max_active_fraction_ = cp.max_active_fraction;
   secondary_time_ = cp.secondary_time;
   volume_secondary_ = cp.volume_secondary;
+  gauge_right_ = cp.gauge_right;
+  gauge_left_ = cp.gauge_left;
   if (!cfg_.resistance.empty()) {
     det_ = cp.detrained;
     tile_det_ = cp.tile_detrained;
@@ -439,10 +464,21 @@ double Solver::step_all(double dt) {
   return frac;
 }
 
+// After a step: what the gauges' cells sent right and left, summed per gauge in the slots' fixed
+// order (the same bits on any thread count), the slots cleared for the next step.
+void Solver::measure_gauges() {
+  for (std::size_t q = 0; q < slot_gauge_.size(); ++q) {
+    gauge_right_[slot_gauge_[q]] += slot_right_[q];
+    gauge_left_[slot_gauge_[q]] += slot_left_[q];
+    slot_right_[q] = slot_left_[q] = 0.0;
+  }
+}
+
 StepReport Solver::step(double t_end) {
   const double dt = next_dt(t_end);
   StepReport r;
   r.active_fraction = step_all(dt);
+  if (!cfg_.gauges.empty()) measure_gauges();
   if (!cfg_.secondary.empty()) release_secondary();
   // Cheap guard on the whole state: a NaN or infinite depth shows in the volume, a NaN or infinite
   // momentum in the kinetic energy.
@@ -467,6 +503,8 @@ Sh2dResult Solver::finish(StopReason stop, const LoopState& loop) {
   d.volume_initial = volume_initial_;
   d.volume_secondary = volume_secondary_;
   d.secondary_time = secondary_time_;
+  res.gauge_right = gauge_right_;
+  res.gauge_left = gauge_left_;
   d.kinetic_energy_peak = loop.kinetic_energy_peak;
   d.cell_updates = cell_updates_;
   d.max_active_fraction = max_active_fraction_;

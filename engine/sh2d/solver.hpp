@@ -225,6 +225,15 @@ class Solver {
   std::vector<TileWork> work_;  // per OpenMP thread
   std::vector<double> secondary_time_;  // per secondary release area: when released, NaN while waiting
   double volume_secondary_ = 0;
+  std::vector<double> gauge_right_, gauge_left_;  // per flux gauge: the volume that left each way so far
+  // Per cell: its slot among the gauges' cells (-1: none); per slot its gauge, face sides and the
+  // volume its update sent right and left in the step (written by the cell's own update only).
+  std::vector<int> gauge_slot_;
+  std::vector<int> slot_gauge_;
+  std::vector<std::array<std::int8_t, 4>> slot_sides_;
+  std::vector<double> slot_right_, slot_left_;
+  bool gauge_cell(std::size_t k) const { return !gauge_slot_.empty() && gauge_slot_[k] >= 0; }
+  void measure_gauges();
 };
 
 }  // namespace runout::engine::sh2d_detail

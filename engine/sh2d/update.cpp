@@ -59,6 +59,15 @@ void Solver::update_cell(TileWork& w, int i, int j, int i0, double t1, double dt
   const double ss = upwind_blend(w.Fy0[y], rs, rc), sn = upwind_blend(w.Fy0[y + w.bw], rc, rn);
   const bool ow = w.has_outside && i > 0 && outside(i - 1, j), oe = w.has_outside && i < nx_ - 1 && outside(i + 1, j);
   const bool os = w.has_outside && j > 0 && outside(i, j - 1), on = w.has_outside && j < ny_ - 1 && outside(i, j + 1);
+  if (gauge_cell(idx(i, j))) {  // a flux gauge's cell: what its faces send to the gauge's right and left
+    const int q = gauge_slot_[idx(i, j)];
+    const double sent[4] = {-w.Fx0[x] * sw * dt * t_.dy, w.Fx0[x + 1] * se * dt * t_.dy, -w.Fy0[y] * ss * dt * t_.dx,
+                            w.Fy0[y + w.bw] * sn * dt * t_.dx};
+    for (int f = 0; f < 4; ++f) {
+      if (slot_sides_[q][f] > 0) slot_right_[q] += sent[f];
+      if (slot_sides_[q][f] < 0) slot_left_[q] += sent[f];
+    }
+  }
   if (i == 0 || ow) out -= w.Fx0[x] * sw * dt * t_.dy;
   if (i == nx_ - 1 || oe) out += w.Fx0[x + 1] * se * dt * t_.dy;
   if (j == 0 || os) out -= w.Fy0[y] * ss * dt * t_.dx;
@@ -195,9 +204,9 @@ void Solver::update_cells(int tt, TileWork& w, const CellBox& c, double t, doubl
     const bool inner = j > 0 && j < ny_ - 1;
     const int fb = std::min(i1, nx_ - 1);
     for (int i = i0; i < i1; ++i) {
-      if (inner && i > 0 && i < fb && !near_outside(idx(i, j))) {
-        int e = i + 1;  // a run of cells for the row kernel
-        while (e < fb && !near_outside(idx(e, j))) ++e;
+      if (inner && i > 0 && i < fb && !near_outside(idx(i, j)) && !gauge_cell(idx(i, j))) {
+        int e = i + 1;  // a run of cells for the row kernel (a gauge's cells take the general one)
+        while (e < fb && !near_outside(idx(e, j)) && !gauge_cell(idx(e, j))) ++e;
         if constexpr (B == Basal::hysteresis) {
           const std::size_t q = w.at(i, j);
           start_terms(e - i, idx(i, j), &w.Hp[q], &w.Up[q], &w.Vp[q], w);

@@ -45,6 +45,18 @@ void write_record(const std::string& path, const ResolvedScenario& s, const terr
   mb->set_volume_secondary_m3(d.volume_secondary);
   mb->set_volume_detrained_m3(d.volume_detrained);
   mb->set_volume_entrained_m3(d.volume_entrained);
+  for (const auto& q : sum.dams) {
+    auto* dr = rec.add_dams();
+    dr->set_name(q.name);
+    dr->set_kind(q.lines ? "crest lines" : "footprints");
+    dr->set_cells(int(q.cells));
+    dr->set_height_max_m(q.height_max_m);
+    dr->set_crest_length_m(q.crest_length_m);
+    dr->set_crossed_right_m3(q.crossed_right_m3);
+    dr->set_crossed_left_m3(q.crossed_left_m3);
+    dr->set_overflow_m3(q.overflow_m3);
+    dr->set_max_depth_m(q.max_depth_m);
+  }
   for (std::size_t a = 0; a < secondary.size(); ++a) {
     auto* sr = rec.mutable_release()->add_secondary();
     sr->set_name(secondary[a].name);
@@ -109,6 +121,56 @@ engine::ErodibleCover erodible_cover(const ResolvedScenario& s, const std::vecto
         e.density[k] = s.cover[a].density;
       }
   return e;
+}
+
+// The dams as the engine sees them: the terrain raised by each dam's height on its cells (the
+// largest where dams overlap) and a flux gauge across each dam's crest lines (a cell on the crests of
+// two dams, where they meet, counts for the first).
+void raise_dams(const ResolvedScenario& s, const std::vector<terrain::DamCells>& dams, engine::Terrain2D& t,
+                engine::Sh2dConfig& cfg) {
+  std::vector<double> raise(t.cells(), 0.0);
+  for (const auto& d : dams)
+    for (std::size_t k = 0; k < raise.size(); ++k) raise[k] = std::max(raise[k], d.raise[k]);
+  for (std::size_t k = 0; k < raise.size(); ++k) t.z[k] += raise[k];
+  std::vector<std::uint8_t> taken(t.cells(), 0);
+  for (std::size_t a = 0; a < dams.size(); ++a) {
+    if (!dams[a].lines) continue;
+    engine::FluxGauge g{s.dams[a].name, {}, {}};
+    for (std::size_t q = 0; q < dams[a].crest.size(); ++q)
+      if (!taken[dams[a].crest[q]]++) {
+        g.cells.push_back(dams[a].crest[q]);
+        g.sides.push_back(dams[a].sides[q]);
+      }
+    cfg.gauges.push_back(std::move(g));
+  }
+}
+
+// What each dam held back or let pass: its gauge's crossings (crest lines) and the deepest flow on it.
+std::vector<DamSummary> dam_summaries(const ResolvedScenario& s, const std::vector<terrain::DamCells>& dams,
+                                      const engine::Sh2dResult& res) {
+  std::vector<DamSummary> out;
+  std::size_t gauge = 0;
+  for (std::size_t a = 0; a < dams.size(); ++a) {
+    const auto& d = dams[a];
+    DamSummary q;
+    q.name = s.dams[a].name;
+    q.lines = d.lines;
+    q.cells = d.cells;
+    q.crest_length_m = d.length_m;
+    for (std::size_t k = 0; k < d.raise.size(); ++k)
+      if (d.raise[k] > 0) {
+        q.height_max_m = std::max(q.height_max_m, d.raise[k]);
+        q.max_depth_m = std::max(q.max_depth_m, res.hazard.max_depth[k]);
+      }
+    if (d.lines) {
+      q.crossed_right_m3 = res.gauge_right[gauge];
+      q.crossed_left_m3 = res.gauge_left[gauge];
+      q.overflow_m3 = std::max({q.crossed_right_m3, q.crossed_left_m3, 0.0});
+      ++gauge;
+    }
+    out.push_back(q);
+  }
+  return out;
 }
 
 // The secondary release areas as the engine takes them: the cells of each and their depths.
@@ -184,6 +246,7 @@ class DepthAveragedRun final : public EngineRun {
   std::vector<double> h0_;
   OutputInputs output_inputs_;
   engine::Terrain2D t_;
+  engine::Sh2dState initial_;  // the release, as the engine starts from it
   engine::Sh2dConfig cfg_;
   std::vector<terrain::ReleaseArea> secondary_;
   std::string hash_;  // the scenario's, in checkpoints
@@ -206,11 +269,15 @@ DepthAveragedRun::DepthAveragedRun(const ResolvedScenario& s, const std::string&
   sum_.release_volume_m3 = rel_rep_.volume_m3;
   sum_.notes = rel_rep_.notes;
   t_ = engine_terrain(grid_);
+  // The release's normal thickness on the ground's slope, before the dams raise the terrain: next to
+  // a dam the raised terrain's slope is the dam's flank, which would change the released volume.
+  initial_ = engine::state_from_normal_depth(t_, h0_);
   cfg_ = s.config;
   secondary_ = terrain::secondary_release_areas(grid_, s.dem, s.releases);
   cfg_.secondary = engine_secondary(secondary_);
   cfg_.resistance = resistance_areas(s, output_inputs_.resistance_areas);
   cfg_.cover = erodible_cover(s, output_inputs_.cover_areas);
+  raise_dams(s, output_inputs_.dams, t_, cfg_);
 
   // Checkpoints: the solver's whole state between two steps, with the scenario's hash; the time
   // series so far lies beside it (CHECKPOINT.timeseries.h5), so that a continued run's outputs are
@@ -218,7 +285,7 @@ DepthAveragedRun::DepthAveragedRun(const ResolvedScenario& s, const std::string&
   continued = !opt.restart_path.empty();
   if (!opt.checkpoint_path.empty() || continued) hash_ = scenario_hash(s);
   if (!continued) {
-    engine_ = std::make_unique<engine::Sh2dEngine>(t_, cfg_, engine::state_from_normal_depth(t_, h0_));
+    engine_ = std::make_unique<engine::Sh2dEngine>(t_, cfg_, std::move(initial_));
   } else {
     const ShCheckpoint restart = load_restart(opt, hash_, t_, cfg_.tile);
     try {
@@ -267,6 +334,7 @@ RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& tim
   sum.volume_outflow = d.volume_outflow;
   sum.volume_detrained = d.volume_detrained;
   sum.volume_entrained = d.volume_entrained;
+  sum.dams = dam_summaries(s_, output_inputs_.dams, res);
   sum.volume_error = d.volume_error();
   sum.t = d.t;
   sum.steps = d.steps;

@@ -34,6 +34,7 @@ figures::HazardMap map_base(const ResolvedScenario& s, const terrain::Grid& grid
   base.release = h0;
   base.resistance = overlay.resistance;
   base.cover = overlay.cover;
+  base.dams = overlay.dams;
   base.max_depth = hz.max_depth;
   base.outline_threshold = s.outline_threshold;
   base.parameters = map_parameters(s, grid, sum.release_volume_m3);
@@ -87,6 +88,7 @@ OutputInputs read_output_inputs(const ResolvedScenario& s, const terrain::Grid& 
   // Each area of cover, read with the releases' rules (an area on no cell of the domain is refused,
   // naming its field).
   for (const auto& c : s.cover) in.cover_areas.push_back(terrain::rasterize_releases(grid, s.dem, {c.release}));
+  for (const auto& d : s.dams) in.dams.push_back(terrain::rasterize_dam(grid, d.request));
   return in;
 }
 
@@ -226,6 +228,8 @@ std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain
   p.push_back("density: " + num(m.density_kg_m3()) + " kg/m³");
   if (!s.resistance.empty()) p.push_back(resistance_line(s));
   if (!s.cover.empty()) p.push_back(cover_line(s));
+  for (const auto& d : s.dams)
+    p.push_back("dam: " + d.name + (d.request.has_height ? ", " + num(d.request.height) + " m high" : ", height from '" + d.request.height_attribute + "'"));
   p.push_back("release: " + num(std::round(release_volume_m3)) + " m³ in " + std::to_string(s.releases.size()) +
               (s.releases.size() == 1 ? " release" : " releases"));
   p.push_back("grid: " + num(grid.dx) + " m, " + std::to_string(grid.nx) + " × " + std::to_string(grid.ny) + " cells, " + grid.crs_name);

@@ -36,6 +36,8 @@ struct OutputInputs {
   std::vector<std::vector<std::uint8_t>> resistance_areas;
   /// Per area of erodible cover (scenario `entrainment.areas[]`), its normal thickness per cell.
   std::vector<std::vector<double>> cover_areas;
+  /// Per dam (scenario `dams[]`), its cells, height and crest.
+  std::vector<terrain::DamCells> dams;
 };
 /// Throws TerrainError naming the field (a point outside the domain, a line or outline that cannot be
 /// read, an outline that covers no cell of the domain).
@@ -49,6 +51,7 @@ struct MapOverlay {
   std::vector<PlacedPoint> points;
   std::vector<std::uint8_t> resistance;  ///< cells of resistance areas, outlined
   std::vector<std::uint8_t> cover;       ///< cells of erodible cover, outlined
+  std::vector<std::uint8_t> dams;        ///< cells of dams, outlined
   products::Line path;
   std::vector<figures::MapPoint> path_marks;
 };

@@ -35,6 +35,16 @@ struct RunOptions {
   std::string terrain_cache_dir;
 };
 
+/// A dam of the scenario (dams[]) and what passed it (run.json's dams[]).
+struct DamSummary {
+  std::string name;
+  bool lines = false;  ///< crest lines (else footprints)
+  long cells = 0;
+  double height_max_m = 0, crest_length_m = 0;
+  double crossed_right_m3 = 0, crossed_left_m3 = 0, overflow_m3 = 0;  ///< crest lines
+  double max_depth_m = 0;  ///< on the raised cells
+};
+
 struct RunSummary {
   int nx = 0, ny = 0;
   double dx = 0;
@@ -51,6 +61,7 @@ struct RunSummary {
   double cpu_seconds = 0;  ///< processor time of the solve (all threads)
   std::vector<std::string> files;  ///< written, relative to the output directory
   std::vector<std::string> notes;
+  std::vector<DamSummary> dams;  ///< depth-averaged: per dam
 };
 
 /// Run a scenario and write every output into `out_dir` (which must exist). Throws ScenarioError or

@@ -22,7 +22,7 @@ using terrain::TerrainError;
 namespace {
 
 const Rgb kInk{0.1, 0.1, 0.1}, kRelease{0.05, 0.05, 0.05}, kOutline{0.43, 0.0, 0.08}, kContour{0.25, 0.22, 0.18},
-    kPath{0.05, 0.2, 0.45}, kForest{0.1, 0.45, 0.12}, kCover{0.0, 0.55, 0.75};
+    kPath{0.05, 0.2, 0.45}, kForest{0.1, 0.45, 0.12}, kCover{0.0, 0.55, 0.75}, kDam{0.45, 0.25, 0.1};
 constexpr double kPanel = 290, kLeft = 84, kGap = 30, kRight = 20, kBottom = 86;
 
 // The DEM as an in-memory raster (north-up, row 0 north).
@@ -247,6 +247,7 @@ double draw_panel(cairo_t* cr, double x, double y, const HazardMap& m, double co
   if (!m.release.empty()) item("release", [&](double yy) { legend_line(cr, x, yy, kRelease, 2, true); });
   if (!m.resistance.empty()) item("resistance area (forest)", [&](double yy) { legend_line(cr, x, yy, kForest, 2, true); });
   if (!m.cover.empty()) item("erodible cover (entrainment)", [&](double yy) { legend_line(cr, x, yy, kCover, 2, true); });
+  if (!m.dams.empty()) item("dam or wall", [&](double yy) { legend_line(cr, x, yy, kDam, 3); });
   if (!m.max_depth.empty())
     item("outline: max depth > " + label_number(m.outline_threshold) + " m", [&](double yy) { legend_line(cr, x, yy, kOutline, 2); });
   for (const auto& b : m.boundaries)
@@ -324,6 +325,8 @@ MapLayout draw_hazard_map(const std::string& png_path, const std::string& pdf_pa
       draw_edges(cr, f, [&](int i, int j) { return m.resistance[std::size_t(j) * g.nx + i] != 0; }, kForest, 1.6, true, true);
     if (!m.cover.empty())
       draw_edges(cr, f, [&](int i, int j) { return m.cover[std::size_t(j) * g.nx + i] != 0; }, kCover, 1.6, true, true);
+    if (!m.dams.empty())
+      draw_edges(cr, f, [&](int i, int j) { return m.dams[std::size_t(j) * g.nx + i] != 0; }, kDam, 2.2, true);
     if (m.path.size() >= 2) {
       cairo_new_path(cr);
       for (std::size_t k = 0; k < m.path.size(); ++k)

@@ -31,6 +31,7 @@ struct HazardMap {
   std::vector<double> release;          ///< release thickness per cell (> 0: released)
   std::vector<std::uint8_t> resistance;  ///< cells of resistance areas (forest), outlined; empty: none
   std::vector<std::uint8_t> cover;       ///< cells of erodible cover (entrainment), outlined; empty: none
+  std::vector<std::uint8_t> dams;        ///< cells raised by dams and walls, outlined; empty: none
   std::vector<double> max_depth;        ///< for the outline
   double outline_threshold = 0.1;       ///< [m]
   std::vector<ClassBoundaries> boundaries;

@@ -22,8 +22,8 @@ using h5::put_attr_string;
 // The scalars, by position in the dataset "scalars" (their names are in its attribute "names").
 constexpr const char* kScalarNames =
     "nx,ny,tile,t,steps,volume_initial,kinetic_energy_peak,cell_updates,active_fraction_sum,max_active_fraction,"
-    "next_snapshot,last_snapshot,timeseries_frames,volume_secondary,secondary_areas,resistance_areas,erodible_cover";
-constexpr std::size_t kScalars = 17;
+    "next_snapshot,last_snapshot,timeseries_frames,volume_secondary,secondary_areas,resistance_areas,erodible_cover,flux_gauges";
+constexpr std::size_t kScalars = 18;
 
 struct File {
   hid_t id = -1;
@@ -80,7 +80,7 @@ void write_sh_checkpoint(const std::string& path, const std::string& scenario_ha
                                       s.kinetic_energy_peak, s.cell_updates, s.active_fraction_sum, s.max_active_fraction,
                                       s.next_snapshot, s.last_snapshot, double(timeseries_frames), s.volume_secondary,
                                       double(s.secondary_time.size()), s.detrained.empty() ? 0.0 : 1.0,
-                                      s.cover.empty() ? 0.0 : 1.0};
+                                      s.cover.empty() ? 0.0 : 1.0, double(s.gauge_right.size())};
       put(f.id, "scalars", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, sc.data(), sc.size());
       hid_t ds = H5Dopen2(f.id, "scalars", H5P_DEFAULT);
       put_attr_string(ds, "names", kScalarNames);
@@ -99,6 +99,8 @@ void write_sh_checkpoint(const std::string& path, const std::string& scenario_ha
       put(f.id, "tile_wet", H5T_STD_U8LE, H5T_NATIVE_UINT8, s.tile_wet.data(), s.tile_wet.size());
       put(f.id, "tile_active", H5T_STD_U8LE, H5T_NATIVE_UINT8, s.tile_active.data(), s.tile_active.size());
       put(f.id, "secondary_time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, s.secondary_time.data(), s.secondary_time.size());
+      put(f.id, "gauge_right", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, s.gauge_right.data(), s.gauge_right.size());
+      put(f.id, "gauge_left", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, s.gauge_left.data(), s.gauge_left.size());
       if (!s.detrained.empty()) {  // resistance areas: the depth detrained so far, per cell and per tile
         put(f.id, "detrained", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, s.detrained.data(), s.detrained.size(), rows);
         put(f.id, "tile_detrained", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, s.tile_detrained.data(), s.tile_detrained.size());
@@ -173,6 +175,9 @@ ShCheckpoint read_sh_checkpoint(const std::string& path) {
   s.tile_wet = get<std::uint8_t>(f.id, "tile_wet", H5T_NATIVE_UINT8, nt, path);
   s.tile_active = get<std::uint8_t>(f.id, "tile_active", H5T_NATIVE_UINT8, nt, path);
   s.secondary_time = get<double>(f.id, "secondary_time", H5T_NATIVE_DOUBLE, std::size_t(sc[14]), path);
+  if (!(sc[17] >= 0 && sc[17] < 1e6)) throw ScenarioError("checkpoint " + path + ": damaged (flux gauge count)");
+  s.gauge_right = get<double>(f.id, "gauge_right", H5T_NATIVE_DOUBLE, std::size_t(sc[17]), path);
+  s.gauge_left = get<double>(f.id, "gauge_left", H5T_NATIVE_DOUBLE, std::size_t(sc[17]), path);
   if (sc[15] != 0) {
     s.detrained = get<double>(f.id, "detrained", H5T_NATIVE_DOUBLE, n, path);
     s.tile_detrained = get<double>(f.id, "tile_detrained", H5T_NATIVE_DOUBLE, nt, path);

@@ -206,7 +206,17 @@ OptionTable ground_options() {
        }},
       {"entrainment.density_kg_m3", T::number, U::keep, "100", Range{1, 1000}, {}, "kg/m^3",
        "the cover's density for the areas that give none (com1DFA's rhoEnt)", "ErodibleCover::density"},
-  };
+      {"dams[].name", T::text, U::as_given, "", {}, {}, "", "the dam's name in run.json and on the maps; default \"dam N\"",
+       "ResolvedScenario::dams"},
+      {"dams[].path", T::path, U::required, "", {}, {}, "",
+       "crest lines or footprints (polygons) in any CRS: the terrain raised on the cells they touch, grown by one cell",
+       "ResolvedScenario::dams"},
+      {"dams[].crs", T::text, U::as_given, "", {}, {}, "", "the file's CRS when it has none", "ResolvedScenario::dams"},
+      {"dams[].height_m", T::number, U::as_given, "", Range{0, 100, true}, {}, "m", "the dam's height above the ground (or height_attribute)",
+       "DamRequest::height"},
+      {"dams[].height_attribute", T::text, U::as_given, "", {}, {}, "", "the attribute that holds each feature's height",
+       "DamRequest::height_attribute"},
+        };
 }
 
 OptionTable variation_options() {

@@ -253,6 +253,26 @@ void resolve_cover(const v1::Scenario& s, const std::string& base, ResolvedScena
   }
 }
 
+// The dams: each a vector file with a height (given or per feature).
+void resolve_dams(const v1::Scenario& s, const std::string& base, ResolvedScenario& r) {
+  for (int a = 0; a < s.dams_size(); ++a) {
+    const auto& d = s.dams(a);
+    const std::string f = "dams[" + std::to_string(a) + "]";
+    DamSettings q;
+    q.name = d.name().empty() ? "dam " + std::to_string(a + 1) : d.name();
+    q.request.field = f;
+    q.request.path = path_in(base, d.path(), f + ".path");
+    add_vector(q.request.path, f + ".path", r);
+    q.request.crs = d.crs();
+    q.request.has_height = d.has_height_m();
+    q.request.height = d.height_m();
+    q.request.height_attribute = d.height_attribute();
+    if (!q.request.has_height && q.request.height_attribute.empty()) bad(f, "needs height_m or height_attribute");
+    if (q.request.has_height && !q.request.height_attribute.empty()) bad(f + ".height_attribute", "give height_m or height_attribute, not both");
+    r.dams.push_back(q);
+  }
+}
+
 void resolve_releases(const v1::Scenario& s, const std::string& base, ResolvedScenario& r) {
   if (s.releases().empty()) bad("releases", "at least one release is needed");
   for (int k = 0; k < s.releases_size(); ++k) {
@@ -337,6 +357,7 @@ void check_terrain_vof(const v1::Scenario& s) {
     bad("resistance", "the 3D engine takes no resistance areas (the depth-averaged engine does)");
   if (s.entrainment().ByteSizeLong() > 0)
     bad("entrainment", "the 3D engine takes no erodible cover (the depth-averaged engine does)");
+  if (s.dams_size() > 0) bad("dams", "the 3D engine takes no dams yet (the depth-averaged engine does)");
 }
 
 // The erodible cover: at least one area, and a friction law with a constant mu (the kernels of the
@@ -387,6 +408,7 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   resolve_inputs(s, base, r);
   resolve_releases(s, base, r);
   resolve_cover(s, base, r);
+  resolve_dams(s, base, r);
   map_options(scenario_options(), s, r);
   map_options(depth_averaged_options(), s, r);
   if (vof) check_terrain_vof(s);  // first: the 3D engine takes one friction law
@@ -441,6 +463,7 @@ std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version,
   if (s.has_mesh()) s.mutable_mesh()->clear_corridor_path();
   if (s.has_resistance())
     for (auto& a : *s.mutable_resistance()->mutable_areas()) a.clear_path();
+  for (auto& d : *s.mutable_dams()) d.clear_path();
   if (s.has_entrainment())
     for (auto& a : *s.mutable_entrainment()->mutable_areas()) {
       a.clear_path();

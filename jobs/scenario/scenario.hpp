@@ -54,6 +54,12 @@ struct CoverAreaSettings {
   double density = 100;  ///< [kg/m^3]
 };
 
+/// A dam (scenario `dams[]`), resolved: its name and how its file is read.
+struct DamSettings {
+  std::string name;
+  terrain::DamRequest request;
+};
+
 struct ResolvedScenario {
   v1::Scenario scenario;  ///< as given, with the defaults filled in
   std::string source;     ///< the file it came from (empty when given as a message)
@@ -68,6 +74,7 @@ struct ResolvedScenario {
   PathSettings path;
   std::vector<ResistanceAreaSettings> resistance;  ///< none: no resistance areas
   std::vector<CoverAreaSettings> cover;            ///< entrainment.areas[]; none: no erodible cover
+  std::vector<DamSettings> dams;                   ///< dams[]; none: no dams
   std::string corridor_path;  ///< mesh.corridor_path (3D engine on the DEM), resolved; empty: none
   bool maps = true;  ///< outputs.maps: the report maps (PNG, PDF)
   std::vector<std::string> input_files;  ///< for hashing

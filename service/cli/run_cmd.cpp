@@ -52,6 +52,11 @@ void print_summary(const jobs::RunSummary& sum, bool vof, const fs::path& dest) 
   if (sum.volume_detrained > 0) std::printf(", %.6g m3 left in resistance areas", sum.volume_detrained);
   if (sum.volume_entrained > 0) std::printf(", %.6g m3 entrained", sum.volume_entrained);
   std::printf(" (error %.1e)\n", sum.volume_error);
+  for (const auto& q : sum.dams) {
+    std::printf("dam         %s: %.0f m high, deepest flow on it %.2f m", q.name.c_str(), q.height_max_m, q.max_depth_m);
+    if (q.lines) std::printf(", %.6g m3 passed it", q.overflow_m3);
+    std::printf("\n");
+  }
   std::printf("hazard      affected area %.0f m2, runout %.0f m from the release centroid, max speed %.1f m/s, max depth %.2f m\n",
               sum.affected_area_m2, sum.runout_m, sum.max_speed, sum.max_depth);
   std::printf("results in  %s:", dest.string().c_str());

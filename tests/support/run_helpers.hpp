@@ -37,9 +37,11 @@ using test_support::run_record;
 using test_support::station_at;
 using test_support::as_vector;
 
-// A DEM in UTM 32N (EPSG:32632): a slope of `deg` falling to the east, flattening into a valley.
-inline void make_dem(const std::string& path, int n, double cell, double deg, const char* epsg = "EPSG:32632", bool with_crs = true,
-              int hole_i0 = -1, int hole_i1 = -1) {
+// A DEM of n x n cells in `epsg` from x = 500000, y = 5200000 (south-west corner), the elevation
+// z(x, y) of each cell's centre relative to that corner, row r from the north; no data (-9999) where
+// z returns NaN.
+template <class F>
+void make_dem_of(const std::string& path, int n, double cell, F z, const char* epsg = "EPSG:32632", bool with_crs = true) {
   GDALAllRegister();
   auto* drv = GetGDALDriverManager()->GetDriverByName(path.size() > 4 && path.substr(path.size() - 4) == ".asc" ? "AAIGrid" : "GTiff");
   auto* mem = GetGDALDriverManager()->GetDriverByName("MEM");
@@ -52,17 +54,42 @@ inline void make_dem(const std::string& path, int n, double cell, double deg, co
     s.SetFromUserInput(epsg);
     ds->SetSpatialRef(&s);
   }
-  std::vector<float> z(std::size_t(n) * n);
+  std::vector<float> v(std::size_t(n) * n);
   for (int r = 0; r < n; ++r)
     for (int i = 0; i < n; ++i) {
-      const double x = i * cell;
-      z[std::size_t(r) * n + i] = float(std::max(0.0, (0.6 * n * cell - x)) * std::tan(deg * M_PI / 180) + 0.02 * r * cell);
-      if (i >= hole_i0 && i < hole_i1 && r >= n / 3 && r < 2 * n / 3) z[std::size_t(r) * n + i] = -9999.0f;
+      const double e = z(i, r);
+      v[std::size_t(r) * n + i] = std::isnan(e) ? -9999.0f : float(e);
     }
   ds->GetRasterBand(1)->SetNoDataValue(-9999.0);
-  EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, n, n, z.data(), n, n, GDT_Float32, 0, 0), CE_None);
+  EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, n, n, v.data(), n, n, GDT_Float32, 0, 0), CE_None);
   GDALDatasetUniquePtr out(drv->CreateCopy(path.c_str(), ds.get(), FALSE, nullptr, nullptr, nullptr));
   ASSERT_TRUE(out);
+}
+
+// A DEM in UTM 32N (EPSG:32632): a slope of `deg` falling to the east, flattening into a valley.
+inline void make_dem(const std::string& path, int n, double cell, double deg, const char* epsg = "EPSG:32632", bool with_crs = true,
+              int hole_i0 = -1, int hole_i1 = -1) {
+  make_dem_of(
+      path, n, cell,
+      [&](int i, int r) {
+        if (i >= hole_i0 && i < hole_i1 && r >= n / 3 && r < 2 * n / 3) return double(NAN);
+        return std::max(0.0, (0.6 * n * cell - i * cell)) * std::tan(deg * M_PI / 180) + 0.02 * r * cell;
+      },
+      epsg, with_crs);
+}
+
+// A GeoJSON file of lines; coordinates in `epsg`.
+inline void make_lines(const std::string& path, const std::vector<std::vector<std::pair<double, double>>>& lines, const char* epsg,
+                       const char* extra_props = "") {
+  std::ofstream f(path);
+  f << R"({"type":"FeatureCollection","crs":{"type":"name","properties":{"name":"urn:ogc:def:crs:EPSG::)" << (epsg + 5)
+    << R"("}},"features":[)";
+  for (std::size_t k = 0; k < lines.size(); ++k) {
+    f << (k ? "," : "") << R"({"type":"Feature","properties":{"id":)" << k << extra_props << R"(},"geometry":{"type":"LineString","coordinates":[)";
+    for (std::size_t v = 0; v < lines[k].size(); ++v) f << (v ? "," : "") << "[" << std::setprecision(12) << lines[k][v].first << "," << lines[k][v].second << "]";
+    f << "]}}";
+  }
+  f << "]}";
 }
 
 // A GeoJSON polygon file; coordinates in `epsg` (axis order x/lon first).
