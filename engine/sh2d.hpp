@@ -216,6 +216,11 @@ struct Sh2dConfig {
   std::vector<SecondaryRelease> secondary;  ///< released when the flow reaches them
   ResistanceAreas resistance;               ///< none by default
   ErodibleCover cover;                      ///< none by default
+  /// Dams and walls: per cell the height [m, vertical] a dam stands above the terrain (0: none);
+  /// empty: none. The terrain is not raised: the faces between cells of different dam heights are
+  /// steps (hydrostatic reconstruction with the run-up of the flow's velocity head; see
+  /// docs/design/depth-averaged.md "Dams and walls"), the slopes and curvature stay the ground's.
+  std::vector<double> dam_height;
   std::vector<FluxGauge> gauges;            ///< none by default
 };
 

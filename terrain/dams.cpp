@@ -1,5 +1,5 @@
 // Dams and walls on the grid (terrain.hpp rasterize_dam): the cells their crest lines or footprints
-// touch, grown by one cell, raised by their height; the crest lines' flux gauges.
+// touch, with their height; the crest lines' flux gauges.
 #include <ogrsf_frmts.h>
 
 #include <algorithm>
@@ -102,7 +102,7 @@ DamCells rasterize_dam(const Grid& g, const DamRequest& rq) {
   if (!ds) throw TerrainError(file + ": cannot read it as a vector file" + gdal_message());
   const OGRSpatialReference dst = grid_crs(g);
   DamCells d;
-  d.raise.assign(g.cells(), 0.0);
+  d.height.assign(g.cells(), 0.0);
   std::vector<double> wx(g.cells(), 0.0), wy(g.cells(), 0.0);
   int polygons = 0;
   for (auto* layer : ds->GetLayers()) {
@@ -125,21 +125,15 @@ DamCells rasterize_dam(const Grid& g, const DamRequest& rq) {
       if (ct && geom->transform(ct.get()) != OGRERR_NONE) throw TerrainError(what + ": cannot transform it to " + g.crs_name);
       std::vector<std::uint8_t> touched(g.cells(), 0);
       touch_feature(g, *geom, line, touched, wx, wy, d.length_m);
-      // Grown by one cell in the four directions, then raised by the feature's height.
-      for (int j = 0; j < g.ny; ++j)
-        for (int i = 0; i < g.nx; ++i) {
-          const std::size_t k = std::size_t(j) * g.nx + i;
-          const bool near = touched[k] || (i > 0 && touched[k - 1]) || (i + 1 < g.nx && touched[k + 1]) ||
-                            (j > 0 && touched[k - g.nx]) || (j + 1 < g.ny && touched[k + g.nx]);
-          if (near && (g.outside.empty() || !g.outside[k])) d.raise[k] = std::max(d.raise[k], h);
-        }
+      for (std::size_t k = 0; k < g.cells(); ++k)
+        if (touched[k] && (g.outside.empty() || !g.outside[k])) d.height[k] = std::max(d.height[k], h);
     }
   }
   if (d.features == 0) throw TerrainError(file + ": no feature in the file");
   auto inside = [&](std::size_t k) { return g.outside.empty() || !g.outside[k]; };
   auto on_crest = [&](std::size_t k) { return (wx[k] != 0 || wy[k] != 0) && inside(k); };
   for (std::size_t k = 0; k < g.cells(); ++k) {
-    d.cells += d.raise[k] > 0;
+    d.cells += d.height[k] > 0;
     if (!d.lines || !on_crest(k)) continue;
     const int i = int(k % std::size_t(g.nx)), j = int(k / std::size_t(g.nx));
     const int di[4] = {-1, 1, 0, 0}, dj[4] = {0, 0, -1, 1};  // W, E, S, N

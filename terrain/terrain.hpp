@@ -124,21 +124,22 @@ struct DamRequest {
   std::string height_attribute;
 };
 
-/// A dam as the depth-averaged engine sees it: the terrain raised by its height on the cells the
-/// geometry touches (every cell a crest line passes through, every cell a footprint covers or its
-/// outline passes through), grown by one cell in the four directions, so that a flow crossing it
-/// passes at least three raised cells (no wall thinner than the grid, however thin the geometry);
-/// and for crest lines, the flux gauge across the crest (engine FluxGauge): the cells the lines pass
-/// through and which of their faces lead to the lines' right (+1) or left (-1): the side of the
-/// neighbour's centre seen along the line's right-hand normal in the cell.
+/// A dam as the depth-averaged engine sees it: a height above the ground on the cells the geometry
+/// touches (every cell a crest line passes through, every cell a footprint covers or its outline
+/// passes through; the engine's faces to lower cells are steps, engine Sh2dConfig::dam_height). The
+/// cells a line passes through touch at least at corners, and the flow crosses only the cells'
+/// faces, so a crest line one cell wide blocks every path across it. For crest lines, the flux gauge
+/// across the crest (engine FluxGauge): the cells the lines pass through and which of their faces
+/// lead to the lines' right (+1) or left (-1): the side of the neighbour's centre seen along the
+/// line's right-hand normal in the cell.
 struct DamCells {
-  std::vector<double> raise;  ///< per cell, the height added [m] (0 off the dam)
+  std::vector<double> height;  ///< per cell, the dam's height above the ground [m] (0 off the dam)
   std::vector<std::size_t> crest;  ///< crest lines: the cells they pass through
   std::vector<std::array<std::int8_t, 4>> sides;  ///< per crest cell: its W, E, S, N faces' side
   int features = 0;
   bool lines = false;        ///< crest lines (else footprints)
   double length_m = 0;       ///< crest lines: their length on the grid
-  long cells = 0;            ///< raised cells
+  long cells = 0;            ///< the dam's cells
 };
 /// Throws TerrainError naming rq.field (unreadable file, no CRS, a geometry neither line nor polygon,
 /// lines mixed with polygons, a height missing or outside (0, 100] m, a dam on no cell of the domain).

@@ -44,8 +44,38 @@ RUNOUT_SIMD_CLONES void face_row(int n, std::ptrdiff_t s, const double* __restri
 
 }  // namespace
 
+// The flux through a face between two cells of different dam heights (a dam's step): the flux of the
+// sides reconstructed over the step (over_step), and on each side the wall's reaction to the part that
+// does not pass (its wall flux minus that of the reconstructed side: no mass, pressure and the normal
+// momentum turned back), stored for the update of that side's cell (TileWork Wx*, Wy*). A flow that
+// cannot reach over the step meets a wall; the mass through the face is conserved exactly.
 template <bool X>
-Face Solver::face(const TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi, Boundary2D blo,
+Face Solver::dam_face(TileWork& w, int ia, int ja, int ib, int jb, bool held) const {
+  const std::size_t a = idx(ia, ja), b = idx(ib, jb);
+  const FaceState L = side_state<X>(w, w.at(ia, ja), 0.5), R = side_state<X>(w, w.at(ib, jb), -0.5);
+  const double sa = X ? geo_.bx[a] : geo_.by[a], sb = X ? geo_.bx[b] : geo_.by[b];
+  FaceState Ls = L, Rs = R;
+  Ls.H = over_step(vmax(L.H, 0.0), vmax(L.un, 0.0), sa, g_, dam_[b] - dam_[a]);
+  Rs.H = over_step(vmax(R.H, 0.0), vmax(-R.un, 0.0), sb, g_, dam_[a] - dam_[b]);
+  const Face wl = wall_flux(L, true), wls = wall_flux(Ls, true), wr = wall_flux(R, false), wrs = wall_flux(Rs, false);
+  if constexpr (X) {  // x faces: normal = x momentum
+    const std::size_t k = w.fx(ib, jb);
+    w.Wxa1[k] = wl.f1 - wls.f1;
+    w.Wxa2[k] = wl.f2 - wls.f2;
+    w.Wxb1[k] = wr.f1 - wrs.f1;
+    w.Wxb2[k] = wr.f2 - wrs.f2;
+  } else {  // y faces: normal = y momentum
+    const std::size_t k = w.fy(ib, jb);
+    w.Wya1[k] = wl.f2 - wls.f2;
+    w.Wya2[k] = wl.f1 - wls.f1;
+    w.Wyb1[k] = wr.f2 - wrs.f2;
+    w.Wyb2[k] = wr.f1 - wrs.f1;
+  }
+  return face_flux(Ls, Rs, held);
+}
+
+template <bool X>
+Face Solver::face(TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi, Boundary2D blo,
                   Boundary2D bhi) const {
   // Flux through the face between cells a (left/below) and b; lo/hi: the face is a domain edge.
   if (!lo && !hi && !w.all_active && cell_active(ia, ja) != cell_active(ib, jb)) return Face{0, 0, 0};
@@ -59,6 +89,7 @@ Face Solver::face(const TileWork& w, int ia, int ja, int ib, int jb, bool lo, bo
   if (oa) L = outflow_ghost(R, false);
   if (ob) R = outflow_ghost(L, true);
   const bool held = !lo && !hi && !oa && !ob && w.held[w.at(ia, ja)] != 0.0 && w.held[w.at(ib, jb)] != 0.0;
+  if (!lo && !hi && !oa && !ob && step_face(idx(ia, ja), idx(ib, jb))) return dam_face<X>(w, ia, ja, ib, jb, held);
   return face_flux(L, R, held);
 }
 
@@ -80,9 +111,11 @@ void Solver::faces(TileWork& w, int ci0, int ci1, int cj0, int cj1) const {
     w.Fy2[k] = g.f1;
   };
   // A face takes the row kernel where both its cells lie in the domain (inside its edges, neither
-  // outside it) and every tile around is active: there the general function computes the same flux.
+  // outside it), it is no dam's step and every tile around is active: there the general function
+  // computes the same flux.
   auto plain = [&](int ia, int ja, int ib, int jb) {
-    return w.all_active && !(w.has_outside && (outside(ia, ja) || outside(ib, jb)));
+    return w.all_active && !(w.has_outside && (outside(ia, ja) || outside(ib, jb))) &&
+           !step_face(idx(ia, ja), idx(ib, jb));
   };
   for (int j = cj0; j < cj1; ++j)  // x faces: the face left of cell (i, j)
     for (int i = ci0; i <= ci1; ++i) {

@@ -252,6 +252,25 @@ RUNOUT_KERNEL Face face_flux(const FaceState& L, const FaceState& R, bool held) 
   return Face{held ? 0.0 : f0, held ? 0.5 * (pL + pR) : f1, held ? 0.5 * (qL + qR) : f2};
 }
 
+// ---- Dams: step faces ------------------------------------------------------------------------
+
+// The depth of a face side that reaches over a dam's step `rise` [m] above its own bed (<= 0: no step
+// on this side): hydrostatic reconstruction (Audusse et al. 2004) with the side's run-up, the part of
+// H + head above the step, at most H. The head is the velocity head towards the step (un_to >= 0,
+// horizontal, on ground of slope s_n along the face normal, so the 3D speed's square is
+// un_to^2 (1 + s_n^2)): a flow that could climb the dam's face without losses passes it.
+RUNOUT_KERNEL double over_step(double H, double un_to, double s_n, double g, double rise) {
+  const double head = un_to * un_to * (1 + s_n * s_n) / (2 * g);
+  return rise > 0 ? vmin(H, vmax(0.0, H + head - rise)) : H;
+}
+
+// The flux a wall puts on a face side (`left`: the side left of the face, the wall right of it): the
+// flux against its mirror (boundary_ghost): no mass, the pressure, the normal momentum turned back.
+RUNOUT_KERNEL Face wall_flux(const FaceState& in, bool left) {
+  const FaceState m = boundary_ghost(in, true);
+  return left ? face_flux(in, m, false) : face_flux(m, in, false);
+}
+
 // ---- Positivity limiter and update ---------------------------------------------------------------
 
 // The draining-time factor of a cell holding H that would send out `out` in one step: the share it

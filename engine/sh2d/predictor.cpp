@@ -65,9 +65,9 @@ void Solver::predictor_cells(TileWork& w, double dt) const {
   const int fa = std::max(w.bi0, 1), fb = std::min(w.bi0 + w.bw, nx_ - 1);
   for (int j = w.bj0; j < w.bj0 + w.bh; ++j)
     for (int i = w.bi0; i < w.bi0 + w.bw; ++i) {
-      if (fast && j > 0 && j < ny_ - 1 && i >= fa && i < fb && !near_outside(idx(i, j))) {
+      if (fast && j > 0 && j < ny_ - 1 && i >= fa && i < fb && !general(idx(i, j))) {
         int e = i + 1;  // a run of cells for the row kernel
-        while (e < fb && !near_outside(idx(e, j))) ++e;
+        while (e < fb && !general(idx(e, j))) ++e;
         if constexpr (B == Basal::hysteresis) {
           const std::size_t k0 = idx(i, j);
           start_terms(e - i, k0, &Hs[k0], &Us[k0], &Vs[k0], w);
@@ -78,10 +78,12 @@ void Solver::predictor_cells(TileWork& w, double dt) const {
       }
       const std::size_t k = idx(i, j);
       const double H = Hs[k], U = Us[k], V = Vs[k];
-      // Slopes only between cells of the domain.
+      // Slopes only between cells of the domain, not across a dam's step.
       const bool edge = near_outside(k);
-      const bool tx = i > 0 && i < nx_ - 1 && !(edge && (outside(i - 1, j) || outside(i + 1, j) || outside(i, j)));
-      const bool ty = j > 0 && j < ny_ - 1 && !(edge && (outside(i, j - 1) || outside(i, j + 1) || outside(i, j)));
+      const bool tx = i > 0 && i < nx_ - 1 && !(edge && (outside(i - 1, j) || outside(i + 1, j) || outside(i, j))) &&
+                      !step_face(k, k - 1) && !step_face(k, k + 1);
+      const bool ty = j > 0 && j < ny_ - 1 && !(edge && (outside(i, j - 1) || outside(i, j + 1) || outside(i, j))) &&
+                      !step_face(k, k - N) && !step_face(k, k + N);
       Slopes s = limited_slopes<lim>(Hs.data(), Us.data(), Vs.data(), std::ptrdiff_t(k), tx ? -1 : 0, tx ? 1 : 0,
                                      ty ? -N : 0, ty ? N : 0, tx, ty, K.dry);
       double Pxx = Pxx_[k], Pxy = Pxy_[k], Pyy = Pyy_[k], Ps = Ps_[k];

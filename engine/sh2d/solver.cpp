@@ -41,6 +41,15 @@ void validate_cover(const Terrain2D& t, const Sh2dConfig& cfg) {
   if (cfg.material.friction().flow) bad("need a constant mu (Coulomb or Voellmy), not a flow-dependent friction law");
 }
 
+void validate_dams(const Terrain2D& t, const Sh2dConfig& cfg) {
+  auto bad = [](const std::string& m) { throw std::invalid_argument("2D solver: dams: " + m); };
+  const auto& d = cfg.dam_height;
+  if (d.empty()) return;
+  if (d.size() != t.cells()) bad("the dam heights' size differs from the grid");
+  for (std::size_t k = 0; k < d.size(); ++k)
+    if (!(d[k] >= 0 && d[k] <= 1000)) bad("a dam height must lie in [0, 1000] m (cell " + std::to_string(k) + ")");
+}
+
 void validate(const Terrain2D& t, const Sh2dConfig& cfg, const Sh2dState& s) {
   auto bad = [](const std::string& m) { throw std::invalid_argument("2D solver: " + m); };
   if (t.nx < 1 || t.ny < 1) bad("terrain grid is empty");
@@ -80,6 +89,7 @@ void validate(const Terrain2D& t, const Sh2dConfig& cfg, const Sh2dState& s) {
   }
   validate_resistance(t, cfg);
   validate_cover(t, cfg);
+  validate_dams(t, cfg);
   cfg.material.validate();
 }
 
@@ -142,6 +152,8 @@ Solver::Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
         near_out_[idx(i, j)] = outside(i, j) || (i > 0 && outside(i - 1, j)) || (i < nx_ - 1 && outside(i + 1, j)) ||
                                (j > 0 && outside(i, j - 1)) || (j < ny_ - 1 && outside(i, j + 1));
   }
+  if (std::any_of(cfg.dam_height.begin(), cfg.dam_height.end(), [](double d) { return d > 0; })) dam_ = cfg.dam_height;
+  mark_general();
   box_out_.assign(ntiles_, 0);
   if (!out_.empty())
     for (int tt = 0; tt < ntiles_; ++tt) {
@@ -193,7 +205,23 @@ Solver::Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
   slot_left_.assign(slot_gauge_.size(), 0.0);
   volume_initial_ = sum_tiles(tile_mass_) * (t_.dx * t_.dy);
   work_.resize(std::size_t(omp_get_max_threads()));
-  for (auto& w : work_) w.reserve(T_);
+  for (auto& w : work_) w.reserve(T_, !dam_.empty());
+}
+
+// The cells that take the general loops (general()): next to the outside, on either side of a dam's
+// step, a flux gauge's cell.
+void Solver::mark_general() {
+  if (near_out_.empty() && dam_.empty() && cfg_.gauges.empty()) return;
+  general_.assign(n_, 0);
+  for (int j = 0; j < ny_; ++j)
+    for (int i = 0; i < nx_; ++i) {
+      const std::size_t k = idx(i, j);
+      const bool step = (i > 0 && step_face(k, k - 1)) || (i < nx_ - 1 && step_face(k, k + 1)) ||
+                        (j > 0 && step_face(k, k - nx_)) || (j < ny_ - 1 && step_face(k, k + nx_));
+      general_[k] = near_outside(k) || step;
+    }
+  for (const auto& g : cfg_.gauges)
+    for (std::size_t k : g.cells) general_[k] = 1;
 }
 
 // Each waiting secondary release area that the flow has reached (a cell of it flowing at the end of
@@ -448,7 +476,7 @@ double Solver::step_all(double dt) {
   const int na = int(active_.size());
   while (work_.size() < std::size_t(omp_get_max_threads())) {  // more threads than when the solver was built
     work_.emplace_back();
-    work_.back().reserve(T_);
+    work_.back().reserve(T_, !dam_.empty());
   }
   long ncells = 0;  // the cells computed: those of the active tiles within reach of material
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : ncells)

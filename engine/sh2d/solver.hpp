@@ -46,6 +46,10 @@ struct TileWork {
   // Face fluxes (mass, x-momentum, y-momentum); Fx*[(j - bj0) * (bw + 1) + (i - bi0)]: face left of
   // cell (i, j), Fy*[(j - bj0) * bw + (i - bi0)]: face below it.
   std::vector<double> Fx0, Fx1, Fx2, Fy0, Fy1, Fy2;
+  // At a dam's step face (Sh2dConfig::dam_height): the wall's reaction on each side, added to the
+  // face's momentum flux for that side's cell (normal, tangential; a: left/lower cell, b: right/upper);
+  // written only at step faces, read only there (sized only with dams).
+  std::vector<double> Wxa1, Wxa2, Wxb1, Wxb2, Wya1, Wya2, Wyb1, Wyb2;
   // One tile row's terms of the tile sums (index i - i0): kinetic energy, speed of a flowing cell
   // (else 0), CFL rate; written by the update's cell kernels, summed in cell order afterwards. And
   // the row kernel's normal depth and pressure of a flowing cell (else 0), for the hazard maps.
@@ -55,8 +59,10 @@ struct TileWork {
   std::vector<double> row_mu, row_w;
   Face fxf(std::size_t k) const { return Face{Fx0[k], Fx1[k], Fx2[k]}; }
   Face fyf(std::size_t k) const { return Face{Fy0[k], Fy1[k], Fy2[k]}; }
-  void reserve(int T) {
+  void reserve(int T, bool dams) {
     const std::size_t n = std::size_t(T + 4) * (T + 4);
+    for (auto* v : {&Wxa1, &Wxa2, &Wxb1, &Wxb2}) v->assign(dams ? std::size_t(T + 5) * (T + 4) : 0, 0.0);
+    for (auto* v : {&Wya1, &Wya2, &Wyb1, &Wyb2}) v->assign(dams ? std::size_t(T + 4) * (T + 5) : 0, 0.0);
     for (auto* v : {&sHx, &sux, &svx, &sHy, &suy, &svy, &Hp, &Up, &Vp, &Pxx, &Pxy, &Pyy, &Ps, &r}) v->assign(n, 0.0);
     held.assign(n, 0.0);
     for (auto* v : {&Fx0, &Fx1, &Fx2}) v->assign(std::size_t(T + 5) * (T + 4), 0.0);
@@ -124,6 +130,12 @@ class Solver {
   bool outside(int i, int j) const { return !out_.empty() && out_[idx(i, j)]; }
   // The cell or one of its four neighbours lies outside the domain (such cells take the general loop).
   bool near_outside(std::size_t k) const { return !near_out_.empty() && near_out_[k]; }
+  // The dam height of a cell (0 without dams) and whether the face between cells k and m is a step.
+  double dam(std::size_t k) const { return dam_.empty() ? 0.0 : dam_[k]; }
+  bool step_face(std::size_t k, std::size_t m) const { return !dam_.empty() && dam_[k] != dam_[m]; }
+  // The cell takes the general loops of the predictor and the update (near the outside, next to a
+  // dam's step, a flux gauge's cell); the row kernels take the others.
+  bool general(std::size_t k) const { return !general_.empty() && general_[k]; }
   double vel(double H, double M) const { return H > cfg_.dry_depth ? M / H : 0.0; }
 
   // Pi = g [c^4 Kx d d^T + c^2 Ky s s^T], d the downslope unit vector (or (dx, dy) on flat ground).
@@ -157,6 +169,7 @@ class Solver {
   void release_secondary();
   void record_hazard(std::size_t k, double t);
   void rebuild_active();
+  void mark_general();
   long step_tile(int tt, double t, double dt, TileWork& w);  // returns the cells it computed
   CellBox material_box(int i0, int i1, int j0, int j1) const;
   void clear_outside(int tt, const CellBox& c);
@@ -172,7 +185,9 @@ class Solver {
   void start_terms(int n, std::size_t k0, const double* H, const double* U, const double* V, TileWork& w) const;
   void faces(TileWork& w, int ci0, int ci1, int cj0, int cj1) const;
   template <bool X>
-  Face face(const TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi, Boundary2D blo, Boundary2D bhi) const;
+  Face face(TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi, Boundary2D blo, Boundary2D bhi) const;
+  template <bool X>
+  Face dam_face(TileWork& w, int ia, int ja, int ib, int jb, bool held) const;
   long positivity(TileWork& w, int i0, int i1, int j0, int j1, double dt) const;
   void update(int tt, TileWork& w, const CellBox& c, double t, double dt);
   template <Basal B>
@@ -183,7 +198,7 @@ class Solver {
   void update_row(TileWork& w, int j, int ia, int ib, int i0, double t1, double dt);
   template <Basal B, bool Row = false>
   void update_run(TileWork& w, int j, int ia, int ib, int i0, double t1, double dt, double sw, double se, double ss,
-                  double sn, double smu, double swt);
+                  double sn, double smu, double swt, double wu, double wv);
 
   const Terrain2D& t_;
   const Sh2dConfig& cfg_;
@@ -200,6 +215,8 @@ class Solver {
   std::vector<double> H_[2], HU_[2], HV_[2], U_[2], V_[2];
   int cur_ = 0;
   std::vector<std::uint8_t> out_, near_out_;  // empty when every cell is inside
+  std::vector<double> dam_;                   // per cell the dam height [m]; empty without dams
+  std::vector<std::uint8_t> general_;         // see general(); empty when every cell takes the rows
   std::vector<std::uint8_t> box_out_;         // per tile: its box (tile grown by 2) holds outside cells
   std::vector<double> Pxx_, Pxy_, Pyy_;  // pressure coefficients for K = 1 (also the start values)
   std::vector<double> Ps_;                // wave_factor of those

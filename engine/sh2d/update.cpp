@@ -46,9 +46,11 @@ long Solver::positivity(TileWork& w, int i0, int i1, int j0, int j1, double dt) 
   return limited;
 }
 
-// The update of one cell in the general form (domain edges, cells outside the domain next to it):
-// the face fluxes scaled by the sending cells' draining factors (1 beyond the domain's edge), the
-// outflow through its edges into `out`, then the kernels of the row kernel.
+// The update of one cell in the general form (domain edges, cells outside the domain next to it, a
+// dam's step, a flux gauge's cell): the face fluxes scaled by the sending cells' draining factors (1
+// beyond the domain's edge), the outflow through its edges into `out`, what a gauge's cell sends
+// right and left, the reaction of a dam's walls through its step faces, then the kernels of the row
+// kernel.
 template <Basal B>
 void Solver::update_cell(TileWork& w, int i, int j, int i0, double t1, double dt, double& out) {
   const std::size_t q = w.at(i, j), x = w.fx(i, j), y = w.fy(i, j);
@@ -80,7 +82,16 @@ void Solver::update_cell(TileWork& w, int i, int j, int i0, double t1, double dt
     smu = p.mu;
     swt = start_weight(p.q);
   }
-  update_run<B>(w, j, i, i + 1, i0, t1, dt, sw, se, ss, sn, smu, swt);
+  double wu = 0, wv = 0;  // the dams' walls' reaction through its step faces
+  if (!dam_.empty()) {
+    const std::size_t k = idx(i, j);
+    const double lx = dt / t_.dx, ly = dt / t_.dy;
+    if (i > 0 && step_face(k, k - 1)) wu += lx * w.Wxb1[x], wv += lx * w.Wxb2[x];
+    if (i < nx_ - 1 && step_face(k, k + 1)) wu -= lx * w.Wxa1[x + 1], wv -= lx * w.Wxa2[x + 1];
+    if (j > 0 && step_face(k, k - nx_)) wu += ly * w.Wyb1[y], wv += ly * w.Wyb2[y];
+    if (j < ny_ - 1 && step_face(k, k + nx_)) wu -= ly * w.Wya1[y + w.bw], wv -= ly * w.Wya2[y + w.bw];
+  }
+  update_run<B>(w, j, i, i + 1, i0, t1, dt, sw, se, ss, sn, smu, swt, wu, wv);
 }
 
 // The update of cells (ia..ib-1, j), all inside the domain and away from its edges, in a loop the
@@ -90,7 +101,7 @@ void Solver::update_cell(TileWork& w, int i, int j, int i0, double t1, double dt
 // exactly 1 and its square root is skipped.
 template <Basal B>
 RUNOUT_SIMD_CLONES void Solver::update_row(TileWork& w, int j, int ia, int ib, int i0, double t1, double dt) {
-  update_run<B, true>(w, j, ia, ib, i0, t1, dt, 0, 0, 0, 0, 0, 0);
+  update_run<B, true>(w, j, ia, ib, i0, t1, dt, 0, 0, 0, 0, 0, 0, 0, 0);
 }
 
 // The update of cells (ia..ib-1, j): Row, the draining factors from the work space's neighbours and
@@ -98,7 +109,8 @@ RUNOUT_SIMD_CLONES void Solver::update_row(TileWork& w, int j, int ia, int ib, i
 // the parts smu, swt given.
 template <Basal B, bool Row>
 RUNOUT_KERNEL void Solver::update_run(TileWork& w, int j, int ia, int ib, int i0, double t1, double dt, double sw1,
-                                      double se1, double ss1, double sn1, double smu1, double swt1) {
+                                      double se1, double ss1, double sn1, double smu1, double swt1, double wu1,
+                                      double wv1) {
   const std::size_t k0 = idx(ia, j), q0 = w.at(ia, j);
   const std::ptrdiff_t bw = w.bw;
   const double *__restrict H0 = &H_[cur_][k0], *__restrict HU0 = &HU_[cur_][k0], *__restrict HV0 = &HV_[cur_][k0];
@@ -140,8 +152,12 @@ RUNOUT_KERNEL void Solver::update_run(TileWork& w, int j, int ia, int ib, int i0
       swt = rwt[m];
     }
     const double H = flux_update(H0[m], lx, ly, Fx0[m], Fx0[m + 1], Fy0[m], Fy0[m + bw], sw, se, ss, sn);
-    const double MU = flux_update(HU0[m], lx, ly, Fx1[m], Fx1[m + 1], Fy1[m], Fy1[m + bw], sw, se, ss, sn);
-    const double MV = flux_update(HV0[m], lx, ly, Fx2[m], Fx2[m + 1], Fy2[m], Fy2[m + bw], sw, se, ss, sn);
+    double MU = flux_update(HU0[m], lx, ly, Fx1[m], Fx1[m + 1], Fy1[m], Fy1[m + bw], sw, se, ss, sn);
+    double MV = flux_update(HV0[m], lx, ly, Fx2[m], Fx2[m + 1], Fy2[m], Fy2[m + bw], sw, se, ss, sn);
+    if constexpr (!Row) {  // a dam's walls (the sums skipped where they are 0: the same bits as without)
+      MU = wu1 != 0.0 ? MU + wu1 : MU;
+      MV = wv1 != 0.0 ? MV + wv1 : MV;
+    }
     double cres = 0, kdet = 0, cv = 0;
     if constexpr (B == Basal::ground) {
       cres = cr[m];
@@ -204,9 +220,9 @@ void Solver::update_cells(int tt, TileWork& w, const CellBox& c, double t, doubl
     const bool inner = j > 0 && j < ny_ - 1;
     const int fb = std::min(i1, nx_ - 1);
     for (int i = i0; i < i1; ++i) {
-      if (inner && i > 0 && i < fb && !near_outside(idx(i, j)) && !gauge_cell(idx(i, j))) {
-        int e = i + 1;  // a run of cells for the row kernel (a gauge's cells take the general one)
-        while (e < fb && !near_outside(idx(e, j)) && !gauge_cell(idx(e, j))) ++e;
+      if (inner && i > 0 && i < fb && !general(idx(i, j))) {
+        int e = i + 1;  // a run of cells for the row kernel
+        while (e < fb && !general(idx(e, j))) ++e;
         if constexpr (B == Basal::hysteresis) {
           const std::size_t q = w.at(i, j);
           start_terms(e - i, idx(i, j), &w.Hp[q], &w.Up[q], &w.Vp[q], w);

@@ -123,15 +123,15 @@ engine::ErodibleCover erodible_cover(const ResolvedScenario& s, const std::vecto
   return e;
 }
 
-// The dams as the engine sees them: the terrain raised by each dam's height on its cells (the
-// largest where dams overlap) and a flux gauge across each dam's crest lines (a cell on the crests of
-// two dams, where they meet, counts for the first).
-void raise_dams(const ResolvedScenario& s, const std::vector<terrain::DamCells>& dams, engine::Terrain2D& t,
+// The dams as the engine sees them: each cell's dam height (the largest where dams overlap) and a
+// flux gauge across each dam's crest lines (a cell on the crests of two dams, where they meet,
+// counts for the first).
+void place_dams(const ResolvedScenario& s, const std::vector<terrain::DamCells>& dams, const engine::Terrain2D& t,
                 engine::Sh2dConfig& cfg) {
-  std::vector<double> raise(t.cells(), 0.0);
+  if (dams.empty()) return;
+  cfg.dam_height.assign(t.cells(), 0.0);
   for (const auto& d : dams)
-    for (std::size_t k = 0; k < raise.size(); ++k) raise[k] = std::max(raise[k], d.raise[k]);
-  for (std::size_t k = 0; k < raise.size(); ++k) t.z[k] += raise[k];
+    for (std::size_t k = 0; k < d.height.size(); ++k) cfg.dam_height[k] = std::max(cfg.dam_height[k], d.height[k]);
   std::vector<std::uint8_t> taken(t.cells(), 0);
   for (std::size_t a = 0; a < dams.size(); ++a) {
     if (!dams[a].lines) continue;
@@ -157,9 +157,9 @@ std::vector<DamSummary> dam_summaries(const ResolvedScenario& s, const std::vect
     q.lines = d.lines;
     q.cells = d.cells;
     q.crest_length_m = d.length_m;
-    for (std::size_t k = 0; k < d.raise.size(); ++k)
-      if (d.raise[k] > 0) {
-        q.height_max_m = std::max(q.height_max_m, d.raise[k]);
+    for (std::size_t k = 0; k < d.height.size(); ++k)
+      if (d.height[k] > 0) {
+        q.height_max_m = std::max(q.height_max_m, d.height[k]);
         q.max_depth_m = std::max(q.max_depth_m, res.hazard.max_depth[k]);
       }
     if (d.lines) {
@@ -269,15 +269,13 @@ DepthAveragedRun::DepthAveragedRun(const ResolvedScenario& s, const std::string&
   sum_.release_volume_m3 = rel_rep_.volume_m3;
   sum_.notes = rel_rep_.notes;
   t_ = engine_terrain(grid_);
-  // The release's normal thickness on the ground's slope, before the dams raise the terrain: next to
-  // a dam the raised terrain's slope is the dam's flank, which would change the released volume.
   initial_ = engine::state_from_normal_depth(t_, h0_);
   cfg_ = s.config;
   secondary_ = terrain::secondary_release_areas(grid_, s.dem, s.releases);
   cfg_.secondary = engine_secondary(secondary_);
   cfg_.resistance = resistance_areas(s, output_inputs_.resistance_areas);
   cfg_.cover = erodible_cover(s, output_inputs_.cover_areas);
-  raise_dams(s, output_inputs_.dams, t_, cfg_);
+  place_dams(s, output_inputs_.dams, t_, cfg_);
 
   // Checkpoints: the solver's whole state between two steps, with the scenario's hash; the time
   // series so far lies beside it (CHECKPOINT.timeseries.h5), so that a continued run's outputs are

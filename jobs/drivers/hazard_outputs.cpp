@@ -138,9 +138,9 @@ HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Gri
     overlay.resistance.resize(cells.size(), 0);
     for (std::size_t k = 0; k < cells.size(); ++k) overlay.resistance[k] |= cells[k];
   }
-  for (const auto& dam : in.dams) {  // the raised cells of any dam
-    overlay.dams.resize(dam.raise.size(), 0);
-    for (std::size_t k = 0; k < dam.raise.size(); ++k) overlay.dams[k] |= dam.raise[k] > 0;
+  for (const auto& dam : in.dams) {  // the cells of any dam
+    overlay.dams.resize(dam.height.size(), 0);
+    for (std::size_t k = 0; k < dam.height.size(); ++k) overlay.dams[k] |= dam.height[k] > 0;
   }
   for (const auto& d : in.cover_areas) {  // the cells of any area of cover
     overlay.cover.resize(d.size(), 0);

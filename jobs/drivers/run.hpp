@@ -42,7 +42,7 @@ struct DamSummary {
   long cells = 0;
   double height_max_m = 0, crest_length_m = 0;
   double crossed_right_m3 = 0, crossed_left_m3 = 0, overflow_m3 = 0;  ///< crest lines
-  double max_depth_m = 0;  ///< on the raised cells
+  double max_depth_m = 0;  ///< on the dam's cells (above its crest)
 };
 
 struct RunSummary {

@@ -17,7 +17,7 @@ struct ShCheckpoint {
 };
 
 /// The checkpoint's format; a file of another format (another build, a VOF checkpoint) is refused.
-inline constexpr const char* kShCheckpointFormat = "runout depth-averaged checkpoint 4";
+inline constexpr const char* kShCheckpointFormat = "runout depth-averaged checkpoint 5";
 
 /// Write atomically (a temporary file renamed over `path`). Throws std::runtime_error.
 void write_sh_checkpoint(const std::string& path, const std::string& scenario_hash, int timeseries_frames,

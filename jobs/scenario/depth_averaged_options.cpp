@@ -209,7 +209,7 @@ OptionTable ground_options() {
       {"dams[].name", T::text, U::as_given, "", {}, {}, "", "the dam's name in run.json and on the maps; default \"dam N\"",
        "ResolvedScenario::dams"},
       {"dams[].path", T::path, U::required, "", {}, {}, "",
-       "crest lines or footprints (polygons) in any CRS: the terrain raised on the cells they touch, grown by one cell",
+       "crest lines or footprints (polygons) in any CRS: a step of the height on the cells they touch",
        "ResolvedScenario::dams"},
       {"dams[].crs", T::text, U::as_given, "", {}, {}, "", "the file's CRS when it has none", "ResolvedScenario::dams"},
       {"dams[].height_m", T::number, U::as_given, "", Range{0, 100, true}, {}, "m", "the dam's height above the ground (or height_attribute)",
