@@ -104,6 +104,8 @@ inline void expect_same(const Sh2dResult& a, const Sh2dResult& b) {
   EXPECT_EQ(a.detrained, b.detrained);
   EXPECT_EQ(a.diag.volume_entrained, b.diag.volume_entrained);
   EXPECT_EQ(a.cover, b.cover);
+  EXPECT_EQ(a.gauge_right, b.gauge_right);
+  EXPECT_EQ(a.gauge_left, b.gauge_left);
 }
 
 // The engine refuses `cfg` with std::invalid_argument whose message holds `needle`.
