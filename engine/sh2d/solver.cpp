@@ -144,16 +144,7 @@ Solver::Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
       V_[b][k] = vel(H_[b][k], HV_[b][k]);
     }
   }
-  if (std::any_of(t.outside.begin(), t.outside.end(), [](std::uint8_t o) { return o != 0; })) {
-    out_ = t.outside;
-    near_out_.assign(n_, 0);
-    for (int j = 0; j < ny_; ++j)
-      for (int i = 0; i < nx_; ++i)
-        near_out_[idx(i, j)] = outside(i, j) || (i > 0 && outside(i - 1, j)) || (i < nx_ - 1 && outside(i + 1, j)) ||
-                               (j > 0 && outside(i, j - 1)) || (j < ny_ - 1 && outside(i, j + 1));
-  }
-  if (std::any_of(cfg.dam_height.begin(), cfg.dam_height.end(), [](double d) { return d > 0; })) dam_ = cfg.dam_height;
-  mark_general();
+  mark_cells();
   box_out_.assign(ntiles_, 0);
   if (!out_.empty())
     for (int tt = 0; tt < ntiles_; ++tt) {
@@ -192,25 +183,24 @@ Solver::Solver(const Terrain2D& t, const Sh2dConfig& cfg, Sh2dState s)
   for (int tt = 0; tt < ntiles_; ++tt) fill_whole(tt);
   rebuild_active();
   secondary_time_.assign(cfg.secondary.size(), nan);
-  gauge_right_.assign(cfg.gauges.size(), 0.0);
-  gauge_left_.assign(cfg.gauges.size(), 0.0);
-  if (!cfg.gauges.empty()) gauge_slot_.assign(n_, -1);
-  for (std::size_t a = 0; a < cfg.gauges.size(); ++a)
-    for (std::size_t q = 0; q < cfg.gauges[a].cells.size(); ++q) {
-      gauge_slot_[cfg.gauges[a].cells[q]] = int(slot_gauge_.size());
-      slot_gauge_.push_back(int(a));
-      slot_sides_.push_back(cfg.gauges[a].sides[q]);
-    }
-  slot_right_.assign(slot_gauge_.size(), 0.0);
-  slot_left_.assign(slot_gauge_.size(), 0.0);
+  set_gauges();
   volume_initial_ = sum_tiles(tile_mass_) * (t_.dx * t_.dy);
   work_.resize(std::size_t(omp_get_max_threads()));
   for (auto& w : work_) w.reserve(T_, !dam_.empty());
 }
 
-// The cells that take the general loops (general()): next to the outside, on either side of a dam's
-// step, a flux gauge's cell.
-void Solver::mark_general() {
+// The cells outside the domain and next to it, the dams' heights, and the cells that take the general
+// loops (general()): next to the outside, on either side of a dam's step, a flux gauge's cell.
+void Solver::mark_cells() {
+  if (std::any_of(t_.outside.begin(), t_.outside.end(), [](std::uint8_t o) { return o != 0; })) {
+    out_ = t_.outside;
+    near_out_.assign(n_, 0);
+    for (int j = 0; j < ny_; ++j)
+      for (int i = 0; i < nx_; ++i)
+        near_out_[idx(i, j)] = outside(i, j) || (i > 0 && outside(i - 1, j)) || (i < nx_ - 1 && outside(i + 1, j)) ||
+                               (j > 0 && outside(i, j - 1)) || (j < ny_ - 1 && outside(i, j + 1));
+  }
+  if (std::any_of(cfg_.dam_height.begin(), cfg_.dam_height.end(), [](double d) { return d > 0; })) dam_ = cfg_.dam_height;
   if (near_out_.empty() && dam_.empty() && cfg_.gauges.empty()) return;
   general_.assign(n_, 0);
   for (int j = 0; j < ny_; ++j)
@@ -222,6 +212,21 @@ void Solver::mark_general() {
     }
   for (const auto& g : cfg_.gauges)
     for (std::size_t k : g.cells) general_[k] = 1;
+}
+
+// The flux gauges' counts and each gauge cell's slot (its gauge, its faces' sides, its step's counts).
+void Solver::set_gauges() {
+  gauge_right_.assign(cfg_.gauges.size(), 0.0);
+  gauge_left_.assign(cfg_.gauges.size(), 0.0);
+  if (!cfg_.gauges.empty()) gauge_slot_.assign(n_, -1);
+  for (std::size_t a = 0; a < cfg_.gauges.size(); ++a)
+    for (std::size_t q = 0; q < cfg_.gauges[a].cells.size(); ++q) {
+      gauge_slot_[cfg_.gauges[a].cells[q]] = int(slot_gauge_.size());
+      slot_gauge_.push_back(int(a));
+      slot_sides_.push_back(cfg_.gauges[a].sides[q]);
+    }
+  slot_right_.assign(slot_gauge_.size(), 0.0);
+  slot_left_.assign(slot_gauge_.size(), 0.0);
 }
 
 // Each waiting secondary release area that the flow has reached (a cell of it flowing at the end of

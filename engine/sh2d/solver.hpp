@@ -169,7 +169,8 @@ class Solver {
   void release_secondary();
   void record_hazard(std::size_t k, double t);
   void rebuild_active();
-  void mark_general();
+  void mark_cells();
+  void set_gauges();
   long step_tile(int tt, double t, double dt, TileWork& w);  // returns the cells it computed
   CellBox material_box(int i0, int i1, int j0, int j1) const;
   void clear_outside(int tt, const CellBox& c);

@@ -59,6 +59,26 @@ void check_path_runout(const TempDir& d, const jobs::ResolvedScenario& r) {
               rec.results().path().alpha_deg(), g.dx);
 }
 
+// The largest value of a raster over the cells whose centres lie within `radius` of (x, y) (the
+// raster's CRS).
+double max_near(const std::string& tif, double x, double y, double radius) {
+  GDALDatasetUniquePtr ds(GDALDataset::Open(tif.c_str(), GDAL_OF_RASTER));
+  EXPECT_TRUE(ds);
+  if (!ds) return NAN;
+  double gt[6];
+  ds->GetGeoTransform(gt);
+  const int w = ds->GetRasterXSize(), h = ds->GetRasterYSize();
+  std::vector<double> v(std::size_t(w) * h);
+  EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, w, h, v.data(), w, h, GDT_Float64, 0, 0), CE_None);
+  double m = 0;
+  for (int r = 0; r < h; ++r)
+    for (int i = 0; i < w; ++i) {
+      const double cx = gt[0] + (i + 0.5) * gt[1], cy = gt[3] + (r + 0.5) * gt[5], z = v[std::size_t(r) * w + i];
+      if (std::hypot(cx - x, cy - y) <= radius && std::isfinite(z)) m = std::max(m, z);
+    }
+  return m;
+}
+
 }  // namespace
 
 TEST(Scenarios, InDenArelenReachesTheValleyFloor) {
@@ -96,7 +116,11 @@ TEST(Scenarios, InDenArelenReachesTheValleyFloor) {
 // the UTM grid) and a forest polygon: the flow takes up cover along the track and the volume balance
 // counts it; cover_depth.tif holds the cover left (at most the 0.4 m laid, less where the flow passed),
 // the maps outline both.
-TEST(Scenarios, InDenArelenTakesUpTheCoverAndMeetsTheForest) {
+// In den Arelen with all of the ground's features: an erodible cover (a thickness raster in
+// EPSG:2056), a forest (a polygon in WGS84) and a catch dam 12 m high across the northern gully (a
+// crest line in EPSG:2056). The flow takes up cover, leaves material in the forest, and the dam
+// catches the northern lobe: what passes it is a film (less than 1e-3 of the volume).
+TEST(Scenarios, InDenArelenTakesUpTheCoverMeetsTheForestAndTheDam) {
   const auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/in-den-arelen-ground.json");
   TempDir d;
   const auto sum = jobs::run_scenario(r, d.p.string());
@@ -106,6 +130,13 @@ TEST(Scenarios, InDenArelenTakesUpTheCoverAndMeetsTheForest) {
   for (const char* f : {"cover_depth.tif", "detrained_depth.tif", "map_max_pressure.png"}) EXPECT_TRUE(fs::exists(d / f)) << f;
   const auto rec = run_record(d / "run.json");
   EXPECT_NEAR(rec.mass_balance().volume_entrained_m3(), sum.volume_entrained, 1e-9 * sum.volume_entrained);
+  EXPECT_GT(rec.mass_balance().volume_detrained_m3(), 0.05 * sum.volume_initial);
+  ASSERT_EQ(rec.dams_size(), 1);
+  EXPECT_EQ(rec.dams(0).name(), "catch dam");
+  EXPECT_EQ(rec.dams(0).height_max_m(), 12.0);
+  EXPECT_NEAR(rec.dams(0).crest_length_m(), 301, 2);
+  EXPECT_LT(rec.dams(0).overflow_m3(), 1e-3 * sum.volume_initial);
+  EXPECT_GT(max_near(d / "max_depth.tif", 563940, 5188350, 40), 1.0);  // the flow reached the dam
   GDALDatasetUniquePtr ds(GDALDataset::Open((d / "cover_depth.tif").c_str(), GDAL_OF_RASTER));
   ASSERT_TRUE(ds);
   std::vector<float> v(std::size_t(sum.nx) * sum.ny);

@@ -368,9 +368,10 @@ std::vector<std::uint8_t> block_mask(const terrain::Grid& g) {
 
 }  // namespace
 
-// Resistance areas (forest) are outlined on the maps in green and the erodible cover in blue: the
-// same map with an area shows pixels of its colour along its edges that the map without it has not.
-TEST(HazardProducts, MapsOutlineTheResistanceAreasAndTheCover) {
+// Resistance areas (forest) are outlined on the maps in green, the erodible cover in blue and dams in
+// brown: the same map with an area shows pixels of its colour along its edges that the map without
+// it has not.
+TEST(HazardProducts, MapsOutlineTheResistanceAreasTheCoverAndTheDams) {
   TempDir d;
   const auto g = tilted_grid();
   figures::HazardMap m;
@@ -390,4 +391,10 @@ TEST(HazardProducts, MapsOutlineTheResistanceAreasAndTheCover) {
   const auto cover = figures::draw_hazard_map(d / "cover.png", "", g, m);
   EXPECT_EQ(map_pixels(d / "plain.png", plain, g, blue), 0);
   EXPECT_GT(map_pixels(d / "cover.png", cover, g, blue), edge_px / 3);
+  m.cover.clear();
+  m.dams = block_mask(g);
+  auto brown = [](int r, int gr, int b) { return r > gr + 40 && gr > b + 30 && r < 200; };
+  const auto dam = figures::draw_hazard_map(d / "dam.png", "", g, m);
+  EXPECT_EQ(map_pixels(d / "plain.png", plain, g, brown), 0);
+  EXPECT_GT(map_pixels(d / "dam.png", dam, g, brown), edge_px / 2);  // a solid line, 2.2 px wide
 }
