@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "jobs/drivers/hazard_outputs.hpp"
+#include "jobs/drivers/zoning.hpp"
 #include "jobs/ensemble/statistics.hpp"
 #include "jobs/figures/hazard_map.hpp"
 #include "jobs/figures/histogram.hpp"
@@ -59,26 +60,7 @@ std::string percentile_tag(double p) {
   return b;
 }
 
-// The finest member's grid: every member's rasters lie on it or are resampled onto it.
-terrain::Grid aggregate_grid(const ResolvedScenario& e, const std::vector<MemberResults>& members) {
-  terrain::DemRequest req = e.dem;
-  for (const auto& m : members) {
-    double r = 0;
-    if (ensemble::number_at(m.member.scenario, "grid.resolution_m", r) && r > 0 && (req.resolution <= 0 || r < req.resolution))
-      req.resolution = r;
-  }
-  return terrain::prepare_grid(req);
-}
 
-// A member's record, or an error naming the member.
-v1::RunRecord member_record(const MemberResults& m) {
-  try {
-    return read_run_record((fs::path(m.dir) / "run.json").string());
-  } catch (const std::exception& e) {
-    throw std::runtime_error("member " + std::to_string(m.member.index) + " (" + ensemble::describe(m.member.values) +
-                             "): its results cannot be read: " + e.what());
-  }
-}
 
 // The maps' parameter block: what varied, the grid and the software.
 std::vector<std::string> map_block(const ResolvedScenario& e, const std::vector<MemberResults>& members, const terrain::Grid& g) {
@@ -130,27 +112,6 @@ void write_runout_csv(const std::string& path, const std::vector<MemberResults>&
   if (!f.flush()) throw std::runtime_error("cannot write " + path);
 }
 
-// Per member: its figures in the record, and whether it reached each point of interest.
-void record_member(const MemberResults& m, const v1::RunRecord& r, v1::EnsembleRecord& rec, std::vector<int>& reached) {
-  auto* em = rec.add_members();
-  em->set_index(m.member.index);
-  for (const auto& pv : m.member.values) {
-    auto* v = em->add_values();
-    v->set_parameter(pv.parameter);
-    v->set_value(pv.value);
-  }
-  em->set_scenario_hash(m.hash);
-  const auto& res = r.results();
-  if (res.path().has_runout_s_m()) em->set_runout_s_m(res.path().runout_s_m());
-  if (res.path().has_alpha_deg()) em->set_alpha_deg(res.path().alpha_deg());
-  em->set_affected_area_m2(res.affected_area_m2());
-  em->set_max_pressure_kpa(res.max_pressure_kpa());
-  em->set_release_volume_m3(r.release().volume_m3());
-  em->set_max_speed_m_s(r.solver().max_speed_m_s());
-  if (reached.empty()) reached.assign(std::size_t(res.points_of_interest_size()), 0);
-  for (int k = 0; k < res.points_of_interest_size() && std::size_t(k) < reached.size(); ++k)
-    reached[std::size_t(k)] += res.points_of_interest(k).inside_outline();
-}
 
 void runout_distribution(const std::vector<MemberResults>& members, const ensemble::AggregateSettings& a, const std::string& criterion,
                          v1::EnsembleRecord& rec) {
@@ -297,13 +258,60 @@ void write_runout(Aggregate& a, const std::string& criterion) {
   for (const char* f : {"runout_histogram.png", "runout_histogram.pdf"}) a.add(f);
 }
 
+
+}  // namespace
+
+// The finest member's grid: every member's rasters lie on it or are resampled onto it.
+terrain::Grid aggregate_grid(const ResolvedScenario& e, const std::vector<MemberResults>& members) {
+  terrain::DemRequest req = e.dem;
+  for (const auto& m : members) {
+    double r = 0;
+    if (ensemble::number_at(m.member.scenario, "grid.resolution_m", r) && r > 0 && (req.resolution <= 0 || r < req.resolution))
+      req.resolution = r;
+  }
+  return terrain::prepare_grid(req);
+}
+
+// A member's record, or an error naming the member.
+v1::RunRecord member_record(const MemberResults& m) {
+  try {
+    return read_run_record((fs::path(m.dir) / "run.json").string());
+  } catch (const std::exception& e) {
+    throw std::runtime_error("member " + std::to_string(m.member.index) + " (" + ensemble::describe(m.member.values) +
+                             "): its results cannot be read: " + e.what());
+  }
+}
+
+// Per member: its figures in the record, and whether it reached each point of interest.
+void record_member(const MemberResults& m, const v1::RunRecord& r, v1::EnsembleRecord& rec, std::vector<int>& reached) {
+  auto* em = rec.add_members();
+  em->set_index(m.member.index);
+  for (const auto& pv : m.member.values) {
+    auto* v = em->add_values();
+    v->set_parameter(pv.parameter);
+    v->set_value(pv.value);
+  }
+  em->set_scenario_hash(m.hash);
+  const auto& res = r.results();
+  if (res.path().has_runout_s_m()) em->set_runout_s_m(res.path().runout_s_m());
+  if (res.path().has_alpha_deg()) em->set_alpha_deg(res.path().alpha_deg());
+  em->set_affected_area_m2(res.affected_area_m2());
+  em->set_max_pressure_kpa(res.max_pressure_kpa());
+  em->set_release_volume_m3(r.release().volume_m3());
+  em->set_max_speed_m_s(r.solver().max_speed_m_s());
+  if (reached.empty()) reached.assign(std::size_t(res.points_of_interest_size()), 0);
+  for (int k = 0; k < res.points_of_interest_size() && std::size_t(k) < reached.size(); ++k)
+    reached[std::size_t(k)] += res.points_of_interest(k).inside_outline();
+}
+
 // The record's head: software, kind, scenario, design, creation time.
 v1::EnsembleRecord record_head(const ResolvedScenario& e) {
   v1::EnsembleRecord rec;
   *rec.mutable_software() = this_software();
-  rec.set_kind("ensemble");
+  rec.set_kind(e.scenario.has_zoning() ? "zoning" : "ensemble");
   *rec.mutable_scenario() = e.scenario;
-  rec.set_design(e.scenario.variations().design().empty() ? "cross-product" : e.scenario.variations().design());
+  rec.set_design(e.scenario.has_zoning() ? "return periods"
+                 : e.scenario.variations().design().empty() ? "cross-product" : e.scenario.variations().design());
   char b[32];
   const std::time_t now = std::time(nullptr);
   std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
@@ -311,10 +319,9 @@ v1::EnsembleRecord record_head(const ResolvedScenario& e) {
   return rec;
 }
 
-}  // namespace
-
 v1::EnsembleRecord aggregate_ensemble(const ResolvedScenario& e, const std::vector<MemberResults>& members, const std::string& out_dir,
                                       const std::function<bool(int, int)>& progress) {
+  if (e.scenario.has_zoning()) return aggregate_zoning(e, members, out_dir, progress);
   const auto t0 = std::chrono::steady_clock::now();
   if (members.empty()) throw std::runtime_error("an ensemble without members");
   const terrain::Grid g = aggregate_grid(e, members);

@@ -8,6 +8,8 @@
 //   - the probability of reaching each point of interest (run.json, and on the maps);
 //   - run.json: the ensemble's record (runout.v1.EnsembleRecord).
 // A member at another resolution is resampled onto the finest member's grid (nearest neighbour).
+// A zoning (scenario zoning) is an ensemble of one member per return period whose aggregate is the
+// zones (jobs/drivers/zoning.hpp).
 #include <functional>
 #include <string>
 #include <vector>
@@ -28,7 +30,17 @@ struct MemberResults {
 /// Thrown when the progress hook asks the aggregate to stop.
 struct AggregateStopped {};
 
-/// Aggregate the members into `out_dir` (existing, empty). `progress(done, total)` after each member
+/// The finest member's grid: every member's rasters lie on it or are resampled onto it.
+terrain::Grid aggregate_grid(const ResolvedScenario& e, const std::vector<MemberResults>& members);
+/// A member's record; throws std::runtime_error naming the member where it cannot be read.
+v1::RunRecord member_record(const MemberResults& m);
+/// A member's figures into the record (members[]), and which points of interest it reached.
+void record_member(const MemberResults& m, const v1::RunRecord& r, v1::EnsembleRecord& rec, std::vector<int>& reached);
+/// The record's head: software, kind ("ensemble" or "zoning"), scenario, design, creation time.
+v1::EnsembleRecord record_head(const ResolvedScenario& e);
+
+/// Aggregate the members into `out_dir` (existing, empty); a zoning's (scenario zoning) are its
+/// zones (jobs/drivers/zoning.hpp). `progress(done, total)` after each member
 /// read; returning false throws AggregateStopped (the caller discards the folder). Throws
 /// terrain::TerrainError or std::runtime_error naming the member whose results cannot be read.
 v1::EnsembleRecord aggregate_ensemble(const ResolvedScenario& ensemble, const std::vector<MemberResults>& members,

@@ -318,9 +318,70 @@ bool make_member(const v1::Scenario& base, const std::vector<Param>& params, con
   return true;
 }
 
+// A zoning's members: one per return period, ascending, each the scenario with its values (every
+// value's path checked as a variation's is), its own maps and outputs, without the zoning block.
+std::vector<Member> expand_zoning(const v1::Scenario& s) {
+  const auto& z = s.zoning();
+  if (s.has_variations()) bad("zoning", "a scenario takes variations or zoning, not both");
+  if (s.has_lab()) bad("zoning", "zones are drawn on a DEM; a laboratory set-up (lab) takes none");
+  if (z.scenarios_size() < 2) bad("zoning.scenarios", "at least two scenarios by return period (e.g. 30, 100 and 300 years)");
+  if (z.has_red_pressure_kpa() && !(z.red_pressure_kpa() > 0 && z.red_pressure_kpa() <= 10000))
+    bad("zoning.red_pressure_kpa", "must lie in (0, 10000] kPa, got " + num(z.red_pressure_kpa()));
+  const double frequent = z.has_frequent_y() ? z.frequent_y() : 30, design = z.has_design_y() ? z.design_y() : 300;
+  if (!(frequent >= 1 && frequent <= 100000)) bad("zoning.frequent_y", "must lie in [1, 100000] years, got " + num(frequent));
+  if (!(design >= frequent && design <= 100000))
+    bad("zoning.design_y", "must lie in [frequent_y (" + num(frequent) + "), 100000] years, got " + num(design));
+  std::vector<int> order(std::size_t(z.scenarios_size()));
+  for (int k = 0; k < z.scenarios_size(); ++k) {
+    order[std::size_t(k)] = k;
+    const double t = z.scenarios(k).return_period_y();
+    if (!(t >= 1 && t <= 100000))
+      bad("zoning.scenarios[" + std::to_string(k) + "].return_period_y", "must lie in [1, 100000] years, got " + num(t));
+    for (int j = 0; j < k; ++j)
+      if (z.scenarios(j).return_period_y() == t)
+        bad("zoning.scenarios[" + std::to_string(k) + "].return_period_y", num(t) + " years is also scenarios[" + std::to_string(j) + "]'s");
+  }
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return z.scenarios(a).return_period_y() < z.scenarios(b).return_period_y(); });
+  std::vector<Member> out;
+  for (int k : order) {
+    const auto& rp = z.scenarios(k);
+    const std::string field = "zoning.scenarios[" + std::to_string(k) + "].values";
+    std::vector<Param> params;
+    std::vector<double> values;
+    std::set<std::string> seen;
+    for (int j = 0; j < rp.values_size(); ++j) {
+      const std::string at = field + "[" + std::to_string(j) + "]";
+      v1::Variation v;
+      v.set_parameter(rp.values(j).parameter());
+      v.add_values(rp.values(j).value());
+      try {
+        params.push_back(read_param(v, 0, s, false));
+      } catch (const ScenarioError& e) {  // named as this value, not as a variation
+        throw ScenarioError(at + std::string(e.what()).substr(24));
+      }
+      params.back().field = at;
+      if (!seen.insert(params.back().path).second) bad(at + ".parameter", "'" + params.back().path + "' is given twice");
+      values.push_back(rp.values(j).value());
+    }
+    Member m;
+    if (!make_member(s, params, values, m)) bad(field, "leaves out every release");
+    m.scenario.clear_zoning();
+    *m.scenario.mutable_outputs() = s.outputs();  // each scenario's maps and files, as the scenario asks
+    auto* rasters = m.scenario.mutable_outputs()->mutable_rasters();
+    if (!rasters->empty())  // the zones read these two of every scenario
+      for (const char* r : {"max_depth", "max_pressure"})
+        if (std::find(rasters->begin(), rasters->end(), r) == rasters->end()) rasters->Add(r);
+    m.return_period_y = rp.return_period_y();
+    m.values.insert(m.values.begin(), {"return_period_y", rp.return_period_y()});
+    m.index = int(out.size());
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
 }  // namespace
 
-bool is_ensemble(const v1::Scenario& s) { return s.has_variations(); }
+bool is_ensemble(const v1::Scenario& s) { return s.has_variations() || s.has_zoning(); }
 
 bool number_at(const v1::Scenario& s, const std::string& path, double& value) {
   v1::Scenario copy = s;
@@ -334,6 +395,7 @@ bool number_at(const v1::Scenario& s, const std::string& path, double& value) {
 }
 
 std::vector<Member> expand(const v1::Scenario& s) {
+  if (s.has_zoning()) return expand_zoning(s);
   const auto& var = s.variations();
   if (s.engine() == "vof" && s.has_lab()) bad("variations", "ensembles run on a DEM; a laboratory set-up (lab) takes none");
   if (var.parameters().empty()) bad("variations.parameters", "at least one parameter to vary");
@@ -408,6 +470,12 @@ AggregateSettings aggregate_settings(const ResolvedScenario& r) {
   if (a.percentiles.empty()) a.percentiles = {5, 50, 95};
   a.maps = r.maps;
   a.name = r.scenario.name();
+  if (r.scenario.has_zoning()) {
+    const auto& z = r.scenario.zoning();
+    a.red_pressure_kpa = z.has_red_pressure_kpa() ? z.red_pressure_kpa() : 30;
+    a.frequent_y = z.has_frequent_y() ? z.frequent_y() : 30;
+    a.design_y = z.has_design_y() ? z.design_y() : 300;
+  }
   for (auto* list : {&a.depth_m, &a.speed_m_s, &a.pressure_kpa, &a.percentiles}) {
     std::sort(list->begin(), list->end());
     list->erase(std::unique(list->begin(), list->end()), list->end());
@@ -428,6 +496,7 @@ std::string ensemble_hash(const std::vector<std::string>& member_hashes, const A
   list("pressure_kpa", a.pressure_kpa);
   list("percentiles", a.percentiles);
   h.update(std::string("maps ") + (a.maps ? "1" : "0") + "\nname " + a.name + "\n");  // the maps and their titles
+  if (a.zoning()) h.update("zoning " + num(a.red_pressure_kpa) + " " + num(a.frequent_y) + " " + num(a.design_y) + "\n");
   for (const auto& m : member_hashes) h.update(m + "\n");
   return h.hex();
 }
@@ -440,7 +509,8 @@ Plan plan(const ResolvedScenario& e) {
     try {
       hash = scenario_hash(resolve_scenario(m.scenario, "/"));
     } catch (const ScenarioError& x) {
-      throw ScenarioError("variations: member " + std::to_string(m.index) + " (" + describe(m.values) + "): " + x.what());
+      throw ScenarioError(std::string(e.scenario.has_zoning() ? "zoning" : "variations") + ": member " + std::to_string(m.index) + " (" +
+                          describe(m.values) + "): " + x.what());
     }
     hashes.push_back(hash);
     p.members.push_back({std::move(m), hash});

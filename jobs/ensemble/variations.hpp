@@ -1,7 +1,7 @@
 #pragma once
-// Ensembles: a scenario with a `variations` block stands for many runs. This file turns the block into
-// its members (each a whole scenario of its own, without variations) and into the settings of the
-// aggregate. Everything here is deterministic: the same scenario gives the same members, in the same
+// Ensembles: a scenario with a `variations` block stands for many runs, and so does one with a
+// `zoning` block (one run per return period). This file turns the block into its members (each a
+// whole scenario of its own, without the block) and into the settings of the aggregate. Everything here is deterministic: the same scenario gives the same members, in the same
 // order, on every machine (the random draws use std::mt19937_64, whose sequence the standard fixes,
 // and our own mapping from its integers to numbers).
 #include <cstdint>
@@ -22,6 +22,7 @@ struct ParameterValue {
 /// One member: its place in the ensemble, the values that make it, and its scenario.
 struct Member {
   int index = 0;
+  double return_period_y = 0;  ///< a zoning's member: its return period (0 in a variations ensemble)
   std::vector<ParameterValue> values;
   v1::Scenario scenario;  ///< the ensemble's scenario with the values set, without `variations`
 };
@@ -34,6 +35,9 @@ struct AggregateSettings {
   std::vector<double> percentiles;   ///< of max depth, speed and pressure per cell, ascending, in [0, 100]
   bool maps = true;                  ///< the aggregate's maps (outputs.maps)
   std::string name;                  ///< the scenario's name (the maps' titles)
+  /// A zoning (scenario zoning): its rule, defaults filled in (0: not a zoning).
+  double red_pressure_kpa = 0, frequent_y = 0, design_y = 0;
+  bool zoning() const { return design_y > 0; }
 };
 
 /// The most members one ensemble may have.
@@ -42,12 +46,14 @@ inline constexpr int kMaxMembers = 100000;
 /// The version of what an ensemble's aggregate contains; part of its hash (ensemble_hash).
 inline constexpr int kEnsembleResultsVersion = 1;
 
-/// Whether the scenario is an ensemble (has a `variations` block).
+/// Whether the scenario is an ensemble (has a `variations` or a `zoning` block).
 bool is_ensemble(const v1::Scenario& s);
 
-/// The members of an ensemble's scenario, in order. Throws ScenarioError naming the field
-/// ("variations.parameters[1].percent: ...") for a block that does not make members: an unknown
-/// parameter, a value the parameter cannot take, no values, too many members.
+/// The members of an ensemble's scenario, in order (a zoning's by ascending return period). Throws
+/// ScenarioError naming the field ("variations.parameters[1].percent: ...",
+/// "zoning.scenarios[2].values: ...") for a block that does not make members: an unknown parameter,
+/// a value the parameter cannot take, no values, too many members, both blocks, a return period
+/// given twice.
 std::vector<Member> expand(const v1::Scenario& s);
 
 /// The aggregate's settings of a resolved ensemble scenario.

@@ -259,6 +259,19 @@ OptionTable variation_options() {
       {"variations.member_outputs", T::choice, U::keep, "rasters", {}, {"rasters", "all"}, "",
        "the members' outputs: hazard rasters and run.json only (no maps, no time series), or all the scenario asks for",
        "ensemble members"},
+      {"zoning.scenarios[].return_period_y", T::number, U::required, "", Range{1, 100000}, {}, "years",
+       "the scenario's return period (each once; at least two scenarios)", "zoning members"},
+      {"zoning.scenarios[].values[].parameter", T::text, U::required, "", {}, {}, "",
+       "a number of the scenario by its path, as variations name it (releases[].thickness_factor, material.voellmy_mu, ...)",
+       "zoning members"},
+      {"zoning.scenarios[].values[].value", T::number, U::as_given, "", Range{}, {}, "parameter's", "its value in this scenario",
+       "zoning members"},
+      {"zoning.red_pressure_kpa", T::number, U::as_given, "30", Range{0, 10000, true}, {}, "kPa",
+       "red where a scenario up to design_y reaches this pressure", "zoning aggregate"},
+      {"zoning.frequent_y", T::number, U::as_given, "30", Range{1, 100000}, {}, "years",
+       "red wherever a scenario up to this return period reaches", "zoning aggregate"},
+      {"zoning.design_y", T::number, U::as_given, "300", Range{1, 100000}, {}, "years",
+       "the scenarios up to this return period make red and blue; rarer ones yellow", "zoning aggregate"},
   };
 }
 

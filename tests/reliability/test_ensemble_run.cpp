@@ -101,3 +101,20 @@ TEST(EnsembleRun, AnInterruptedEnsembleContinuesToTheSameAggregate) {
   ASSERT_EQ(run(resumed.string(), state.string()), 0);
   expect_same_aggregate(whole, resumed);
 }
+
+// `runout run` on the bundled zoning (three return periods) through the local job system: the zones,
+// their polygons and map, each scenario's pressure map beside them, and the record of kind "zoning".
+TEST(EnsembleRun, AZoningWritesTheZonesAndEachScenariosMap) {
+  runout::test_support::TempDir tmp;
+  const fs::path out = tmp.p / "zones";
+  const std::string cmd = kBin + " run " + std::string(RUNOUT_SOURCE_DIR) + "/scenarios/in-den-arelen-zoning.json --out " + out.string() +
+                          " --state-dir " + (tmp.p / "state").string() + " --workers 2 --quiet";
+  const int rc = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(rc) && WEXITSTATUS(rc) == 0) << cmd;
+  for (const char* f : {"zones.tif", "zones.qml", "zones.gpkg", "zones.geojson", "map_zones.png", "map_max_pressure_30y.png",
+                        "map_max_pressure_100y.png", "map_max_pressure_300y.png", "max_depth_300y.tif", "run.json"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+  const std::string rec = read_file(out / "run.json");
+  EXPECT_NE(rec.find("\"kind\": \"zoning\""), std::string::npos);
+  EXPECT_NE(rec.find("\"guideline\": \"BFF & EISLF (1984)"), std::string::npos);
+}

@@ -270,3 +270,85 @@ TEST(EnsembleStatistics, PercentilesInterpolateBetweenOrderStatistics) {
   std::vector<double> v = {10, 30, 20};
   EXPECT_DOUBLE_EQ(ens::percentile_of(v, 50), 20);
 }
+
+namespace {
+
+// A zoning of the test scenario: return periods with the values given.
+v1::ReturnPeriodScenario* period(v1::Scenario& s, double years, std::initializer_list<std::pair<const char*, double>> values) {
+  auto* p = s.mutable_zoning()->add_scenarios();
+  p->set_return_period_y(years);
+  for (const auto& [name, value] : values) {
+    auto* v = p->add_values();
+    v->set_parameter(name);
+    v->set_value(value);
+  }
+  return p;
+}
+
+}  // namespace
+
+// A zoning makes one member per return period, ascending whatever the order given, each the scenario
+// with its values set, its return period recorded, its own outputs (maps as the scenario says), and
+// no zoning block.
+TEST(Zoning, OneMemberPerReturnPeriodAscendingWithItsValues) {
+  auto s = arelen();
+  period(s, 300, {{"releases[].thickness_factor", 1.0}, {"material.bed_friction_deg", 15}});
+  period(s, 30, {{"releases[].thickness_factor", 0.6}, {"material.bed_friction_deg", 18}});
+  period(s, 100, {});
+  ASSERT_TRUE(ens::is_ensemble(s));
+  const auto m = ens::expand(s);
+  ASSERT_EQ(m.size(), 3u);
+  EXPECT_EQ(m[0].return_period_y, 30);
+  EXPECT_EQ(m[1].return_period_y, 100);
+  EXPECT_EQ(m[2].return_period_y, 300);
+  EXPECT_EQ(m[0].scenario.material().bed_friction_deg(), 18);
+  EXPECT_EQ(m[0].scenario.releases(0).thickness_factor(), 0.6);
+  EXPECT_EQ(m[1].scenario.material().bed_friction_deg(), s.material().bed_friction_deg());  // the scenario's own
+  EXPECT_EQ(ens::describe(m[0].values), "return_period_y = 30, releases[].thickness_factor = 0.6, material.bed_friction_deg = 18");
+  for (const auto& x : m) {
+    EXPECT_FALSE(x.scenario.has_zoning());
+    EXPECT_FALSE(ens::is_ensemble(x.scenario));
+    EXPECT_EQ(x.scenario.outputs().maps(), s.outputs().maps());
+  }
+}
+
+// A zoning that cannot make its members is refused naming the field.
+TEST(Zoning, ErrorsNameTheField) {
+  auto s = arelen();
+  period(s, 30, {});
+  EXPECT_EQ(expand_error(s), "zoning.scenarios: at least two scenarios by return period (e.g. 30, 100 and 300 years)");
+  period(s, 30, {});
+  EXPECT_EQ(expand_error(s), "zoning.scenarios[1].return_period_y: 30 years is also scenarios[0]'s");
+  s = arelen();
+  period(s, 30, {});
+  period(s, 300, {{"material.bed_friction_deg", 15}, {"material.no_such_thing", 1}});
+  EXPECT_NE(expand_error(s).find("zoning.scenarios[1].values[1].parameter: 'material.no_such_thing' is not a number"), std::string::npos)
+      << expand_error(s);
+  s = arelen();
+  period(s, 30, {{"material.bed_friction_deg", 15}, {"material.bed_friction_deg", 16}});
+  period(s, 300, {});
+  EXPECT_NE(expand_error(s).find("zoning.scenarios[0].values[1].parameter: 'material.bed_friction_deg' is given twice"), std::string::npos)
+      << expand_error(s);
+  s = arelen();
+  period(s, 0.5, {});
+  period(s, 300, {});
+  EXPECT_EQ(expand_error(s), "zoning.scenarios[0].return_period_y: must lie in [1, 100000] years, got 0.5");
+  s = arelen();
+  period(s, 30, {});
+  period(s, 300, {});
+  s.mutable_zoning()->set_design_y(10);
+  EXPECT_EQ(expand_error(s), "zoning.design_y: must lie in [frequent_y (30), 100000] years, got 10");
+  vary(s, "material.bed_friction_deg")->add_values(14);
+  EXPECT_EQ(expand_error(s), "zoning: a scenario takes variations or zoning, not both");
+}
+
+// The zoning's rule is part of its hash: another red pressure or return period is another result.
+TEST(Zoning, HashFollowsTheRule) {
+  ens::AggregateSettings a{{0.1}, {1}, {3, 30}, {5, 50, 95}, true, "arelen"};
+  a.red_pressure_kpa = 30, a.frequent_y = 30, a.design_y = 300;
+  const auto h = ens::ensemble_hash({"m1", "m2"}, a);
+  a.red_pressure_kpa = 25;
+  EXPECT_NE(h, ens::ensemble_hash({"m1", "m2"}, a));
+  a.red_pressure_kpa = 30, a.design_y = 100;
+  EXPECT_NE(h, ens::ensemble_hash({"m1", "m2"}, a));
+}
