@@ -4,13 +4,15 @@
 #include <cstdio>
 
 namespace runout::jobs::products {
-namespace {
-
-std::string num(double v) {
+std::string legend_number(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%g", v);
   return b;
 }
+
+namespace {
+
+std::string num(double v) { return legend_number(v); }
 
 }  // namespace
 

@@ -21,6 +21,9 @@ struct ZoneMap {
 /// is at least zones[k].from_kpa and below zones[k + 1].from_kpa.
 ZoneMap pressure_zones(const std::vector<ZoneThreshold>& zones, const std::vector<double>& max_pressure_kpa);
 
+/// A number as the legends write it ("30", "0.5", "1e+03": printf's %g).
+std::string legend_number(double v);
+
 /// "blue: 3 – 30 kPa", "red: ≥ 30 kPa"
 std::string zone_label(const terrain::ValueClass& c);
 

@@ -1,5 +1,7 @@
 #include "jobs/products/zoning.hpp"
 
+#include "jobs/products/zones.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -7,11 +9,7 @@
 namespace runout::jobs::products {
 namespace {
 
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
-}
+std::string num(double v) { return legend_number(v); }
 
 }  // namespace
 

@@ -62,21 +62,7 @@ void check_path_runout(const TempDir& d, const jobs::ResolvedScenario& r) {
 // The largest value of a raster over the cells whose centres lie within `radius` of (x, y) (the
 // raster's CRS).
 double max_near(const std::string& tif, double x, double y, double radius) {
-  GDALDatasetUniquePtr ds(GDALDataset::Open(tif.c_str(), GDAL_OF_RASTER));
-  EXPECT_TRUE(ds);
-  if (!ds) return NAN;
-  double gt[6];
-  ds->GetGeoTransform(gt);
-  const int w = ds->GetRasterXSize(), h = ds->GetRasterYSize();
-  std::vector<double> v(std::size_t(w) * h);
-  EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, w, h, v.data(), w, h, GDT_Float64, 0, 0), CE_None);
-  double m = 0;
-  for (int r = 0; r < h; ++r)
-    for (int i = 0; i < w; ++i) {
-      const double cx = gt[0] + (i + 0.5) * gt[1], cy = gt[3] + (r + 0.5) * gt[5], z = v[std::size_t(r) * w + i];
-      if (std::hypot(cx - x, cy - y) <= radius && std::isfinite(z)) m = std::max(m, z);
-    }
-  return m;
+  return read_raster_values(tif).max_where([&](double cx, double cy) { return std::hypot(cx - x, cy - y) <= radius; });
 }
 
 }  // namespace

@@ -61,21 +61,7 @@ bool reachable(const terrain::Grid& g, const std::vector<double>& raise, std::si
 
 // The largest value of a raster of the run over the cells whose centres lie in xa <= x < xb.
 double max_between(const std::string& tif, double xa, double xb) {
-  GDALDatasetUniquePtr ds(GDALDataset::Open(tif.c_str(), GDAL_OF_RASTER));
-  EXPECT_TRUE(ds);
-  if (!ds) return NAN;
-  double gt[6];
-  ds->GetGeoTransform(gt);
-  const int w = ds->GetRasterXSize(), h = ds->GetRasterYSize();
-  std::vector<double> v(std::size_t(w) * h);
-  EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, w, h, v.data(), w, h, GDT_Float64, 0, 0), CE_None);
-  double m = 0;
-  for (int r = 0; r < h; ++r)
-    for (int i = 0; i < w; ++i) {
-      const double x = gt[0] + (i + 0.5) * gt[1], z = v[std::size_t(r) * w + i];
-      if (x >= xa && x < xb && std::isfinite(z)) m = std::max(m, z);
-    }
-  return m;
+  return read_raster_values(tif).max_where([&](double x, double) { return x >= xa && x < xb; });
 }
 
 }  // namespace

@@ -21,21 +21,8 @@ namespace products = runout::jobs::products;
 
 namespace {
 
-// A raster of the zoning's folder as numbers, row 0 north (GDAL's order); NaN for no data.
-std::vector<double> read_all(const fs::path& tif, int& w, int& h) {
-  GDALDatasetUniquePtr ds(GDALDataset::Open(tif.c_str(), GDAL_OF_RASTER));
-  EXPECT_TRUE(ds) << tif;
-  if (!ds) return {};
-  w = ds->GetRasterXSize();
-  h = ds->GetRasterYSize();
-  std::vector<double> v(std::size_t(w) * h);
-  EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, w, h, v.data(), w, h, GDT_Float64, 0, 0), CE_None);
-  int has = 0;
-  const double nodata = ds->GetRasterBand(1)->GetNoDataValue(&has);
-  for (double& x : v)
-    if (has && x == nodata) x = NAN;
-  return v;
-}
+// A raster of the zoning's folder as numbers (no data as NaN).
+std::vector<double> read_all(const fs::path& tif) { return read_raster_values(tif.string()).v; }
 
 }  // namespace
 
@@ -80,14 +67,13 @@ TEST(Zoning, InDenArelenZonesAreTheRuleAppliedToTheScenarios) {
   for (const char* f : {"zones.tif", "zones.qml", "zones.gpkg", "zones.geojson", "map_zones.png", "map_zones.pdf", "map_max_pressure_30y.png",
                         "map_max_pressure_100y.png", "map_max_pressure_300y.png", "run.json"})
     EXPECT_TRUE(fs::exists(d.p / "zones" / f)) << f;
-  int w = 0, h = 0;
-  const auto zones = read_all(d.p / "zones/zones.tif", w, h);
+  const auto zones = read_all(d.p / "zones/zones.tif");
   const double years[3] = {30, 100, 300};
   std::vector<double> depth[3], pressure[3];
   for (int k = 0; k < 3; ++k) {
     const std::string tag = std::to_string(int(years[k])) + "y.tif";
-    depth[k] = read_all(d.p / "zones" / ("max_depth_" + tag), w, h);
-    pressure[k] = read_all(d.p / "zones" / ("max_pressure_" + tag), w, h);
+    depth[k] = read_all(d.p / "zones" / ("max_depth_" + tag));
+    pressure[k] = read_all(d.p / "zones" / ("max_pressure_" + tag));
   }
   long count[4] = {0, 0, 0, 0}, reached[3] = {0, 0, 0};
   for (std::size_t c = 0; c < zones.size(); ++c) {

@@ -193,6 +193,43 @@ inline void check_outputs(const TempDir& d, const jobs::RunSummary& sum, const s
 }
 
 // The first lines of an ESRI ASCII grid as key -> value.
+// A raster's first band as numbers (row 0 north, GDAL's order; no data as NaN) with the centre of
+// each cell: cx(i), cy(r) in the raster's CRS.
+struct RasterValues {
+  int w = 0, h = 0;
+  double gt[6] = {0, 1, 0, 0, 0, -1};
+  std::vector<double> v;
+  double cx(int i) const { return gt[0] + (i + 0.5) * gt[1]; }
+  double cy(int r) const { return gt[3] + (r + 0.5) * gt[5]; }
+  /// The largest finite value over the cells whose centres `keep(x, y)` accepts (0 where none).
+  template <class Keep>
+  double max_where(Keep keep) const {
+    double m = 0;
+    for (int r = 0; r < h; ++r)
+      for (int i = 0; i < w; ++i) {
+        const double z = v[std::size_t(r) * w + i];
+        if (std::isfinite(z) && keep(cx(i), cy(r))) m = std::max(m, z);
+      }
+    return m;
+  }
+};
+inline RasterValues read_raster_values(const std::string& path) {
+  RasterValues r;
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER));
+  EXPECT_TRUE(ds) << path;
+  if (!ds) return r;
+  ds->GetGeoTransform(r.gt);
+  r.w = ds->GetRasterXSize();
+  r.h = ds->GetRasterYSize();
+  r.v.resize(std::size_t(r.w) * r.h);
+  EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, r.w, r.h, r.v.data(), r.w, r.h, GDT_Float64, 0, 0), CE_None);
+  int has = 0;
+  const double nodata = ds->GetRasterBand(1)->GetNoDataValue(&has);
+  for (double& x : r.v)
+    if (has && x == nodata) x = NAN;
+  return r;
+}
+
 inline std::map<std::string, double> ascii_header(const std::string& path) {
   std::ifstream in(path);
   std::map<std::string, double> h;
