@@ -37,33 +37,41 @@ using test_support::run_record;
 using test_support::station_at;
 using test_support::as_vector;
 
-// A DEM of n x n cells in `epsg` from x = 500000, y = 5200000 (south-west corner), the elevation
-// z(x, y) of each cell's centre relative to that corner, row r from the north; no data (-9999) where
-// z returns NaN.
+// A DEM of nx x ny cells in `epsg` with its south-west corner at (x0, y0), the elevation z(i, r) of
+// each cell's centre (column i, row r from the north); no data (-9999) where z returns NaN. An
+// ".asc" path is written as an ESRI ASCII grid, any other as GeoTIFF.
 template <class F>
-void make_dem_of(const std::string& path, int n, double cell, F z, const char* epsg = "EPSG:32632", bool with_crs = true) {
+void make_dem_box(const std::string& path, int nx, int ny, double cell, double x0, double y0, F z, const char* epsg = "EPSG:32632",
+                  bool with_crs = true) {
   GDALAllRegister();
   auto* drv = GetGDALDriverManager()->GetDriverByName(path.size() > 4 && path.substr(path.size() - 4) == ".asc" ? "AAIGrid" : "GTiff");
   auto* mem = GetGDALDriverManager()->GetDriverByName("MEM");
-  GDALDatasetUniquePtr ds(mem->Create("", n, n, 1, GDT_Float32, nullptr));
-  const double x0 = 500000, y0 = 5200000;
-  double gt[6] = {x0, cell, 0, y0 + n * cell, 0, -cell};
+  GDALDatasetUniquePtr ds(mem->Create("", nx, ny, 1, GDT_Float32, nullptr));
+  double gt[6] = {x0, cell, 0, y0 + ny * cell, 0, -cell};
   ds->SetGeoTransform(gt);
   if (with_crs) {
     OGRSpatialReference s;
     s.SetFromUserInput(epsg);
     ds->SetSpatialRef(&s);
   }
-  std::vector<float> v(std::size_t(n) * n);
-  for (int r = 0; r < n; ++r)
-    for (int i = 0; i < n; ++i) {
+  std::vector<float> v(std::size_t(nx) * ny);
+  for (int r = 0; r < ny; ++r)
+    for (int i = 0; i < nx; ++i) {
       const double e = z(i, r);
-      v[std::size_t(r) * n + i] = std::isnan(e) ? -9999.0f : float(e);
+      v[std::size_t(r) * nx + i] = std::isnan(e) ? -9999.0f : float(e);
     }
   ds->GetRasterBand(1)->SetNoDataValue(-9999.0);
-  EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, n, n, v.data(), n, n, GDT_Float32, 0, 0), CE_None);
+  EXPECT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, nx, ny, v.data(), nx, ny, GDT_Float32, 0, 0), CE_None);
   GDALDatasetUniquePtr out(drv->CreateCopy(path.c_str(), ds.get(), FALSE, nullptr, nullptr, nullptr));
   ASSERT_TRUE(out);
+}
+
+// A DEM of n x n cells in `epsg` from x = 500000, y = 5200000 (south-west corner), the elevation
+// z(x, y) of each cell's centre relative to that corner, row r from the north; no data (-9999) where
+// z returns NaN.
+template <class F>
+void make_dem_of(const std::string& path, int n, double cell, F z, const char* epsg = "EPSG:32632", bool with_crs = true) {
+  make_dem_box(path, n, n, cell, 500000, 5200000, z, epsg, with_crs);
 }
 
 // A DEM in UTM 32N (EPSG:32632): a slope of `deg` falling to the east, flattening into a valley.
