@@ -1,6 +1,7 @@
-// AvaFrame's published test cases through runout (docs/validation/validation.md, "Side by side with
-// AvaFrame"): the inclined plane with entrainment and resistance (avaInclinedPlaneEntresTest), its
-// input files as AvaFrame ships them (tests/data/avaframe-ip/PROVENANCE.md).
+// AvaFrame's published test cases through runout (docs/validation/validation.md, A10 and A11): the
+// inclined plane with entrainment and resistance (avaInclinedPlaneEntresTest) and the channelled
+// hockey stick with entrainment (avaHockeyChannelEntTest), their input files as AvaFrame ships them
+// (tests/data/avaframe-ip/ and avaframe-hs/, PROVENANCE.md there).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,7 +16,34 @@ using namespace runout::test_support::run;
 namespace {
 
 const std::string kData = std::string(RUNOUT_SOURCE_DIR) + "/tests/data/avaframe-ip/";
+const std::string kDataHs = std::string(RUNOUT_SOURCE_DIR) + "/tests/data/avaframe-hs/";
 constexpr double kAvaFrameEntrainedKg = 1742135.46;  // AvaFrame 1.11, samosAT
+
+// The standard normal distribution function.
+double phi(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
+
+// AvaFrame's hockey stick (generateTopo.hockey: a 34 deg plane from 2200 m, a circle of 200 m into
+// the flat foreland) with its narrowing channel added on top, at (x, y) of its own frame (x from the
+// top, y across from the channel's axis).
+double hockey_channel(double x, double y) {
+  const double a = 34.0 * M_PI / 180, z0 = 2200, rc = 200;
+  const double x1 = z0 / std::tan(a), beta = 0.5 * (M_PI - a), xc = rc / std::tan(beta), yc = xc * std::cos(a), xcirc = x1 + xc;
+  double z = x < x1 - yc ? z0 - std::tan(a) * x : x <= x1 + xc ? rc - std::sqrt(std::abs(rc * rc - (xcirc - x) * (xcirc - x))) : 0.0;
+  const double cff = 250, c_radius = 100, c_init = 250, mu_start = 0.2, mu_end = 0.86;
+  const double c0 = x < x1 * 0.5 * (mu_start + mu_end) ? phi((x - mu_start * x1) / cff) : 1 - phi((x - mu_end * x1) / cff);
+  const double extent = c_init * (1 - c0) + c0 * c_radius;
+  z += std::abs(y) < extent ? extent * c0 * (1 - std::sqrt(std::abs(1 - y * y / (extent * extent)))) : extent * c0;
+  return z;
+}
+
+// The Voellmy stand-in for samosAT and AvaFrame's density (inclined_plane below says why).
+void samosat_like(v1::Material* m) {
+  m->clear_bed_friction_deg();
+  m->set_rheology("voellmy");
+  m->set_density_kg_m3(200);
+  m->set_voellmy_mu(0.155);
+  m->set_voellmy_xi(1200);
+}
 
 // The benchmark's scenario: AvaFrame's inclined plane (built as its generateTopo does), release,
 // cover and forest; Voellmy friction close to samosAT's for a flow about 1 m deep (mu = tan delta =
@@ -30,12 +58,7 @@ v1::Scenario inclined_plane(const TempDir& d, double res) {
   r->clear_thickness_m();
   r->set_thickness_attribute("thickness");
   r->set_crs("EPSG:31287");
-  auto* m = s.mutable_material();
-  m->clear_bed_friction_deg();
-  m->set_rheology("voellmy");
-  m->set_density_kg_m3(200);
-  m->set_voellmy_mu(0.155);
-  m->set_voellmy_xi(1200);
+  samosat_like(s.mutable_material());
   auto* e = s.mutable_entrainment();
   auto* a = e->add_areas();
   a->set_path(kData + "entrainment1IP.shp");
@@ -82,4 +105,48 @@ TEST(AvaFrameBenchmarks, InclinedPlaneTakesUpTheWholeCoverAsAvaFrameDoes) {
   EXPECT_NEAR(det.volume_entrained_m3(), mb.volume_entrained_m3(), 1e-9 * mb.volume_entrained_m3());
   EXPECT_GT(det.volume_detrained_m3(), 0.5 * (det.volume_initial_m3() + det.volume_entrained_m3()));
   EXPECT_LT(det.relative_error(), 1e-12);
+}
+
+// The channelled hockey stick: the flow runs down the channel and takes up the part of the cover it
+// passes over (the polygon is wider than the channel), so here the friction matters. Against
+// AvaFrame's samosAT reference: entrained mass within 10 % (-5.2 % at 10 m), the farthest cell
+// deeper than 0.1 m within 100 m (4405 against 4465 m), the stop at 1 % of the peak kinetic energy
+// within 10 % of its time (296 against 300.7 s).
+TEST(AvaFrameBenchmarks, HockeyChannelTakesUpCoverAsAvaFrameDoes) {
+  TempDir d;
+  make_dem_box(d / "dem.tif", 1001, 401, 5.0, 997.5, -5002.5,
+               [](int i, int r) { return hockey_channel(5.0 * i, 1000 - 5.0 * r); }, "EPSG:31287");
+  v1::Scenario s = base_scenario(d / "dem.tif", kDataHs + "release1HS.shp", 10);
+  s.mutable_grid()->set_crs("dem");
+  auto* r = s.mutable_releases(0);
+  r->clear_thickness_m();
+  r->set_thickness_attribute("thickness");
+  r->set_crs("EPSG:31287");
+  samosat_like(s.mutable_material());
+  auto* e = s.mutable_entrainment();
+  auto* a = e->add_areas();
+  a->set_path(kDataHs + "entrainment1HS.shp");
+  a->set_thickness_attribute("thickness");
+  e->set_density_kg_m3(100);
+  s.mutable_numerics()->set_end_time_s(400);
+  s.mutable_numerics()->set_stop_fraction(0.01);
+  s.mutable_outputs()->set_maps(false);
+  fs::create_directories(d / "out");
+  jobs::run_scenario(jobs::resolve_scenario(s, d.p.string()), d / "out");
+  const auto rec = run_record(d / "out/run.json");
+  const auto& mb = rec.mass_balance();
+  const double entrained_kg = mb.volume_entrained_m3() * 200;
+  const auto depth = read_raster_values(d / "out/max_depth.tif");
+  double reach = 0;  // the farthest cell deeper than 0.1 m, as measured on AvaFrame's peak thickness
+  for (int row = 0; row < depth.h; ++row)
+    for (int i = 0; i < depth.w; ++i)
+      if (depth.v[std::size_t(row) * depth.w + i] > 0.1) reach = std::max(reach, depth.cx(i));
+  std::printf("initial %.0f kg, entrained %.0f kg (AvaFrame 333560), farthest x %.0f m (AvaFrame 4465), stop %s at %.1f s (AvaFrame 300.7)\n",
+              mb.volume_initial_m3() * 200, entrained_kg, reach, rec.solver().stop().c_str(), rec.solver().simulated_s());
+  EXPECT_NEAR(mb.volume_initial_m3() * 200 / 19924078.16, 1.0, 0.005);
+  EXPECT_NEAR(entrained_kg / 333560.24, 1.0, 0.10);
+  EXPECT_NEAR(reach, 4465, 100);
+  EXPECT_EQ(rec.solver().stop(), "kinetic-energy");
+  EXPECT_NEAR(rec.solver().simulated_s() / 300.7, 1.0, 0.10);
+  EXPECT_LT(mb.relative_error(), 1e-12);
 }
