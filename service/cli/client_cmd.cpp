@@ -108,7 +108,7 @@ void add_connection_options(CLI::App& app, service::ClientOptions& opt, Connecti
   if (server_env) server->envname("RUNOUT_SERVER");
   app.add_option("--token", opt.token, "Bearer token (default $RUNOUT_TOKEN)")->type_name("TOKEN")->envname("RUNOUT_TOKEN");
   app.add_option("--token-file", c.token_file, "Read the bearer token from the first line of FILE")->type_name("FILE");
-  app.add_option("--tls-ca", opt.tls_ca, "TLS, with the PEM certificate of the CA that signed the server's")
+  app.add_option("--tls-ca", opt.tls_ca, "TLS, with the PEM certificate (FILE) of the certificate authority that signed the server's certificate")
       ->type_name("FILE");
   app.add_flag("--tls", opt.tls, "TLS, with the system's root certificates");
 }

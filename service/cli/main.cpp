@@ -14,13 +14,15 @@
 
 namespace {
 
-const char* kHelp = R"(runout - hazard mapping for rapid granular flows (depth-averaged Savage-Hutter engine)
+const char* kHelp = R"(runout - hazard mapping for rapid granular flows: a depth-averaged Savage-Hutter engine
+(engine "depth-averaged") for runout, depth, speed and pressure maps, and a 3D two-phase VOF engine
+(engine "vof") on the DEM and on laboratory set-ups
 
 usage: runout <command> [options]      (runout <command> --help: the command's options in detail)
 
 commands:
   run SCENARIO.json --out DIR [--force] [--quiet] [--threads N] [--iseesnow SIMULATION_ID]
-        [--checkpoint FILE] [--restart FILE]
+        [--checkpoint FILE] [--restart FILE] [--state-dir DIR] [--workers N] [--members] [--no-terrain-cache]
         Run a scenario (JSON form of runout.v1.Scenario, see README) and write the hazard rasters
         (COG GeoTIFF), the runout outline (GeoJSON in WGS84, GeoPackage) and the run record (run.json)
         into DIR. Results appear only when the run succeeded. An existing DIR is replaced only with
@@ -34,11 +36,15 @@ commands:
         monitors travel in FILE, the frames so far in FILE.fields.h5, so run.json and fields.h5 are
         the whole run's. Depth-averaged runs: the solver's whole state and hazard maps travel in
         FILE, the time series so far in FILE.timeseries.h5; the continued run's outputs are the
-        uninterrupted run's, bit for bit (docs/design/depth-averaged.md).
+        uninterrupted run's, bit for bit (docs/design/depth-averaged.md). A scenario with variations
+        (an ensemble) or zoning (zones from scenarios by return period) runs its members on this
+        machine's cores through the local job system (--state-dir DIR, --workers N; --members also
+        copies each member's results) and writes the aggregate into DIR.
   verify [CASE...] [--full] [--resolutions R1,R2,...] [--limiter NAME] [--csv] [--threads N]
         Run the verification cases against exact solutions and invariants and print a table
-        (or CSV). Cases: A1 A2 A3 A4 A5 A6 A7 STRESS (default: all). --full adds the finest
-        resolutions. --resolutions overrides a case's cell sizes in metres (A2: cells across the cap).
+        (or CSV). Cases: A1-A7 and STRESS (depth-averaged engine), V1-V7 (VOF engine); default: all.
+        --full adds the finest resolutions. --resolutions overrides a case's cell sizes in metres
+        (A2: cells across the cap).
         Limiters: minmod (default), vanleer, superbee.
   serve [--recover] [--config FILE] [--listen HOST:PORT] [--state-dir DIR] [--data-root DIR]... [--tokens FILE]
         [--tls-cert FILE --tls-key FILE] [--workers N] [--threads-per-run N] [--log-file FILE] [--backend local|slurm]
