@@ -44,6 +44,19 @@ RUNOUT_SIMD_CLONES void face_row(int n, std::ptrdiff_t s, const double* __restri
 
 }  // namespace
 
+// A step face whose flux does not go through dam_face (a neighbour inactive or outside the domain):
+// no wall reaction on either side (the update reads it at every step face).
+template <bool X>
+void Solver::no_reaction(TileWork& w, int ib, int jb) const {
+  if constexpr (X) {
+    const std::size_t k = w.fx(ib, jb);
+    w.Wxa1[k] = w.Wxa2[k] = w.Wxb1[k] = w.Wxb2[k] = 0.0;
+  } else {
+    const std::size_t k = w.fy(ib, jb);
+    w.Wya1[k] = w.Wya2[k] = w.Wyb1[k] = w.Wyb2[k] = 0.0;
+  }
+}
+
 // The flux through a face between two cells of different dam heights (a dam's step): the flux of the
 // sides reconstructed over the step (over_step), and on each side the wall's reaction to the part that
 // does not pass (its wall flux minus that of the reconstructed side: no mass, pressure and the normal
@@ -57,7 +70,8 @@ Face Solver::dam_face(TileWork& w, int ia, int ja, int ib, int jb, bool held) co
   FaceState Ls = L, Rs = R;
   Ls.H = over_step(vmax(L.H, 0.0), vmax(L.un, 0.0), sa, g_, dam_[b] - dam_[a]);
   Rs.H = over_step(vmax(R.H, 0.0), vmax(-R.un, 0.0), sb, g_, dam_[a] - dam_[b]);
-  const Face wl = wall_flux(L, true), wls = wall_flux(Ls, true), wr = wall_flux(R, false), wrs = wall_flux(Rs, false);
+  const Face wl = wall_flux(L, true, held), wls = wall_flux(Ls, true, held), wr = wall_flux(R, false, held),
+             wrs = wall_flux(Rs, false, held);
   if constexpr (X) {  // x faces: normal = x momentum
     const std::size_t k = w.fx(ib, jb);
     w.Wxa1[k] = wl.f1 - wls.f1;
@@ -78,6 +92,8 @@ template <bool X>
 Face Solver::face(TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi, Boundary2D blo,
                   Boundary2D bhi) const {
   // Flux through the face between cells a (left/below) and b; lo/hi: the face is a domain edge.
+  const bool step = !lo && !hi && step_face(idx(ia, ja), idx(ib, jb));
+  if (step) no_reaction<X>(w, ib, jb);  // dam_face writes it where the face takes the step's flux
   if (!lo && !hi && !w.all_active && cell_active(ia, ja) != cell_active(ib, jb)) return Face{0, 0, 0};
   const bool oa = !lo && w.has_outside && outside(ia, ja), ob = !hi && w.has_outside && outside(ib, jb);
   if (oa && ob) return Face{0, 0, 0};
@@ -89,7 +105,7 @@ Face Solver::face(TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi,
   if (oa) L = outflow_ghost(R, false);
   if (ob) R = outflow_ghost(L, true);
   const bool held = !lo && !hi && !oa && !ob && w.held[w.at(ia, ja)] != 0.0 && w.held[w.at(ib, jb)] != 0.0;
-  if (!lo && !hi && !oa && !ob && step_face(idx(ia, ja), idx(ib, jb))) return dam_face<X>(w, ia, ja, ib, jb, held);
+  if (step && !oa && !ob) return dam_face<X>(w, ia, ja, ib, jb, held);
   return face_flux(L, R, held);
 }
 

@@ -265,10 +265,11 @@ RUNOUT_KERNEL double over_step(double H, double un_to, double s_n, double g, dou
 }
 
 // The flux a wall puts on a face side (`left`: the side left of the face, the wall right of it): the
-// flux against its mirror (boundary_ghost): no mass, the pressure, the normal momentum turned back.
-RUNOUT_KERNEL Face wall_flux(const FaceState& in, bool left) {
+// flux against its mirror (boundary_ghost): no mass, the pressure, the normal momentum turned back;
+// between cells friction holds at rest (held) the pressure only, as face_flux.
+RUNOUT_KERNEL Face wall_flux(const FaceState& in, bool left, bool held) {
   const FaceState m = boundary_ghost(in, true);
-  return left ? face_flux(in, m, false) : face_flux(m, in, false);
+  return left ? face_flux(in, m, held) : face_flux(m, in, held);
 }
 
 // ---- Positivity limiter and update ---------------------------------------------------------------

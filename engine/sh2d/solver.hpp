@@ -189,6 +189,8 @@ class Solver {
   Face face(TileWork& w, int ia, int ja, int ib, int jb, bool lo, bool hi, Boundary2D blo, Boundary2D bhi) const;
   template <bool X>
   Face dam_face(TileWork& w, int ia, int ja, int ib, int jb, bool held) const;
+  template <bool X>
+  void no_reaction(TileWork& w, int ib, int jb) const;
   long positivity(TileWork& w, int i0, int i1, int j0, int j1, double dt) const;
   void update(int tt, TileWork& w, const CellBox& c, double t, double dt);
   template <Basal B>

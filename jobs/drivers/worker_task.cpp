@@ -69,7 +69,7 @@ bool send_event(int fd, const v1::WorkerEvent& ev) {
 int aggregate(const ResolvedScenario& r, const v1::WorkerTask& task, int events) {
   const auto expanded = ensemble::expand(r.scenario);
   if (task.member_dirs_size() == 0)
-    throw std::invalid_argument("an ensemble (variations) runs as its members: submit it to the job system (runout run or the service)");
+    throw std::invalid_argument("an ensemble (variations or zoning) runs as its members: submit it to the job system (runout run or the service)");
   if (int(expanded.size()) != task.member_dirs_size() || task.member_hashes_size() != task.member_dirs_size())
     throw std::runtime_error("the ensemble has " + std::to_string(expanded.size()) + " members, the task names " +
                              std::to_string(task.member_dirs_size()));

@@ -335,8 +335,8 @@ std::vector<Member> expand_zoning(const v1::Scenario& s) {
   for (int k = 0; k < z.scenarios_size(); ++k) {
     order[std::size_t(k)] = k;
     const double t = z.scenarios(k).return_period_y();
-    if (!(t >= 1 && t <= 100000))
-      bad("zoning.scenarios[" + std::to_string(k) + "].return_period_y", "must lie in [1, 100000] years, got " + num(t));
+    if (!(t >= 1 && t <= 100000 && t == std::floor(t)))
+      bad("zoning.scenarios[" + std::to_string(k) + "].return_period_y", "must be a whole number of years in [1, 100000], got " + num(t));
     for (int j = 0; j < k; ++j)
       if (z.scenarios(j).return_period_y() == t)
         bad("zoning.scenarios[" + std::to_string(k) + "].return_period_y", num(t) + " years is also scenarios[" + std::to_string(j) + "]'s");
@@ -351,6 +351,7 @@ std::vector<Member> expand_zoning(const v1::Scenario& s) {
     std::set<std::string> seen;
     for (int j = 0; j < rp.values_size(); ++j) {
       const std::string at = field + "[" + std::to_string(j) + "]";
+      if (!rp.values(j).has_value()) bad(at + ".value", "missing: the number this scenario gives '" + rp.values(j).parameter() + "'");
       v1::Variation v;
       v.set_parameter(rp.values(j).parameter());
       v.add_values(rp.values(j).value());
@@ -496,7 +497,10 @@ std::string ensemble_hash(const std::vector<std::string>& member_hashes, const A
   list("pressure_kpa", a.pressure_kpa);
   list("percentiles", a.percentiles);
   h.update(std::string("maps ") + (a.maps ? "1" : "0") + "\nname " + a.name + "\n");  // the maps and their titles
-  if (a.zoning()) h.update("zoning " + num(a.red_pressure_kpa) + " " + num(a.frequent_y) + " " + num(a.design_y) + "\n");
+  if (a.zoning()) {  // the rule, and which member is which return period (a member's own hash does not say)
+    h.update("zoning " + num(a.red_pressure_kpa) + " " + num(a.frequent_y) + " " + num(a.design_y) + "\n");
+    for (double t : a.return_periods_y) h.update("return period " + num(t) + "\n");
+  }
   for (const auto& m : member_hashes) h.update(m + "\n");
   return h.hex();
 }
@@ -516,6 +520,7 @@ Plan plan(const ResolvedScenario& e) {
     p.members.push_back({std::move(m), hash});
   }
   p.settings = aggregate_settings(e);
+  for (const auto& m : p.members) p.settings.return_periods_y.push_back(m.member.return_period_y);
   p.hash = ensemble_hash(hashes, p.settings);
   return p;
 }

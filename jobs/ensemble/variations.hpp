@@ -37,6 +37,7 @@ struct AggregateSettings {
   std::string name;                  ///< the scenario's name (the maps' titles)
   /// A zoning (scenario zoning): its rule, defaults filled in (0: not a zoning).
   double red_pressure_kpa = 0, frequent_y = 0, design_y = 0;
+  std::vector<double> return_periods_y;  ///< per member, in order (plan fills it; part of the hash)
   bool zoning() const { return design_y > 0; }
 };
 
@@ -60,7 +61,8 @@ std::vector<Member> expand(const v1::Scenario& s);
 AggregateSettings aggregate_settings(const ResolvedScenario& r);
 
 /// The ensemble's hash: its members' hashes in order, the aggregate's settings (thresholds,
-/// percentiles, maps and the name in their titles) and its results version. Two ensembles with the same hash have the same aggregate.
+/// percentiles, maps and the name in their titles; a zoning's rule and each member's return period)
+/// and its results version. Two ensembles with the same hash have the same aggregate.
 std::string ensemble_hash(const std::vector<std::string>& member_hashes, const AggregateSettings& a);
 
 /// An ensemble ready to be queued: each member resolved (validated) and hashed, and the ensemble's hash.

@@ -332,7 +332,11 @@ TEST(Zoning, ErrorsNameTheField) {
   s = arelen();
   period(s, 0.5, {});
   period(s, 300, {});
-  EXPECT_EQ(expand_error(s), "zoning.scenarios[0].return_period_y: must lie in [1, 100000] years, got 0.5");
+  EXPECT_EQ(expand_error(s), "zoning.scenarios[0].return_period_y: must be a whole number of years in [1, 100000], got 0.5");
+  s = arelen();
+  period(s, 30, {});
+  period(s, 300, {})->add_values()->set_parameter("material.bed_friction_deg");
+  EXPECT_EQ(expand_error(s), "zoning.scenarios[1].values[0].value: missing: the number this scenario gives 'material.bed_friction_deg'");
   s = arelen();
   period(s, 30, {});
   period(s, 300, {});
@@ -351,4 +355,10 @@ TEST(Zoning, HashFollowsTheRule) {
   EXPECT_NE(h, ens::ensemble_hash({"m1", "m2"}, a));
   a.red_pressure_kpa = 30, a.design_y = 100;
   EXPECT_NE(h, ens::ensemble_hash({"m1", "m2"}, a));
+  // The same members as other return periods: other zones (a member's hash does not hold its period).
+  a.design_y = 300;
+  a.return_periods_y = {30, 100};
+  const auto h2 = ens::ensemble_hash({"m1", "m2"}, a);
+  a.return_periods_y = {30, 1000};
+  EXPECT_NE(h2, ens::ensemble_hash({"m1", "m2"}, a));
 }

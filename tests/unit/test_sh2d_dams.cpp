@@ -3,6 +3,7 @@
 // exactly as the volume balance moves it, a run continued from a checkpoint is the uninterrupted run,
 // and bad dam heights are refused.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <cmath>
 #include <limits>
@@ -70,6 +71,38 @@ TEST(Sh2dDams, ALakeAtRestAgainstADamStaysAtRest) {
   }
   EXPECT_EQ(r.gauge_right[0], 0.0);
   EXPECT_EQ(r.gauge_left[0], 0.0);
+}
+
+// The same lakes on several tiles, where the dam and the lakes meet cells outside the domain (the
+// top row, dams standing on some of them) and across tile borders, on one and on two threads: at
+// rest to the bit (a face whose flux does not take the step's, towards the outside, puts no wall
+// reaction on its cells).
+TEST(Sh2dDams, ALakeAtRestStaysAtRestWhereTheDamMeetsTheOutside) {
+  DammedFlat f(3.0);
+  f.cfg.material.delta = 0;
+  f.cfg.time.t_end = 30;
+  f.cfg.time.stop_fraction = 0;
+  f.cfg.tile = 8;
+  f.t.outside.assign(f.t.cells(), 0);
+  for (int i = 0; i < kNx; ++i) {
+    const std::size_t k = std::size_t(kNy - 1) * kNx + i;
+    f.t.outside[k] = 1;
+    f.cfg.dam_height[k] = i % 3 == 0 ? 2.5 : 0.0;  // dams on outside cells too: steps towards the outside
+  }
+  f.cfg.gauges.clear();
+  std::vector<double> h(f.t.cells(), 0.0);
+  for (int j = 0; j < kNy - 1; ++j)
+    for (int i = 0; i < kNx; ++i) h[std::size_t(j) * kNx + i] = i < kDam ? 2.0 : i > kDam ? 1.0 : 0.0;
+  const auto init = state_from_normal_depth(f.t, h);
+  for (int threads : {1, 2}) {
+    omp_set_num_threads(threads);
+    const auto r = run_sh2d(f.t, f.cfg, init);
+    EXPECT_EQ(r.state.H, init.H) << threads << " thread(s)";
+    for (std::size_t k = 0; k < f.t.cells(); ++k) {
+      ASSERT_EQ(r.state.HU[k], 0.0) << k << ", " << threads << " thread(s)";
+      ASSERT_EQ(r.state.HV[k], 0.0) << k << ", " << threads << " thread(s)";
+    }
+  }
 }
 
 // A pile 8 m high collapses against a dam 1 m high (Coulomb, 2 deg): part of it passes. What the
