@@ -5,8 +5,9 @@
 // over the active tiles and checkpoints (the time loop is engine/stepping.cpp's); tile.cpp one tile's
 // step (the cells it computes, the order of the stages); predictor.cpp the reconstruction and the
 // predictor to the half step (with the earth pressure and the start/stop law's terms); fluxes.cpp the
-// face fluxes with the boundary and outflow ghosts; update.cpp the positivity limiter, the update with
-// its sources and friction, the hazard maps and the tile sums; surface.cpp the surface geometry.
+// face fluxes with the boundary and outflow ghosts and the dams' step faces; update.cpp the positivity
+// limiter, the update with its sources and friction, the hazard maps and the tile sums; surface.cpp the
+// surface geometry; cells.cpp which cells take the general loops and the flux gauges.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>

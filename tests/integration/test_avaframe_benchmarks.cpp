@@ -36,13 +36,30 @@ double hockey_channel(double x, double y) {
   return z;
 }
 
-// The Voellmy stand-in for samosAT and AvaFrame's density (inclined_plane below says why).
-void samosat_like(v1::Material* m) {
+// An AvaFrame test case as a scenario: the DEM (dem.tif in `d`, in AvaFrame's frame, EPSG:31287), its
+// release (attribute thickness, normal) and cover (attribute thickness, 100 kg/m^3), Voellmy friction
+// close to samosAT's at AvaFrame's density 200 kg/m^3 (inclined_plane says why), 400 s.
+v1::Scenario avaframe_scenario(const TempDir& d, const std::string& release, const std::string& cover, double res) {
+  v1::Scenario s = base_scenario(d / "dem.tif", release, res);
+  s.mutable_grid()->set_crs("dem");
+  auto* r = s.mutable_releases(0);
+  r->clear_thickness_m();
+  r->set_thickness_attribute("thickness");
+  r->set_crs("EPSG:31287");
+  auto* m = s.mutable_material();
   m->clear_bed_friction_deg();
   m->set_rheology("voellmy");
   m->set_density_kg_m3(200);
   m->set_voellmy_mu(0.155);
   m->set_voellmy_xi(1200);
+  auto* e = s.mutable_entrainment();
+  auto* a = e->add_areas();
+  a->set_path(cover);
+  a->set_thickness_attribute("thickness");
+  e->set_density_kg_m3(100);
+  s.mutable_numerics()->set_end_time_s(400);
+  s.mutable_outputs()->set_maps(false);
+  return s;
 }
 
 // The benchmark's scenario: AvaFrame's inclined plane (built as its generateTopo does), release,
@@ -52,22 +69,9 @@ void samosat_like(v1::Material* m) {
 v1::Scenario inclined_plane(const TempDir& d, double res) {
   const double t = std::tan(34.0 * M_PI / 180);
   make_dem_box(d / "dem.tif", 1001, 401, 5.0, 997.5, -5002.5, [&](int i, int) { return 2200 - t * 5.0 * i; }, "EPSG:31287");
-  v1::Scenario s = base_scenario(d / "dem.tif", kData + "release1IP.shp", res);
-  s.mutable_grid()->set_crs("dem");
-  auto* r = s.mutable_releases(0);
-  r->clear_thickness_m();
-  r->set_thickness_attribute("thickness");
-  r->set_crs("EPSG:31287");
-  samosat_like(s.mutable_material());
-  auto* e = s.mutable_entrainment();
-  auto* a = e->add_areas();
-  a->set_path(kData + "entrainment1IP.shp");
-  a->set_thickness_attribute("thickness");
-  e->set_density_kg_m3(100);
+  v1::Scenario s = avaframe_scenario(d, kData + "release1IP.shp", kData + "entrainment1IP.shp", res);
   s.mutable_resistance()->add_areas()->set_path(kData + "resistance1IP.shp");
-  s.mutable_numerics()->set_end_time_s(400);
   s.mutable_numerics()->set_stop_fraction(0);
-  s.mutable_outputs()->set_maps(false);
   return s;
 }
 
@@ -116,21 +120,8 @@ TEST(AvaFrameBenchmarks, HockeyChannelTakesUpCoverAsAvaFrameDoes) {
   TempDir d;
   make_dem_box(d / "dem.tif", 1001, 401, 5.0, 997.5, -5002.5,
                [](int i, int r) { return hockey_channel(5.0 * i, 1000 - 5.0 * r); }, "EPSG:31287");
-  v1::Scenario s = base_scenario(d / "dem.tif", kDataHs + "release1HS.shp", 10);
-  s.mutable_grid()->set_crs("dem");
-  auto* r = s.mutable_releases(0);
-  r->clear_thickness_m();
-  r->set_thickness_attribute("thickness");
-  r->set_crs("EPSG:31287");
-  samosat_like(s.mutable_material());
-  auto* e = s.mutable_entrainment();
-  auto* a = e->add_areas();
-  a->set_path(kDataHs + "entrainment1HS.shp");
-  a->set_thickness_attribute("thickness");
-  e->set_density_kg_m3(100);
-  s.mutable_numerics()->set_end_time_s(400);
+  v1::Scenario s = avaframe_scenario(d, kDataHs + "release1HS.shp", kDataHs + "entrainment1HS.shp", 10);
   s.mutable_numerics()->set_stop_fraction(0.01);
-  s.mutable_outputs()->set_maps(false);
   fs::create_directories(d / "out");
   jobs::run_scenario(jobs::resolve_scenario(s, d.p.string()), d / "out");
   const auto rec = run_record(d / "out/run.json");
