@@ -131,8 +131,7 @@ class Solver {
   bool outside(int i, int j) const { return !out_.empty() && out_[idx(i, j)]; }
   // The cell or one of its four neighbours lies outside the domain (such cells take the general loop).
   bool near_outside(std::size_t k) const { return !near_out_.empty() && near_out_[k]; }
-  // The dam height of a cell (0 without dams) and whether the face between cells k and m is a step.
-  double dam(std::size_t k) const { return dam_.empty() ? 0.0 : dam_[k]; }
+  // Whether the face between cells k and m is a dam's step (their dam heights differ).
   bool step_face(std::size_t k, std::size_t m) const { return !dam_.empty() && dam_[k] != dam_[m]; }
   // The cell takes the general loops of the predictor and the update (near the outside, next to a
   // dam's step, a flux gauge's cell); the row kernels take the others.

@@ -61,19 +61,21 @@ void Solver::update_cell(TileWork& w, int i, int j, int i0, double t1, double dt
   const double ss = upwind_blend(w.Fy0[y], rs, rc), sn = upwind_blend(w.Fy0[y + w.bw], rc, rn);
   const bool ow = w.has_outside && i > 0 && outside(i - 1, j), oe = w.has_outside && i < nx_ - 1 && outside(i + 1, j);
   const bool os = w.has_outside && j > 0 && outside(i, j - 1), on = w.has_outside && j < ny_ - 1 && outside(i, j + 1);
-  if (gauge_cell(idx(i, j))) {  // a flux gauge's cell: what its faces send to the gauge's right and left
-    const int q = gauge_slot_[idx(i, j)];
-    const double sent[4] = {-w.Fx0[x] * sw * dt * t_.dy, w.Fx0[x + 1] * se * dt * t_.dy, -w.Fy0[y] * ss * dt * t_.dx,
-                            w.Fy0[y + w.bw] * sn * dt * t_.dx};
+  // The volume each face sends out in the step (W, E, S, N; negative: it comes in): what leaves
+  // through the domain's edges, and what a flux gauge's cell sends to the gauge's right and left.
+  const double sent[4] = {-w.Fx0[x] * sw * dt * t_.dy, w.Fx0[x + 1] * se * dt * t_.dy, -w.Fy0[y] * ss * dt * t_.dx,
+                          w.Fy0[y + w.bw] * sn * dt * t_.dx};
+  if (gauge_cell(idx(i, j))) {
+    const int g = gauge_slot_[idx(i, j)];
     for (int f = 0; f < 4; ++f) {
-      if (slot_sides_[q][f] > 0) slot_right_[q] += sent[f];
-      if (slot_sides_[q][f] < 0) slot_left_[q] += sent[f];
+      if (slot_sides_[g][f] > 0) slot_right_[g] += sent[f];
+      if (slot_sides_[g][f] < 0) slot_left_[g] += sent[f];
     }
   }
-  if (i == 0 || ow) out -= w.Fx0[x] * sw * dt * t_.dy;
-  if (i == nx_ - 1 || oe) out += w.Fx0[x + 1] * se * dt * t_.dy;
-  if (j == 0 || os) out -= w.Fy0[y] * ss * dt * t_.dx;
-  if (j == ny_ - 1 || on) out += w.Fy0[y + w.bw] * sn * dt * t_.dx;
+  if (i == 0 || ow) out += sent[0];
+  if (i == nx_ - 1 || oe) out += sent[1];
+  if (j == 0 || os) out += sent[2];
+  if (j == ny_ - 1 || on) out += sent[3];
   double smu = 0, swt = 0;
   if constexpr (B == Basal::hysteresis) {
     const std::size_t k = idx(i, j);

@@ -12,6 +12,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "jobs/drivers/hazard_maps.hpp"
 #include "jobs/drivers/hazard_outputs.hpp"
 #include "jobs/drivers/zoning.hpp"
 #include "jobs/ensemble/statistics.hpp"
@@ -79,9 +80,7 @@ std::vector<std::string> map_block(const ResolvedScenario& e, const std::vector<
     }
   for (const auto& name : order)
     p.push_back("varied: " + name + " " + num(range[name].first) + " – " + num(range[name].second));
-  p.push_back("grid: " + num(g.dx) + " m, " + std::to_string(g.nx) + " × " + std::to_string(g.ny) + " cells, " + g.crs_name);
-  const auto sw = this_software();
-  p.push_back("software: runout " + sw.version() + " (" + sw.git_commit().substr(0, 10) + ")");
+  for (auto& line : map_footer(g)) p.push_back(std::move(line));
   return p;
 }
 

@@ -232,10 +232,14 @@ std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain
     p.push_back("dam: " + d.name + (d.request.has_height ? ", " + num(d.request.height) + " m high" : ", height from '" + d.request.height_attribute + "'"));
   p.push_back("release: " + num(std::round(release_volume_m3)) + " m³ in " + std::to_string(s.releases.size()) +
               (s.releases.size() == 1 ? " release" : " releases"));
-  p.push_back("grid: " + num(grid.dx) + " m, " + std::to_string(grid.nx) + " × " + std::to_string(grid.ny) + " cells, " + grid.crs_name);
-  const auto sw = this_software();
-  p.push_back("software: runout " + sw.version() + " (" + sw.git_commit().substr(0, 10) + ")");
+  for (auto& line : map_footer(grid)) p.push_back(std::move(line));
   return p;
+}
+
+std::vector<std::string> map_footer(const terrain::Grid& grid) {
+  const auto sw = this_software();
+  return {"grid: " + num(grid.dx) + " m, " + std::to_string(grid.nx) + " × " + std::to_string(grid.ny) + " cells, " + grid.crs_name,
+          "software: runout " + sw.version() + " (" + sw.git_commit().substr(0, 10) + ")"};
 }
 
 void write_hazard_maps(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,

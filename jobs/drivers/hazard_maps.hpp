@@ -45,6 +45,9 @@ OutputInputs read_output_inputs(const ResolvedScenario& s, const terrain::Grid& 
 
 /// The lines of the maps' parameter block: engine, friction, release, grid, software.
 std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain::Grid& grid, double release_volume_m3);
+/// The last lines of every map's parameter block: the grid ("grid: 10 m, 200 × 150 cells, EPSG:32632")
+/// and the software with its commit.
+std::vector<std::string> map_footer(const terrain::Grid& grid);
 
 /// What every map of a run draws besides its quantity.
 struct MapOverlay {

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "jobs/drivers/hazard_maps.hpp"
 #include "jobs/drivers/hazard_outputs.hpp"
 #include "jobs/figures/hazard_map.hpp"
 #include "jobs/figures/qml.hpp"
@@ -126,9 +127,7 @@ void draw_zones(const ResolvedScenario& e, const products::ZoningRule& rule, con
     const std::vector<ensemble::ParameterValue> own(v.begin() + (v.empty() ? 0 : 1), v.end());
     m.parameters.push_back(period_tag(mr.member.return_period_y) + ": " + (own.empty() ? "the scenario's values" : ensemble::describe(own)));
   }
-  m.parameters.push_back("grid: " + num(g.dx) + " m, " + std::to_string(g.nx) + " × " + std::to_string(g.ny) + " cells, " + g.crs_name);
-  const auto sw = this_software();
-  m.parameters.push_back("software: runout " + sw.version() + " (" + sw.git_commit().substr(0, 10) + ")");
+  for (auto& line : map_footer(g)) m.parameters.push_back(std::move(line));
   const auto& pois = e.scenario.outputs().points_of_interest();
   const char* names[4] = {"", "yellow", "blue", "red"};
   for (int k = 0; k < pois.size(); ++k) {
