@@ -64,9 +64,12 @@ void write_band_stack(const std::string& path, const Grid& g, const std::vector<
   init_gdal();
   CPLErrorReset();
   if (bands.empty()) throw TerrainError("writing '" + path + "': no bands");
+  // The bands go one at a time into a tiled GeoTIFF beside the file (a frame's band need not be in
+  // memory with the others), which then becomes the Cloud Optimized GeoTIFF.
   auto* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
+  const std::string part = path + ".part.tif";
   const char* opts[] = {"TILED=YES", "COMPRESS=DEFLATE", "PREDICTOR=3", "BIGTIFF=IF_SAFER", "INTERLEAVE=BAND", nullptr};
-  GDALDatasetUniquePtr ds(gtiff->Create(path.c_str(), g.nx, g.ny, int(bands.size()), GDT_Float32, const_cast<char**>(opts)));
+  GDALDatasetUniquePtr ds(gtiff->Create(part.c_str(), g.nx, g.ny, int(bands.size()), GDT_Float32, const_cast<char**>(opts)));
   if (!ds) throw TerrainError("writing '" + path + "' failed" + gdal_message());
   double gt[6] = {g.x_min, g.dx, 0, g.y_min + g.ny * g.dx, 0, -g.dx};
   ds->SetGeoTransform(gt);
@@ -84,7 +87,15 @@ void write_band_stack(const std::string& path, const Grid& g, const std::vector<
     if (band->RasterIO(GF_Write, 0, 0, g.nx, g.ny, rows.data(), g.nx, g.ny, GDT_Float32, 0, 0) != CE_None)
       throw TerrainError("writing '" + path + "' failed" + gdal_message());
   }
-  ds.reset();  // closes the file; a failure to flush shows in CPLGetLastErrorType
+  try {
+    save_cog(*ds, path, "PREDICTOR=YES");
+  } catch (...) {
+    ds.reset();
+    VSIUnlink(part.c_str());
+    throw;
+  }
+  ds.reset();
+  VSIUnlink(part.c_str());
   if (CPLGetLastErrorType() == CE_Failure) throw TerrainError("writing '" + path + "' failed" + gdal_message());
 }
 

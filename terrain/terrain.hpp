@@ -160,10 +160,21 @@ std::vector<std::uint8_t> rasterize_polygons(const Grid& g, const std::string& p
 /// tile; NaN cells are written as nodata.
 void write_cog(const std::string& path, const Grid& g, const std::vector<double>& values, const BandInfo& band);
 
-/// A multi-band GeoTIFF on the grid (tiled, DEFLATE, BigTIFF when needed), Float32, nodata -9999
+/// A field of a time cube: its variable name, long name, unit and its values at frame b (row 0 south).
+struct CubeField {
+  std::string name, long_name, unit;
+  std::function<std::vector<double>(std::size_t)> values;
+};
+/// The frames as one NetCDF-4 file with the CF conventions (time, y, x; coordinate variables, the
+/// grid's CRS as grid mapping; Float32, DEFLATE, nodata -9999 for NaN and the cells outside the
+/// domain). Time is in seconds since the release, which CF's units put at 1970-01-01. Throws TerrainError.
+void write_time_cube(const std::string& path, const Grid& g, const std::vector<double>& times_s, const std::vector<CubeField>& fields);
+
+/// A multi-band Cloud Optimized GeoTIFF on the grid (DEFLATE, BigTIFF when needed), Float32, nodata -9999
 /// (NaN and the cells outside the domain): band k holds values(k) (row 0 south) and bands[k]'s
 /// description, unit and metadata; `dataset_metadata` goes to the file. Bands are written one at a
-/// time, so that a long series never needs to be in memory at once.
+/// time into a tiled GeoTIFF beside it (`path`.part.tif, removed), so that a long series never needs
+/// to be in memory at once.
 void write_band_stack(const std::string& path, const Grid& g, const std::vector<BandInfo>& bands,
                       const std::function<std::vector<double>(std::size_t)>& values,
                       const std::vector<std::pair<std::string, std::string>>& dataset_metadata);

@@ -324,7 +324,10 @@ RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& tim
   sum.seconds_prepare = times.prepare;
   sum.cpu_seconds = times.cpu;
   int frames = 0;
-  if (series_) frames = series_->finish();
+  if (series_) {
+    frames = series_->finish();
+    use_flow_path(s_, grid_, h0_, res.hazard.max_depth, series_->mass_centres(), output_inputs_);
+  }
   sum.seconds_run = times.run;
   const auto& d = res.diag;
   sum.volume_initial = d.volume_initial;
@@ -360,8 +363,8 @@ RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& tim
     // QGIS styles for the frames' GeoTIFFs: the depth and speed maps' classes, on any band chosen.
     figures::write_qml_ramp((fs::path(out_dir_) / "timeseries_depth.qml").string(), figures::hazard_palette("max_depth"));
     figures::write_qml_ramp((fs::path(out_dir_) / "timeseries_speed.qml").string(), figures::hazard_palette("max_speed"));
-    for (const char* f : {"timeseries.h5", "timeseries.xmf", "timeseries_depth.tif", "timeseries_depth.qml", "timeseries_speed.tif",
-                          "timeseries_speed.qml"})
+    for (const char* f : {"timeseries.h5", "timeseries.xmf", "timeseries.nc", "timeseries_depth.tif", "timeseries_depth.qml",
+                          "timeseries_speed.tif", "timeseries_speed.qml"})
       sum.files.push_back(f);
   }
   sum.seconds_write = std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();

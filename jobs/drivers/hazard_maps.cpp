@@ -69,9 +69,11 @@ OutputInputs read_output_inputs(const ResolvedScenario& s, const terrain::Grid& 
   in.points = place_points_of_interest(s, grid);
   if (!s.path.line_path.empty()) {
     in.path = terrain::read_line(grid, s.path.line_path, s.path.crs, "path.line_path");
-  } else {
+    in.path_source = s.path.line_path;
+  } else {  // until the run gives the flow's own path (use_flow_path)
     const auto [mx, my] = release_centroid(grid, h0);
     if (std::isfinite(mx)) in.path = products::steepest_descent(grid, mx, my);
+    in.path_source = "steepest descent from the release's centroid";
   }
   if (!s.observed_outline.empty()) {
     in.observed = terrain::rasterize_polygons(grid, s.observed_outline, s.observed_crs, "observations.outline_path");
@@ -90,6 +92,36 @@ OutputInputs read_output_inputs(const ResolvedScenario& s, const terrain::Grid& 
   for (const auto& c : s.cover) in.cover_areas.push_back(terrain::rasterize_releases(grid, s.dem, {c.release}));
   for (const auto& d : s.dams) in.dams.push_back(terrain::rasterize_dam(grid, d.request));
   return in;
+}
+
+void use_flow_path(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const std::vector<double>& max_depth,
+                   const std::vector<std::array<double, 3>>& centres, OutputInputs& in) {
+  if (!s.path.line_path.empty()) return;  // the user's line stands
+  std::vector<products::TrackPoint> track;
+  for (const auto& c : centres)
+    if (std::isfinite(c[1]) && std::isfinite(c[2])) track.push_back({c[0], c[1], c[2]});
+  // The path must reach the flow's farthest point: the mass centre's path where its cross-sections
+  // take that point in (a flow that stayed together), else the longest flow line (a flow that split,
+  // or whose mass centre left the outline, has its farthest reach off the mass centre's path).
+  std::pair<double, double> far{NAN, NAN};
+  auto longest = products::longest_flow_line(grid, h0, max_depth, s.outline_threshold, &far);
+  auto centre = products::track_inside_outline(grid, track, max_depth, s.outline_threshold) ? products::flow_path(grid, track, h0)
+                                                                                            : products::Line{};
+  char b[300];
+  if (centre.size() >= 2 && (longest.empty() || products::distance_to_line(centre, far.first, far.second) <= 0.5 * s.path.width_m)) {
+    in.path = std::move(centre);
+    std::snprintf(b, sizeof b, "the flow's mass centre (%zu frames to t = %g s), extended to the release's top and to the domain's edge",
+                  track.size(), track.back().t);
+  } else if (longest.size() >= 2) {
+    in.path = std::move(longest);
+    std::snprintf(b, sizeof b,
+                  "the longest flow line through the outline from the release's top to its farthest cell (%.0f, %.0f), extended to the "
+                  "domain's edge (the mass centre's path does not reach that cell)",
+                  far.first, far.second);
+  } else {
+    return;
+  }
+  in.path_source = b;
 }
 
 void write_path_outputs(const ResolvedScenario& s, const products::PathProfile& p, const std::string& out_dir, RunSummary& sum) {
@@ -253,7 +285,11 @@ void write_hazard_maps(const ResolvedScenario& s, const terrain::Grid& grid, con
     figures::HazardMap m = base;
     m.palette = figures::hazard_palette(r.name);
     m.title = name + ": " + m.palette.title;
-    m.values = values[q];
+    // Every quantity only where the flow is mapped (inside the outline): speed, pressure and arrival
+    // time reach out to the flow threshold, where a film of a centimetre would colour the map.
+    m.values = figures::inside_outline(values[q], hz.max_depth, s.outline_threshold);
+    m.colour_note = "coloured inside the outline only (max depth > " + num(s.outline_threshold) + " m)";
+    m.show_maximum = true;
     if (r.name == "max_pressure") m.boundaries.push_back({zones.cls, zones.palette});
     draw(r.name, std::move(m));
   }

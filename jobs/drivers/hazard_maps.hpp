@@ -2,6 +2,7 @@
 // The report-ready maps of a run on the DEM (both engines alike): one per hazard quantity and one of
 // the pressure zones, PNG and PDF, with the release, the outline, the points of interest and the
 // run's parameters; and the points of interest's figures for run.json.
+#include <array>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,7 @@ struct PlacedPoint {
 struct OutputInputs {
   std::vector<PlacedPoint> points;
   products::Line path;
+  std::string path_source;  ///< what the path is (run.json's path.source)
   std::vector<std::uint8_t> observed;
   /// Per resistance area (scenario `resistance.areas[]`), its cells (empty: no areas).
   std::vector<std::vector<std::uint8_t>> resistance_areas;
@@ -42,6 +44,13 @@ struct OutputInputs {
 /// Throws TerrainError naming the field (a point outside the domain, a line or outline that cannot be
 /// read, an outline that covers no cell of the domain).
 OutputInputs read_output_inputs(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0);
+
+/// Without a path line in the scenario: the path becomes the one the flow took instead of the
+/// steepest descent, when the flow moved: products::flow_path of the frames' mass centres (`centres`
+/// as TimeSeriesWriter::mass_centres gives them) while they stay inside the outline, else (a flow
+/// that split) products::longest_flow_line. A scenario's own line is kept.
+void use_flow_path(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const std::vector<double>& max_depth,
+                   const std::vector<std::array<double, 3>>& centres, OutputInputs& in);
 
 /// The lines of the maps' parameter block: engine, friction, release, grid, software.
 std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain::Grid& grid, double release_volume_m3);

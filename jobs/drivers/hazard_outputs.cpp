@@ -146,9 +146,11 @@ HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Gri
     overlay.cover.resize(d.size(), 0);
     for (std::size_t k = 0; k < d.size(); ++k) overlay.cover[k] |= d[k] > 0;
   }
-  res.path_source = s.path.line_path.empty() ? "steepest descent from the release's centroid" : s.path.line_path;
+  res.path_source = in.path_source;
   if (overlay.path.size() >= 2) {
     res.path = products::analyse_path(grid, overlay.path, {raster("max_depth"), raster("max_speed"), pressure_kpa, h0}, s.path);
+    if (res.path->runout) sum.path_runout_m = res.path->s[*res.path->runout];
+    sum.path_criterion = res.path->criterion;
     write_path_outputs(s, *res.path, out_dir, sum);
     if (res.path->runout) overlay.path_marks.push_back({"runout", res.path->x[*res.path->runout], res.path->y[*res.path->runout]});
     if (res.path->beta) overlay.path_marks.push_back({"β", res.path->x[*res.path->beta], res.path->y[*res.path->beta]});

@@ -2,6 +2,8 @@
 #include "jobs/drivers/run.hpp"
 
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <ctime>
 
 #include "jobs/drivers/engine_run.hpp"
@@ -15,6 +17,15 @@ double since(std::chrono::steady_clock::time_point t0) {
 }
 
 }  // namespace
+
+std::string runout_phrase(const RunSummary& sum) {
+  char b[200];
+  if (std::isfinite(sum.path_runout_m))
+    std::snprintf(b, sizeof b, "runout %.0f m along the path (%s)", sum.path_runout_m, sum.path_criterion.c_str());
+  else
+    std::snprintf(b, sizeof b, "runout %.0f m from the release centroid", sum.runout_m);
+  return b;
+}
 
 RunSummary run_scenario(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();

@@ -2,6 +2,7 @@
 // The run driver: terrain -> engine -> outputs (rasters, outline, map, run record) for one resolved
 // scenario, writing into a directory.
 // The command line's `runout run` and (later) the service's workers call the same code.
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,10 @@ struct RunSummary {
   std::string crs;
   double release_area_m2 = 0, release_volume_m3 = 0;
   double affected_area_m2 = 0, runout_m = 0, max_speed = 0, max_depth = 0;
+  /// The runout point's distance along the path (the figure the profile and the maps show); NaN
+  /// without a path or without a runout point; with the path analysis's criterion.
+  double path_runout_m = NAN;
+  std::string path_criterion;
   double volume_initial = 0, volume_final = 0, volume_outflow = 0, volume_error = 0;
   double volume_detrained = 0;  ///< depth-averaged: left behind in resistance areas
   double volume_entrained = 0;  ///< depth-averaged: taken up from the erodible cover (flow volume)
@@ -63,6 +68,11 @@ struct RunSummary {
   std::vector<std::string> notes;
   std::vector<DamSummary> dams;  ///< depth-averaged: per dam
 };
+
+/// The run's runout in words, one figure wherever it is printed: "runout 3075 m along the path (max
+/// pressure >= 1 kPa inside the outline)" where the path analysis found a runout point, else the
+/// farthest outlined cell's distance from the release's centroid.
+std::string runout_phrase(const RunSummary& sum);
 
 /// Run a scenario and write every output into `out_dir` (which must exist). Throws ScenarioError or
 /// terrain::TerrainError for bad input; returns the summary also written to run.json.

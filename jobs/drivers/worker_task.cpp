@@ -169,8 +169,8 @@ int worker_main(int in_fd, int out_fd) {
       d->set_simulated_s(sum.t);
       d->set_stop(task.validate_only() ? "validated" : sum.stop);
       char b[300];
-      std::snprintf(b, sizeof b, "%ld steps to t = %.3f s (stop: %s), affected area %.0f m2, runout %.0f m, max speed %.1f m/s",
-                    sum.steps, sum.t, sum.stop.c_str(), sum.affected_area_m2, sum.runout_m, sum.max_speed);
+      std::snprintf(b, sizeof b, "%ld steps to t = %.3f s (stop: %s), affected area %.0f m2, %s, max speed %.1f m/s", sum.steps,
+                    sum.t, sum.stop.c_str(), sum.affected_area_m2, runout_phrase(sum).c_str(), sum.max_speed);
       d->set_summary(b);
     }
     return send_event(events, ev) ? 0 : 3;

@@ -238,6 +238,13 @@ double draw_panel(cairo_t* cr, double x, double y, const HazardMap& m, double co
     const double h = text(x + 38, y + 2, c.label, body);
     y += std::max(24.0, h + 6);
   }
+  if (m.show_maximum) {
+    double top = -HUGE_VAL;
+    for (double v : m.values)
+      if (std::isfinite(v)) top = std::max(top, v);
+    if (std::isfinite(top)) y += text(x, y + 2, "maximum " + label_number(top) + (m.palette.unit.empty() ? "" : " " + m.palette.unit), body) + 6;
+  }
+  if (!m.colour_note.empty()) y += text(x, y + 2, m.colour_note, {12, false, kInk, kPanel}) + 6;
   y += 10;
   auto item = [&](const std::string& label, const std::function<void(double)>& symbol) {
     if (cr) symbol(y + 9);
@@ -277,6 +284,13 @@ double draw_panel(cairo_t* cr, double x, double y, const HazardMap& m, double co
 }
 
 }  // namespace
+
+std::vector<double> inside_outline(const std::vector<double>& values, const std::vector<double>& max_depth, double threshold) {
+  std::vector<double> v = values;
+  for (std::size_t k = 0; k < v.size() && k < max_depth.size(); ++k)
+    if (!(max_depth[k] > threshold)) v[k] = NAN;
+  return v;
+}
 
 MapLayout draw_hazard_map(const std::string& png_path, const std::string& pdf_path, const Grid& g, const HazardMap& m) {
   GDALAllRegister();

@@ -39,7 +39,17 @@ struct HazardMap {
   std::vector<std::pair<double, double>> path;  ///< the avalanche path's vertices in the grid's CRS (drawn when given)
   std::vector<MapPoint> path_marks;             ///< named points on it (the runout point, the beta point)
   std::vector<std::string> parameters;  ///< the parameter block, one line each
+  /// Under the colour bar: where the quantity is coloured (e.g. "coloured inside the outline only");
+  /// empty: nothing said.
+  std::string colour_note;
+  /// Under the colour bar: the largest finite value of `values` in the palette's unit (so that a
+  /// top class's "≥ 300" says how far it goes).
+  bool show_maximum = false;
 };
+
+/// `values` with every cell where `max_depth` is at most `threshold` set to NaN: a quantity coloured
+/// only inside the runout outline.
+std::vector<double> inside_outline(const std::vector<double>& values, const std::vector<double>& max_depth, double threshold);
 
 /// Where things were drawn on the PNG (pixels), for checks.
 struct MapLayout {

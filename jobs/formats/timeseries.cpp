@@ -2,6 +2,7 @@
 
 #include <hdf5.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <cstdio>
@@ -72,8 +73,25 @@ struct TimeSeriesWriter::Impl {
     return v;
   }
 
+  // The volume-weighted centre of a frame's depth (normal depth over the surface's cosine: the
+  // column's volume per plan area).
+  std::array<double, 3> mass_centre(double t, const std::vector<double>& depth) const {
+    double m = 0, mx = 0, my = 0;
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const std::size_t k = std::size_t(j) * nx + i;
+        if (!(depth[k] > 0)) continue;
+        const double w = depth[k] / geo.c[k];
+        m += w;
+        mx += w * grid.cx(i);
+        my += w * grid.cy(j);
+      }
+    return {t, m > 0 ? mx / m : NAN, m > 0 ? my / m : NAN};
+  }
+
   void write_xdmf() const;
-  void write_geotiffs() const;
+  void write_geotiffs();
+  std::vector<std::array<double, 3>> track;  ///< t, x, y of each frame's mass centre (after finish)
 };
 
 TimeSeriesWriter::TimeSeriesWriter(const std::string& dir, const terrain::Grid& grid, const engine::Terrain2D& t, double flow_threshold)
@@ -136,6 +154,8 @@ TimeSeriesWriter::TimeSeriesWriter(const std::string& dir, const terrain::Grid& 
 }
 
 int TimeSeriesWriter::frames() const { return int(impl_->times.size()); }
+
+const std::vector<std::array<double, 3>>& TimeSeriesWriter::mass_centres() const { return impl_->track; }
 
 void TimeSeriesWriter::save_copy(const std::string& path) {
   auto& m = *impl_;
@@ -220,7 +240,7 @@ void TimeSeriesWriter::Impl::write_xdmf() const {
 }
 
 // The frames as georeferenced multi-band GeoTIFFs, read back from the HDF5 file one band at a time.
-void TimeSeriesWriter::Impl::write_geotiffs() const {
+void TimeSeriesWriter::Impl::write_geotiffs() {
   std::vector<terrain::BandInfo> depth, speed;
   std::string all;
   char t[32];
@@ -231,6 +251,7 @@ void TimeSeriesWriter::Impl::write_geotiffs() const {
     all += (all.empty() ? "" : ",") + std::string(t);
   }
   if (times.empty()) return;
+  track.clear();
   for (auto [field, bands] : {std::pair<const char*, const std::vector<terrain::BandInfo>*>{"depth", &depth}, {"speed", &speed}}) {
     // HDF5 and GDAL one after the other: GDAL's own HDF5 driver takes the same library.
     std::lock_guard lk(hdf5_mutex());
@@ -238,7 +259,18 @@ void TimeSeriesWriter::Impl::write_geotiffs() const {
     if (f < 0) throw std::runtime_error("time series: cannot reopen " + dir + "/timeseries.h5");
     try {
       terrain::write_band_stack(dir + "/timeseries_" + field + ".tif", grid, *bands,
-                                [&](std::size_t b) { return read_frame(f, b, field); }, {{"TIMES_S", all}});
+                                [&](std::size_t b) {
+                                  auto v = read_frame(f, b, field);
+                                  if (field == std::string("depth")) track.push_back(mass_centre(times[b], v));
+                                  return v;
+                                },
+                                {{"TIMES_S", all}});
+      // The same frames as one CF NetCDF file with a time axis (QGIS's temporal controller), once.
+      if (field == std::string("speed"))
+        terrain::write_time_cube(dir + "/timeseries.nc", grid, times,
+                                 {{"depth", "flow depth normal to the surface", "m", [&](std::size_t b) { return read_frame(f, b, "depth"); }},
+                                  {"speed", "flow speed where the depth exceeds the flow threshold", "m/s",
+                                   [&](std::size_t b) { return read_frame(f, b, "speed"); }}});
     } catch (...) {
       H5Fclose(f);
       throw;

@@ -2,9 +2,11 @@
 // Time series of a run: HDF5 (one group per frame: normal depth and speed, Float32; the terrain
 // surface as x, y, z of the cell centres in the grid's CRS) with an XDMF file that describes them as
 // a temporal collection on the terrain surface, z up (ParaView); and, for QGIS and every GDAL reader,
-// georeferenced multi-band GeoTIFFs of the frames (timeseries_depth.tif, timeseries_speed.tif, one
-// band per frame with its time). Speeds are masked (NaN, nodata) where the depth is at most the flow
-// threshold, as in the maximum-speed map.
+// georeferenced multi-band Cloud Optimized GeoTIFFs of the frames (timeseries_depth.tif,
+// timeseries_speed.tif, one band per frame with its time) and the same frames as one CF NetCDF file
+// with a time axis (timeseries.nc: QGIS's temporal controller steps through it). Speeds are masked
+// (NaN, nodata) where the depth is at most the flow threshold, as in the maximum-speed map.
+#include <array>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -38,6 +40,9 @@ class TimeSeriesWriter {
   int finish();
   /// Frames written so far.
   int frames() const;
+  /// After finish: per frame, its time and the flow's volume-weighted mass centre (t, x, y in the
+  /// grid's CRS; x, y NaN for a frame without flow).
+  const std::vector<std::array<double, 3>>& mass_centres() const;
   /// Put a copy of the frames so far at `path` (atomically: a temporary file renamed), for a
   /// checkpoint taken now. Throws std::runtime_error.
   void save_copy(const std::string& path);

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <queue>
 
 namespace runout::jobs::products {
 namespace {
@@ -47,6 +48,8 @@ Line resample(const Line& line, double ds, double& length) {
   return out;
 }
 
+void extend_to_edge(const terrain::Grid& g, Line& line);
+
 }  // namespace
 
 Line steepest_descent(const terrain::Grid& g, double x, double y) {
@@ -72,8 +75,15 @@ Line steepest_descent(const terrain::Grid& g, double x, double y) {
     j = bj;
     line.emplace_back(g.cx(i), g.cy(j));
   }
+  extend_to_edge(g, line);
+  return line;
+}
+
+namespace {
+
+void extend_to_edge(const terrain::Grid& g, Line& line) {
   // On straight in the last 200 m's direction, to the domain's edge.
-  if (line.size() < 2) return line;
+  if (line.size() < 2) return;
   const std::size_t back = std::min(line.size() - 1, std::size_t(std::ceil(200 / g.dx)));
   double dx = line.back().first - line[line.size() - 1 - back].first, dy = line.back().second - line[line.size() - 1 - back].second;
   const double n = std::hypot(dx, dy);
@@ -87,6 +97,30 @@ Line steepest_descent(const terrain::Grid& g, double x, double y) {
     py = ny;
   }
   if (std::hypot(px - line.back().first, py - line.back().second) > 0) line.emplace_back(px, py);
+}
+
+}  // namespace
+
+Line flow_path(const terrain::Grid& g, const std::vector<TrackPoint>& track, const std::vector<double>& release) {
+  Line line;
+  for (const auto& p : track)
+    if (line.empty() || std::hypot(p.x - line.back().first, p.y - line.back().second) >= 0.5 * g.dx) line.emplace_back(p.x, p.y);
+  if (line.size() < 2) return {};
+  // Up to the release's upper edge: back against the first direction while the line stays on the
+  // domain, to the last released cell met.
+  double dx = line[0].first - line[1].first, dy = line[0].second - line[1].second;
+  const double n = std::hypot(dx, dy);
+  dx /= n;
+  dy /= n;
+  std::pair<double, double> top = line.front();
+  for (double d = g.dx;; d += 0.5 * g.dx) {
+    const double x = line[0].first + dx * d, y = line[0].second + dy * d;
+    const double v = cell_value(g, release, x, y);
+    if (std::isnan(v)) break;
+    if (v > 0) top = {x, y};
+  }
+  if (top != line.front()) line.insert(line.begin(), top);
+  extend_to_edge(g, line);
   return line;
 }
 
@@ -150,6 +184,84 @@ PathProfile analyse_path(const terrain::Grid& g, const Line& line, const PathFie
     for (std::size_t k = *p.beta; k < reach.size(); ++k)
       for (double c : reach[k]) p.runout_zone_area_m2 += c >= set.threshold ? g.dx * g.dx : 0.0;
   return p;
+}
+
+Line longest_flow_line(const terrain::Grid& g, const std::vector<double>& release, const std::vector<double>& max_depth, double threshold,
+                       std::pair<double, double>* far_end) {
+  const std::size_t n = g.cells();
+  auto open = [&](int i, int j) {
+    if (!inside(g, i, j)) return false;
+    const std::size_t k = std::size_t(j) * g.nx + i;
+    return release[k] > 0 || max_depth[k] > threshold;
+  };
+  std::size_t top = n;
+  for (std::size_t k = 0; k < n; ++k)
+    if (release[k] > 0 && (g.outside.empty() || !g.outside[k]) && (top == n || g.z[k] > g.z[top])) top = k;
+  if (top == n) return {};
+  // Dijkstra over the open cells from the top.
+  std::vector<double> dist(n, HUGE_VAL);
+  std::vector<std::size_t> from(n, n);
+  using Item = std::pair<double, std::size_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  dist[top] = 0;
+  queue.push({0, top});
+  while (!queue.empty()) {
+    const auto [d, k] = queue.top();
+    queue.pop();
+    if (d > dist[k]) continue;
+    const int i = int(k % std::size_t(g.nx)), j = int(k / std::size_t(g.nx));
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        if ((di == 0 && dj == 0) || !open(i + di, j + dj)) continue;
+        const std::size_t m = std::size_t(j + dj) * g.nx + std::size_t(i + di);
+        const double nd = d + (di != 0 && dj != 0 ? M_SQRT2 : 1.0);
+        if (nd < dist[m]) {
+          dist[m] = nd;
+          from[m] = k;
+          queue.push({nd, m});
+        }
+      }
+  }
+  std::size_t far = top;
+  for (std::size_t k = 0; k < n; ++k)
+    if (std::isfinite(dist[k]) && max_depth[k] > threshold && dist[k] > dist[far]) far = k;
+  if (far == top) return {};
+  if (far_end) *far_end = {g.cx(int(far % std::size_t(g.nx))), g.cy(int(far / std::size_t(g.nx)))};
+  std::vector<std::size_t> cells;
+  for (std::size_t k = far; k != n; k = from[k]) cells.push_back(k);
+  std::reverse(cells.begin(), cells.end());
+  // The staircase of cells smoothed by a running mean over five cells (the ends kept).
+  Line line;
+  const std::ptrdiff_t last = std::ptrdiff_t(cells.size()) - 1;
+  for (std::ptrdiff_t a = 0; a <= last; ++a) {
+    const std::ptrdiff_t lo = std::max<std::ptrdiff_t>(0, a - 2), hi = std::min(last, a + 2), w = std::min(a - lo, hi - a);
+    double x = 0, y = 0;
+    for (std::ptrdiff_t b = a - w; b <= a + w; ++b) {
+      x += g.cx(int(cells[std::size_t(b)] % std::size_t(g.nx)));
+      y += g.cy(int(cells[std::size_t(b)] / std::size_t(g.nx)));
+    }
+    line.emplace_back(x / double(2 * w + 1), y / double(2 * w + 1));
+  }
+  extend_to_edge(g, line);
+  return line;
+}
+
+double distance_to_line(const Line& line, double x, double y) {
+  double best = HUGE_VAL;
+  for (std::size_t k = 0; k + 1 < line.size(); ++k) {
+    const double ax = line[k].first, ay = line[k].second, dx = line[k + 1].first - ax, dy = line[k + 1].second - ay;
+    const double len2 = dx * dx + dy * dy;
+    const double t = len2 > 0 ? std::clamp(((x - ax) * dx + (y - ay) * dy) / len2, 0.0, 1.0) : 0.0;
+    best = std::min(best, std::hypot(x - ax - t * dx, y - ay - t * dy));
+  }
+  if (line.size() == 1) best = std::hypot(x - line[0].first, y - line[0].second);
+  return best;
+}
+
+bool track_inside_outline(const terrain::Grid& g, const std::vector<TrackPoint>& track, const std::vector<double>& max_depth, double threshold) {
+  for (std::size_t k = 1; k < track.size(); ++k)
+    if (!(cell_value(g, max_depth, track[k].x, track[k].y) > threshold)) return false;
+  return true;
 }
 
 void write_profile_csv(const std::string& path, const PathProfile& p) {

@@ -22,6 +22,34 @@ using Line = std::vector<std::pair<double, double>>;
 /// last 200 m's direction to the domain's edge, so that a flat run-out zone is crossed too.
 Line steepest_descent(const terrain::Grid& g, double x, double y);
 
+/// The flow's mass centre at one time (volume-weighted, in the grid's CRS).
+struct TrackPoint {
+  double t = 0, x = 0, y = 0;
+};
+
+/// The path the flow took, as com1DFA and AIMEC take it: the mass centre's track in time order
+/// (points closer than half a cell to the last one kept dropped), extended at the top straight back
+/// against its first direction to the release's upper edge (the last released cell on that line),
+/// and at the bottom straight on in its last 200 m's direction to the domain's edge, so that the
+/// front beyond the mass centre's stop is crossed. Empty when the track has fewer than two distinct
+/// points (a flow that did not move).
+Line flow_path(const terrain::Grid& g, const std::vector<TrackPoint>& track, const std::vector<double>& release);
+
+/// The longest flow line: from the highest released cell through the released and outlined cells
+/// (moves to the eight neighbours, one or √2 cells long) to the outlined cell farthest from it along
+/// such moves, smoothed over five cells and then extended straight on to the domain's edge as the
+/// track is. It follows the branch that reached farthest. Empty without released or outlined cells.
+/// `far_end`, when given, receives the farthest cell's centre.
+Line longest_flow_line(const terrain::Grid& g, const std::vector<double>& release, const std::vector<double>& max_depth, double threshold,
+                       std::pair<double, double>* far_end = nullptr);
+
+/// The horizontal distance from (x, y) to the polyline.
+double distance_to_line(const Line& line, double x, double y);
+
+/// Whether every point of the track (after its first) lies on a cell of the outline (max depth
+/// above `threshold`): false when the flow split and its mass centre left it.
+bool track_inside_outline(const terrain::Grid& g, const std::vector<TrackPoint>& track, const std::vector<double>& max_depth, double threshold);
+
 /// The hazard maps the analysis reads, per cell (row 0 south; NaN outside the domain).
 struct PathFields {
   const std::vector<double>& depth;         ///< [m]

@@ -57,8 +57,8 @@ void print_summary(const jobs::RunSummary& sum, bool vof, const fs::path& dest) 
     if (q.lines) std::printf(", %.6g m3 passed it", q.overflow_m3);
     std::printf("\n");
   }
-  std::printf("hazard      affected area %.0f m2, runout %.0f m from the release centroid, max speed %.1f m/s, max depth %.2f m\n",
-              sum.affected_area_m2, sum.runout_m, sum.max_speed, sum.max_depth);
+  std::printf("hazard      affected area %.0f m2, %s, max speed %.1f m/s, max depth %.2f m\n", sum.affected_area_m2,
+              jobs::runout_phrase(sum).c_str(), sum.max_speed, sum.max_depth);
   std::printf("results in  %s:", dest.string().c_str());
   for (const auto& f : sum.files) std::printf(" %s", f.c_str());
   std::printf("\n");

@@ -1,7 +1,10 @@
 // The bundled depth-averaged scenarios, coarsened: In den Arelen, Wolfsgruben and the ISeeSnow cases.
 #include <algorithm>
 #include <cstdio>
+#include <sstream>
 
+#include "jobs/figures/hazard_map.hpp"
+#include "jobs/figures/palette.hpp"
 #include "terrain/points.hpp"
 #include "tests/support/run_helpers.hpp"
 
@@ -96,6 +99,90 @@ TEST(Scenarios, InDenArelenReachesTheValleyFloor) {
   float v = 0;
   ASSERT_EQ(md->GetRasterBand(1)->RasterIO(GF_Read, i, rr, 1, 1, &v, 1, 1, GDT_Float32, 0, 0), CE_None);
   EXPECT_GT(v, 0.01f);
+}
+
+// The demo as scripts/demo runs it (In den Arelen, 10 m): its maps colour speed, pressure and arrival
+// time only inside the outline; the runout is one figure (the summary's, run.json's, the profile's
+// and the map's point); and the path follows the flow. The flow splits into several gullies, so the
+// path is the longest flow line: every station from the release's top to its farthest cell lies on
+// a released or outlined cell, and it ends at the tongue that reaches farthest (south-east).
+TEST(Scenarios, TheDemoMapsColourOnlyTheOutlineAndItsRunoutIsOneFigureOnTheFlowsPath) {
+  const std::string file = std::string(RUNOUT_SOURCE_DIR) + "/scenarios/in-den-arelen.json";
+  const auto r = jobs::load_scenario(file);
+  TempDir d;
+  const auto sum = jobs::run_scenario(r, d.p.string());
+  const auto rec = run_record(d / "run.json");
+  const auto& path = rec.results().path();
+  EXPECT_EQ(path.source().rfind("the longest flow line", 0), 0u) << path.source();
+  // One figure: the summary, run.json and the profile's last station at 1 kPa or more.
+  ASSERT_TRUE(path.has_runout_s_m());
+  EXPECT_NEAR(sum.path_runout_m, path.runout_s_m(), 1e-6);
+  EXPECT_NE(jobs::runout_phrase(sum).find("runout " + std::to_string(int(std::lround(path.runout_s_m()))) + " m along the path"),
+            std::string::npos)
+      << jobs::runout_phrase(sum);
+  std::ifstream csv(d / "path_profile.csv");
+  std::string row;
+  std::getline(csv, row);
+  double last_s = -1;
+  std::vector<std::pair<double, double>> stations;
+  while (std::getline(csv, row)) {
+    std::vector<double> v;
+    std::stringstream ss(row);
+    for (std::string c; std::getline(ss, c, ',');) v.push_back(c.empty() ? NAN : std::stod(c));
+    stations.emplace_back(v[1], v[2]);
+    if (v.size() > 6 && v[6] >= 1) last_s = v[0];
+  }
+  EXPECT_EQ(last_s, path.runout_s_m());
+  // The path follows the flow: the stations up to the last on an outlined cell lie on outlined cells
+  // (or, in the first 300 m, on the release), but for the smoothing's corners (at most 1 %); beyond
+  // it the runout point is at most 100 m on, where a film thinner than the outline's depth still
+  // exerts 1 kPa (the runout's criterion, AIMEC's).
+  const auto depth = read_raster_values(d / "max_depth.tif");
+  const auto runout_at = std::size_t(std::lround(path.runout_s_m() / path.section_spacing_m()));
+  std::size_t on = 0, last_on = 0;
+  for (std::size_t k = 0; k <= runout_at && k < stations.size(); ++k) {
+    const int i = int((stations[k].first - depth.gt[0]) / depth.gt[1]), row_ = int((stations[k].second - depth.gt[3]) / depth.gt[5]);
+    const bool flow = depth.v[std::size_t(row_) * depth.w + i] > r.outline_threshold;
+    if (flow) last_on = k;
+    on += flow || double(k) * path.section_spacing_m() < 300;
+  }
+  EXPECT_GE(double(on), 0.99 * double(last_on + 1)) << on << " of " << last_on + 1;
+  EXPECT_LE(double(runout_at - last_on) * path.section_spacing_m(), 100.0);
+  EXPECT_GT(path.runout_xyz(0), 565000);  // the south-eastern tongue
+  EXPECT_LT(path.runout_xyz(1), 5187000);
+  // No colour outside the outline: at the centre of every cell outside it (and not next to it, where
+  // the outline's line is drawn) the maps show none of their palette's colours.
+  terrain::Grid g;
+  g.nx = depth.w;
+  g.ny = depth.h;
+  g.dx = depth.gt[1];
+  g.x_min = depth.gt[0];
+  g.y_min = depth.gt[3] + depth.h * depth.gt[5];
+  g.z.assign(g.cells(), 0);
+  for (const char* q : {"max_speed", "max_pressure", "arrival_time", "max_depth"}) {
+    figures::HazardMap probe;  // where the map's frame lies: the same title, so the same layout
+    probe.title = r.scenario.name() + ": " + figures::hazard_palette(q).title;
+    const auto lay = figures::draw_hazard_map("", "", g, probe);
+    GDALDatasetUniquePtr png(GDALDataset::Open((d / ("map_" + std::string(q) + ".png")).c_str(), GDAL_OF_RASTER));
+    ASSERT_TRUE(png) << q;
+    long outside = 0, coloured = 0;
+    for (int row_ = 1; row_ + 1 < g.ny; ++row_)
+      for (int i = 1; i + 1 < g.nx; ++i) {
+        bool near = false;
+        for (int a = -1; a <= 1; ++a)
+          for (int b = -1; b <= 1; ++b) near |= depth.v[std::size_t(row_ + a) * g.nx + i + b] > r.outline_threshold;
+        if (near || std::isnan(depth.v[std::size_t(row_) * g.nx + i])) continue;
+        ++outside;
+        figures::Rgb8 c{};
+        for (int band = 0; band < 3; ++band)
+          (void)png->GetRasterBand(band + 1)->RasterIO(GF_Read, int(lay.map_x + (i + 0.5) * lay.cell_px),
+                                                       int(lay.map_y + (row_ + 0.5) * lay.cell_px), 1, 1, &c[std::size_t(band)], 1, 1,
+                                                       GDT_Byte, 0, 0);
+        for (const auto& cls : figures::hazard_palette(q).classes) coloured += c == cls.colour;
+      }
+    EXPECT_GT(outside, 50000) << q;
+    EXPECT_EQ(coloured, 0) << q << ": cells outside the outline in a class's colour";
+  }
 }
 
 // In den Arelen with an illustrative erodible cover (a thickness raster in EPSG:2056, resampled onto

@@ -335,6 +335,60 @@ TEST(HazardProducts, PathAnalysisHasKnownAnswers) {
   EXPECT_FALSE(jobs::products::analyse_path(g, line, {depth, speed, pressure, release}, set).runout);
 }
 
+// The flow's own path, known answers on the tilted grid (100 x 80 cells of 10 m):
+// - a mass-centre track along a diagonal starts at the release's upper edge (back along the track's
+//   first direction), passes every track point (points closer than half a cell dropped) and goes on
+//   in the last direction to the domain's edge; a track that did not move gives no path;
+// - a flow that split into a short branch (north) and a long one (east) has its longest flow line
+//   from the release's highest cell to the long branch's tip, on released or outlined cells all the
+//   way (but for the smoothing's corner).
+TEST(HazardProducts, TheFlowsPathFollowsItsMassCentreOrItsFarthestBranch) {
+  const terrain::Grid g = tilted_grid();
+  std::vector<double> release(g.cells(), 0), depth(g.cells(), 0);
+  for (int j = 40; j < 46; ++j)
+    for (int i = 10; i < 16; ++i) release[std::size_t(j) * g.nx + i] = 1;  // x 100-160 m, y 400-460 m from the corner
+  const double x0 = g.x_min, y0 = g.y_min;
+  std::vector<jobs::products::TrackPoint> track = {{0, x0 + 130, y0 + 430}, {5, x0 + 130.2, y0 + 430}, {10, x0 + 230, y0 + 380},
+                                                   {15, x0 + 330, y0 + 330}, {20, x0 + 430, y0 + 280}};
+  const auto line = jobs::products::flow_path(g, track, release);
+  ASSERT_GE(line.size(), 6u);
+  // The top: on the line back from (130, 430) against (100, -50), the last released cell's point
+  // lies within a cell of the release's upper-left corner (100, 460).
+  EXPECT_NEAR(line.front().first - x0, 100, 12.0);
+  EXPECT_NEAR(line.front().second - y0, 445, 12.0);
+  EXPECT_DOUBLE_EQ(line[1].first, x0 + 130);  // then the track, the point 0.2 m on dropped
+  EXPECT_DOUBLE_EQ(line[2].first, x0 + 230);
+  EXPECT_DOUBLE_EQ(line[4].second, y0 + 280);
+  // On to the edge in the last direction (2, -1): the bottom edge at y = 0 is met at x = 990 m.
+  EXPECT_LT(line.back().second - y0, 10.0);
+  EXPECT_NEAR(line.back().first - x0, 430 + 2 * 280, 25.0);
+  EXPECT_TRUE(jobs::products::flow_path(g, {{0, x0 + 130, y0 + 430}, {5, x0 + 131, y0 + 430}}, release).empty());
+
+  // A split flow: from the release a branch 3 cells wide north to y = 700 m and one east to x = 900 m.
+  for (int j = 40; j < 70; ++j)
+    for (int i = 12; i < 15; ++i) depth[std::size_t(j) * g.nx + i] = 1;
+  for (int j = 41; j < 44; ++j)
+    for (int i = 12; i < 90; ++i) depth[std::size_t(j) * g.nx + i] = 1;
+  std::pair<double, double> far;
+  const auto longest = jobs::products::longest_flow_line(g, release, depth, 0.1, &far);
+  EXPECT_DOUBLE_EQ(far.first, g.cx(89));  // the east branch's tip
+  EXPECT_GE(far.second, g.cy(41));
+  EXPECT_LE(far.second, g.cy(43));
+  ASSERT_GE(longest.size(), 70u);
+  std::size_t on_flow = 0, before_tip = 0;
+  for (const auto& [x, y] : longest) {
+    if (x > far.first + 1) break;  // the straight extension beyond the tip
+    ++before_tip;
+    const int i = int((x - g.x_min) / g.dx), j = int((y - g.y_min) / g.dx);
+    on_flow += depth[std::size_t(j) * g.nx + i] > 0.1 || release[std::size_t(j) * g.nx + i] > 0;
+  }
+  EXPECT_GE(on_flow + 2, before_tip);  // the five-cell smoothing may cut the corner where the branch leaves the release
+  // The mass centre of such a flow lies between the branches, off the outline: not a path.
+  EXPECT_FALSE(jobs::products::track_inside_outline(g, {{0, x0 + 130, y0 + 430}, {10, x0 + 400, y0 + 600}}, depth, 0.1));
+  EXPECT_TRUE(jobs::products::track_inside_outline(g, {{0, x0 + 130, y0 + 430}, {10, x0 + 400, y0 + 420}}, depth, 0.1));
+  EXPECT_NEAR(jobs::products::distance_to_line(longest, x0 + 500, y0 + 735), 300, 1e-9);
+}
+
 namespace {
 
 // The pixels of a map's frame (the grid's cells) whose colour satisfies `pred(r, g, b)`.
