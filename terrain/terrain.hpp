@@ -207,6 +207,10 @@ struct OutlineReport {
   double area_m2 = 0;
   bool geojson = false;  ///< written (not for a grid in a local CRS)
 };
+/// Add `qml` (a QGIS style document) to the GeoPackage's layer_styles table as the default style of
+/// `layer` (QGIS's table: QGIS applies it when it opens the layer). Throws TerrainError.
+void add_layer_style(const std::string& gpkg_path, const std::string& layer, const std::string& style_name, const std::string& qml);
+
 /// Outline of the cells where values > threshold: GeoJSON in WGS84 lon/lat (unless the grid's CRS is
 /// local) and GeoPackage in the grid's CRS.
 OutlineReport write_outline(const std::string& geojson_path, const std::string& gpkg_path, const Grid& g,

@@ -103,6 +103,44 @@ std::vector<ClassArea> write_class_polygons(const std::string& geojson_path, con
   return areas;
 }
 
+void add_layer_style(const std::string& gpkg_path, const std::string& layer, const std::string& style_name, const std::string& qml) {
+  init_gdal();
+  GDALDatasetUniquePtr ds(GDALDataset::Open(gpkg_path.c_str(), GDAL_OF_VECTOR | GDAL_OF_UPDATE));
+  if (!ds) throw TerrainError("'" + gpkg_path + "': cannot open it to add its style" + gdal_message());
+  OGRLayer* styles = ds->GetLayerByName("layer_styles");
+  if (!styles) {  // QGIS's own table of styles (the columns it writes and reads)
+    styles = ds->CreateLayer("layer_styles", nullptr, wkbNone, nullptr);
+    if (!styles) throw TerrainError("'" + gpkg_path + "': cannot create its layer_styles table" + gdal_message());
+    for (const char* f : {"f_table_catalog", "f_table_schema", "f_table_name", "f_geometry_column", "styleName", "styleQML", "styleSLD"}) {
+      OGRFieldDefn d(f, OFTString);
+      styles->CreateField(&d);
+    }
+    OGRFieldDefn def("useAsDefault", OFTInteger);
+    def.SetSubType(OFSTBoolean);
+    styles->CreateField(&def);
+    for (const char* f : {"description", "owner", "ui"}) {
+      OGRFieldDefn d(f, OFTString);
+      styles->CreateField(&d);
+    }
+    OGRFieldDefn t("update_time", OFTDateTime);
+    styles->CreateField(&t);
+  }
+  OGRLayer* target = ds->GetLayerByName(layer.c_str());
+  if (!target) throw TerrainError("'" + gpkg_path + "' has no layer '" + layer + "' to style");
+  OGRFeature f(styles->GetLayerDefn());
+  f.SetField("f_table_catalog", "");
+  f.SetField("f_table_schema", "");
+  f.SetField("f_table_name", layer.c_str());
+  f.SetField("f_geometry_column", target->GetGeometryColumn());
+  f.SetField("styleName", style_name.c_str());
+  f.SetField("styleQML", qml.c_str());
+  f.SetField("styleSLD", "");
+  f.SetField("useAsDefault", 1);
+  f.SetField("description", "runout's style of the layer");
+  f.SetField("owner", "");
+  if (styles->CreateFeature(&f) != OGRERR_NONE) throw TerrainError("'" + gpkg_path + "': cannot add the style" + gdal_message());
+}
+
 OutlineReport write_outline(const std::string& geojson_path, const std::string& gpkg_path, const Grid& g,
                             const std::vector<double>& values, double threshold) {
   std::vector<std::uint8_t> inside(g.cells());

@@ -88,6 +88,13 @@ std::string steep_terrain_note(const ResolvedScenario& s, const terrain::Grid& g
 
 namespace {
 
+// The zones' names in class order (the polygons' `name` field).
+std::vector<std::string> zone_names(const products::ZoneMap& z) {
+  std::vector<std::string> names;
+  for (const auto& c : z.classes) names.push_back(c.name);
+  return names;
+}
+
 std::string affected_area_criterion(double outline_threshold) { return "max depth > " + json_number(outline_threshold) + " m"; }
 
 // The pressure zones: the class raster with its QGIS style, and the polygons.
@@ -99,8 +106,13 @@ void write_zones(const terrain::Grid& grid, const products::ZoneMap& z, const st
   figures::write_qml_classes(path("pressure_zones.qml"), z.palette);
   out.zone_areas = terrain::write_class_polygons(path("pressure_zones.geojson"), path("pressure_zones.gpkg"), "pressure_zones", grid,
                                                  z.cls, z.classes, "kpa");
+  // The polygons' style: in the GeoPackage (QGIS's default) and as a file of its own (the raster's
+  // pressure_zones.qml would otherwise be taken for the GeoJSON's).
+  const std::string style = figures::qml_polygon_classes(z.palette, zone_names(z));
+  terrain::add_layer_style(path("pressure_zones.gpkg"), "pressure_zones", "runout pressure zones", style);
+  figures::write_qml(path("pressure_zones_polygons.qml"), style);
   // GeoTIFF keeps the zones' names (GDAL's category names) in its sidecar.
-  for (const char* f : {"pressure_zones.tif", "pressure_zones.tif.aux.xml", "pressure_zones.qml"})
+  for (const char* f : {"pressure_zones.tif", "pressure_zones.tif.aux.xml", "pressure_zones.qml", "pressure_zones_polygons.qml"})
     if (fs::exists(path(f))) sum.files.push_back(f);
   if (out.outline.geojson) sum.files.push_back("pressure_zones.geojson");
   sum.files.push_back("pressure_zones.gpkg");
@@ -158,6 +170,9 @@ HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Gri
     sum.notes.push_back("no path analysis: the path has no length on the grid");
   }
   res.outline = terrain::write_outline(out("outline.geojson"), out("outline.gpkg"), grid, hz.max_depth, s.outline_threshold);
+  terrain::add_layer_style(out("outline.gpkg"), "runout_outline", "runout outline", figures::qml_outline());
+  figures::write_qml(out("outline.qml"), figures::qml_outline());
+  sum.files.push_back("outline.qml");
   if (res.outline.geojson) sum.files.push_back("outline.geojson");
   else sum.notes.push_back("outline.geojson and pressure_zones.geojson not written: the grid's CRS is local (no geographic coordinates)");
   sum.files.push_back("outline.gpkg");

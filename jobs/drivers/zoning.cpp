@@ -165,7 +165,12 @@ v1::EnsembleRecord aggregate_zoning(const ResolvedScenario& e, const std::vector
                            {"hazard zones from the scenarios by return period (0: none, 1 yellow, 2 blue, 3 red)", ""});
   figures::write_qml_classes(out("zones.qml"), products::zone_palette(rule));
   const auto areas = terrain::write_class_polygons(out("zones.geojson"), out("zones.gpkg"), "zones", g, zones, classes, "zone");
-  for (const char* f : {"zones.tif", "zones.tif.aux.xml", "zones.qml", "zones.geojson", "zones.gpkg"})
+  std::vector<std::string> names;
+  for (const auto& c : classes) names.push_back(c.name);
+  const std::string style = figures::qml_polygon_classes(products::zone_palette(rule), names);
+  terrain::add_layer_style(out("zones.gpkg"), "zones", "runout hazard zones", style);
+  figures::write_qml(out("zones_polygons.qml"), style);
+  for (const char* f : {"zones.tif", "zones.tif.aux.xml", "zones.qml", "zones.geojson", "zones.gpkg", "zones_polygons.qml"})
     if (fs::exists(out(f))) rec.add_outputs(f);
   auto* z = rec.mutable_zoning();
   record_zoning(rule, members, sc, zones, areas, g, *z);

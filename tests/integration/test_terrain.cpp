@@ -1,5 +1,7 @@
 // Terrain: the terrain pipeline (DEM preparation, reprojection, releases, the area of interest) and
 // the depth-averaged run driver on synthetic inputs made here with GDAL.
+#include <tuple>
+
 #include "jobs/drivers/hazard_maps.hpp"
 #include "jobs/drivers/hazard_outputs.hpp"
 #include "tests/support/run_helpers.hpp"
@@ -103,6 +105,58 @@ TEST(Terrain, SyntheticSlopeRunsAndWritesEveryOutput) {
     flowing += depth[k] > 0.01f;
   }
   EXPECT_GT(flowing, 10);
+  // Both are Cloud Optimized GeoTIFFs.
+  EXPECT_STREQ(td->GetMetadataItem("LAYOUT", "IMAGE_STRUCTURE"), "COG");
+  EXPECT_STREQ(tv->GetMetadataItem("LAYOUT", "IMAGE_STRUCTURE"), "COG");
+  EXPECT_FALSE(fs::exists(d / "out/timeseries_depth.tif.part.tif"));
+  // The same frames in one CF NetCDF file: a time axis of the frames' times (seconds since the
+  // release, put at the epoch), y ascending, depth and speed as in the GeoTIFFs' bands.
+  GDALDatasetUniquePtr nc(GDALDataset::Open((d / "out/timeseries.nc").c_str(), GDAL_OF_MULTIDIM_RASTER));
+  ASSERT_TRUE(nc);
+  auto root = nc->GetRootGroup();
+  auto time = root->OpenMDArray("time");
+  ASSERT_TRUE(time);
+  ASSERT_EQ(time->GetDimensionCount(), 1u);
+  EXPECT_EQ(time->GetDimensions()[0]->GetSize(), std::uint64_t(frames));
+  EXPECT_EQ(time->GetAttribute("units")->ReadAsString(), std::string("seconds since 1970-01-01 00:00:00"));
+  std::vector<double> times(std::size_t(frames), 0);
+  const GUInt64 t0 = 0;
+  const size_t tn = std::size_t(frames);
+  ASSERT_TRUE(time->Read(&t0, &tn, nullptr, nullptr, GDALExtendedDataType::Create(GDT_Float64), times.data()));
+  EXPECT_EQ(times.front(), 0.0);
+  EXPECT_NEAR(times.back(), sum.t, 1e-9 * sum.t);
+  auto ncd = root->OpenMDArray("depth");
+  ASSERT_TRUE(ncd);
+  ASSERT_EQ(ncd->GetDimensionCount(), 3u);
+  EXPECT_EQ(ncd->GetUnit(), "m");
+  std::vector<float> cube_frame(static_cast<std::size_t>(n));
+  const GUInt64 start[3] = {GUInt64(frames / 2 - 1), 0, 0};
+  const size_t count[3] = {1, 120, 120};
+  ASSERT_TRUE(ncd->Read(start, count, nullptr, nullptr, GDALExtendedDataType::Create(GDT_Float32), cube_frame.data()));
+  for (int r = 0; r < 120; ++r)  // the NetCDF's row r is the GeoTIFF's row 119 - r (y ascending)
+    for (int i = 0; i < 120; ++i) ASSERT_EQ(cube_frame[std::size_t(r) * 120 + i], depth[std::size_t(119 - r) * 120 + i]) << r << ", " << i;
+  // The vector outputs carry their QGIS style: the GeoPackage's default in layer_styles, and a .qml
+  // of their own (not the raster's pressure_zones.qml).
+  for (const auto& [file, layer, renderer] : {std::tuple<std::string, std::string, std::string>{"outline", "runout_outline", "singleSymbol"},
+                                              {"pressure_zones", "pressure_zones", "categorizedSymbol"}}) {
+    GDALDatasetUniquePtr g(GDALDataset::Open((d / ("out/" + file + ".gpkg")).c_str(), GDAL_OF_VECTOR));
+    ASSERT_TRUE(g) << file;
+    OGRLayer* styles = g->GetLayerByName("layer_styles");
+    ASSERT_TRUE(styles) << file;
+    int rows = 0;
+    for (auto& f : styles) {
+      ++rows;
+      EXPECT_STREQ(f->GetFieldAsString("f_table_name"), layer.c_str());
+      EXPECT_EQ(f->GetFieldAsInteger("useAsDefault"), 1);
+      EXPECT_NE(std::string(f->GetFieldAsString("styleQML")).find("type=\"" + renderer + "\""), std::string::npos) << file;
+    }
+    EXPECT_EQ(rows, 1) << file;
+  }
+  EXPECT_TRUE(fs::exists(d / "out/outline.qml"));
+  std::ifstream zq(d / "out/pressure_zones_polygons.qml");
+  std::stringstream zs;
+  zs << zq.rdbuf();
+  EXPECT_NE(zs.str().find("categorizedSymbol"), std::string::npos);
 }
 
 TEST(Terrain, ReleaseInWgs84AndInUtmGiveTheSameGrid) {
