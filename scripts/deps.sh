@@ -1,5 +1,6 @@
-# Sourced by scripts/test and scripts/demo: installs the Debian packages the build needs, if missing,
-# then configures and builds into build/. Idempotent.
+# Sourced by scripts/test and scripts/demo: installs the Debian packages the build needs (and for
+# scripts/test those its tests need), if missing, then configures and builds into build/; installs
+# the program (runout_install). Idempotent.
 set -euo pipefail
 
 RUNOUT_PACKAGES=(
@@ -12,12 +13,20 @@ RUNOUT_PACKAGES=(
   python3-grpcio python3-protobuf
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev
-  munge slurmctld slurmd slurm-client
 )
 
+# What only the tests need besides: a one-node Slurm cluster (the slurm tests), dpkg-shlibdeps for
+# the Debian package (install.deb), QGIS for the Processing provider's test.
+RUNOUT_TEST_PACKAGES=(
+  munge slurmctld slurmd slurm-client
+  dpkg-dev
+)
+
+# runout_install_deps [test]: the build's packages, and with `test` the tests' too.
 runout_install_deps() {
-  local missing=()
-  for p in "${RUNOUT_PACKAGES[@]}"; do
+  local missing=() wanted=("${RUNOUT_PACKAGES[@]}")
+  if [ "${1:-}" = test ]; then wanted+=("${RUNOUT_TEST_PACKAGES[@]}"); fi
+  for p in "${wanted[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   if [ ${#missing[@]} -eq 0 ]; then
@@ -35,4 +44,15 @@ runout_build() {
   root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
   cmake -S "$root" -B "$root/build" -G Ninja -DCMAKE_BUILD_TYPE="${RUNOUT_BUILD_TYPE:-Release}" ${RUNOUT_CMAKE_ARGS:-}
   cmake --build "$root/build" --parallel "$(nproc)"
+}
+
+# runout_install [PREFIX]: `cmake --install` of the build (default /usr/local, with sudo where the
+# prefix is not writable), so that `runout` is on the PATH.
+runout_install() {
+  local root prefix="${1:-${RUNOUT_PREFIX:-/usr/local}}" SUDO=""
+  root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+  mkdir -p "$prefix" 2>/dev/null || true
+  if [ ! -w "$prefix" ] && [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  $SUDO cmake --install "$root/build" --prefix "$prefix" > /dev/null
+  echo "runout: installed $prefix/bin/runout" >&2
 }
