@@ -20,6 +20,7 @@ RUNOUT_PACKAGES=(
 RUNOUT_TEST_PACKAGES=(
   munge slurmctld slurmd slurm-client
   dpkg-dev
+  qgis python3-qgis
 )
 
 # runout_install_deps [test]: the build's packages, and with `test` the tests' too.

@@ -3,6 +3,7 @@
 // the difference map of the maximum depth.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -36,13 +37,42 @@ std::string number(double v) {
   return buf;
 }
 
+// The rows of the scenarios' points of interest (run.json's results.points_of_interest), matched
+// by name: each point's maximum depth, speed and pressure in both runs. A point in one run only gets
+// its row with "-" for the other.
+std::vector<jobs::RegressionRow> point_rows(const fs::path& run, const fs::path& other) {
+  const auto a = jobs::read_run_record((run / "run.json").string()), b = jobs::read_run_record((other / "run.json").string());
+  std::vector<jobs::RegressionRow> rows;
+  auto find = [](const v1::RunRecord& r, const std::string& name) -> const v1::PointReport* {
+    for (const auto& p : r.results().points_of_interest())
+      if (p.name() == name) return &p;
+    return nullptr;
+  };
+  std::vector<std::string> names;
+  for (const auto* r : {&a, &b})
+    for (const auto& p : r->results().points_of_interest())
+      if (std::find(names.begin(), names.end(), p.name()) == names.end()) names.push_back(p.name());
+  for (const auto& name : names) {
+    const auto *pa = find(a, name), *pb = find(b, name);
+    auto row = [&](const char* what, const char* unit, double (v1::PointReport::*get)() const) {
+      const double va = pa ? (pa->*get)() : NAN, vb = pb ? (pb->*get)() : NAN;
+      rows.push_back({name + ": " + what, unit, vb, va, va - vb, 0, true});  // reference: OTHER, value: RUN
+    };
+    row("maximum depth", "m", &v1::PointReport::max_depth_m);
+    row("maximum speed", "m/s", &v1::PointReport::max_speed_m_s);
+    row("maximum pressure", "kPa", &v1::PointReport::max_pressure_kpa);
+  }
+  return rows;
+}
+
 }  // namespace
 
 int compare(const std::vector<std::string>& args) {
   std::string run, other, out;
   CLI::App app{"Compare two finished runs on the same grid (e.g. the 3D and the depth-averaged engine's): runout, affected\n"
-               "area, maximum depth and speed, the In den Arelen farmhouse where it lies on the grid, and the difference\n"
-               "map of the maximum depth (RUN minus OTHER). Writes compare.md, diff.tif and diff.png into --out.",
+               "area, maximum depth and speed, the scenarios' points of interest (by name: their maximum depth, speed and\n"
+               "pressure), and the difference map of the maximum depth (RUN minus OTHER). Writes compare.md, diff.tif\n"
+               "and diff.png into --out.",
                "runout compare"};
   prepare(app);
   app.add_option("RUN", run, "A result folder (run.json, max_depth.tif)")->required()->type_name("DIR");
@@ -54,7 +84,11 @@ int compare(const std::vector<std::string>& args) {
     jobs::RegressionReference ref;
     ref.figures = jobs::measure_run(other, true);
     fs::create_directories(out);
-    const auto o = jobs::compare_run(a, ref, (fs::path(run) / "max_depth.tif").string(), other, out);
+    auto o = jobs::compare_run(a, ref, (fs::path(run) / "max_depth.tif").string(), other, out);
+    // The scenarios' own points instead of the regression's In den Arelen farmhouse.
+    o.rows.erase(std::remove_if(o.rows.begin(), o.rows.end(), [](const jobs::RegressionRow& r) { return r.name.rfind("farmhouse", 0) == 0; }),
+                 o.rows.end());
+    for (auto& r : point_rows(run, other)) o.rows.push_back(std::move(r));
     const std::string da = describe(run), db = describe(other);
     std::ofstream md(fs::path(out) / "compare.md");
     md << "# " << run << " (" << da << ") against " << other << " (" << db << ")\n\n";
