@@ -16,11 +16,13 @@ RUNOUT_PACKAGES=(
 )
 
 # What only the tests need besides: a one-node Slurm cluster (the slurm tests), dpkg-shlibdeps for
-# the Debian package (install.deb), QGIS for the Processing provider's test.
+# the Debian package (install.deb), QGIS for the Processing provider's test, poppler's PDF tools for
+# the report's test.
 RUNOUT_TEST_PACKAGES=(
   munge slurmctld slurmd slurm-client
   dpkg-dev
   qgis python3-qgis
+  poppler-utils
 )
 
 # runout_install_deps [test]: the build's packages, and with `test` the tests' too.

@@ -225,6 +225,10 @@ void write_ascii_on(const std::string& path, const std::string& template_path, c
 /// on the grid, else resampled onto it (nearest neighbour, GDAL's warper). Errors name `what`.
 std::vector<double> read_raster_on(const std::string& path, const Grid& g, const std::string& what);
 
+/// The grid of a raster written on a run's grid (elevation.tif): its size, cells, CRS, band 1 as the
+/// ground and its nodata cells as outside the domain. Errors name `what`.
+Grid grid_of_raster(const std::string& path, const std::string& what);
+
 /// `values` with the cells outside the domain (Grid::outside) as NaN: nodata in every raster written.
 std::vector<double> masked_outside(const Grid& g, const std::vector<double>& values);
 

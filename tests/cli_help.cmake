@@ -31,6 +31,7 @@ expect_help(fetch JOB --out --force --members ${CONNECTION})
 expect_help(health ${CONNECTION})
 expect_help(regress --server --token --token-file --tls-ca --tls --out --scenario --reference --accept --reason)
 expect_help(compare RUN OTHER --out)
+expect_help(report RUN --out --paper --dpi)
 expect_help(version)
 expect_help(worker)
 
@@ -48,7 +49,7 @@ foreach(args help --help -h)
 endforeach()
 # The overview names every command, both engines and every verification case family.
 execute_process(COMMAND ${RUNOUT} --help OUTPUT_VARIABLE out)
-foreach(word run verify serve submit status watch cancel fetch health regress compare worker version "help [COMMAND]"
+foreach(word run verify serve submit status watch cancel fetch health regress compare report worker version "help [COMMAND]"
         "engine \"depth-averaged\"" "engine \"vof\"" A1-A7 STRESS V1-V7 variations zoning)
   string(FIND "${out}" "${word}" at)
   if(at LESS 0)

@@ -5,6 +5,7 @@
 #include "jobs/drivers/hazard_maps.hpp"
 #include "jobs/drivers/hazard_outputs.hpp"
 #include "jobs/drivers/record_head.hpp"
+#include "jobs/drivers/report.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -79,6 +80,7 @@ void write_record(const std::string& path, const ResolvedScenario& s, const terr
     if (std::find(rel_rep.notes.begin(), rel_rep.notes.end(), n) == rel_rep.notes.end()) rec.add_notes(n);
   auto* re = rec.mutable_results();
   record_hazard_results(s, sum, outputs, *re);
+  for (const auto& line : outputs.parameters) rec.add_parameters(line);
   re->set_timeseries_frames(frames);
   auto* ti = rec.mutable_timings_s();
   ti->set_prepare(sum.seconds_prepare);
@@ -372,8 +374,14 @@ RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& tim
   const std::string record = (fs::path(out_dir_) / "run.json").string();
   if (!opt_.iseesnow_id.empty())
     for (auto& f : write_iseesnow(s_, opt_.iseesnow_id, out_dir_, grid_, res, sum.cpu_seconds)) sum.files.push_back(std::move(f));
+  if (!s_.report.empty()) sum.files.push_back("report.pdf");  // written from the folder once run.json is
   write_record(record, s_, dem_rep_, grid_, rel_rep_, res, sum, continued_from_, outputs, frames, secondary_);
   sum.files.push_back("run.json");
+  if (!s_.report.empty()) {
+    ReportOptions ro;
+    ro.paper = s_.report;
+    write_run_report(out_dir_, (fs::path(out_dir_) / "report.pdf").string(), ro);
+  }
   return sum;
 }
 

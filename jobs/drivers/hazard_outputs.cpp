@@ -135,6 +135,11 @@ HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Gri
     sum.files.push_back(r.name + ".tif");
     sum.files.push_back(r.name + ".qml");
   }
+  // The ground and the release on the run's grid, for GIS and for `runout report`.
+  terrain::write_cog(out("elevation.tif"), grid, terrain::masked_outside(grid, grid.z), {"ground elevation on the run's grid", "m"});
+  terrain::write_cog(out("release.tif"), grid, terrain::masked_outside(grid, h0), {"release thickness (0: not released)", "m"});
+  for (const char* f : {"elevation.tif", "release.tif"}) sum.files.push_back(f);
+  res.parameters = map_parameters(s, grid, sum.release_volume_m3);
   auto raster = [&](const std::string& name) -> const std::vector<double>& {
     const auto& all = hazard_rasters();
     return values[std::size_t(std::find_if(all.begin(), all.end(), [&](const HazardRaster& r) { return r.name == name; }) - all.begin())];

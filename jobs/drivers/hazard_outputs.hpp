@@ -49,6 +49,7 @@ struct HazardOutputs {
   std::optional<products::OutlineScores> scores;  ///< against observations.outline_path
   std::optional<products::PathProfile> path;      ///< the path analysis (none: no line on the grid)
   std::string path_source;
+  std::vector<std::string> parameters;  ///< the parameters in words (map_parameters), for run.json
 };
 
 /// The hazard rasters the scenario asks for (hazard_rasters(), each with its QGIS style), the

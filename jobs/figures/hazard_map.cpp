@@ -10,16 +10,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <memory>
 
+#include "jobs/figures/map_drawing.hpp"
 #include "jobs/figures/pen.hpp"
 
 namespace runout::figures {
 using terrain::Grid;
 using terrain::TerrainError;
 
-namespace {
+namespace detail {
 
 const Rgb kInk{0.1, 0.1, 0.1}, kRelease{0.05, 0.05, 0.05}, kOutline{0.43, 0.0, 0.08}, kContour{0.25, 0.22, 0.18},
     kPath{0.05, 0.2, 0.45}, kForest{0.1, 0.45, 0.12}, kCover{0.0, 0.55, 0.75}, kDam{0.45, 0.25, 0.1};
@@ -54,10 +57,6 @@ std::vector<std::uint8_t> hillshade(GDALDataset& dem, const Grid& g) {
 }
 
 // Elevation contours every `interval` metres (GDAL's contour generator), as polylines in the grid's CRS.
-struct Contour {
-  double elevation;
-  std::vector<std::pair<double, double>> xy;
-};
 std::vector<Contour> contours(GDALDataset& dem, double interval) {
   auto* drv = GetGDALDriverManager()->GetDriverByName("Memory");
   GDALDatasetUniquePtr vds(drv->Create("", 0, 0, 0, GDT_Unknown, nullptr));
@@ -81,15 +80,20 @@ std::vector<Contour> contours(GDALDataset& dem, double interval) {
   return out;
 }
 
-struct Frame {
-  const Grid& g;
-  double x0, y0, s;  // the map's top-left corner on the page, page units per cell
-  double px(double x) const { return x0 + (x - g.x_min) / g.dx * s; }
-  double py(double y) const { return y0 + (g.y_min + g.ny * g.dx - y) / g.dx * s; }
-};
 
-void colour(cairo_t* cr, const Rgb& c, double alpha = 1) { cairo_set_source_rgba(cr, c.r, c.g, c.b, alpha); }
+void colour(cairo_t* cr, const Rgb& c, double alpha) { cairo_set_source_rgba(cr, c.r, c.g, c.b, alpha); }
 Rgb rgb(const Rgb8& c) { return {c[0] / 255.0, c[1] / 255.0, c[2] / 255.0}; }
+
+// A cell's colour: its class's where classed, else the hillshade's grey (`sh` in 0-1), pale outside
+// the domain.
+Rgb8 cell_colour(const Grid& g, const HazardMap& m, std::size_t k, double sh) {
+  Rgb8 c;
+  const int cls = m.values.empty() ? -1 : m.palette.class_of(m.values[k]);
+  if (!g.outside.empty() && g.outside[k]) c.fill(std::uint8_t(215 + 40 * sh));
+  else if (cls >= 0) c = m.palette.classes[std::size_t(cls)].colour;
+  else c.fill(std::uint8_t(std::clamp(70 + 185 * sh, 0.0, 255.0)));
+  return c;
+}
 
 // The cells: hillshade grey, pale outside the domain, the palette's colour (opaque) where classed.
 void draw_cells(cairo_t* cr, const Frame& f, const HazardMap& m, const std::vector<std::uint8_t>& shade) {
@@ -102,11 +106,7 @@ void draw_cells(cairo_t* cr, const Frame& f, const HazardMap& m, const std::vect
     for (int i = 0; i < g.nx; ++i) {
       const std::size_t k = std::size_t(g.ny - 1 - r) * g.nx + i;
       const double sh = shade[std::size_t(r) * g.nx + i] / 255.0;
-      Rgb8 c;
-      const int cls = m.values.empty() ? -1 : m.palette.class_of(m.values[k]);
-      if (!g.outside.empty() && g.outside[k]) c.fill(std::uint8_t(215 + 40 * sh));
-      else if (cls >= 0) c = m.palette.classes[std::size_t(cls)].colour;
-      else c.fill(std::uint8_t(std::clamp(70 + 185 * sh, 0.0, 255.0)));
+      const Rgb8 c = cell_colour(g, m, k, sh);
       auto* px = reinterpret_cast<std::uint32_t*>(data + std::size_t(r) * stride) + i;
       *px = (std::uint32_t(c[0]) << 16) | (std::uint32_t(c[1]) << 8) | c[2];
     }
@@ -122,8 +122,8 @@ void draw_cells(cairo_t* cr, const Frame& f, const HazardMap& m, const std::vect
 }
 
 // The edges between cells inside and outside, as one path (cell j = 0 is the southern row).
-void draw_edges(cairo_t* cr, const Frame& f, const std::function<bool(int, int)>& inside, const Rgb& c, double width, bool halo = false,
-                bool dashed = false) {
+void draw_edges(cairo_t* cr, const Frame& f, const std::function<bool(int, int)>& inside, const Rgb& c, double width, bool halo,
+                bool dashed) {
   const Grid& g = f.g;
   auto in = [&](int i, int j) { return i >= 0 && j >= 0 && i < g.nx && j < g.ny && inside(i, j); };
   auto X = [&](int i) { return f.x0 + i * f.s; };
@@ -162,6 +162,23 @@ void draw_contours(cairo_t* cr, const Frame& f, const std::vector<Contour>& cs, 
     cairo_stroke(cr);
   }
   cairo_restore(cr);
+}
+
+void draw_area_edges(cairo_t* cr, const Frame& f, const HazardMap& m, double w) {
+  const Grid& g = f.g;
+  for (const auto& b : m.boundaries)
+    for (std::size_t k = 0; k < b.palette.classes.size(); ++k)
+      draw_edges(cr, f, [&](int i, int j) { return b.cls[std::size_t(j) * g.nx + i] >= k + 1; }, rgb(b.palette.classes[k].colour), 2.5 * w, true);
+  if (!m.max_depth.empty())
+    draw_edges(cr, f, [&](int i, int j) { return m.max_depth[std::size_t(j) * g.nx + i] > m.outline_threshold; }, kOutline, 1.6 * w);
+  if (!m.release.empty())
+    draw_edges(cr, f, [&](int i, int j) { return m.release[std::size_t(j) * g.nx + i] > 0; }, kRelease, 1.6 * w, true, true);
+  if (!m.resistance.empty())
+    draw_edges(cr, f, [&](int i, int j) { return m.resistance[std::size_t(j) * g.nx + i] != 0; }, kForest, 1.6 * w, true, true);
+  if (!m.cover.empty())
+    draw_edges(cr, f, [&](int i, int j) { return m.cover[std::size_t(j) * g.nx + i] != 0; }, kCover, 1.6 * w, true, true);
+  if (!m.dams.empty())
+    draw_edges(cr, f, [&](int i, int j) { return m.dams[std::size_t(j) * g.nx + i] != 0; }, kDam, 2.2 * w, true);
 }
 
 // Ticks with coordinates in the grid's CRS on the map's lower and left edges.
@@ -242,7 +259,10 @@ double draw_panel(cairo_t* cr, double x, double y, const HazardMap& m, double co
     double top = -HUGE_VAL;
     for (double v : m.values)
       if (std::isfinite(v)) top = std::max(top, v);
-    if (std::isfinite(top)) y += text(x, y + 2, "maximum " + label_number(top) + (m.palette.unit.empty() ? "" : " " + m.palette.unit), body) + 6;
+    char four[32];  // four significant digits
+    std::snprintf(four, sizeof four, "%.4g", top);
+    if (std::isfinite(top))
+      y += text(x, y + 2, "maximum " + label_number(std::strtod(four, nullptr)) + (m.palette.unit.empty() ? "" : " " + m.palette.unit), body) + 6;
   }
   if (!m.colour_note.empty()) y += text(x, y + 2, m.colour_note, {12, false, kInk, kPanel}) + 6;
   y += 10;
@@ -283,7 +303,9 @@ double draw_panel(cairo_t* cr, double x, double y, const HazardMap& m, double co
   return y;
 }
 
-}  // namespace
+}  // namespace detail
+
+using namespace detail;
 
 std::vector<double> inside_outline(const std::vector<double>& values, const std::vector<double>& max_depth, double threshold) {
   std::vector<double> v = values;
@@ -328,19 +350,7 @@ MapLayout draw_hazard_map(const std::string& png_path, const std::string& pdf_pa
     const Frame f{g, kLeft, top, s};
     draw_cells(cr, f, m, shade);
     draw_contours(cr, f, lines, lay.contour_interval_m);
-    for (const auto& b : m.boundaries)
-      for (std::size_t k = 0; k < b.palette.classes.size(); ++k)
-        draw_edges(cr, f, [&](int i, int j) { return b.cls[std::size_t(j) * g.nx + i] >= k + 1; }, rgb(b.palette.classes[k].colour), 2.5, true);
-    if (!m.max_depth.empty())
-      draw_edges(cr, f, [&](int i, int j) { return m.max_depth[std::size_t(j) * g.nx + i] > m.outline_threshold; }, kOutline, 1.6);
-    if (!m.release.empty())
-      draw_edges(cr, f, [&](int i, int j) { return m.release[std::size_t(j) * g.nx + i] > 0; }, kRelease, 1.6, true, true);
-    if (!m.resistance.empty())
-      draw_edges(cr, f, [&](int i, int j) { return m.resistance[std::size_t(j) * g.nx + i] != 0; }, kForest, 1.6, true, true);
-    if (!m.cover.empty())
-      draw_edges(cr, f, [&](int i, int j) { return m.cover[std::size_t(j) * g.nx + i] != 0; }, kCover, 1.6, true, true);
-    if (!m.dams.empty())
-      draw_edges(cr, f, [&](int i, int j) { return m.dams[std::size_t(j) * g.nx + i] != 0; }, kDam, 2.2, true);
+    draw_area_edges(cr, f, m, 1.0);
     if (m.path.size() >= 2) {
       cairo_new_path(cr);
       for (std::size_t k = 0; k < m.path.size(); ++k)

@@ -11,6 +11,9 @@
 #include "jobs/figures/palette.hpp"
 #include "terrain/terrain.hpp"
 
+// Cairo's context, declared as cairo.h does (the header itself stays inside jobs/figures).
+typedef struct _cairo cairo_t;
+
 namespace runout::figures {
 
 struct MapPoint {
@@ -60,6 +63,28 @@ struct MapLayout {
   int title_lines = 1, unknown_glyphs = 0;      ///< over every text drawn
   double contour_interval_m = 0;
 };
+
+/// A map on a report page (map_page.cpp): the extent drawn at a stated scale 1:N (the smallest of
+/// 1:1000, 2000, 2500, 5000, 10 000, 12 500, 20 000, 25 000, 50 000, 100 000, 200 000 at which it fits
+/// the room), its cells as one raster of `dpi`, labelled index contours, coordinate ticks, a scale bar
+/// and the legend panel.
+struct MapPageSpec {
+  double x = 0, y = 0, w = 0, h = 0;  ///< the room for the map on the page [pt]
+  double panel_x = 0, panel_y = 0, panel_scale = 0.75;  ///< the legend panel's top-left [pt] and its size
+  double dpi = 300;
+  std::array<double, 4> extent{};  ///< x_min, y_min, x_max, y_max shown (grid's CRS); all 0: the grid
+};
+struct MapPageLayout {
+  int scale = 0;                  ///< 1:scale
+  std::array<double, 4> frame{};  ///< the map's box on the page [pt]
+  int image_w = 0, image_h = 0;   ///< the cells' raster [pixels]
+  int contour_labels = 0, leader_lines = 0;
+  std::vector<std::array<double, 4>> label_boxes;  ///< every label placed (x, y, w, h); no two overlap
+  int unknown_glyphs = 0;
+};
+/// Draw the map page's map into `cr` (a PDF page of points). Throws terrain::TerrainError when the
+/// extent does not fit the room at 1:200 000.
+MapPageLayout draw_map_page(cairo_t* cr, const terrain::Grid& g, const HazardMap& m, const MapPageSpec& spec);
 
 /// Draw the map into `png_path` and `pdf_path` (either may be empty). Throws terrain::TerrainError.
 MapLayout draw_hazard_map(const std::string& png_path, const std::string& pdf_path, const terrain::Grid& g, const HazardMap& m);

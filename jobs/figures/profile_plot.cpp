@@ -108,11 +108,22 @@ void draw(cairo_t* cr, const ProfilePlot& p, double height, double top) {
 
 }  // namespace
 
-void draw_profile_plot(const std::string& png_path, const std::string& pdf_path, const ProfilePlot& p) {
+std::pair<double, double> profile_plot_size(const ProfilePlot& p) {
   if (p.s.size() < 2 || p.z.size() != p.s.size()) throw std::runtime_error("profile plot: fewer than two stations");
   const double top = 14 + draw_text(nullptr, 20, 12, p.title, {18, true, kInk, kW - 40}).h + 40;
-  const double height = top + 1.4 * kPanel + kGap + p.series.size() * (kPanel + kGap) + 30;
-  render_png_pdf(png_path, pdf_path, kW, std::ceil(height), [&](cairo_t* cr) { draw(cr, p, height, top); });
+  return {kW, std::ceil(top + 1.4 * kPanel + kGap + double(p.series.size()) * (kPanel + kGap) + 30)};
+}
+
+void draw_profile(cairo_t* cr, const ProfilePlot& p) {
+  const auto [w, height] = profile_plot_size(p);
+  const double top = 14 + draw_text(nullptr, 20, 12, p.title, {18, true, kInk, kW - 40}).h + 40;
+  (void)w;
+  draw(cr, p, height, top);
+}
+
+void draw_profile_plot(const std::string& png_path, const std::string& pdf_path, const ProfilePlot& p) {
+  const auto [w, h] = profile_plot_size(p);
+  render_png_pdf(png_path, pdf_path, w, h, [&](cairo_t* cr) { draw_profile(cr, p); });
 }
 
 }  // namespace runout::figures

@@ -77,6 +77,7 @@ struct ResolvedScenario {
   std::vector<DamSettings> dams;                   ///< dams[]; none: no dams
   std::string corridor_path;  ///< mesh.corridor_path (3D engine on the DEM), resolved; empty: none
   bool maps = true;  ///< outputs.maps: the report maps (PNG, PDF)
+  std::string report;  ///< outputs.report: "a4" or "a3", the run's report.pdf; "": none
   std::vector<std::string> input_files;  ///< for hashing
   /// The engine registry's row that runs it (jobs/drivers/engines.cpp): kDepthAveragedEngine;
   /// kVofLabEngine, engine "vof" with a laboratory set-up (`lab`); kVofTerrainEngine, engine "vof"

@@ -38,6 +38,7 @@ int fetch(const std::vector<std::string>& args);
 int health(const std::vector<std::string>& args);
 int regress(const std::vector<std::string>& args);
 int compare(const std::vector<std::string>& args);
+int report(const std::vector<std::string>& args);
 std::string version_report();
 
 // The command line of every command is parsed with CLI11 (CLI/CLI.hpp), one CLI::App per command,

@@ -75,8 +75,12 @@ commands:
         map and a difference map; exit 1 on a regression. --accept makes this run the reference.
   compare RUN OTHER --out DIR
         Two finished runs on the same grid side by side (e.g. the 3D engine's and the depth-averaged
-        one's): runout, affected area, maximum depth and speed, the farmhouse of In den Arelen where it
-        lies on the grid; compare.md with the table, and the difference map of the maximum depth.
+        one's): runout, affected area, maximum depth and speed, the scenarios' points of interest;
+        compare.md with the table, and the difference map of the maximum depth.
+  report RUN --out FILE.pdf [--paper a4|a3] [--dpi N]
+        A finished run on terrain as one PDF for a hazard report: the parameters in words, the mass
+        balance, the results, the points of interest and zones as tables, each map at a stated 1:N
+        scale (300 dpi rasters), the path profile.
   worker
         (Started by the server, not by hand.) Run one job handed over on standard input and report
         on standard output (service/proto/runout/v1/worker.proto; docs/user/operations.md).
@@ -206,13 +210,13 @@ int main(int argc, char** argv) {
   const std::pair<const char*, Command> commands[] = {
       {"run", cli::run},       {"verify", cli::verify}, {"serve", cli::serve},   {"submit", cli::submit},
       {"status", cli::status}, {"watch", cli::watch},   {"cancel", cli::cancel}, {"fetch", cli::fetch},
-      {"health", cli::health}, {"regress", cli::regress}, {"compare", cli::compare}, {"version", cli::version}, {"--version", cli::version},
+      {"health", cli::health}, {"regress", cli::regress}, {"compare", cli::compare}, {"report", cli::report}, {"version", cli::version}, {"--version", cli::version},
       {"worker", cli::worker}};
   try {
     for (const auto& [name, fn] : commands)
       if (cmd == name) return fn(args);
     std::cerr << "runout: unknown command '" << cmd
-              << "' (valid: run, verify, serve, submit, status, watch, cancel, fetch, health, regress, compare, version, help)\n";
+              << "' (valid: run, verify, serve, submit, status, watch, cancel, fetch, health, regress, compare, report, version, help)\n";
     return cli::kUsage;
   } catch (const std::exception& e) {
     std::cerr << "runout: internal error: " << e.what() << "\n";

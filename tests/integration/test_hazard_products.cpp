@@ -3,6 +3,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <cairo-pdf.h>
+
 #include "jobs/figures/hazard_map.hpp"
 #include "jobs/figures/palette.hpp"
 #include "jobs/products/path.hpp"
@@ -333,6 +335,49 @@ TEST(HazardProducts, PathAnalysisHasKnownAnswers) {
   set.field = "pft";
   set.threshold = 2;
   EXPECT_FALSE(jobs::products::analyse_path(g, line, {depth, speed, pressure, release}, set).runout);
+}
+
+// A report's map page, known answers on the tilted grid (1000 x 800 m) in a room of 500 x 400 pt:
+// the scale is the smallest round one at which it fits (1:10 000: 283 x 227 pt; 1:5000 would need
+// 567 pt), the cells' raster has the page's 300 dpi (1000 m at 1:10 000 is 3.94 in: 1182 pixels),
+// and the labels of six points crowded into 60 m (the names longer than the points' spacing) are
+// placed so that no two overlap, some moved out with leader lines.
+TEST(HazardProducts, AReportMapPageHasItsScaleItsResolutionAndLabelsThatDoNotOverlap) {
+  TempDir d;
+  const auto g = tilted_grid();
+  figures::HazardMap m;
+  m.title = "test";
+  m.palette = figures::hazard_palette("max_depth");
+  m.values.assign(g.cells(), 1.0);
+  m.max_depth.assign(g.cells(), 1.0);
+  for (int k = 0; k < 6; ++k) m.points.push_back({"farmhouse number " + std::to_string(k), g.x_min + 500 + 10 * k, g.y_min + 400 + 10 * k});
+  figures::MapPageSpec spec;
+  spec.x = 40;
+  spec.y = 40;
+  spec.w = 500;
+  spec.h = 400;
+  spec.panel_x = 560;
+  spec.panel_y = 40;
+  std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> surf(cairo_pdf_surface_create((d / "page.pdf").c_str(), 842, 595),
+                                                                          cairo_surface_destroy);
+  std::unique_ptr<cairo_t, decltype(&cairo_destroy)> cr(cairo_create(surf.get()), cairo_destroy);
+  const auto lay = figures::draw_map_page(cr.get(), g, m, spec);
+  EXPECT_EQ(lay.scale, 10000);
+  EXPECT_NEAR(lay.frame[2], 1000 * 72 / 0.0254 / 10000, 1e-9);
+  EXPECT_NEAR(lay.frame[3], 800 * 72 / 0.0254 / 10000, 1e-9);
+  EXPECT_EQ(lay.image_w, 1182);
+  EXPECT_EQ(lay.image_h, 945);
+  EXPECT_EQ(lay.unknown_glyphs, 0);
+  ASSERT_GE(lay.label_boxes.size(), 6u);
+  for (std::size_t a = 0; a < lay.label_boxes.size(); ++a)
+    for (std::size_t b = a + 1; b < lay.label_boxes.size(); ++b) {
+      const auto &p = lay.label_boxes[a], &q = lay.label_boxes[b];
+      EXPECT_FALSE(p[0] < q[0] + q[2] && q[0] < p[0] + p[2] && p[1] < q[1] + q[3] && q[1] < p[1] + p[3]) << a << " and " << b << " overlap";
+    }
+  EXPECT_GT(lay.leader_lines, 0);
+  // Too large for the room even at 1:200 000: refused, named.
+  spec.w = spec.h = 2;
+  EXPECT_THROW(figures::draw_map_page(cr.get(), g, m, spec), terrain::TerrainError);
 }
 
 // The flow's own path, known answers on the tilted grid (100 x 80 cells of 10 m):

@@ -89,6 +89,7 @@ void write_terrain_record(const std::string& path, const ResolvedScenario& r, co
   so->set_max_speed_m_s(sum.max_speed);
   auto* re = rec.mutable_results();
   record_hazard_results(r, sum, f.outputs, *re);
+  for (const auto& line : f.outputs.parameters) rec.add_parameters(line);
   re->set_frames(f.frames);
   write_profiles(f, rec);
   auto* ti = rec.mutable_timings_s();

@@ -1,0 +1,21 @@
+#pragma once
+// `runout report`: a finished run's folder as one PDF for a hazard report (figures/report.hpp), read
+// back from what the run wrote (run.json, the hazard rasters, elevation.tif, release.tif,
+// pressure_zones.tif, path_profile.csv): the parameters in words, the mass balance, the results, the
+// points of interest and the zones as tables, the maps at a stated scale and the path profile.
+#include <string>
+
+#include "jobs/figures/report.hpp"
+
+namespace runout::jobs {
+
+struct ReportOptions {
+  std::string paper = "a4";  ///< a4 or a3 (landscape)
+  double dpi = 300;          ///< the maps' rasters
+};
+
+/// Write the report of the run in `run_dir` to `pdf_path`. Throws std::runtime_error naming the file
+/// that is missing or unreadable (a laboratory run has no maps on terrain: refused).
+figures::ReportLayout write_run_report(const std::string& run_dir, const std::string& pdf_path, const ReportOptions& opt);
+
+}  // namespace runout::jobs

@@ -1,0 +1,58 @@
+#pragma once
+// The map's drawing parts that both the stand-alone hazard map (hazard_map.cpp) and the report's
+// map pages (map_page.cpp) draw with: the DEM's hillshade and contours, the cells in the palette's
+// colours, the edges of areas, the legend panel. Internal to jobs/figures.
+#include <cairo.h>
+#include <gdal_priv.h>
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "jobs/figures/hazard_map.hpp"
+#include "jobs/figures/pen.hpp"
+
+namespace runout::figures::detail {
+
+extern const Rgb kInk, kRelease, kOutline, kContour, kPath, kForest, kCover, kDam;
+
+/// The DEM as an in-memory raster (north-up, row 0 north).
+GDALDatasetUniquePtr dem_raster(const terrain::Grid& g);
+/// Hillshade with GDAL's DEM tools, one byte per cell, row 0 north.
+std::vector<std::uint8_t> hillshade(GDALDataset& dem, const terrain::Grid& g);
+
+/// An elevation contour in the grid's CRS.
+struct Contour {
+  double elevation;
+  std::vector<std::pair<double, double>> xy;
+};
+/// Contours every `interval` metres (GDAL's contour generator).
+std::vector<Contour> contours(GDALDataset& dem, double interval);
+
+/// Where the grid lies on the page: the grid's top-left corner at (x0, y0), s page units per cell.
+struct Frame {
+  const terrain::Grid& g;
+  double x0, y0, s;
+  double px(double x) const { return x0 + (x - g.x_min) / g.dx * s; }
+  double py(double y) const { return y0 + (g.y_min + g.ny * g.dx - y) / g.dx * s; }
+};
+
+void colour(cairo_t* cr, const Rgb& c, double alpha = 1);
+Rgb rgb(const Rgb8& c);
+/// A cell's colour: its class's where classed, else the hillshade's grey (`sh` in 0-1), pale
+/// outside the domain.
+Rgb8 cell_colour(const terrain::Grid& g, const HazardMap& m, std::size_t k, double sh);
+/// The edges between cells inside and outside, as one path, in `c` (a white halo first when `halo`).
+void draw_edges(cairo_t* cr, const Frame& f, const std::function<bool(int, int)>& inside, const Rgb& c, double width, bool halo = false,
+                bool dashed = false);
+/// The map's areas as edges: class boundaries, outline, release, forest, cover, dams (widths times `w`).
+void draw_area_edges(cairo_t* cr, const Frame& f, const HazardMap& m, double w);
+/// The contours, index contours (every fifth) darker, clipped to the grid's frame.
+void draw_contours(cairo_t* cr, const Frame& f, const std::vector<Contour>& cs, double interval);
+/// A point of interest's symbol.
+void draw_point(cairo_t* cr, double x, double y);
+/// The legend panel (colour bar, line legend, north arrow, parameters) at (x, y); a null `cr` only
+/// measures. Returns the panel's bottom.
+double draw_panel(cairo_t* cr, double x, double y, const HazardMap& m, double contour_interval, MapLayout& lay);
+
+}  // namespace runout::figures::detail
