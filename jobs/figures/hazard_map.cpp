@@ -202,18 +202,23 @@ void draw_ticks(cairo_t* cr, const Frame& f, MapLayout& lay) {
   }
 }
 
+void scale_bar(cairo_t* cr, double x, double y, double length, double height) {
+  colour(cr, kInk);
+  cairo_rectangle(cr, x, y, length, height);
+  cairo_fill(cr);
+  cairo_set_source_rgb(cr, 1, 1, 1);
+  cairo_rectangle(cr, x + length / 2, y + 1, length / 2 - 1, height - 2);
+  cairo_fill(cr);
+}
+
+std::string length_label(double metres) { return metres >= 1000 ? label_number(metres / 1000) + " km" : label_number(metres) + " m"; }
+
 // A scale bar under the map, and the CRS beside it.
 void draw_scale(cairo_t* cr, const Frame& f, MapLayout& lay) {
   const Grid& g = f.g;
   const double len = nice_step(g.nx * g.dx, 4), bar = len / g.dx * f.s, x = f.x0, y = f.y0 + g.ny * f.s + 34;
-  colour(cr, kInk);
-  cairo_rectangle(cr, x, y, bar, 7);
-  cairo_fill(cr);
-  cairo_set_source_rgb(cr, 1, 1, 1);
-  cairo_rectangle(cr, x + bar / 2, y + 1, bar / 2 - 1, 5);
-  cairo_fill(cr);
-  const std::string l = len >= 1000 ? label_number(len / 1000) + " km" : label_number(len) + " m";
-  lay.unknown_glyphs += draw_text(cr, x + bar + 8, y - 4, l, {11, false, kInk}).unknown_glyphs;
+  scale_bar(cr, x, y, bar, 7);
+  lay.unknown_glyphs += draw_text(cr, x + bar + 8, y - 4, length_label(len), {11, false, kInk}).unknown_glyphs;
   lay.unknown_glyphs += draw_text(cr, x, y + 12, g.crs_name + ", cells of " + label_number(g.dx) + " m", {11, false, kInk}).unknown_glyphs;
 }
 

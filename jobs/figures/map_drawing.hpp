@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "jobs/figures/hazard_map.hpp"
@@ -49,6 +50,10 @@ void draw_edges(cairo_t* cr, const Frame& f, const std::function<bool(int, int)>
 void draw_area_edges(cairo_t* cr, const Frame& f, const HazardMap& m, double w);
 /// The contours, index contours (every fifth) darker, clipped to the grid's frame.
 void draw_contours(cairo_t* cr, const Frame& f, const std::vector<Contour>& cs, double interval);
+/// A scale bar `length` long at (x, y): black, its right half white inside.
+void scale_bar(cairo_t* cr, double x, double y, double length, double height);
+/// "500 m", "2 km".
+std::string length_label(double metres);
 /// A point of interest's symbol.
 void draw_point(cairo_t* cr, double x, double y);
 /// The legend panel (colour bar, line legend, north arrow, parameters) at (x, y); a null `cr` only

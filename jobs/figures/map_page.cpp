@@ -3,6 +3,7 @@
 // another (moved round the point, with a leader line when moved away), ticks, a scale bar and the
 // legend panel.
 #include <cairo.h>
+#include <gdal_priv.h>
 
 #include <algorithm>
 #include <cmath>
@@ -177,14 +178,8 @@ void draw_frame_furniture(cairo_t* cr, const Box& fr, const Box& ext, double ppm
     unknown += draw_text(cr, fr[0] - 14, Y, label_number(y, true), {7, false, kInk, -1, 90, 1}).unknown_glyphs;
   }
   const double len = nice_step(ext[2], 4), bar = len * ppm, bx = fr[0], by = fr[1] + fr[3] + 20;
-  colour(cr, kInk);
-  cairo_rectangle(cr, bx, by, bar, 5);
-  cairo_fill(cr);
-  cairo_set_source_rgb(cr, 1, 1, 1);
-  cairo_rectangle(cr, bx + bar / 2, by + 1, bar / 2 - 1, 3);
-  cairo_fill(cr);
-  const std::string l = len >= 1000 ? label_number(len / 1000) + " km" : label_number(len) + " m";
-  unknown += draw_text(cr, bx + bar + 6, by - 3, l + "     scale 1:" + label_number(scale, true) + " (on the page as printed)",
+  scale_bar(cr, bx, by, bar, 5);
+  unknown += draw_text(cr, bx + bar + 6, by - 3, length_label(len) + "     scale 1:" + label_number(scale, true) + " (on the page as printed)",
                        {8, false, kInk})
                  .unknown_glyphs;
   unknown += draw_text(cr, bx, by + 8, g.crs_name + ", cells of " + label_number(g.dx) + " m", {7, false, kInk}).unknown_glyphs;
@@ -193,6 +188,7 @@ void draw_frame_furniture(cairo_t* cr, const Box& fr, const Box& ext, double ppm
 }  // namespace
 
 MapPageLayout draw_map_page(cairo_t* cr, const Grid& g, const HazardMap& m, const MapPageSpec& spec) {
+  GDALAllRegister();  // the DEM's in-memory raster, hillshade and contours
   MapPageLayout lay;
   Box ext = {spec.extent[0], spec.extent[1], spec.extent[2] - spec.extent[0], spec.extent[3] - spec.extent[1]};
   if (!(ext[2] > 0 && ext[3] > 0)) ext = {g.x_min, g.y_min, g.nx * g.dx, g.ny * g.dx};
