@@ -202,6 +202,73 @@ void draw_ticks(cairo_t* cr, const Frame& f, MapLayout& lay) {
   }
 }
 
+bool overlap(const Box& a, const Box& b) {
+  return a[0] < b[0] + b[2] && b[0] < a[0] + a[2] && a[1] < b[1] + b[3] && b[1] < a[1] + a[3];
+}
+bool within(const Box& a, const Box& frame) {
+  return a[0] >= frame[0] && a[1] >= frame[1] && a[0] + a[2] <= frame[0] + frame[2] && a[1] + a[3] <= frame[1] + frame[3];
+}
+
+bool LabelPlacer::free(const Box& b) const {
+  if (!within(b, frame)) return false;
+  return std::none_of(boxes.begin(), boxes.end(), [&](const Box& o) { return overlap(b, o); });
+}
+
+
+// Whether a label's box crosses the outline (cells under it both inside and outside).
+bool crosses_outline(const Frame& f, const HazardMap& m, const Box& b) {
+  if (m.max_depth.empty()) return false;
+  const Grid& g = f.g;
+  bool in = false, out = false;
+  for (double y = b[1]; y <= b[1] + b[3]; y += std::max(1.0, f.s / 2))
+    for (double x = b[0]; x <= b[0] + b[2]; x += std::max(1.0, f.s / 2)) {
+      const int i = int(std::floor((x - f.x0) / f.s)), j = g.ny - 1 - int(std::floor((y - f.y0) / f.s));
+      if (i < 0 || j < 0 || i >= g.nx || j >= g.ny) continue;
+      (m.max_depth[std::size_t(j) * g.nx + i] > m.outline_threshold ? in : out) = true;
+    }
+  return in && out;
+}
+
+// A point's label: beside the point (right, left, above, below), else moved further out with a
+// leader line; the first place that overlaps no label, preferring places off the outline's line.
+// Returns 1 when a leader line was drawn, 0 when placed beside, -1 when no place was free.
+int place_label(cairo_t* cr, const Frame& f, const HazardMap& m, double px, double py, const std::string& text, const TextStyle& style,
+                LabelPlacer& labels, int& unknown) {
+  const auto size = draw_text(nullptr, 0, 0, text, style);
+  const double w = size.w, h = size.h;
+  std::vector<std::pair<Box, bool>> candidates = {{{px + 7, py - h / 2, w, h}, false},
+                                                  {{px - 7 - w, py - h / 2, w, h}, false},
+                                                  {{px - w / 2, py - 7 - h, w, h}, false},
+                                                  {{px - w / 2, py + 7, w, h}, false}};
+  for (double r : {30.0, 55.0, 85.0})
+    for (int a = 0; a < 8; ++a) {
+      const double dx = std::cos(a * M_PI / 4), dy = -std::sin(a * M_PI / 4);
+      const double cx = px + r * dx, cy = py + r * dy;
+      candidates.push_back({{dx >= 0 ? cx : cx - w, cy - h / 2, w, h}, true});
+    }
+  const std::pair<Box, bool>* chosen = nullptr;
+  for (int pass = 0; pass < 2 && !chosen; ++pass)  // off the outline's line first, then anywhere free
+    for (const auto& c : candidates)
+      if (labels.free(c.first) && (pass == 1 || !crosses_outline(f, m, c.first))) {
+        chosen = &c;
+        break;
+      }
+  if (!chosen) return -1;
+  const Box& b = chosen->first;
+  if (chosen->second) {  // the leader line from the point to the label's nearer side
+    cairo_new_path(cr);
+    cairo_move_to(cr, px, py);
+    cairo_line_to(cr, b[0] + (b[0] > px ? 0 : b[2]), b[1] + b[3] / 2);
+    stroke(cr, kInk, 0.6);
+  }
+  cairo_set_source_rgba(cr, 1, 1, 1, 0.8);
+  cairo_rectangle(cr, b[0] - 1, b[1], b[2] + 2, b[3]);
+  cairo_fill(cr);
+  unknown += draw_text(cr, b[0], b[1], text, style).unknown_glyphs;
+  labels.boxes.push_back(b);
+  return chosen->second ? 1 : 0;
+}
+
 void scale_bar(cairo_t* cr, double x, double y, double length, double height) {
   colour(cr, kInk);
   cairo_rectangle(cr, x, y, length, height);
@@ -366,13 +433,18 @@ MapLayout draw_hazard_map(const std::string& png_path, const std::string& pdf_pa
         cairo_arc(cr, f.px(p.x), f.py(p.y), 4, 0, 2 * M_PI);
         colour(cr, kPath);
         cairo_fill(cr);
-        l.unknown_glyphs += draw_text(cr, f.px(p.x) + 7, f.py(p.y) + 2, p.name, {11, false, kPath}).unknown_glyphs;
       }
     }
-    for (const auto& p : m.points) {
-      draw_point(cr, f.px(p.x), f.py(p.y));
-      l.unknown_glyphs += draw_text(cr, f.px(p.x) + 8, f.py(p.y) - 18, p.name, {12, true, kInk}).unknown_glyphs;
-    }
+    for (const auto& p : m.points) draw_point(cr, f.px(p.x), f.py(p.y));
+    // The labels where no two overlap and, where it can be, off the outline's line (points first).
+    LabelPlacer labels{{kLeft, top, mw, mh}, {}};
+    for (const auto* marks : {&m.points, &m.path_marks})
+      for (const auto& p : *marks) labels.boxes.push_back({f.px(p.x) - 5, f.py(p.y) - 5, 10, 10});
+    for (const auto& p : m.points) place_label(cr, f, m, f.px(p.x), f.py(p.y), p.name, {12, true, kInk}, labels, l.unknown_glyphs);
+    if (m.path.size() >= 2)
+      for (const auto& p : m.path_marks) place_label(cr, f, m, f.px(p.x), f.py(p.y), p.name, {11, false, kPath}, labels, l.unknown_glyphs);
+    const std::size_t symbols = m.points.size() + m.path_marks.size();
+    l.label_boxes.assign(labels.boxes.begin() + std::ptrdiff_t(symbols), labels.boxes.end());
     colour(cr, kInk);
     cairo_set_line_width(cr, 1);
     cairo_rectangle(cr, kLeft, top, mw, mh);

@@ -62,6 +62,9 @@ struct MapLayout {
   std::array<double, 4> title{};                ///< the title's box
   int title_lines = 1, unknown_glyphs = 0;      ///< over every text drawn
   double contour_interval_m = 0;
+  /// The labels of the points and path marks (x, y, w, h), in the map's frame, no two overlapping
+  /// and, where a place allowed it, none across the outline's line.
+  std::vector<std::array<double, 4>> label_boxes;
 };
 
 /// A map on a report page (map_page.cpp): the extent drawn at a stated scale 1:N (the smallest of

@@ -5,6 +5,7 @@
 #include <cairo.h>
 #include <gdal_priv.h>
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -50,6 +51,22 @@ void draw_edges(cairo_t* cr, const Frame& f, const std::function<bool(int, int)>
 void draw_area_edges(cairo_t* cr, const Frame& f, const HazardMap& m, double w);
 /// The contours, index contours (every fifth) darker, clipped to the grid's frame.
 void draw_contours(cairo_t* cr, const Frame& f, const std::vector<Contour>& cs, double interval);
+using Box = std::array<double, 4>;  ///< x, y, w, h on the page
+bool overlap(const Box& a, const Box& b);
+bool within(const Box& a, const Box& frame);
+/// The labels placed so far on a map; a new one goes where it overlaps none and stays in the frame.
+struct LabelPlacer {
+  Box frame;
+  std::vector<Box> boxes;
+  bool free(const Box& b) const;
+};
+/// Whether a label's box crosses the outline (cells under it both inside and outside).
+bool crosses_outline(const Frame& f, const HazardMap& m, const Box& b);
+/// A point's label: beside the point (right, left, above, below), else moved further out with a
+/// leader line; the first place that overlaps no label, preferring places off the outline's line.
+/// Returns 1 when a leader line was drawn, 0 when placed beside, -1 when no place was free.
+int place_label(cairo_t* cr, const Frame& f, const HazardMap& m, double px, double py, const std::string& text, const TextStyle& style,
+                LabelPlacer& labels, int& unknown);
 /// A scale bar `length` long at (x, y): black, its right half white inside.
 void scale_bar(cairo_t* cr, double x, double y, double length, double height);
 /// "500 m", "2 km".

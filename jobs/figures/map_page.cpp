@@ -22,25 +22,6 @@ namespace {
 constexpr double kMetrePerInch = 0.0254;
 constexpr int kScales[] = {1000, 2000, 2500, 5000, 10000, 12500, 20000, 25000, 50000, 100000, 200000};
 
-using Box = std::array<double, 4>;  // x, y, w, h
-
-bool overlap(const Box& a, const Box& b) {
-  return a[0] < b[0] + b[2] && b[0] < a[0] + a[2] && a[1] < b[1] + b[3] && b[1] < a[1] + a[3];
-}
-bool within(const Box& a, const Box& frame) {
-  return a[0] >= frame[0] && a[1] >= frame[1] && a[0] + a[2] <= frame[0] + frame[2] && a[1] + a[3] <= frame[1] + frame[3];
-}
-
-// The labels placed so far; a new one goes where it overlaps none and stays in the frame.
-struct Labels {
-  Box frame;
-  std::vector<Box> boxes;
-  bool free(const Box& b) const {
-    if (!within(b, frame)) return false;
-    return std::none_of(boxes.begin(), boxes.end(), [&](const Box& o) { return overlap(b, o); });
-  }
-};
-
 // The cells' raster at the page's resolution: each pixel the colour of the cell under its centre.
 std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> cell_image(const Grid& g, const HazardMap& m,
                                                                               const std::vector<std::uint8_t>& shade, const Box& ext,
@@ -65,7 +46,7 @@ std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> cell_image(co
 }
 
 // Index contours' elevations along their lines, every 180 points or more, where they overlap no label.
-int label_contours(cairo_t* cr, const Frame& f, const std::vector<Contour>& cs, double interval, Labels& labels) {
+int label_contours(cairo_t* cr, const Frame& f, const std::vector<Contour>& cs, double interval, LabelPlacer& labels) {
   int placed = 0;
   const TextStyle style{7, false, kContour};
   for (const auto& c : cs) {
@@ -90,60 +71,6 @@ int label_contours(cairo_t* cr, const Frame& f, const std::vector<Contour>& cs, 
     }
   }
   return placed;
-}
-
-// Whether a label's box crosses the outline (cells under it both inside and outside).
-bool crosses_outline(const Frame& f, const HazardMap& m, const Box& b) {
-  if (m.max_depth.empty()) return false;
-  const Grid& g = f.g;
-  bool in = false, out = false;
-  for (double y = b[1]; y <= b[1] + b[3]; y += std::max(1.0, f.s / 2))
-    for (double x = b[0]; x <= b[0] + b[2]; x += std::max(1.0, f.s / 2)) {
-      const int i = int(std::floor((x - f.x0) / f.s)), j = g.ny - 1 - int(std::floor((y - f.y0) / f.s));
-      if (i < 0 || j < 0 || i >= g.nx || j >= g.ny) continue;
-      (m.max_depth[std::size_t(j) * g.nx + i] > m.outline_threshold ? in : out) = true;
-    }
-  return in && out;
-}
-
-// A point's label: beside the point (right, left, above, below), else moved further out with a
-// leader line; the first place that overlaps no label, preferring places off the outline's line.
-// Returns 1 when a leader line was drawn, 0 when placed beside, -1 when no place was free.
-int place_label(cairo_t* cr, const Frame& f, const HazardMap& m, double px, double py, const std::string& text, const TextStyle& style,
-                Labels& labels, int& unknown) {
-  const auto size = draw_text(nullptr, 0, 0, text, style);
-  const double w = size.w, h = size.h;
-  std::vector<std::pair<Box, bool>> candidates = {{{px + 7, py - h / 2, w, h}, false},
-                                                  {{px - 7 - w, py - h / 2, w, h}, false},
-                                                  {{px - w / 2, py - 7 - h, w, h}, false},
-                                                  {{px - w / 2, py + 7, w, h}, false}};
-  for (double r : {30.0, 55.0, 85.0})
-    for (int a = 0; a < 8; ++a) {
-      const double dx = std::cos(a * M_PI / 4), dy = -std::sin(a * M_PI / 4);
-      const double cx = px + r * dx, cy = py + r * dy;
-      candidates.push_back({{dx >= 0 ? cx : cx - w, cy - h / 2, w, h}, true});
-    }
-  const std::pair<Box, bool>* chosen = nullptr;
-  for (int pass = 0; pass < 2 && !chosen; ++pass)  // off the outline's line first, then anywhere free
-    for (const auto& c : candidates)
-      if (labels.free(c.first) && (pass == 1 || !crosses_outline(f, m, c.first))) {
-        chosen = &c;
-        break;
-      }
-  if (!chosen) return -1;
-  const Box& b = chosen->first;
-  if (chosen->second) {  // the leader line from the point to the label's nearer side
-    cairo_new_path(cr);
-    cairo_move_to(cr, px, py);
-    cairo_line_to(cr, b[0] + (b[0] > px ? 0 : b[2]), b[1] + b[3] / 2);
-    stroke(cr, kInk, 0.6);
-  }
-  cairo_set_source_rgba(cr, 1, 1, 1, 0.8);
-  cairo_rectangle(cr, b[0] - 1, b[1], b[2] + 2, b[3]);
-  cairo_fill(cr);
-  unknown += draw_text(cr, b[0], b[1], text, style).unknown_glyphs;
-  labels.boxes.push_back(b);
-  return chosen->second ? 1 : 0;
 }
 
 // The scale 1:N at which the extent fits the room.
@@ -228,7 +155,7 @@ MapPageLayout draw_map_page(cairo_t* cr, const Grid& g, const HazardMap& m, cons
   }
   cairo_restore(cr);
   // The labels: points and path marks first (they matter most), then the contours' elevations.
-  Labels labels{fr, {}};
+  LabelPlacer labels{fr, {}};
   auto mark = [&](const MapPoint& p, const TextStyle& st, bool point) {
     const double x = f.px(p.x), y = f.py(p.y);
     if (x < fr[0] || y < fr[1] || x > fr[0] + fr[2] || y > fr[1] + fr[3]) return;

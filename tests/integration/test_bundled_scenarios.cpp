@@ -183,6 +183,27 @@ TEST(Scenarios, TheDemoMapsColourOnlyTheOutlineAndItsRunoutIsOneFigureOnTheFlows
     EXPECT_GT(outside, 50000) << q;
     EXPECT_EQ(coloured, 0) << q << ": cells outside the outline in a class's colour";
   }
+  // The farmhouse's label does not cross the outline: the map's cells under its box are all inside
+  // or all outside (the point lies on the outline's edge; its label moved off it).
+  figures::HazardMap drawn;
+  drawn.title = r.scenario.name() + ": maximum pressure";
+  drawn.max_depth = depth.v;
+  for (int row_ = 0; row_ < g.ny; ++row_)  // row 0 south, as the maps take it
+    for (int i = 0; i < g.nx; ++i) drawn.max_depth[std::size_t(g.ny - 1 - row_) * g.nx + i] = depth.v[std::size_t(row_) * g.nx + i];
+  drawn.outline_threshold = r.outline_threshold;
+  const auto& poi = rec.results().points_of_interest(0);
+  drawn.points.push_back({poi.name(), poi.x(), poi.y()});
+  const auto placed = figures::draw_hazard_map(d / "labels.png", "", g, drawn);
+  ASSERT_EQ(placed.label_boxes.size(), 1u);
+  const auto& b = placed.label_boxes[0];
+  bool in = false, out = false;
+  for (double y = b[1]; y <= b[1] + b[3]; y += 1)
+    for (double x = b[0]; x <= b[0] + b[2]; x += 1) {
+      const int i = int((x - placed.map_x) / placed.cell_px), row_ = int((y - placed.map_y) / placed.cell_px);
+      if (i < 0 || row_ < 0 || i >= g.nx || row_ >= g.ny) continue;
+      (depth.v[std::size_t(row_) * g.nx + i] > r.outline_threshold ? in : out) = true;
+    }
+  EXPECT_FALSE(in && out) << "the farmhouse's label crosses the outline";
 }
 
 // In den Arelen with an illustrative erodible cover (a thickness raster in EPSG:2056, resampled onto
