@@ -78,8 +78,11 @@ std::vector<std::string> map_block(const ResolvedScenario& e, const std::vector<
       it->second.first = std::min(it->second.first, pv.value);
       it->second.second = std::max(it->second.second, pv.value);
     }
-  for (const auto& name : order)
-    p.push_back("varied: " + name + " " + num(range[name].first) + " – " + num(range[name].second));
+  for (const auto& name : order) {
+    const auto w = ensemble::parameter_in_words(name);
+    const std::string unit = w.unit.empty() ? "" : w.unit == "°" ? "°" : " " + w.unit;
+    p.push_back("varied: " + w.words + " " + num(range[name].first) + unit + " – " + num(range[name].second) + unit);
+  }
   for (auto& line : map_footer(g)) p.push_back(std::move(line));
   return p;
 }

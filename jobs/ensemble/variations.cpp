@@ -531,6 +531,36 @@ std::string describe(const std::vector<ParameterValue>& values) {
   return s;
 }
 
+ParameterWords parameter_in_words(const std::string& path) {
+  // "releases[0].thickness_factor" -> the block ("releases", a list: "release 1"), the field.
+  std::string block = path.substr(0, path.rfind('.') == std::string::npos ? 0 : path.rfind('.'));
+  std::string field = path.substr(path.rfind('.') == std::string::npos ? 0 : path.rfind('.') + 1);
+  ParameterWords w;
+  // The unit from the field's suffix, as the scenario's fields name it.
+  static const std::pair<const char*, const char*> kUnits[] = {{"_deg", "°"}, {"_kg_m3", "kg/m³"}, {"_m_s2", "m/s²"}, {"_m_s", "m/s"},
+                                                               {"_kpa", "kPa"}, {"_pa", "Pa"}, {"_m3", "m³"}, {"_m", "m"}, {"_s", "s"}};
+  for (const auto& [suffix, unit] : kUnits) {
+    const std::string sfx(suffix);
+    if (field.size() > sfx.size() && field.compare(field.size() - sfx.size(), sfx.size(), sfx) == 0) {
+      field.resize(field.size() - sfx.size());
+      w.unit = unit;
+      break;
+    }
+  }
+  std::replace(field.begin(), field.end(), '_', ' ');
+  if (w.unit == "°" && field.find("angle") == std::string::npos) field += " angle";
+  std::string owner;
+  if (block.rfind("releases", 0) == 0) {  // every release, or release k + 1
+    const auto open = block.find('['), close = block.find(']');
+    const std::string index = open != std::string::npos && close > open + 1 ? block.substr(open + 1, close - open - 1) : "";
+    owner = index.empty() ? "release " : "release " + std::to_string(std::stoi(index) + 1) + " ";
+  } else if (block == "grid" || block == "numerics") {
+    owner = block + " ";
+  }
+  w.words = owner + field;
+  return w;
+}
+
 double normal_quantile(double p) {
   // Wichura, M. J. (1988), Algorithm AS 241: The percentage points of the normal distribution.
   const double q = p - 0.5;

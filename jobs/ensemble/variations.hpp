@@ -83,6 +83,15 @@ Plan plan(const ResolvedScenario& ensemble);
 /// "material.bed_friction_deg = 17, releases[].thickness_factor = 1.2"
 std::string describe(const std::vector<ParameterValue>& values);
 
+/// A varied parameter's path in words for the maps and the report: "releases[].thickness_factor" is
+/// "release thickness factor", "releases[0].thickness_m" "release 1 thickness" in m,
+/// "material.bed_friction_deg" "bed friction angle" in °, "grid.resolution_m" "grid resolution" in m
+/// (the unit from the field's suffix, as the scenario's fields name it).
+struct ParameterWords {
+  std::string words, unit;  ///< unit "" for a number without one
+};
+ParameterWords parameter_in_words(const std::string& path);
+
 /// The number at `path` in the scenario ("material.bed_friction_deg", "releases[0].thickness_m");
 /// false when the path names no number or the number is unset.
 bool number_at(const v1::Scenario& s, const std::string& path, double& value);

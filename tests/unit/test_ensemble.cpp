@@ -362,3 +362,25 @@ TEST(Zoning, HashFollowsTheRule) {
   a.return_periods_y = {30, 1000};
   EXPECT_NE(h2, ens::ensemble_hash({"m1", "m2"}, a));
 }
+
+// The varied parameters in words on the ensemble's maps (not the scenario's field paths).
+TEST(Ensemble, VariedParametersAreNamedInWordsWithTheirUnits) {
+  auto w = jobs::ensemble::parameter_in_words("releases[].thickness_factor");
+  EXPECT_EQ(w.words, "release thickness factor");
+  EXPECT_EQ(w.unit, "");
+  w = jobs::ensemble::parameter_in_words("releases[1].thickness_m");
+  EXPECT_EQ(w.words, "release 2 thickness");
+  EXPECT_EQ(w.unit, "m");
+  w = jobs::ensemble::parameter_in_words("material.bed_friction_deg");
+  EXPECT_EQ(w.words, "bed friction angle");
+  EXPECT_EQ(w.unit, "°");
+  w = jobs::ensemble::parameter_in_words("material.density_kg_m3");
+  EXPECT_EQ(w.words, "density");
+  EXPECT_EQ(w.unit, "kg/m³");
+  w = jobs::ensemble::parameter_in_words("grid.resolution_m");
+  EXPECT_EQ(w.words, "grid resolution");
+  EXPECT_EQ(w.unit, "m");
+  w = jobs::ensemble::parameter_in_words("material.voellmy_xi");
+  EXPECT_EQ(w.words, "voellmy xi");
+  EXPECT_EQ(w.unit, "");
+}
