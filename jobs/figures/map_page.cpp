@@ -170,14 +170,16 @@ MapPageLayout draw_map_page(cairo_t* cr, const Grid& g, const HazardMap& m, cons
       colour(cr, kPath);
       cairo_fill(cr);
     }
-    labels.boxes.push_back({x - 3.5, y - 3.5, 7, 7});  // the symbol itself
-    lay.leader_lines += place_label(cr, f, m, x, y, p.name, st, labels, lay.unknown_glyphs) == 1;
+    labels.boxes.push_back({x - 3.5, y - 3.5, 7, 7});  // the symbol itself: no label over it
+    const int placed = place_label(cr, f, m, x, y, p.name, st, labels, lay.unknown_glyphs);
+    lay.leader_lines += placed == 1;
+    if (placed >= 0) lay.label_boxes.push_back(labels.boxes.back());
   };
   for (const auto& p : m.points) mark(p, {9, true, kInk}, true);
   for (const auto& p : m.path_marks) mark(p, {8, false, kPath}, false);
+  const std::size_t before = labels.boxes.size();
   if (interval > 0) lay.contour_labels = label_contours(cr, f, lines, interval, labels);
-  for (const auto& b : labels.boxes)
-    if (b[2] > 7.5 || b[3] > 7.5) lay.label_boxes.push_back(b);
+  lay.label_boxes.insert(lay.label_boxes.end(), labels.boxes.begin() + std::ptrdiff_t(before), labels.boxes.end());
   draw_frame_furniture(cr, fr, ext, ppm, lay.scale, g, lay.unknown_glyphs);
   // The legend panel, scaled to the page.
   MapLayout panel;
