@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "terrain/gdal_support.hpp"
@@ -61,14 +62,12 @@ void write_time_cube(const std::string& path, const Grid& g, const std::vector<d
   std::vector<double> xs(std::size_t(g.nx)), ys(std::size_t(g.ny));
   for (int i = 0; i < g.nx; ++i) xs[std::size_t(i)] = g.cx(i);
   for (int j = 0; j < g.ny; ++j) ys[std::size_t(j)] = g.cy(j);  // row 0 south: y ascending
-  auto x = coordinate(*root, dim_x, xs);
-  auto y = coordinate(*root, dim_y, ys);
-  text_attribute(*x, "standard_name", "projection_x_coordinate");
-  text_attribute(*y, "standard_name", "projection_y_coordinate");
-  text_attribute(*x, "units", "m");
-  text_attribute(*y, "units", "m");
-  text_attribute(*x, "axis", "X");
-  text_attribute(*y, "axis", "Y");
+  for (const auto& [dim, values, axis] : {std::tuple{dim_x, &xs, "x"}, std::tuple{dim_y, &ys, "y"}}) {
+    auto c = coordinate(*root, dim, *values);
+    text_attribute(*c, "standard_name", std::string("projection_") + axis + "_coordinate");
+    text_attribute(*c, "units", "m");
+    text_attribute(*c, "axis", axis == std::string("x") ? "X" : "Y");
+  }
   OGRSpatialReference srs;
   srs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   if (!g.crs_wkt.empty() && srs.importFromWkt(g.crs_wkt.c_str()) != OGRERR_NONE)
