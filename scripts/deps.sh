@@ -56,6 +56,6 @@ runout_install() {
   root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
   mkdir -p "$prefix" 2>/dev/null || true
   if [ ! -w "$prefix" ] && [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-  $SUDO cmake --install "$root/build" --prefix "$prefix" > /dev/null
+  $SUDO cmake --install "$root/build" --prefix "$prefix" > /dev/null || return 1
   echo "runout: installed $prefix/bin/runout" >&2
 }

@@ -45,7 +45,9 @@ void write_time_cube(const std::string& path, const Grid& g, const std::vector<d
   auto* drv = GetGDALDriverManager()->GetDriverByName("netCDF");
   if (!drv) throw TerrainError("writing '" + path + "': GDAL has no netCDF driver");
   const char* opts[] = {"FORMAT=NC4", "CONVENTIONS=CF-1.8", nullptr};
-  std::unique_ptr<GDALDataset> ds(drv->CreateMultiDimensional(path.c_str(), nullptr, const_cast<char**>(opts)));
+  const std::string part = path + ".part";  // moved into place once whole
+  VSIUnlink(part.c_str());
+  std::unique_ptr<GDALDataset> ds(drv->CreateMultiDimensional(part.c_str(), nullptr, const_cast<char**>(opts)));
   if (!ds) throw TerrainError("writing '" + path + "' failed" + gdal_message());
   auto root = ds->GetRootGroup();
   auto dim_t = root->CreateDimension("time", GDAL_DIM_TYPE_TEMPORAL, "", times_s.size());
@@ -93,7 +95,10 @@ void write_time_cube(const std::string& path, const Grid& g, const std::vector<d
     }
   }
   ds.reset();
-  if (CPLGetLastErrorType() == CE_Failure) throw TerrainError("writing '" + path + "' failed" + gdal_message());
+  if (CPLGetLastErrorType() == CE_Failure || VSIRename(part.c_str(), path.c_str()) != 0) {
+    VSIUnlink(part.c_str());
+    throw TerrainError("writing '" + path + "' failed" + gdal_message());
+  }
 }
 
 }  // namespace runout::terrain

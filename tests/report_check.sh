@@ -49,6 +49,36 @@ PY
 [ -f "$tmp/run30/report.pdf" ] || fail "outputs.report wrote no report.pdf"
 grep -q '"report.pdf"' "$tmp/run30/run.json" || fail "run.json does not list report.pdf"
 pdfinfo "$tmp/run30/report.pdf" | grep -q "Pages: *[7-9]" || fail "outputs.report's PDF has not the pages of a report"
+# A report that cannot be made loses no run: without max_depth.tif (outputs.rasters) the run ends
+# well, with a note in run.json, and neither report.pdf nor its part is left or listed.
+/usr/bin/python3 - "$tmp/with-report.json" "$tmp/no-depth.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["outputs"]["rasters"] = ["max_speed", "max_pressure"]
+json.dump(s, open(sys.argv[2], "w"))
+PY
+"$runout" run "$tmp/no-depth.json" --out "$tmp/run-nodepth" --quiet > /dev/null 2>&1 || fail "a run whose report cannot be made failed"
+[ ! -e "$tmp/run-nodepth/report.pdf" ] && [ ! -e "$tmp/run-nodepth/report.pdf.part" ] || fail "a report that could not be made left a file"
+grep -q '"report.pdf"' "$tmp/run-nodepth/run.json" && fail "run.json lists a report that is not there"
+grep -q 'report.pdf not written (outputs.report)' "$tmp/run-nodepth/run.json" || fail "run.json does not say why the report is missing"
+# The 3D engine's run writes no report itself: outputs.report refused, named.
+/usr/bin/python3 - "$src/scenarios/in-den-arelen-3d-regress.json" "$tmp/vof-report.json" <<'PY'
+import json, os, sys
+src, dst = sys.argv[1], sys.argv[2]
+s = json.load(open(src))
+base = os.path.dirname(os.path.abspath(src))
+for block in ("dem", "area_of_interest"):
+    if block in s: s[block]["path"] = os.path.join(base, s[block]["path"])
+for r in s["releases"]:
+    r["path"] = os.path.join(base, r["path"])
+s.setdefault("outputs", {})["report"] = "a4"
+json.dump(s, open(dst, "w"))
+PY
+set +e
+"$runout" run "$tmp/vof-report.json" --out "$tmp/vof" --quiet > /dev/null 2> "$tmp/vof.txt"
+rc=$?
+set -e
+[ "$rc" -eq 4 ] && grep -q "outputs.report" "$tmp/vof.txt" || fail "the 3D engine with outputs.report: exit $rc, $(cat "$tmp/vof.txt")"
 # Not a run on terrain: refused, named, no file left.
 set +e
 "$runout" report "$src/docs" --out "$tmp/bad.pdf" 2> "$tmp/bad.txt"

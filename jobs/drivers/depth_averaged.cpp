@@ -326,10 +326,9 @@ RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& tim
   sum.seconds_prepare = times.prepare;
   sum.cpu_seconds = times.cpu;
   int frames = 0;
-  if (series_) {
-    frames = series_->finish();
-    use_flow_path(s_, grid_, h0_, res.hazard.max_depth, series_->mass_centres(), output_inputs_);
-  }
+  if (series_) frames = series_->finish();
+  use_flow_path(s_, grid_, h0_, res.hazard.max_depth, series_ ? series_->mass_centres() : std::vector<std::array<double, 3>>{},
+                output_inputs_);
   sum.seconds_run = times.run;
   const auto& d = res.diag;
   sum.volume_initial = d.volume_initial;
@@ -374,14 +373,14 @@ RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& tim
   const std::string record = (fs::path(out_dir_) / "run.json").string();
   if (!opt_.iseesnow_id.empty())
     for (auto& f : write_iseesnow(s_, opt_.iseesnow_id, out_dir_, grid_, res, sum.cpu_seconds)) sum.files.push_back(std::move(f));
-  if (!s_.report.empty()) sum.files.push_back("report.pdf");  // written from the folder once run.json is
   write_record(record, s_, dem_rep_, grid_, rel_rep_, res, sum, continued_from_, outputs, frames, secondary_);
-  sum.files.push_back("run.json");
+  // The report reads the folder with its run.json; the record then lists it, or says why it is not
+  // there (a report that cannot be made loses no run).
   if (!s_.report.empty()) {
-    ReportOptions ro;
-    ro.paper = s_.report;
-    write_run_report(out_dir_, (fs::path(out_dir_) / "report.pdf").string(), ro);
+    if (write_report_output(out_dir_, s_.report, sum)) sum.files.push_back("report.pdf");
+    write_record(record, s_, dem_rep_, grid_, rel_rep_, res, sum, continued_from_, outputs, frames, secondary_);
   }
+  sum.files.push_back("run.json");
   return sum;
 }
 

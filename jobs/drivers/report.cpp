@@ -47,12 +47,16 @@ std::vector<std::vector<double>> read_profile(const fs::path& csv) {
   std::ifstream f(csv);
   std::string row;
   std::getline(f, row);
-  while (std::getline(f, row)) {
+  for (int line = 2; std::getline(f, row); ++line) {
     std::stringstream ss(row);
-    std::string c;
     for (auto& col : cols) {
+      std::string c;
       std::getline(ss, c, ',');
-      col.push_back(c.empty() ? NAN : std::stod(c));
+      try {
+        col.push_back(c.empty() ? NAN : std::stod(c));
+      } catch (const std::exception&) {
+        throw std::runtime_error("report: " + csv.string() + " line " + std::to_string(line) + ": '" + c + "' is not a number");
+      }
     }
   }
   return cols;
@@ -129,12 +133,31 @@ std::array<double, 4> extent(const terrain::Grid& g, const std::vector<double>& 
 
 }  // namespace
 
+bool write_report_output(const std::string& run_dir, const std::string& paper, RunSummary& sum) {
+  const fs::path pdf = fs::path(run_dir) / "report.pdf", part = fs::path(run_dir) / "report.pdf.part";
+  try {
+    ReportOptions opt;
+    opt.paper = paper;
+    write_run_report(run_dir, part.string(), opt);
+    fs::rename(part, pdf);
+    return true;
+  } catch (const std::exception& e) {
+    std::error_code ec;
+    fs::remove(part, ec);
+    sum.notes.push_back(std::string("report.pdf not written (outputs.report): ") + e.what());
+    return false;
+  }
+}
+
 figures::ReportLayout write_run_report(const std::string& run_dir, const std::string& pdf_path, const ReportOptions& opt) {
   const fs::path dir(run_dir);
   if (!fs::exists(dir / "run.json")) throw std::runtime_error("report: " + (dir / "run.json").string() + " is missing: not a run's folder");
   const auto rec = read_run_record((dir / "run.json").string());
   if (rec.engine() != "depth-averaged" && rec.engine() != "vof-terrain")
-    throw std::runtime_error("report: " + run_dir + " is a " + rec.engine() + " run; reports are of runs on terrain");
+    throw std::runtime_error("report: " + run_dir + " is not a run on terrain (" +
+                             (rec.engine().empty() ? "an ensemble's or a zoning's folder: report a member's or a scenario's folder"
+                                                   : "a " + rec.engine() + " run") +
+                             ")");
   if (!fs::exists(dir / "elevation.tif")) throw std::runtime_error("report: " + (dir / "elevation.tif").string() + " is missing (the report reads the run's own files)");
   figures::Report r;
   r.paper = opt.paper;

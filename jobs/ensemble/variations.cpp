@@ -307,9 +307,10 @@ bool make_member(const v1::Scenario& base, const std::vector<Param>& params, con
     for (auto it = out.rbegin(); it != out.rend(); ++it) rel->DeleteSubrange(*it, 1);
     if (std::all_of(rel->begin(), rel->end(), [](const v1::Release& r) { return r.secondary(); })) return false;
   }
-  if (base.variations().member_outputs() != "all") {  // members feed the aggregate: no maps, no time series
+  if (base.variations().member_outputs() != "all") {  // members feed the aggregate: no maps, no time series, no report
     m.scenario.mutable_outputs()->set_maps(false);
     m.scenario.mutable_outputs()->clear_timeseries_interval_s();
+    m.scenario.mutable_outputs()->clear_report();
   }
   auto* rasters = m.scenario.mutable_outputs()->mutable_rasters();
   if (!rasters->empty())  // the aggregate reads these three of every member

@@ -84,6 +84,7 @@ int choose_scale(double ext_w, double ext_h, double room_w, double room_h) {
 
 // Coordinate ticks on the frame's lower and left edges, a scale bar with the scale under it.
 void draw_frame_furniture(cairo_t* cr, const Box& fr, const Box& ext, double ppm, int scale, const Grid& g, int& unknown) {
+  cairo_save(cr);
   colour(cr, kInk);
   cairo_set_line_width(cr, 0.8);
   cairo_rectangle(cr, fr[0], fr[1], fr[2], fr[3]);
@@ -110,6 +111,7 @@ void draw_frame_furniture(cairo_t* cr, const Box& fr, const Box& ext, double ppm
                        {8, false, kInk})
                  .unknown_glyphs;
   unknown += draw_text(cr, bx, by + 8, g.crs_name + ", cells of " + label_number(g.dx) + " m", {7, false, kInk}).unknown_glyphs;
+  cairo_restore(cr);
 }
 
 }  // namespace

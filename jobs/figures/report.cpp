@@ -72,12 +72,18 @@ void table(Pages& p, const ReportTable& t) {
   }
   p.need(60);
   p.y += p.text(kMargin, p.y, t.title, {12, true, kText}) + 4;
+  // The columns share the page's width: the last one gets what is left (at least a fifth) and wraps.
+  double others = 0;
+  for (std::size_t c = 0; c + 1 < w.size(); ++c) others += w[c] + 14;
+  if (!w.empty()) w.back() = std::min(w.back(), std::max(p.width() - others, p.width() / 5));
   auto row = [&](const std::vector<std::string>& cells, const TextStyle& st) {
     double x = kMargin, h = 12;
+    for (std::size_t c = 0; c < cells.size() && c < w.size(); ++c)
+      h = std::max(h, draw_text(nullptr, 0, 0, cells[c], {st.size, st.bold, st.colour, c + 1 == w.size() ? w[c] : -1}).h);
     p.need(h + 2);
     for (std::size_t c = 0; c < cells.size() && c < w.size(); ++c) {
-      const bool number = &st == &cell && c > 0;  // numbers right-aligned
-      p.text(number ? x + w[c] : x, p.y, cells[c], {st.size, st.bold, st.colour, -1, 0, number ? 2 : 0});
+      const bool number = &st == &cell && c > 0 && c + 1 < w.size();  // numbers right-aligned
+      p.text(number ? x + w[c] : x, p.y, cells[c], {st.size, st.bold, st.colour, c + 1 == w.size() ? w[c] : -1, 0, number ? 2 : 0});
       x += w[c] + 14;
     }
     p.y += h + 2;
@@ -110,7 +116,7 @@ ReportLayout write_report(const std::string& pdf_path, const Report& r) {
   for (const auto& s : r.sections) section(p, s);
   for (const auto& t : r.tables) table(p, t);
   if (!r.disclaimer.empty()) {
-    p.need(40);
+    p.need(draw_text(nullptr, 0, 0, r.disclaimer, {8, false, kText, p.width()}).h + 8);
     p.y += p.text(kMargin, p.y, r.disclaimer, {8, false, kText, p.width()}) + 8;
   }
   // One page per map: the title, the map at its scale, the legend to its right.

@@ -253,7 +253,9 @@ void TimeSeriesWriter::Impl::write_geotiffs() {
   if (times.empty()) return;
   track.clear();
   for (auto [field, bands] : {std::pair<const char*, const std::vector<terrain::BandInfo>*>{"depth", &depth}, {"speed", &speed}}) {
-    // HDF5 and GDAL one after the other: GDAL's own HDF5 driver takes the same library.
+    // The frames are read with the project's HDF5 (MPI build) under the lock; GDAL's netCDF driver
+    // writes NetCDF-4 through Debian's serial HDF5, a library of its own (versioned symbols), so the
+    // lock is held for the reads, not for that library's sake.
     std::lock_guard lk(hdf5_mutex());
     hid_t f = H5Fopen((dir + "/timeseries.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
     if (f < 0) throw std::runtime_error("time series: cannot reopen " + dir + "/timeseries.h5");

@@ -118,6 +118,7 @@ Line flow_path(const terrain::Grid& g, const std::vector<TrackPoint>& track, con
     const double v = cell_value(g, release, x, y);
     if (std::isnan(v)) break;
     if (v > 0) top = {x, y};
+    else if (top != line.front()) break;  // the release's edge: a release beyond a gap is another one
   }
   if (top != line.front()) line.insert(line.begin(), top);
   extend_to_edge(g, line);
@@ -186,19 +187,13 @@ PathProfile analyse_path(const terrain::Grid& g, const Line& line, const PathFie
   return p;
 }
 
-Line longest_flow_line(const terrain::Grid& g, const std::vector<double>& release, const std::vector<double>& max_depth, double threshold,
-                       std::pair<double, double>* far_end) {
+namespace {
+
+// Dijkstra over the open cells from `top` (moves to the eight neighbours, `cost(m)` times their
+// length into cell m); returns each cell's distance and predecessor (n: none).
+template <class Open, class Cost>
+std::pair<std::vector<double>, std::vector<std::size_t>> spread(const terrain::Grid& g, std::size_t top, Open open, Cost cost) {
   const std::size_t n = g.cells();
-  auto open = [&](int i, int j) {
-    if (!inside(g, i, j)) return false;
-    const std::size_t k = std::size_t(j) * g.nx + i;
-    return release[k] > 0 || max_depth[k] > threshold;
-  };
-  std::size_t top = n;
-  for (std::size_t k = 0; k < n; ++k)
-    if (release[k] > 0 && (g.outside.empty() || !g.outside[k]) && (top == n || g.z[k] > g.z[top])) top = k;
-  if (top == n) return {};
-  // Dijkstra over the open cells from the top.
   std::vector<double> dist(n, HUGE_VAL);
   std::vector<std::size_t> from(n, n);
   using Item = std::pair<double, std::size_t>;
@@ -214,7 +209,7 @@ Line longest_flow_line(const terrain::Grid& g, const std::vector<double>& releas
       for (int di = -1; di <= 1; ++di) {
         if ((di == 0 && dj == 0) || !open(i + di, j + dj)) continue;
         const std::size_t m = std::size_t(j + dj) * g.nx + std::size_t(i + di);
-        const double nd = d + (di != 0 && dj != 0 ? M_SQRT2 : 1.0);
+        const double nd = d + (di != 0 && dj != 0 ? M_SQRT2 : 1.0) * cost(m);
         if (nd < dist[m]) {
           dist[m] = nd;
           from[m] = k;
@@ -222,11 +217,55 @@ Line longest_flow_line(const terrain::Grid& g, const std::vector<double>& releas
         }
       }
   }
+  return {std::move(dist), std::move(from)};
+}
+
+// Each open cell's distance (in cells, chamfer 1 / √2) to the nearest cell that is not open.
+template <class Open>
+std::vector<double> distance_to_edge(const terrain::Grid& g, Open open) {
+  std::vector<double> d(g.cells(), 0);
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i) d[std::size_t(j) * g.nx + i] = open(i, j) ? HUGE_VAL : 0;
+  auto relax = [&](int i, int j, int di, int dj) {
+    const int a = i + di, b = j + dj;
+    const double via = (a < 0 || b < 0 || a >= g.nx || b >= g.ny ? 0 : d[std::size_t(b) * g.nx + a]) + (di && dj ? M_SQRT2 : 1.0);
+    double& here = d[std::size_t(j) * g.nx + i];
+    here = std::min(here, via);
+  };
+  for (int j = 0; j < g.ny; ++j)
+    for (int i = 0; i < g.nx; ++i)
+      for (const auto& [di, dj] : {std::pair{-1, 0}, {-1, -1}, {0, -1}, {1, -1}}) relax(i, j, di, dj);
+  for (int j = g.ny - 1; j >= 0; --j)
+    for (int i = g.nx - 1; i >= 0; --i)
+      for (const auto& [di, dj] : {std::pair{1, 0}, {1, 1}, {0, 1}, {-1, 1}}) relax(i, j, di, dj);
+  return d;
+}
+
+}  // namespace
+
+Line longest_flow_line(const terrain::Grid& g, const std::vector<double>& release, const std::vector<double>& max_depth, double threshold,
+                       std::pair<double, double>* far_end) {
+  const std::size_t n = g.cells();
+  auto open = [&](int i, int j) {
+    if (!inside(g, i, j)) return false;
+    const std::size_t k = std::size_t(j) * g.nx + i;
+    return release[k] > 0 || max_depth[k] > threshold;
+  };
+  std::size_t top = n;
+  for (std::size_t k = 0; k < n; ++k)
+    if (release[k] > 0 && (g.outside.empty() || !g.outside[k]) && (top == n || g.z[k] > g.z[top])) top = k;
+  if (top == n) return {};
+  // The farthest outlined cell beyond the release, by the length of moves through the flow ...
+  const auto [dist, unused] = spread(g, top, open, [](std::size_t) { return 1.0; });
   std::size_t far = top;
   for (std::size_t k = 0; k < n; ++k)
-    if (std::isfinite(dist[k]) && max_depth[k] > threshold && dist[k] > dist[far]) far = k;
+    if (std::isfinite(dist[k]) && max_depth[k] > threshold && !(release[k] > 0) && dist[k] > dist[far]) far = k;
   if (far == top) return {};
   if (far_end) *far_end = {g.cx(int(far % std::size_t(g.nx))), g.cy(int(far / std::size_t(g.nx)))};
+  // ... reached along the flow's middle: each move costs its length over the square of one plus the
+  // cell's distance to the flow's edge, so the line keeps off the outline where the flow is wide.
+  const auto edge = distance_to_edge(g, open);
+  const auto [cost, from] = spread(g, top, open, [&](std::size_t m) { return 1.0 / ((1 + edge[m]) * (1 + edge[m])); });
   std::vector<std::size_t> cells;
   for (std::size_t k = far; k != n; k = from[k]) cells.push_back(k);
   std::reverse(cells.begin(), cells.end());

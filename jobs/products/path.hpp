@@ -29,16 +29,19 @@ struct TrackPoint {
 
 /// The path the flow took, as com1DFA and AIMEC take it: the mass centre's track in time order
 /// (points closer than half a cell to the last one kept dropped), extended at the top straight back
-/// against its first direction to the release's upper edge (the last released cell on that line),
+/// against its first direction to the release's upper edge (the last released cell on that line
+/// before the first gap),
 /// and at the bottom straight on in its last 200 m's direction to the domain's edge, so that the
 /// front beyond the mass centre's stop is crossed. Empty when the track has fewer than two distinct
 /// points (a flow that did not move).
 Line flow_path(const terrain::Grid& g, const std::vector<TrackPoint>& track, const std::vector<double>& release);
 
 /// The longest flow line: from the highest released cell through the released and outlined cells
-/// (moves to the eight neighbours, one or √2 cells long) to the outlined cell farthest from it along
-/// such moves, smoothed over five cells and then extended straight on to the domain's edge as the
-/// track is. It follows the branch that reached farthest. Empty without released or outlined cells.
+/// (moves to the eight neighbours, one or √2 cells long) to the outlined cell beyond the release
+/// farthest from it along such moves; the line to it keeps to the flow's middle (each move costs its
+/// length over (1 + the cell's distance to the flow's edge)²), smoothed over five cells and extended
+/// straight on to the domain's edge as the track is. It follows the branch that reached farthest.
+/// Empty without released or outlined cells.
 /// `far_end`, when given, receives the farthest cell's centre.
 Line longest_flow_line(const terrain::Grid& g, const std::vector<double>& release, const std::vector<double>& max_depth, double threshold,
                        std::pair<double, double>* far_end = nullptr);

@@ -340,6 +340,8 @@ void check_terrain_vof(const v1::Scenario& s) {
   apply_material_rheology(m, c);
   check_model(c, ModelBlock::material);
   if (!m.has_bed_friction_deg()) bad("material.bed_friction_deg", "needed by the 3D engine's bed condition");
+  if (!s.outputs().report().empty())
+    bad("outputs.report", "the 3D engine's run writes no report itself; make it with `runout report` on the run's folder");
   const auto& me = s.mesh();
   if (me.has_first_layer_m() && me.has_band_height_m() && !(me.band_height_m() > me.first_layer_m()))
     bad("mesh.band_height_m", "must exceed mesh.first_layer_m");

@@ -408,6 +408,11 @@ TEST(HazardProducts, TheFlowsPathFollowsItsMassCentreOrItsFarthestBranch) {
   EXPECT_LT(line.back().second - y0, 10.0);
   EXPECT_NEAR(line.back().first - x0, 430 + 2 * 280, 25.0);
   EXPECT_TRUE(jobs::products::flow_path(g, {{0, x0 + 130, y0 + 430}, {5, x0 + 131, y0 + 430}}, release).empty());
+  // A second release beyond a gap on the line back is another release: the top stays at this one's edge.
+  auto two = release;
+  for (int j = 46; j < 52; ++j)
+    for (int i = 0; i < 5; ++i) two[std::size_t(j) * g.nx + i] = 1;  // up the line back, 40 m past the first one's edge
+  EXPECT_EQ(jobs::products::flow_path(g, track, two).front(), line.front());
 
   // A split flow: from the release a branch 3 cells wide north to y = 700 m and one east to x = 900 m.
   for (int j = 40; j < 70; ++j)
@@ -428,10 +433,16 @@ TEST(HazardProducts, TheFlowsPathFollowsItsMassCentreOrItsFarthestBranch) {
     on_flow += depth[std::size_t(j) * g.nx + i] > 0.1 || release[std::size_t(j) * g.nx + i] > 0;
   }
   EXPECT_GE(on_flow + 2, before_tip);  // the five-cell smoothing may cut the corner where the branch leaves the release
+  // Along the east branch (rows 41-43) the line keeps to its middle row, not to an edge.
+  int middle = 0, along = 0;
+  for (const auto& [x, y] : longest)
+    if (x > x0 + 300 && x < x0 + 800) ++along, middle += std::fabs(y - g.cy(42)) < 1e-9;
+  EXPECT_GT(along, 40);
+  EXPECT_EQ(middle, along);
   // The mass centre of such a flow lies between the branches, off the outline: not a path.
   EXPECT_FALSE(jobs::products::track_inside_outline(g, {{0, x0 + 130, y0 + 430}, {10, x0 + 400, y0 + 600}}, depth, 0.1));
   EXPECT_TRUE(jobs::products::track_inside_outline(g, {{0, x0 + 130, y0 + 430}, {10, x0 + 400, y0 + 420}}, depth, 0.1));
-  EXPECT_NEAR(jobs::products::distance_to_line(longest, x0 + 500, y0 + 735), 300, 1e-9);
+  EXPECT_NEAR(jobs::products::distance_to_line(longest, x0 + 500, g.cy(42) + 300), 300, 1e-9);
 }
 
 namespace {
