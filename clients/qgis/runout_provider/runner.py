@@ -164,6 +164,7 @@ def run_local(scenario_path: str | os.PathLike, out_dir: str | os.PathLike, feed
     last_progress = ""
     open_streams = 2
     cancelled_at = None
+    ended = None  # when runout's own process was seen ended
     shown = 0.0
     while open_streams:
         if cancelled_at is None and feedback.isCanceled():
@@ -175,6 +176,12 @@ def run_local(scenario_path: str | os.PathLike, out_dir: str | os.PathLike, feed
         try:
             tag, line = q.get(timeout=poll_s)
         except queue.Empty:
+            # runout has ended but a process it started (an ensemble's worker) still holds the pipes
+            # open: stop reading a little after its end instead of waiting on them.
+            if proc.poll() is not None:
+                ended = ended if ended is not None else time.monotonic()
+                if time.monotonic() - ended > 5 * poll_s + 1.0:
+                    break
             continue
         if line is None:
             open_streams -= 1
