@@ -19,7 +19,8 @@ pages=$(echo "$info" | awk '/^Pages:/ {print $2}')
 echo "$info" | grep -q "Page size: *841.89 x 595.27[0-9]* pts (A4)" || fail "not A4 landscape: $(echo "$info" | grep 'Page size')"
 pdftotext -layout "$tmp/report.pdf" "$tmp/report.txt"
 for text in "Parameters" "friction: Coulomb, δ = 15°, φ = 20°" "density: 300 kg/m³" "Mass balance" "Points of interest" \
-            "farmhouse (destroyed 1968)" "Pressure zones" "scale 1:" "runout" "DEM: davos_srtm3.tif"; do
+            "farmhouse (destroyed 1968)" "Pressure zones" "scale 1:" "runout" "DEM: davos_srtm3.tif" \
+            "blue: 3 – 30 kPa" "red: ≥ 30 kPa"; do  # the last two: the pressure map's zone boundaries in its legend
   grep -qF "$text" "$tmp/report.txt" || fail "the report's text lacks '$text'"
 done
 # Every raster image at 300 dpi (one per map page).

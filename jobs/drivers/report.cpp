@@ -14,6 +14,7 @@
 #include "jobs/figures/palette.hpp"
 #include "jobs/figures/pen.hpp"
 #include "jobs/formats/run_record.hpp"
+#include "jobs/products/zones.hpp"
 
 namespace runout::jobs {
 namespace fs = std::filesystem;
@@ -199,6 +200,12 @@ figures::ReportLayout write_run_report(const std::string& run_dir, const std::st
     m.values = figures::inside_outline(raster(dir, q.name + ".tif", g), depth, thr);
     m.colour_note = "coloured inside the outline only (max depth > " + num(thr) + " m)";
     m.show_maximum = true;
+    if (q.name == "max_pressure") {  // the zones' boundaries, by the run's own zones and rule (as its map)
+      std::vector<ZoneThreshold> zones;
+      for (const auto& z : rec.results().pressure_zones()) zones.push_back({z.name(), z.from_kpa()});
+      const auto zm = products::pressure_zones(zones, m.values);
+      m.boundaries.push_back({zm.cls, zm.palette});
+    }
     r.maps.push_back(std::move(m));
   }
   return figures::write_report(pdf_path, r);

@@ -2,7 +2,8 @@
 // `runout report`: a finished run's folder as one PDF for a hazard report (figures/report.hpp), read
 // back from what the run wrote (run.json, the hazard rasters, elevation.tif, release.tif,
 // path_profile.csv): the parameters in words, the mass balance, the results, the points of interest
-// and the zones as tables, the maps at a stated scale and the path profile.
+// and the zones as tables, the maps at a stated scale (the pressure map with the zones' boundaries,
+// drawn by the run's zones and rule) and the path profile.
 #include <string>
 
 #include "jobs/drivers/run.hpp"
