@@ -152,13 +152,7 @@ TEST(Scenarios, TheDemoMapsColourOnlyTheOutlineAndItsRunoutIsOneFigureOnTheFlows
   EXPECT_LT(path.runout_xyz(1), 5187000);
   // No colour outside the outline: at the centre of every cell outside it (and not next to it, where
   // the outline's line is drawn) the maps show none of their palette's colours.
-  terrain::Grid g;
-  g.nx = depth.w;
-  g.ny = depth.h;
-  g.dx = depth.gt[1];
-  g.x_min = depth.gt[0];
-  g.y_min = depth.gt[3] + depth.h * depth.gt[5];
-  g.z.assign(g.cells(), 0);
+  const terrain::Grid g = terrain::grid_of_raster(d / "elevation.tif", "the demo's grid");
   for (const char* q : {"max_speed", "max_pressure", "arrival_time", "max_depth"}) {
     figures::HazardMap probe;  // where the map's frame lies: the same title, so the same layout
     probe.title = r.scenario.name() + ": " + figures::hazard_palette(q).title;
@@ -175,9 +169,10 @@ TEST(Scenarios, TheDemoMapsColourOnlyTheOutlineAndItsRunoutIsOneFigureOnTheFlows
         ++outside;
         figures::Rgb8 c{};
         for (int band = 0; band < 3; ++band)
-          (void)png->GetRasterBand(band + 1)->RasterIO(GF_Read, int(lay.map_x + (i + 0.5) * lay.cell_px),
-                                                       int(lay.map_y + (row_ + 0.5) * lay.cell_px), 1, 1, &c[std::size_t(band)], 1, 1,
-                                                       GDT_Byte, 0, 0);
+          ASSERT_EQ(png->GetRasterBand(band + 1)->RasterIO(GF_Read, int(lay.map_x + (i + 0.5) * lay.cell_px),
+                                                           int(lay.map_y + (row_ + 0.5) * lay.cell_px), 1, 1, &c[std::size_t(band)], 1,
+                                                           1, GDT_Byte, 0, 0),
+                    CE_None);
         for (const auto& cls : figures::hazard_palette(q).classes) coloured += c == cls.colour;
       }
     EXPECT_GT(outside, 50000) << q;
