@@ -127,4 +127,44 @@ ColumnMesh column_mesh(const Grid& g, const ColumnMeshSpec& s, const std::vector
   return m;
 }
 
+void place_structures(ColumnMesh& m, const Grid& g, const std::vector<DamRequest>& rq) {
+  if (rq.empty()) return;
+  Grid cg;  // the columns as a grid: the same CRS and corner, the columns' width, the ground at their centres
+  cg.nx = m.ni;
+  cg.ny = m.nk;
+  cg.dx = m.dx;
+  cg.x_min = m.x_min;
+  cg.y_min = m.y_min;
+  cg.crs_wkt = g.crs_wkt;
+  cg.crs_name = g.crs_name;
+  cg.z.resize(cg.cells());
+  cg.outside.resize(cg.cells());
+  for (int k = 0; k < m.nk; ++k)
+    for (int i = 0; i < m.ni; ++i) {
+      const std::size_t col = std::size_t(k) * std::size_t(m.ni) + std::size_t(i);
+      cg.z[col] = 0.25 * (m.ground_at(i, k) + m.ground_at(i + 1, k) + m.ground_at(i, k + 1) + m.ground_at(i + 1, k + 1));
+      cg.outside[col] = m.kept[col] ? 0 : 1;
+    }
+  m.base.assign(cg.cells(), 0);
+  m.structure.assign(cg.cells(), -1);
+  for (std::size_t a = 0; a < rq.size(); ++a) {
+    DamRequest q = rq[a];
+    q.centres_only = true;
+    const DamCells d = rasterize_dam(cg, q);  // throws when the structure stands on no kept column
+    int taken = 0;
+    for (std::size_t col = 0; col < cg.cells(); ++col) {
+      if (!(d.height[col] > 0)) continue;
+      int layers = 0;
+      while (layers < m.layers() && 0.5 * (m.levels[std::size_t(layers)] + m.levels[std::size_t(layers) + 1]) < d.height[col]) ++layers;
+      if (layers == 0) continue;
+      m.base[col] = layers;
+      m.structure[col] = int(a);
+      ++taken;
+    }
+    if (taken == 0)
+      throw TerrainError(q.field + ": lower than half the mesh's first layer (" + num(m.levels[1]) +
+                         " m) on every column it stands on: it takes no cell (raise mesh.first_layer_m's resolution or leave it out)");
+  }
+}
+
 }  // namespace runout::terrain

@@ -46,6 +46,10 @@ struct ColumnMesh {
   std::vector<double> levels;           ///< layer interfaces above the ground (layer_levels)
   std::vector<double> ground;           ///< (ni + 1) (nk + 1) node elevations, node (i, k) at k (ni + 1) + i
   std::vector<std::uint8_t> kept;       ///< per column (row k south to north, k * ni + i): 1 inside the domain
+  /// Structures (place_structures): per column the layers a structure takes from the ground up (0:
+  /// none; layers(): the whole column) and the structure's index (-1: none). Empty: no structures.
+  std::vector<int> base, structure;
+  int base_of(std::size_t col) const { return base.empty() ? 0 : base[col]; }
   int layers() const { return int(levels.size()) - 1; }
   double ground_at(int i, int k) const { return ground[std::size_t(k) * std::size_t(ni + 1) + std::size_t(i)]; }
   /// Node (i, k) of interface j in the grid's CRS: x east, y north, z up.
@@ -64,6 +68,15 @@ struct ColumnMesh {
 /// flow's resolution and not the terrain. Throws TerrainError when the spec is out of range or no
 /// column is kept.
 ColumnMesh column_mesh(const Grid& g, const ColumnMeshSpec& s, const std::vector<std::uint8_t>& corridor = {});
+
+/// Stands the structures `rq` (footprint polygons with a height or a top elevation) on the column
+/// mesh `m` of grid `g`: a column whose centre lies inside a footprint (or that holds the centroid of
+/// a footprint that covers no centre) loses the layers whose middle lies below the structure's top
+/// there (ColumnMesh::base, ::structure; where structures overlap, the later one's). The heights are
+/// read at the columns' centres, their ground the mean of the column's four ground nodes. Throws
+/// TerrainError naming the request's field (terrain::rasterize_dam's errors), and when a structure
+/// keeps no column or takes no layer (lower than half the first layer).
+void place_structures(ColumnMesh& m, const Grid& g, const std::vector<DamRequest>& rq);
 
 /// The cells of `cells` (one flag per grid cell) dilated by `margin_m`: every cell whose centre lies
 /// within margin_m (Euclidean, centre to centre) of a flagged cell's centre. margin_m >= 0.

@@ -63,10 +63,10 @@ bool is_polygon(OGRwkbGeometryType t) { return wkbFlatten(t) == wkbPolygon || wk
 
 // One feature of a dam file on the grid: its crest pieces (lines: gauge weights) or its footprint
 // (polygons: centres inside, and the outline's cells), as the cells it touches.
-void touch_feature(const Grid& g, OGRGeometry& geom, bool lines, std::vector<std::uint8_t>& touched, std::vector<double>& wx,
-                   std::vector<double>& wy, double& length) {
+void touch_feature(const Grid& g, OGRGeometry& geom, bool lines, bool centres_only, std::vector<std::uint8_t>& touched,
+                   std::vector<double>& wx, std::vector<double>& wy, double& length) {
   std::vector<std::vector<std::pair<double, double>>> runs;
-  vertex_runs(&geom, runs);
+  if (!centres_only) vertex_runs(&geom, runs);
   for (const auto& v : runs)
     for (std::size_t q = 0; q + 1 < v.size(); ++q) {
       const double x0 = v[q].first, y0 = v[q].second, x1 = v[q + 1].first, y1 = v[q + 1].second;
@@ -86,11 +86,17 @@ void touch_feature(const Grid& g, OGRGeometry& geom, bool lines, std::vector<std
   geom.getEnvelope(&env);
   const int i0 = std::max(0, int(std::floor((env.MinX - g.x_min) / g.dx))), i1 = std::min(g.nx - 1, int(std::floor((env.MaxX - g.x_min) / g.dx)));
   const int j0 = std::max(0, int(std::floor((env.MinY - g.y_min) / g.dx))), j1 = std::min(g.ny - 1, int(std::floor((env.MaxY - g.y_min) / g.dx)));
+  bool any = false;
   for (int j = j0; j <= j1; ++j)
     for (int i = i0; i <= i1; ++i) {
       OGRPoint c(g.cx(i), g.cy(j));
-      if (geom.Contains(&c)) touched[std::size_t(j) * g.nx + i] = 1;
+      if (geom.Contains(&c)) touched[std::size_t(j) * g.nx + i] = 1, any = true;
     }
+  if (any || !centres_only) return;
+  OGRPoint centroid;  // a footprint smaller than a cell: the cell holding its centroid
+  if (geom.Centroid(&centroid) != OGRERR_NONE) return;
+  const int i = int(std::floor((centroid.getX() - g.x_min) / g.dx)), j = int(std::floor((centroid.getY() - g.y_min) / g.dx));
+  if (i >= 0 && j >= 0 && i < g.nx && j < g.ny) touched[std::size_t(j) * g.nx + i] = 1;
 }
 
 }  // namespace
@@ -118,15 +124,27 @@ DamCells rasterize_dam(const Grid& g, const DamRequest& rq) {
       d.lines = d.lines || line;
       polygons += !line;
       if (d.lines && polygons > 0) throw TerrainError(what + ": crest lines and footprints (polygons) in one dam: give them as two dams");
-      const double h = rq.has_height ? rq.height : rq.height_attribute.empty() ? -1 : field_value(*f, rq.height_attribute, what);
-      if (h < 0 && !rq.has_height && rq.height_attribute.empty()) throw TerrainError(what + ": no height (set height_m or height_attribute)");
-      if (!(h > 0 && h <= 100)) throw TerrainError(what + ": height must be > 0 m and at most 100 m, got " + fmt(h, 2));
+      const bool top = !rq.top_attribute.empty();
+      const double v = rq.has_height ? rq.height
+                       : top         ? field_value(*f, rq.top_attribute, what)
+                       : rq.height_attribute.empty() ? -1
+                                                     : field_value(*f, rq.height_attribute, what);
+      if (v < 0 && !rq.has_height && !top && rq.height_attribute.empty())
+        throw TerrainError(what + ": no height (set height_m or height_attribute)");
+      if (!top && !(v > 0 && v <= 100)) throw TerrainError(what + ": height must be > 0 m and at most 100 m, got " + fmt(v, 2));
       std::unique_ptr<OGRGeometry> geom(g0->clone());
       if (ct && geom->transform(ct.get()) != OGRERR_NONE) throw TerrainError(what + ": cannot transform it to " + g.crs_name);
       std::vector<std::uint8_t> touched(g.cells(), 0);
-      touch_feature(g, *geom, line, touched, wx, wy, d.length_m);
-      for (std::size_t k = 0; k < g.cells(); ++k)
-        if (touched[k] && (g.outside.empty() || !g.outside[k])) d.height[k] = std::max(d.height[k], h);
+      touch_feature(g, *geom, line, rq.centres_only && !line, touched, wx, wy, d.length_m);
+      for (std::size_t k = 0; k < g.cells(); ++k) {
+        if (!touched[k] || (!g.outside.empty() && g.outside[k])) continue;
+        const double h = top ? v - g.z[k] : v;  // a top elevation: its height over this cell's ground
+        if (top && !(h > 0 && h <= 100))
+          throw TerrainError(what + ": its top (" + rq.top_attribute + " = " + fmt(v, 2) + " m) lies " + fmt(h, 2) +
+                             " m above the ground at (" + fmt(g.cx(int(k % std::size_t(g.nx))), 1) + ", " +
+                             fmt(g.cy(int(k / std::size_t(g.nx))), 1) + "): it must lie between 0 and 100 m above it");
+        d.height[k] = std::max(d.height[k], h);
+      }
     }
   }
   if (d.features == 0) throw TerrainError(file + ": no feature in the file");

@@ -122,6 +122,10 @@ struct DamRequest {
   bool has_height = false;
   double height = 0;            ///< [m]
   std::string height_attribute;
+  std::string top_attribute;    ///< each feature's top elevation [m]: the height is the top less the cell's ground
+  /// Footprints only: the cells whose centres lie inside (at least the cell holding each footprint's
+  /// centroid), not the cells the outline passes through (the 3D engine's structures).
+  bool centres_only = false;
 };
 
 /// A dam as the depth-averaged engine sees it: a height above the ground on the cells the geometry
@@ -142,7 +146,8 @@ struct DamCells {
   long cells = 0;            ///< the dam's cells
 };
 /// Throws TerrainError naming rq.field (unreadable file, no CRS, a geometry neither line nor polygon,
-/// lines mixed with polygons, a height missing or outside (0, 100] m, a dam on no cell of the domain).
+/// lines mixed with polygons, a height missing or outside (0, 100] m, a top below the ground, a dam on
+/// no cell of the domain).
 DamCells rasterize_dam(const Grid& g, const DamRequest& rq);
 
 /// What a raster band says about itself (GDAL's band description, unit type and metadata): QGIS

@@ -36,6 +36,9 @@ class VofBackend {
   virtual const std::vector<double>& granular_flux() const = 0;
   /// What the bed carried at the last momentum build (VofConfig::column_friction; zero without it).
   virtual const BedLoad& bed_load() const = 0;
+  /// The pressure on boundary face f less the still air's there [Pa]: the cell's pressure carried
+  /// hydrostatically to the face (as the Coulomb walls read it), the load a wall or a structure feels.
+  virtual double face_pressure(int f) const = 0;
 };
 
 /// The back end for a mesh and configuration (the CPU solver); a bad configuration is a VofError.

@@ -99,8 +99,8 @@ struct HexGridSpec {
 };
 Mesh structured_hex_mesh(const HexGridSpec& s);
 
-/// Rename the part of a patch whose face centres satisfy `pick` into a new patch (e.g. the top
-/// boundary above x > 0 becomes "atmosphere"). Faces are reordered so that patches stay contiguous.
+/// Rename the part of a patch whose face centres satisfy `pick` (or, for a pick taking an int, whose
+/// face numbers do) into a new patch (e.g. the top boundary above x > 0 becomes "atmosphere"). Faces are reordered so that patches stay contiguous.
 template <class Pick>
 void split_patch(Mesh& m, const std::string& from, const std::string& to, Pick pick);
 

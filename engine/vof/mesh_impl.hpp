@@ -2,6 +2,7 @@
 // Template part of mesh.hpp.
 #include <algorithm>
 #include <stdexcept>
+#include <type_traits>
 
 namespace runout::engine::vof {
 
@@ -11,7 +12,12 @@ void split_patch(Mesh& m, const std::string& from, const std::string& to, Pick p
   if (pi < 0) throw std::invalid_argument("mesh: no patch '" + from + "'");
   const Patch p = m.patches[pi];
   std::vector<int> keep, moved;
-  for (int f = p.start; f < p.start + p.size; ++f) (pick(m.Cf[f]) ? moved : keep).push_back(f);
+  for (int f = p.start; f < p.start + p.size; ++f) {
+    bool take;
+    if constexpr (std::is_invocable_r_v<bool, Pick, int>) take = pick(f);  // by the face's number
+    else take = pick(m.Cf[f]);                                             // by its centre
+    (take ? moved : keep).push_back(f);
+  }
   if (moved.empty()) return;
   // New face order: everything before the patch, its kept faces, its moved faces, everything after.
   std::vector<int> order;

@@ -213,6 +213,12 @@ const std::vector<double>& VofSolver::viscosity() const { return impl_->F.nu1; }
 const std::vector<double>& VofSolver::face_flux() const { return impl_->F.phi; }
 const std::vector<double>& VofSolver::granular_flux() const { return impl_->F.alpha_phi; }
 const BedLoad& VofSolver::bed_load() const { return impl_->UEqn.bed_load; }
+double VofSolver::face_pressure(int f) const {
+  const auto& I = *impl_;
+  const int o = mesh_.owner[std::size_t(f)];
+  const auto& hs = I.hydrostatics;
+  return carried_hydrostatically(I.F.p[o], I.F.rho[o], hs.gh(o), hs.ghf(f)) - hs.still_air_p(hs.ghf(f));
+}
 
 void VofSolver::initialise(const std::vector<double>& alpha, const std::vector<Vec>& U) {
   auto& I = *impl_;

@@ -74,6 +74,7 @@ class VofSolver final : public VofBackend {
   const std::vector<double>& granular_flux() const override;
   /// What the bed carried at the last momentum build (VofConfig::column_friction; zero without it).
   const BedLoad& bed_load() const override;
+  double face_pressure(int f) const override;
 
  private:
   struct Impl;  // the fields, the equations and their solvers (engine/vof/solver.cpp)

@@ -46,6 +46,7 @@ void write_record(const std::string& path, const ResolvedScenario& s, const terr
   mb->set_volume_secondary_m3(d.volume_secondary);
   mb->set_volume_detrained_m3(d.volume_detrained);
   mb->set_volume_entrained_m3(d.volume_entrained);
+  record_structures(sum, rec);
   for (const auto& q : sum.dams) {
     auto* dr = rec.add_dams();
     dr->set_name(q.name);
@@ -125,13 +126,15 @@ engine::ErodibleCover erodible_cover(const ResolvedScenario& s, const std::vecto
   return e;
 }
 
-// The dams as the engine sees them: each cell's dam height (the largest where dams overlap) and a
-// flux gauge across each dam's crest lines (a cell on the crests of two dams, where they meet,
-// counts for the first).
-void place_dams(const ResolvedScenario& s, const std::vector<terrain::DamCells>& dams, const engine::Terrain2D& t,
-                engine::Sh2dConfig& cfg) {
-  if (dams.empty()) return;
+// The dams and structures as the engine sees them: each cell's wall height (the largest where dams or
+// structures overlap; a structure is a footprint dam of its height) and a flux gauge across each
+// dam's crest lines (a cell on the crests of two dams, where they meet, counts for the first).
+void place_dams(const ResolvedScenario& s, const std::vector<terrain::DamCells>& dams, const std::vector<terrain::DamCells>& structures,
+                const engine::Terrain2D& t, engine::Sh2dConfig& cfg) {
+  if (dams.empty() && structures.empty()) return;
   cfg.dam_height.assign(t.cells(), 0.0);
+  for (const auto& d : structures)  // walls of their height on every cell they touch
+    for (std::size_t k = 0; k < d.height.size(); ++k) cfg.dam_height[k] = std::max(cfg.dam_height[k], d.height[k]);
   for (const auto& d : dams)
     for (std::size_t k = 0; k < d.height.size(); ++k) cfg.dam_height[k] = std::max(cfg.dam_height[k], d.height[k]);
   std::vector<std::uint8_t> taken(t.cells(), 0);
@@ -277,7 +280,7 @@ DepthAveragedRun::DepthAveragedRun(const ResolvedScenario& s, const std::string&
   cfg_.secondary = engine_secondary(secondary_);
   cfg_.resistance = resistance_areas(s, output_inputs_.resistance_areas);
   cfg_.cover = erodible_cover(s, output_inputs_.cover_areas);
-  place_dams(s, output_inputs_.dams, t_, cfg_);
+  place_dams(s, output_inputs_.dams, output_inputs_.structures, t_, cfg_);
 
   // Checkpoints: the solver's whole state between two steps, with the scenario's hash; the time
   // series so far lies beside it (CHECKPOINT.timeseries.h5), so that a continued run's outputs are
@@ -337,6 +340,7 @@ RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& tim
   sum.volume_detrained = d.volume_detrained;
   sum.volume_entrained = d.volume_entrained;
   sum.dams = dam_summaries(s_, output_inputs_.dams, res);
+  sum.structures = structure_summaries(s_, grid_, output_inputs_.structures, res.hazard);
   sum.volume_error = d.volume_error();
   sum.t = d.t;
   sum.steps = d.steps;

@@ -35,6 +35,7 @@ figures::HazardMap map_base(const ResolvedScenario& s, const terrain::Grid& grid
   base.resistance = overlay.resistance;
   base.cover = overlay.cover;
   base.dams = overlay.dams;
+  base.structures = overlay.structures;
   base.max_depth = hz.max_depth;
   base.outline_threshold = s.outline_threshold;
   base.parameters = map_parameters(s, grid, sum.release_volume_m3);
@@ -91,6 +92,7 @@ OutputInputs read_output_inputs(const ResolvedScenario& s, const terrain::Grid& 
   // naming its field).
   for (const auto& c : s.cover) in.cover_areas.push_back(terrain::rasterize_releases(grid, s.dem, {c.release}));
   for (const auto& d : s.dams) in.dams.push_back(terrain::rasterize_dam(grid, d.request));
+  for (const auto& d : s.structures) in.structures.push_back(terrain::rasterize_dam(grid, d.request));
   return in;
 }
 
@@ -262,6 +264,11 @@ std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain
   if (!s.cover.empty()) p.push_back(cover_line(s));
   for (const auto& d : s.dams)
     p.push_back("dam: " + d.name + (d.request.has_height ? ", " + num(d.request.height) + " m high" : ", height from '" + d.request.height_attribute + "'"));
+  for (const auto& d : s.structures)
+    p.push_back("structure: " + d.name +
+                (d.request.has_height                  ? ", " + num(d.request.height) + " m high"
+                 : !d.request.top_attribute.empty() ? ", top from '" + d.request.top_attribute + "'"
+                                                    : ", height from '" + d.request.height_attribute + "'"));
   p.push_back("release: " + num(std::round(release_volume_m3)) + " m³ in " + std::to_string(s.releases.size()) +
               (s.releases.size() == 1 ? " release" : " releases"));
   for (auto& line : map_footer(grid)) p.push_back(std::move(line));

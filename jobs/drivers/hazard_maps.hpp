@@ -40,6 +40,8 @@ struct OutputInputs {
   std::vector<std::vector<double>> cover_areas;
   /// Per dam (scenario `dams[]`), its cells, height and crest.
   std::vector<terrain::DamCells> dams;
+  /// Per structure (scenario `structures[]`), the cells its footprints touch and its height there.
+  std::vector<terrain::DamCells> structures;
 };
 /// Throws TerrainError naming the field (a point outside the domain, a line or outline that cannot be
 /// read, an outline that covers no cell of the domain).
@@ -64,6 +66,7 @@ struct MapOverlay {
   std::vector<std::uint8_t> resistance;  ///< cells of resistance areas, outlined
   std::vector<std::uint8_t> cover;       ///< cells of erodible cover, outlined
   std::vector<std::uint8_t> dams;        ///< cells of dams, outlined
+  std::vector<std::uint8_t> structures;  ///< cells of structures, outlined
   products::Line path;
   std::vector<figures::MapPoint> path_marks;
 };

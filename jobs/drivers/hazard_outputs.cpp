@@ -159,6 +159,10 @@ HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Gri
     overlay.dams.resize(dam.height.size(), 0);
     for (std::size_t k = 0; k < dam.height.size(); ++k) overlay.dams[k] |= dam.height[k] > 0;
   }
+  for (const auto& st : in.structures) {  // the cells of any structure
+    overlay.structures.resize(st.height.size(), 0);
+    for (std::size_t k = 0; k < st.height.size(); ++k) overlay.structures[k] |= st.height[k] > 0;
+  }
   for (const auto& d : in.cover_areas) {  // the cells of any area of cover
     overlay.cover.resize(d.size(), 0);
     for (std::size_t k = 0; k < d.size(); ++k) overlay.cover[k] |= d[k] > 0;
@@ -282,6 +286,56 @@ v1::GridReport grid_report(const terrain::Grid& g) {
   gr.set_x_min(g.x_min);
   gr.set_y_min(g.y_min);
   return gr;
+}
+
+std::vector<StructureSummary> structure_summaries(const ResolvedScenario& s, const terrain::Grid& grid,
+                                                  const std::vector<terrain::DamCells>& cells, const engine::HazardMaps& hz) {
+  std::vector<StructureSummary> out;
+  for (std::size_t a = 0; a < cells.size() && a < s.structures.size(); ++a) {
+    const auto& h = cells[a].height;
+    StructureSummary q;
+    q.name = s.structures[a].name;
+    q.cells = cells[a].cells;
+    auto on = [&](int i, int j) { return i >= 0 && j >= 0 && i < grid.nx && j < grid.ny && h[std::size_t(j) * grid.nx + i] > 0; };
+    for (int j = 0; j < grid.ny; ++j)
+      for (int i = 0; i < grid.nx; ++i) {
+        const std::size_t k = std::size_t(j) * grid.nx + i;
+        if (on(i, j)) {
+          q.height_max_m = std::max(q.height_max_m, h[k]);
+          continue;
+        }
+        if (!(on(i - 1, j) || on(i + 1, j) || on(i, j - 1) || on(i, j + 1))) continue;
+        q.max_depth_next_m = std::max(q.max_depth_next_m, hz.max_depth[k]);
+        if (!hz.max_pressure.empty()) q.max_pressure_next_kpa = std::max(q.max_pressure_next_kpa, hz.max_pressure[k] / 1000);
+      }
+    out.push_back(q);
+  }
+  return out;
+}
+
+void record_structures(const RunSummary& sum, v1::RunRecord& rec) {
+  for (const auto& q : sum.structures) {
+    auto* r = rec.add_structures();
+    r->set_name(q.name);
+    r->set_cells(int(q.cells));
+    r->set_height_max_m(q.height_max_m);
+    r->set_max_depth_next_m(q.max_depth_next_m);
+    r->set_max_pressure_next_kpa(q.max_pressure_next_kpa);
+    if (!q.loads) continue;
+    r->set_peak_force_kn(q.peak_force_kn);
+    r->set_peak_force_time_s(q.peak_force_time_s);
+    r->set_peak_force_east_kn(q.peak_force_east_kn);
+    r->set_peak_force_north_kn(q.peak_force_north_kn);
+    r->set_peak_force_up_kn(q.peak_force_up_kn);
+    r->set_impulse_kn_s(q.impulse_kn_s);
+    r->set_max_pressure_kpa(q.max_pressure_kpa);
+    r->set_max_pressure_time_s(q.max_pressure_time_s);
+    r->set_max_pressure_height_m(q.max_pressure_height_m);
+    r->set_wall_area_m2(q.wall_area_m2);
+    for (double v : q.front_height_m) r->add_front_profile_height_m(v);
+    for (double v : q.front_alpha) r->add_front_profile_alpha(v);
+    for (double v : q.front_speed_m_s) r->add_front_profile_speed_m_s(v);
+  }
 }
 
 }  // namespace runout::jobs

@@ -38,6 +38,14 @@ inline constexpr double kSteepSlopeDeg = 60;
 /// flow (max depth above the outline threshold): depth and speed there are not physical.
 std::string steep_terrain_note(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz);
 
+/// Per structure (scenario structures[], `cells` from read_output_inputs): its cells, its height and
+/// the flow in the cells next to it (4-neighbours not on it): the deepest flow and the largest
+/// pressure of the maps `hz` (density rho [kg/m3] times the squared speed, in kPa).
+std::vector<StructureSummary> structure_summaries(const ResolvedScenario& s, const terrain::Grid& grid,
+                                                  const std::vector<terrain::DamCells>& cells, const engine::HazardMaps& hz);
+/// The structures of `sum` into run.json's structures[].
+void record_structures(const RunSummary& sum, v1::RunRecord& rec);
+
 void require_finite_figures(std::initializer_list<std::pair<const char*, double>> figures);
 
 /// What write_hazard_outputs wrote that the run record reports.

@@ -46,6 +46,18 @@ struct DamSummary {
   double max_depth_m = 0;  ///< on the dam's cells (above its crest)
 };
 
+/// A structure (scenario structures[]) and the flow's load on it (proto StructureResult).
+struct StructureSummary {
+  std::string name;
+  long cells = 0;
+  double height_max_m = 0;
+  double max_depth_next_m = 0, max_pressure_next_kpa = 0;
+  bool loads = false;  ///< 3D: the force figures below are set
+  double peak_force_kn = 0, peak_force_time_s = 0, peak_force_east_kn = 0, peak_force_north_kn = 0, peak_force_up_kn = 0;
+  double impulse_kn_s = 0, max_pressure_kpa = 0, max_pressure_time_s = 0, max_pressure_height_m = 0, wall_area_m2 = 0;
+  std::vector<double> front_height_m, front_alpha, front_speed_m_s;
+};
+
 struct RunSummary {
   int nx = 0, ny = 0;
   double dx = 0;
@@ -67,6 +79,7 @@ struct RunSummary {
   std::vector<std::string> files;  ///< written, relative to the output directory
   std::vector<std::string> notes;
   std::vector<DamSummary> dams;  ///< depth-averaged: per dam
+  std::vector<StructureSummary> structures;  ///< per structure (scenario structures[])
 };
 
 /// The run's runout in words, one figure wherever it is printed: "runout 3075 m along the path (max

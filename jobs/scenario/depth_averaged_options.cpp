@@ -219,6 +219,18 @@ OptionTable ground_options() {
        "DamRequest::height"},
       {"dams[].height_attribute", T::text, U::as_given, "", {}, {}, "", "the attribute that holds each feature's height",
        "DamRequest::height_attribute"},
+      {"structures[].name", T::text, U::as_given, "", {}, {}, "", "the structure's name in run.json, the loads' files and on the maps; default \"structure N\"",
+       "ResolvedScenario::structures"},
+      {"structures[].path", T::path, U::required, "", {}, {}, "",
+       "footprints (polygons) in any CRS: a wall of the height on the cells they touch (depth-averaged), an obstacle with its own walls (3D)",
+       "ResolvedScenario::structures"},
+      {"structures[].crs", T::text, U::as_given, "", {}, {}, "", "the file's CRS when it has none", "ResolvedScenario::structures"},
+      {"structures[].height_m", T::number, U::as_given, "", Range{0, 100, true}, {}, "m",
+       "the structure's height above the ground (or height_attribute, or top_attribute)", "DamRequest::height"},
+      {"structures[].height_attribute", T::text, U::as_given, "", {}, {}, "", "the attribute that holds each feature's height [m]",
+       "DamRequest::height_attribute"},
+      {"structures[].top_attribute", T::text, U::as_given, "", {}, {}, "",
+       "the attribute that holds each feature's top elevation [m]; its height is the top less each cell's ground", "DamRequest::top_attribute"},
         };
 }
 

@@ -253,23 +253,44 @@ void resolve_cover(const v1::Scenario& s, const std::string& base, ResolvedScena
   }
 }
 
+// A dam's or a structure's file with its name (or `fallback`) and height fields, as a request.
+template <class M>
+DamSettings vector_with_height(const M& d, const std::string& f, const std::string& fallback, const std::string& base, ResolvedScenario& r) {
+  DamSettings q;
+  q.name = d.name().empty() ? fallback : d.name();
+  q.request.field = f;
+  q.request.path = path_in(base, d.path(), f + ".path");
+  add_vector(q.request.path, f + ".path", r);
+  q.request.crs = d.crs();
+  q.request.has_height = d.has_height_m();
+  q.request.height = d.height_m();
+  q.request.height_attribute = d.height_attribute();
+  return q;
+}
+
 // The dams: each a vector file with a height (given or per feature).
 void resolve_dams(const v1::Scenario& s, const std::string& base, ResolvedScenario& r) {
   for (int a = 0; a < s.dams_size(); ++a) {
-    const auto& d = s.dams(a);
     const std::string f = "dams[" + std::to_string(a) + "]";
-    DamSettings q;
-    q.name = d.name().empty() ? "dam " + std::to_string(a + 1) : d.name();
-    q.request.field = f;
-    q.request.path = path_in(base, d.path(), f + ".path");
-    add_vector(q.request.path, f + ".path", r);
-    q.request.crs = d.crs();
-    q.request.has_height = d.has_height_m();
-    q.request.height = d.height_m();
-    q.request.height_attribute = d.height_attribute();
+    DamSettings q = vector_with_height(s.dams(a), f, "dam " + std::to_string(a + 1), base, r);
     if (!q.request.has_height && q.request.height_attribute.empty()) bad(f, "needs height_m or height_attribute");
     if (q.request.has_height && !q.request.height_attribute.empty()) bad(f + ".height_attribute", "give height_m or height_attribute, not both");
     r.dams.push_back(q);
+  }
+}
+
+// The structures: each a file of footprints with a height, given, per feature or as a top elevation.
+void resolve_structures(const v1::Scenario& s, const std::string& base, ResolvedScenario& r) {
+  for (int a = 0; a < s.structures_size(); ++a) {
+    const std::string f = "structures[" + std::to_string(a) + "]";
+    DamSettings q = vector_with_height(s.structures(a), f, "structure " + std::to_string(a + 1), base, r);
+    for (const auto& other : r.structures)
+      if (other.name == q.name) bad(f + ".name", "\"" + q.name + "\" names another structure already; each needs its own name");
+    q.request.top_attribute = s.structures(a).top_attribute();
+    const int given = int(q.request.has_height) + int(!q.request.height_attribute.empty()) + int(!q.request.top_attribute.empty());
+    if (given == 0) bad(f, "needs height_m, height_attribute or top_attribute");
+    if (given > 1) bad(f, "give one of height_m, height_attribute and top_attribute, not several");
+    r.structures.push_back(q);
   }
 }
 
@@ -359,7 +380,7 @@ void check_terrain_vof(const v1::Scenario& s) {
     bad("resistance", "the 3D engine takes no resistance areas (the depth-averaged engine does)");
   if (s.entrainment().ByteSizeLong() > 0)
     bad("entrainment", "the 3D engine takes no erodible cover (the depth-averaged engine does)");
-  if (s.dams_size() > 0) bad("dams", "the 3D engine takes no dams yet (the depth-averaged engine does)");
+  if (s.dams_size() > 0) bad("dams", "the 3D engine takes no dams yet (the depth-averaged engine does; structures[] go to both)");
 }
 
 // The erodible cover: at least one area, and a friction law with a constant mu (the kernels of the
@@ -411,6 +432,7 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   resolve_releases(s, base, r);
   resolve_cover(s, base, r);
   resolve_dams(s, base, r);
+  resolve_structures(s, base, r);
   map_options(scenario_options(), s, r);
   map_options(depth_averaged_options(), s, r);
   if (vof) check_terrain_vof(s);  // first: the 3D engine takes one friction law
@@ -466,6 +488,7 @@ std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version,
   if (s.has_resistance())
     for (auto& a : *s.mutable_resistance()->mutable_areas()) a.clear_path();
   for (auto& d : *s.mutable_dams()) d.clear_path();
+  for (auto& d : *s.mutable_structures()) d.clear_path();
   if (s.has_entrainment())
     for (auto& a : *s.mutable_entrainment()->mutable_areas()) {
       a.clear_path();

@@ -75,6 +75,7 @@ struct ResolvedScenario {
   std::vector<ResistanceAreaSettings> resistance;  ///< none: no resistance areas
   std::vector<CoverAreaSettings> cover;            ///< entrainment.areas[]; none: no erodible cover
   std::vector<DamSettings> dams;                   ///< dams[]; none: no dams
+  std::vector<DamSettings> structures;             ///< structures[] (footprints); none: no structures
   std::string corridor_path;  ///< mesh.corridor_path (3D engine on the DEM), resolved; empty: none
   bool maps = true;  ///< outputs.maps: the report maps (PNG, PDF)
   std::string report;  ///< outputs.report: "a4" or "a3", the run's report.pdf; "": none

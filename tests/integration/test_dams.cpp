@@ -18,24 +18,6 @@ using namespace runout::test_support::run;
 
 namespace {
 
-// A grid of n x n cells of `cell` m from (500000, 5200000), flat, in UTM 32N.
-terrain::Grid flat_grid(int n, double cell) {
-  terrain::Grid g;
-  g.nx = g.ny = n;
-  g.dx = cell;
-  g.x_min = 500000;
-  g.y_min = 5200000;
-  OGRSpatialReference s;
-  s.importFromEPSG(32632);
-  char* w = nullptr;
-  s.exportToWkt(&w);
-  g.crs_wkt = w;
-  CPLFree(w);
-  g.crs_name = "EPSG:32632";
-  g.z.assign(g.cells(), 0.0);
-  return g;
-}
-
 // Whether a 4-connected path of cells that are not raised leads from cell `from` to cell `to`.
 bool reachable(const terrain::Grid& g, const std::vector<double>& raise, std::size_t from, std::size_t to) {
   std::vector<std::uint8_t> seen(g.cells(), 0);

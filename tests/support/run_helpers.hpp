@@ -114,6 +114,24 @@ inline void make_polygons(const std::string& path, const std::vector<std::vector
   }
   f << "]}";
 }
+// A grid of n x n cells of `cell` m from (500000, 5200000), flat at elevation z, in UTM 32N.
+inline terrain::Grid flat_grid(int n, double cell, double z = 0) {
+  terrain::Grid g;
+  g.nx = g.ny = n;
+  g.dx = cell;
+  g.x_min = 500000;
+  g.y_min = 5200000;
+  OGRSpatialReference s;
+  s.importFromEPSG(32632);
+  char* w = nullptr;
+  s.exportToWkt(&w);
+  g.crs_wkt = w;
+  CPLFree(w);
+  g.crs_name = "EPSG:32632";
+  g.z.assign(g.cells(), z);
+  return g;
+}
+
 inline std::vector<std::pair<double, double>> square(double x0, double y0, double a) {
   return {{x0, y0}, {x0 + a, y0}, {x0 + a, y0 + a}, {x0, y0 + a}, {x0, y0}};
 }

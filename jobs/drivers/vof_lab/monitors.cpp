@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "engine/vof/loads.hpp"
 #include "jobs/scenario/scenario.hpp"
 
 namespace runout::jobs::vof_lab {
@@ -257,6 +258,47 @@ void SurfaceAngleMonitor::write(v1::Monitors& rec, const std::vector<double>& t)
 
 // ---- the collection ----
 
+// ---- the obstacles' load ----
+
+ObstacleLoadMonitor::ObstacleLoadMonitor(const LabSetup& su, double end_time) : end_time_(end_time) {
+  for (const auto& p : su.m.patches)
+    if (p.name == "obstacle") enabled_ = p.size > 0;
+}
+
+void ObstacleLoadMonitor::sample(double, const vof::VofBackend& s) {
+  if (!enabled_) return;
+  const vof::PatchLoad l = vof::patch_load(s, "obstacle");
+  area_ = l.area;
+  fx.push_back(l.force.x);
+  fy.push_back(l.force.y);
+  fz.push_back(l.force.z);
+  pmax.push_back(l.max_pressure);
+}
+
+void ObstacleLoadMonitor::write(v1::Monitors& rec, const std::vector<double>& t) const {
+  if (!enabled_ || fx.empty()) return;
+  auto* o = rec.mutable_obstacle_load();
+  o->set_area_m2(area_);
+  double impulse = 0;
+  for (std::size_t q = 0; q < fx.size() && q < t.size(); ++q) {
+    const double f = std::sqrt(fx[q] * fx[q] + fy[q] * fy[q] + fz[q] * fz[q]);
+    if (f > o->peak_force_n()) {
+      o->set_peak_force_n(f);
+      o->set_peak_force_time_s(t[q]);
+    }
+    if (q > 0) impulse += 0.5 * (fx[q] + fx[q - 1]) * (t[q] - t[q - 1]);
+    o->set_max_pressure_pa(std::max(o->max_pressure_pa(), pmax[q]));
+    o->add_force_x_n(fx[q]);
+    o->add_force_y_n(fy[q]);
+    o->add_force_z_n(fz[q]);
+    o->add_max_pressure_series_pa(pmax[q]);
+  }
+  o->set_impulse_x_n_s(impulse);
+  o->set_force_x_median_second_half_n(median_between(t, fx, 0.5 * end_time_, 1e300));
+  o->set_force_y_median_second_half_n(median_between(t, fy, 0.5 * end_time_, 1e300));
+  o->set_force_z_median_second_half_n(median_between(t, fz, 0.5 * end_time_, 1e300));
+}
+
 namespace {
 double monitor_interval(const v1::Lab& L) { return std::min(0.01, L.end_time_s() / 50); }
 }  // namespace
@@ -266,10 +308,11 @@ LabMonitors::LabMonitors(const LabSetup& su, const v1::Lab& L, double t_start)
       gate(su, L),
       shock(su, L),
       surface(su, L, monitor_interval(L)),
+      obstacle(su, L.end_time_s()),
       every_(monitor_interval(L)),
       next_(t_start + monitor_interval(L)) {}
 
-std::vector<Monitor*> LabMonitors::all() { return {&surface, &outflow, &gate, &moving, &shock}; }
+std::vector<Monitor*> LabMonitors::all() { return {&surface, &outflow, &gate, &moving, &shock, &obstacle}; }
 
 void LabMonitors::after_step(double time, const vof::VofBackend& s) {
   if (time < next_ - 1e-12) return;
@@ -304,7 +347,7 @@ void LabMonitors::restore(const VofCheckpoint& cp, const std::string& path) {
 void LabMonitors::write(v1::RunRecord& rec) const {
   auto* mo = rec.mutable_monitors();
   for (double v : t) mo->add_t_s(v);
-  for (const Monitor* m : std::vector<const Monitor*>{&moving, &outflow, &gate, &surface, &shock}) m->write(*mo, t);
+  for (const Monitor* m : std::vector<const Monitor*>{&moving, &outflow, &gate, &surface, &shock, &obstacle}) m->write(*mo, t);
 }
 
 }  // namespace runout::jobs::vof_lab

@@ -117,6 +117,24 @@ class SurfaceAngleMonitor : public Monitor {
   double period_, every_;
 };
 
+/// The obstacles' load (engine/vof/loads.hpp): the pressure's force on the "obstacle" patch and the
+/// highest face pressure, per sample.
+class ObstacleLoadMonitor : public Monitor {
+ public:
+  explicit ObstacleLoadMonitor(const LabSetup& su, double end_time);
+  bool enabled() const { return enabled_; }
+  void sample(double t, const engine::vof::VofBackend& s) override;
+  void write(v1::Monitors& rec, const std::vector<double>& t) const override;
+  std::vector<std::pair<const char*, std::vector<double>*>> series() override {
+    return {{"obstacle_fx", &fx}, {"obstacle_fy", &fy}, {"obstacle_fz", &fz}, {"obstacle_pmax", &pmax}};
+  }
+  std::vector<double> fx, fy, fz, pmax;
+
+ private:
+  bool enabled_ = false;
+  double area_ = 0, end_time_;
+};
+
 /// The monitors of a run and their sample times.
 class LabMonitors {
  public:
@@ -134,6 +152,7 @@ class LabMonitors {
   MovingShareMonitor moving;
   ShockMonitor shock;
   SurfaceAngleMonitor surface;
+  ObstacleLoadMonitor obstacle;
 
  private:
   std::vector<Monitor*> all();

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "jobs/drivers/vof_terrain/mesh.hpp"
+
 namespace runout::jobs::vof_terrain {
 
 namespace vof = engine::vof;
@@ -43,6 +45,12 @@ vof::VofConfig terrain_config(const ResolvedScenario& r, vof::MeshColumns column
     ground.type = "symmetry";
   }
   c.bc["ground"] = ground;
+  for (const auto& st : r.structures) {
+    vof::PatchBc wall;
+    wall.type = "coulomb_slip";
+    wall.tan_delta = std::tan(s.material().bed_friction_deg() * 3.14159265358979323846 / 180);
+    c.bc[structure_patch(st.name)] = wall;
+  }
   c.bc["atmosphere"].kind = vof::Bc::atmosphere;
   c.bc["sides"].kind = vof::Bc::atmosphere;
   return c;

@@ -16,7 +16,8 @@ namespace runout::jobs::vof_terrain {
 /// friction fell with the pressure; docs/design/vof.md). With vof.bed "coulomb-friction" and
 /// vof.bed_normal_stress "column" (the default) the friction acts on the columns `columns`
 /// (bed_columns()) and the ground takes no shear of its own; ScenarioError when they are missing.
-/// The material in partly filled cells falls onto the bed at vof.settling_speed_m_s.
+/// The material in partly filled cells falls onto the bed at vof.settling_speed_m_s. Each structure's
+/// walls and roof (structure_patch) are Coulomb slip walls at the bed friction angle.
 engine::vof::VofConfig terrain_config(const ResolvedScenario& r, engine::vof::MeshColumns columns = {});
 
 }  // namespace runout::jobs::vof_terrain

@@ -63,6 +63,7 @@ Profile ColumnHazard::profile(std::size_t col, const vof::VofBackend& s) const {
   Profile p;
   for (int j = 0; j < cols_.layers; ++j) {
     const int c = cols_.cell(col, j);
+    if (c < 0) continue;  // inside a structure
     p.height.push_back(0.5 * (cols_.levels[std::size_t(j)] + cols_.levels[std::size_t(j) + 1]));
     p.alpha.push_back(s.alpha()[std::size_t(c)]);
     p.speed.push_back(norm(s.velocity()[std::size_t(c)]));

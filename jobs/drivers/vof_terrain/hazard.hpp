@@ -58,13 +58,15 @@ class ColumnHazard {
   void save(VofCheckpoint& cp) const;
   /// Throws ScenarioError naming `path` when the checkpoint lacks the maps or they are of another grid.
   void restore(const VofCheckpoint& cp, const std::string& path);
+  /// The flow through mesh column `col` now: per layer (those a structure takes left out) its
+  /// middle's height above the ground, phase fraction and speed.
+  Profile profile(std::size_t col, const engine::vof::VofBackend& s) const;
 
  private:
   struct Column {
     double depth = 0, speed = 0, surface_speed = 0, ground_stress = 0;
   };
   Column column(std::size_t gc, const engine::vof::VofBackend& s) const;
-  Profile profile(std::size_t col, const engine::vof::VofBackend& s) const;
 
   const Columns& cols_;
   const engine::vof::Mesh& m_;

@@ -1,6 +1,7 @@
 #include "jobs/drivers/vof_terrain/mesh.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "engine/sh2d.hpp"
@@ -16,15 +17,34 @@ Frame frame_of(const terrain::ColumnMesh& c) {
   return f;
 }
 
-engine::vof::Mesh terrain_mesh(const terrain::ColumnMesh& c, const Frame& frame) {
+engine::vof::Mesh terrain_mesh(const terrain::ColumnMesh& c, const Frame& frame, const std::vector<std::string>& structure_names) {
   engine::vof::HexGridSpec s;
   s.ni = c.ni;
   s.nj = c.layers();
   s.nk = c.nk;
   s.node = [&](int i, int j, int k) { return frame.to_engine(c.node_x(i), c.node_y(k), c.node_z(i, k, j)); };
-  s.blocked = [&](int i, int, int k) { return c.kept[std::size_t(k) * std::size_t(c.ni) + std::size_t(i)] == 0; };
+  s.blocked = [&](int i, int j, int k) {
+    const std::size_t col = std::size_t(k) * std::size_t(c.ni) + std::size_t(i);
+    return c.kept[col] == 0 || j < c.base_of(col);
+  };
   s.patch_names = {"sides", "sides", "ground", "atmosphere", "sides", "sides", "sides"};
-  return engine::vof::structured_hex_mesh(s);
+  engine::vof::Mesh m = engine::vof::structured_hex_mesh(s);
+  // A structure's faces: those of "sides" whose far side (a quarter column beyond the face) lies in
+  // one of its columns.
+  auto column_beyond = [&](int f) -> long {
+    const engine::vof::Vec n = (1.0 / m.magSf[std::size_t(f)]) * m.Sf[std::size_t(f)];
+    const engine::vof::Vec p = m.Cf[std::size_t(f)] + (0.25 * c.dx) * n;
+    const double east = p.x + frame.x, north = frame.y - p.z;
+    const int i = int(std::floor((east - c.x_min) / c.dx)), k = int(std::floor((north - c.y_min) / c.dx));
+    if (i < 0 || k < 0 || i >= c.ni || k >= c.nk) return -1;
+    return long(k) * c.ni + i;
+  };
+  for (std::size_t a = 0; a < structure_names.size() && !c.structure.empty(); ++a)
+    engine::vof::split_patch(m, "sides", structure_patch(structure_names[a]), [&](int f) {
+      const long col = column_beyond(f);
+      return col >= 0 && c.structure[std::size_t(col)] == int(a);
+    });
+  return m;
 }
 
 Columns columns_of(const terrain::ColumnMesh& c) {
@@ -41,7 +61,7 @@ Columns columns_of(const terrain::ColumnMesh& c) {
     for (int j = 0; j < out.layers; ++j)
       for (int i = 0; i < c.ni; ++i) {
         const std::size_t col = std::size_t(k) * std::size_t(c.ni) + std::size_t(i);
-        if (c.kept[col]) out.cells[col * std::size_t(out.layers) + std::size_t(j)] = next++;
+        if (c.kept[col] && j >= c.base_of(col)) out.cells[col * std::size_t(out.layers) + std::size_t(j)] = next++;
       }
   return out;
 }

@@ -3,7 +3,8 @@
 // in the engine's frame. The engine's frame is right-handed with y up, as the laboratory set-ups'
 // (gravity along -y): x east, y the elevation above `origin.z`, z south, in metres from the grid's
 // centre. Patches: "ground" (the bottom of every column), "atmosphere" (the top), "sides" (the
-// grid's edges and the faces towards columns outside the domain).
+// grid's edges and the faces towards columns outside the domain), and per structure
+// (terrain::place_structures) "structure:NAME" (its walls and roof).
 #include <vector>
 
 #include "engine/vof/column_friction.hpp"
@@ -24,10 +25,13 @@ Frame frame_of(const terrain::ColumnMesh& c);
 
 /// The engine's mesh of the kept columns: i east, j up the layers, k north (cell (i, j, k) of the
 /// engine's structured numbering with left-out columns skipped).
-engine::vof::Mesh terrain_mesh(const terrain::ColumnMesh& c, const Frame& frame);
+engine::vof::Mesh terrain_mesh(const terrain::ColumnMesh& c, const Frame& frame, const std::vector<std::string>& structure_names = {});
+
+/// The patch of structure `name`.
+inline std::string structure_patch(const std::string& name) { return "structure:" + name; }
 
 /// The engine's cells of each column, bottom up: cell(col, layer), -1 for columns outside the
-/// domain; col = k * ni + i (row 0 south). Cells numbered as terrain_mesh() numbers them (the one
+/// domain and for the layers a structure takes; col = k * ni + i (row 0 south). Cells numbered as terrain_mesh() numbers them (the one
 /// place that numbering is spelt out besides structured_hex_mesh). With a refinement R each grid
 /// cell holds R x R columns (sub_column).
 struct Columns {

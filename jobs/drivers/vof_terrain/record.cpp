@@ -92,6 +92,7 @@ void write_terrain_record(const std::string& path, const ResolvedScenario& r, co
   for (const auto& line : f.outputs.parameters) rec.add_parameters(line);
   re->set_frames(f.frames);
   write_profiles(f, rec);
+  record_structures(sum, rec);
   auto* ti = rec.mutable_timings_s();
   ti->set_prepare(sum.seconds_prepare);
   ti->set_run(sum.seconds_run);

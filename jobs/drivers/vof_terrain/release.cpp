@@ -19,7 +19,9 @@ std::vector<double> release_alpha(const terrain::ColumnMesh& c, const std::vecto
     throw terrain::TerrainError("release: the thickness raster is not of the mesh's grid");
   const double band = c.levels.back();
   const Columns cols = columns_of(c);
-  std::vector<double> alpha(std::size_t(c.kept_columns()) * std::size_t(c.layers()), 0.0);
+  std::size_t cells = 0;
+  for (int id : cols.cells) cells += id >= 0;
+  std::vector<double> alpha(cells, 0.0);
   for (std::size_t col = 0; col < cols.columns(); ++col) {
     const double h = vertical_m[c.grid_cell(col)];  // every column of a grid cell takes the cell's thickness
     // The grid cell, as the user's rasters number it (the refined column lies in it).
@@ -34,7 +36,8 @@ std::vector<double> release_alpha(const terrain::ColumnMesh& c, const std::vecto
                                   " m in grid cell (" + std::to_string(i) + ", " + std::to_string(k) + ")");
     for (int j = 0; j < c.layers(); ++j) {
       const double lo = c.levels[std::size_t(j)], hi = c.levels[std::size_t(j) + 1];
-      alpha[std::size_t(cols.cell(col, j))] = std::clamp((h - lo) / (hi - lo), 0.0, 1.0);
+      if (cols.cell(col, j) >= 0)  // not inside a structure
+        alpha[std::size_t(cols.cell(col, j))] = std::clamp((h - lo) / (hi - lo), 0.0, 1.0);
     }
   }
   return alpha;

@@ -19,6 +19,7 @@
 #include "jobs/drivers/vof_support.hpp"
 #include "jobs/drivers/vof_terrain/config.hpp"
 #include "jobs/drivers/vof_terrain/hazard.hpp"
+#include "jobs/drivers/vof_terrain/loads.hpp"
 #include "jobs/drivers/vof_terrain/record.hpp"
 #include "jobs/drivers/vof_terrain/setup.hpp"
 #include "jobs/formats/checkpoint.hpp"
@@ -35,6 +36,8 @@ using clk = std::chrono::steady_clock;
 
 // More of the released volume than this through the corridor's edge: run.json says the map is not complete.
 constexpr double kCorridorLossNote = 0.02;
+// The structures' loads go to structure_loads.csv this often [s] (their peaks are taken every step).
+constexpr double kLoadsInterval = 0.1;
 
 double since(clk::time_point t0) { return std::chrono::duration<double>(clk::now() - t0).count(); }
 
@@ -122,6 +125,7 @@ class TerrainRun final : public EngineRun {
   std::string state_hash_;
   double continued_from_ = std::numeric_limits<double>::quiet_NaN();
   std::unique_ptr<ColumnHazard> hazard_;
+  std::unique_ptr<StructureLoads> loads_;  // scenario structures[]
   FrameGrid frame_grid_;  // the frames' grid (the writer keeps a reference)
   std::unique_ptr<VofFrameWriter> frames_;
   RunningFigures fig_;
@@ -158,6 +162,7 @@ TerrainRun::TerrainRun(const ResolvedScenario& r, const std::string& out_dir, co
   hs.rho = r.scenario.material().density_kg_m3();
   hs.flow_threshold = r.config.flow_threshold;
   hazard_ = std::make_unique<ColumnHazard>(su_.columns, s_->mesh(), su_.cos_slope, hs, tracked);
+  loads_ = std::make_unique<StructureLoads>(su_, kLoadsInterval);
   const double write_every = r.scenario.vof().write_interval_s();
   frame_grid_ = frame_grid(su_);
   if (write_every > 0)
@@ -176,6 +181,7 @@ void TerrainRun::save(VofCheckpoint& cp) const {
   cp.scenario_hash = state_hash_;
   fig_.save(cp);
   hazard_->save(cp);
+  loads_->save(cp);
   cp.figures["outflow_m3"] = outflow_;
   cp.figures["ke_peak"] = loop.kinetic_energy_peak;
   cp.figures["corridor_outflow_m3"] = outflow_corridor_;
@@ -185,6 +191,7 @@ void TerrainRun::save(VofCheckpoint& cp) const {
 void TerrainRun::restore(const VofCheckpoint& cp, const std::string& path) {
   fig_.restore(cp, path);
   hazard_->restore(cp, path);
+  loads_->restore(cp, path);
   for (const char* k : {"outflow_m3", "ke_peak", "corridor_outflow_m3", "domain_edge_outflow_m3"})
     if (!cp.figures.count(k)) throw ScenarioError("checkpoint " + path + ": damaged (no figure '" + k + "')");
   outflow_ = cp.figures.at("outflow_m3");
@@ -220,6 +227,7 @@ engine::LoopHooks TerrainRun::hooks() {
   h.after_step = [this](const engine::StepReport& r) {
     fig_.step(step_->last());
     hazard_->update(r.t, *s_);
+    if (!loads_->empty()) loads_->update(r.t, r.dt, *s_, *hazard_);
     balance(r.dt);
   };
   if (frames_) h.frame = [this](double t) { frames_->write(t, *s_); };
@@ -269,6 +277,11 @@ RunSummary TerrainRun::finish(engine::StopReason stop, const RunTimes& times) {
                           {"maximum depth", sum.max_depth}, {"runout", sum.runout_m}});
   const auto outputs = write_hazard_outputs(r_, su_.grid, su_.h0, hazard_->maps(), su_.output_inputs, out_dir_, sum);
   write_3d_rasters(su_, *hazard_, out_dir_, sum);
+  sum.structures = structure_summaries(r_, su_.grid, su_.output_inputs.structures, hazard_->maps());
+  if (!loads_->empty()) {
+    loads_->summarise(sum.structures);
+    sum.files.push_back(loads_->write_csv(out_dir_));
+  }
   const int n_frames = frames_ ? frames_->finish() : 0;
   if (frames_) {
     sum.files.push_back("fields.h5");

@@ -70,9 +70,15 @@ void build_terrain_setup(const ResolvedScenario& r, TerrainSetup& out) {
                                           int(terrain::layer_levels(out.spec).size()) - 1, out.refinement_reason);
   out.domain_columns *= out.spec.refinement * out.spec.refinement;
   out.columns_mesh = terrain::column_mesh(out.grid, out.spec, out.corridor.cells);
+  std::vector<terrain::DamRequest> structures;
+  for (const auto& st : r.structures) {
+    structures.push_back(st.request);
+    out.structure_names.push_back(st.name);
+  }
+  terrain::place_structures(out.columns_mesh, out.grid, structures);
   out.frame = frame_of(out.columns_mesh);
   out.columns = columns_of(out.columns_mesh);
-  out.mesh = terrain_mesh(out.columns_mesh, out.frame);
+  out.mesh = terrain_mesh(out.columns_mesh, out.frame, out.structure_names);
   out.quality = engine::vof::mesh_quality(out.mesh);
   out.corridor_edge = corridor_edge_faces(out.columns, out.mesh, out.grid);
   out.alpha = release_alpha(out.columns_mesh, out.vertical);

@@ -47,7 +47,8 @@ struct TerrainSetup {
   std::string refinement_reason;
   Corridor corridor;               ///< the columns meshed (mesh.corridor)
   int domain_columns = 0;          ///< the columns inside the domain (refined)
-  terrain::ColumnMesh columns_mesh;
+  terrain::ColumnMesh columns_mesh;  ///< with the structures stood on it (terrain::place_structures)
+  std::vector<std::string> structure_names;  ///< per structure (scenario structures[]); patches structure_patch(name)
   Frame frame;
   Columns columns;
   engine::vof::Mesh mesh;

@@ -1,0 +1,49 @@
+#pragma once
+// The flow's load on each structure of a 3D run on the DEM (scenario structures[]): after every step
+// the pressure's force on the structure's patch (engine/vof/loads.hpp) in the grid's CRS (east,
+// north, up); its peak (the largest horizontal force), the impulse (the horizontal force integrated
+// over the steps), the highest face pressure and, at the peak force, the flow's profile in the column
+// in front of the face that took the highest pressure. Series every `interval` seconds go to
+// structure_loads.csv. The figures and series travel with a checkpoint.
+#include <string>
+#include <vector>
+
+#include "engine/vof/backend.hpp"
+#include "jobs/drivers/run.hpp"
+#include "jobs/drivers/vof_terrain/hazard.hpp"
+#include "jobs/drivers/vof_terrain/setup.hpp"
+#include "jobs/formats/checkpoint.hpp"
+
+namespace runout::jobs::vof_terrain {
+
+class StructureLoads {
+ public:
+  StructureLoads(const TerrainSetup& su, double interval);
+  bool empty() const { return loads_.empty(); }
+  /// After a step of length dt ending at t.
+  void update(double t, double dt, const engine::vof::VofBackend& s, const ColumnHazard& hazard);
+  void save(VofCheckpoint& cp) const;
+  /// Throws ScenarioError naming `path` when the checkpoint lacks a structure's figures.
+  void restore(const VofCheckpoint& cp, const std::string& path);
+  /// The figures into the summaries (matched by name).
+  void summarise(std::vector<StructureSummary>& out) const;
+  /// structure_loads.csv: time_s, structure, force_east_kn, force_north_kn, force_up_kn,
+  /// force_horizontal_kn, max_pressure_kpa. Returns the file's name.
+  std::string write_csv(const std::string& out_dir) const;
+
+ private:
+  struct Load {
+    std::string name, patch;
+    double peak = 0, peak_t = 0, peak_e = 0, peak_n = 0, peak_u = 0, impulse = 0, last_h = 0;
+    double p_max = 0, p_max_t = 0, p_max_height = 0, area = 0;
+    int p_max_face = -1;
+    std::vector<double> t, east, north, up, p;  // the series (kN, kPa)
+    std::vector<double> front_h, front_a, front_s;
+  };
+  const TerrainSetup& su_;
+  double interval_, next_ = 0;
+  std::vector<int> column_of_, layer_of_;  // per cell
+  std::vector<Load> loads_;
+};
+
+}  // namespace runout::jobs::vof_terrain
