@@ -90,7 +90,7 @@ std::vector<int> ActiveRegion::layers_from_material() const {
   std::vector<int> stack;
   std::vector<char> out(nc, 0);
   for (int f = m_.n_internal; f < nf; ++f)
-    if (bcs_[f].opening()) {
+    if (bcs_[f].opening_at(f)) {
       const int o = m_.owner[f];
       if (d[o] < 0 && !out[o]) {
         out[o] = 1;

@@ -70,6 +70,15 @@ void AlphaEqn::interface_normal(const Fields& F) {
   grad(m_, region_.cell_faces(), region_.halo, face_alpha, grad_alpha_, region_.face_in_region());
 }
 
+// The flux that carries alpha through face f: the last pressure solve's, but through a boundary face
+// whose condition fixes its flux, the flux fixed for this step (a coupled inflow changes from step to
+// step, and the step's material must enter in the step; a constant inflow's is the same number).
+double AlphaEqn::boundary_flux(const Fields& F, int f) const {
+  if (internal(m_, f)) return F.phi[f];
+  const auto q = bcs_[f].fixed_flux(bc_ctx_, f);
+  return q ? *q : F.phi[f];
+}
+
 // Per face the upwind flux FL and the antidiffusive flux AF (central value plus compression, less
 // upwind); per cell the bounds of alpha among its neighbours (and what flows in from outside).
 void AlphaEqn::fluxes_and_bounds(const Fields& F) {
@@ -77,7 +86,7 @@ void AlphaEqn::fluxes_and_bounds(const Fields& F) {
   const auto& ga = grad_alpha_;
   parallel_each(region_.faces, [&](int f) {
     const int o = m_.owner[f];
-    const double ph = F.phi[f];
+    const double ph = boundary_flux(F, f);
     if (internal(m_, f)) {
       const int nb = m_.neighbour[f];
       const double ao = a[o], an = a[nb];
@@ -108,7 +117,7 @@ void AlphaEqn::fluxes_and_bounds(const Fields& F) {
         const double other = a[m_.owner[f] == c ? m_.neighbour[f] : m_.owner[f]];
         hi = std::max(hi, other);
         lo = std::min(lo, other);
-      } else if (F.phi[f] < 0) {
+      } else if (boundary_flux(F, f) < 0) {
         const double ab = bcs_[f].alpha(bc_ctx_, f);
         hi = std::max(hi, ab);
         lo = std::min(lo, ab);

@@ -32,6 +32,9 @@ struct PatchBc {
   double friction_creep_speed = 1e-4;  ///< Coulomb friction: below this sliding speed [m/s] the friction force falls linearly
   std::function<Vec(const Vec&)> inflow_velocity;  ///< inflow: velocity at a face centre
   std::function<double(const Vec&)> inflow_alpha;  ///< inflow: phase fraction at a face centre
+  /// nest_inflow: whether material enters through boundary face f over the step [t0, t1], and then
+  /// the face's velocity and phase fraction over the step (their mean; t0 == t1: at t0).
+  std::function<bool(int f, double t0, double t1, Vec& velocity, double& alpha)> timed_inflow;
   /// The condition by its name in the registry (engine/vof/bc/registry.cpp), for kinds without a
   /// Bc value; empty: `kind`'s.
   std::string type = {};

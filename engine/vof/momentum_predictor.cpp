@@ -32,7 +32,7 @@ void MomentumEqn::predictor_forces() {
         q = hs.opening_force(f, c, hs.outside_p_rgh(f, c));  // out of c
         rec[c] = rec[c] + (sg * q) * m_.Sf[f];
       }
-    } else if (ao && bcs_[f].opening()) {
+    } else if (ao && bcs_[f].opening_at(f)) {
       q = hs.opening_force(f, o, hs.outside_p_rgh(f, o));
       rec[o] = rec[o] + q * m_.Sf[f];
     }

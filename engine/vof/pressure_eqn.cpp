@@ -81,7 +81,7 @@ void PressureEqn::laplacian_coefficients(const Fields& F, const Coupling& k) {
         coef[f] = k.U.rA_along(k.consistent, a, m_.Sf[f]) * m_.magSf[f] * m_.delta_coeff[f];
         pout_[f] = hs.outside_p_rgh(f, a);
       }
-    } else if (ao && bcs_[f].opening()) {
+    } else if (ao && bcs_[f].opening_at(f)) {
       open_[f] = 1;
       coef[f] = k.rAf[f] * m_.magSf[f] * m_.delta_coeff[f];
       pout_[f] = hs.outside_p_rgh(f, o);
@@ -123,7 +123,7 @@ void PressureEqn::predicted_flux(const MomentumEqn& UEqn, bool initial, const Co
       }
     } else if (region_.active(o)) {
       ph = bcs_[f].predicted_flux(bc_ctx_, f, HbyA[o], initial);
-      if (bcs_[f].opening() && k.consistent) {
+      if (bcs_[f].opening_at(f) && k.consistent) {
         const double Fout = hs.opening_force(f, o, pout_[f]);
         ph += (UEqn.rA_along(false, o, m_.Sf[f]) - UEqn.rA_along(true, o, m_.Sf[f])) * Fout * m_.magSf[f];
         w = Fout;

@@ -89,7 +89,7 @@ struct VofSolver::Impl {
   };
 
   void update_gravity(double t, bool force = false) {
-    hydrostatics.update(t, [&](int f) { return bcs[f].opening(); }, force);
+    hydrostatics.update(t, [&](int f) { return bcs[f].opening_at(f); }, force);
   }
   void update_rho() {
     for (int c : region.halo) F.rho[c] = mixture.rho(F.alpha[c]);
@@ -144,6 +144,8 @@ double VofSolver::Impl::next_dt(const Courant& co, double dt, double time_left, 
 // carries the inflow to the openings (the same equation without gravity). Starting from zero
 // inside instead piled the first step's inflow into the inflow cells (alpha up to 1.03 in B4).
 void VofSolver::Impl::initial_pressure(double t) {
+  bc_ctx.t0 = bc_ctx.t1 = t;
+  bcs.begin_step(bc_ctx);
   UEqn.unit_coefficients();
   region.clear();
   region.update(true);
@@ -275,6 +277,9 @@ void VofSolver::restore(const VofState& st) {
   F.nu1 = st.nu1;
   F.phi = st.phi;
   F.U = st.U;
+  I.bc_ctx.t0 = t_ - dt_;  // the conditions as in the step that led here
+  I.bc_ctx.t1 = t_;
+  I.bcs.begin_step(I.bc_ctx);
   I.update_gravity(t_, true);
   // rho from alpha everywhere (outside the halo it was last computed from the same alpha).
   I.region.set(std::vector<int>(nc, 0));
@@ -303,6 +308,9 @@ StepStats VofSolver::step(double t_limit) {
   const char* limit = "";
   dt_ = I.next_dt(co, dt_, t_limit - t_, limit);
   t_ += dt_;
+  I.bc_ctx.t0 = t_ - dt_;
+  I.bc_ctx.t1 = t_;
+  I.bcs.begin_step(I.bc_ctx);
   I.update_gravity(t_);
   I.keep_old_time();
 

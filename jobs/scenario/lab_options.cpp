@@ -31,7 +31,7 @@ const Range kLength{0, kExt};
 std::vector<std::string> condition_names(bool bed) {
   std::vector<std::string> out;
   for (const auto* r : engine::vof::boundary_conditions())
-    if (!bed || r->bed) out.push_back(engine::vof::scenario_spelling(r->name));
+    if ((!bed || r->bed) && !r->coupled) out.push_back(engine::vof::scenario_spelling(r->name));
   return out;
 }
 

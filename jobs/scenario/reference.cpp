@@ -48,7 +48,8 @@ std::string granular_viscosities_markdown() {
 std::string boundary_conditions_markdown() {
   std::string s = "| `kind` | Boundary condition | `vof.bed` |\n|---|---|---|\n";
   for (const auto* r : engine::vof::boundary_conditions())
-    s += "| `" + engine::vof::scenario_spelling(r->name) + "` | " + std::string(r->caption) + ": " + std::string(r->doc) + " | " +
+    if (!r->coupled)
+      s += "| `" + engine::vof::scenario_spelling(r->name) + "` | " + std::string(r->caption) + ": " + std::string(r->doc) + " | " +
          (r->bed ? (r->bed_friction ? "yes, with `material.bed_friction_deg`" : "yes") : "-") + " |\n";
   return s;
 }

@@ -35,6 +35,7 @@ struct BcContext {
   const GranularViscosity& viscosity;
   const Mixture& mixture;
   WallViscosity wall_viscosity;
+  double t0 = 0, t1 = 0;  ///< the step being taken (begin_step): from t0 to t1
 };
 
 class BoundaryCondition {
@@ -52,8 +53,13 @@ class BoundaryCondition {
   virtual double predicted_flux(const BcContext& c, int f, const Vec& HbyA_o, bool initial) const;
   /// A flux the condition fixes from the start (an inflow's), if any.
   virtual std::optional<double> fixed_flux(const BcContext&, int) const { return std::nullopt; }
-  /// Open to the still air outside (the pressure there is the still air's).
+  /// Whether the condition may open to the still air outside (the pressure there is the still air's).
   virtual bool opening() const { return false; }
+  /// Whether boundary face f is open to the still air in the step being taken (default: opening()).
+  virtual bool opening_at(int) const { return opening(); }
+  /// Before each step (and before the initial pressure) with the step's times in c: a condition
+  /// that changes in time takes its state for the step here.
+  virtual void begin_step(const BcContext&) {}
   /// The cell next to it always belongs to the active region.
   virtual bool seeds_active_region() const { return false; }
 };
@@ -93,6 +99,10 @@ class Boundaries {
   const BoundaryCondition& operator[](int f) const { return *face_[f - n_internal_]; }
   /// Whether any patch opens to the atmosphere (then the pressure level is fixed).
   bool has_opening() const { return has_opening_; }
+  /// Every condition's begin_step with the step's times in c.
+  void begin_step(const BcContext& c) {
+    for (auto& b : conditions_) b->begin_step(c);
+  }
 
  private:
   int n_internal_ = 0;

@@ -21,9 +21,10 @@ struct BoundaryConditionRow {
   std::string_view doc;      ///< what it does (the reference page)
   bool bed = false;           ///< may be the ground of the 3D engine on the DEM (vof.bed)
   bool bed_friction = false;  ///< takes the bed friction angle (PatchBc::tan_delta)
+  bool coupled = false;       ///< fed by another model at run time (a nest's boundary): no scenario names it
 };
 
-inline constexpr std::array<BoundaryConditionRow, 7> kBoundaryConditions{{
+inline constexpr std::array<BoundaryConditionRow, 8> kBoundaryConditions{{
     {"wall", "stick wall", "no flow through it, no slip along it; its shear from the viscosity on the face", true, false},
     {"coulomb_slip", "Coulomb slip wall",
      "the material slides with the slip that makes the cell's shear carry tan(delta) p, and sticks where that shear exceeds it "
@@ -35,6 +36,10 @@ inline constexpr std::array<BoundaryConditionRow, 7> kBoundaryConditions{{
     {"outflow", "outflow", "zero gradient: material leaves freely", false, false},
     {"inflow", "inflow", "prescribed velocity and phase fraction, its cells always computed", false, false},
     {"symmetry", "symmetry", "no flow through it and no shear along it (a plane of symmetry, a frictionless wall)", false, false},
+    {"nest_inflow", "coupled inflow",
+     "a nest's boundary: the flow of the run around it enters where and while it enters, with its velocity and its fill of the "
+     "face over the step; elsewhere open to the still air as the atmosphere",
+     false, false, true},
 }};
 
 namespace detail {

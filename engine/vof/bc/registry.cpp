@@ -18,6 +18,7 @@ std::unique_ptr<BoundaryCondition> make_inflow(const std::string&, const PatchBc
 std::unique_ptr<BoundaryCondition> make_outflow(const std::string&, const PatchBc&);
 std::unique_ptr<BoundaryCondition> make_symmetry(const std::string&, const PatchBc&);
 std::unique_ptr<BoundaryCondition> make_coulomb_friction(const std::string&, const PatchBc&);
+std::unique_ptr<BoundaryCondition> make_nest_inflow(const std::string&, const PatchBc&);
 
 namespace {
 
@@ -35,6 +36,7 @@ constexpr std::array kConditions = {
     Entry{"outflow", Bc::outflow, make_outflow},
     Entry{"inflow", Bc::inflow, make_inflow},
     Entry{"symmetry", Bc::symmetry, make_symmetry},
+    Entry{"nest_inflow", std::nullopt, make_nest_inflow},
 };
 
 constexpr bool same_order() {

@@ -332,7 +332,8 @@ void LabMonitors::save(VofCheckpoint& cp) {
 void LabMonitors::restore(const VofCheckpoint& cp, const std::string& path) {
   std::vector<std::pair<const char*, std::vector<double>*>> all_series = {{"t", &t}};
   for (Monitor* m : all())
-    for (auto s : m->series()) all_series.push_back(s);
+    if (m != &obstacle || obstacle.enabled())  // a set-up without obstacles may continue a checkpoint without their series
+      for (auto s : m->series()) all_series.push_back(s);
   for (auto [name, v] : all_series) {
     const auto it = cp.series.find(name);
     if (it == cp.series.end()) throw ScenarioError("checkpoint " + path + ": damaged (no series '" + name + "')");
