@@ -308,6 +308,10 @@ class Sh2dEngine final : public SteppingEngine {
   double kinetic_energy() const override;
   /// The state now (valid until the next step).
   Sh2dStateView state() const;
+  /// Per flux gauge (Sh2dConfig::gauges): the net volume that left its cells to its right and to its
+  /// left so far [m^3] (valid until the next step).
+  const std::vector<double>& gauge_right() const;
+  const std::vector<double>& gauge_left() const;
   /// The whole state between two steps, with the loop's running figures: a run continued from it
   /// computes the same bits as the uninterrupted run.
   Sh2dCheckpoint checkpoint(const LoopState& loop) const;

@@ -538,6 +538,8 @@ long Sh2dEngine::steps() const { return s_->steps(); }
 StepReport Sh2dEngine::step(double t_end) { return s_->step(t_end); }
 double Sh2dEngine::kinetic_energy() const { return s_->kinetic_energy(); }
 Sh2dStateView Sh2dEngine::state() const { return s_->state(); }
+const std::vector<double>& Sh2dEngine::gauge_right() const { return s_->gauge_right(); }
+const std::vector<double>& Sh2dEngine::gauge_left() const { return s_->gauge_left(); }
 Sh2dCheckpoint Sh2dEngine::checkpoint(const LoopState& loop) const { return s_->checkpoint(loop); }
 Sh2dResult Sh2dEngine::finish(StopReason stop, const LoopState& loop) { return s_->finish(stop, loop); }
 

@@ -111,6 +111,8 @@ class Solver {
   long steps() const { return steps_; }
   double kinetic_energy() const { return sum_tiles(tile_ke_) * (t_.dx * t_.dy); }
   Sh2dStateView state() const { return Sh2dStateView{H_[cur_], HU_[cur_], HV_[cur_]}; }
+  const std::vector<double>& gauge_right() const { return gauge_right_; }
+  const std::vector<double>& gauge_left() const { return gauge_left_; }
   /// The whole state between two steps, with the loop's running figures.
   Sh2dCheckpoint checkpoint(const LoopState& loop) const;
   /// Take up a checkpoint's state (after construction from its depths and momenta).

@@ -4,6 +4,8 @@
 #include "jobs/drivers/engine_run.hpp"
 #include "jobs/drivers/hazard_maps.hpp"
 #include "jobs/drivers/hazard_outputs.hpp"
+#include "jobs/drivers/nest/boundary.hpp"
+#include "jobs/drivers/nest/run.hpp"
 #include "jobs/drivers/record_head.hpp"
 #include "jobs/drivers/report.hpp"
 
@@ -28,6 +30,24 @@ namespace fs = std::filesystem;
 namespace {
 
 // run.json of a depth-averaged run; continued_from: NaN for a run not continued from a checkpoint.
+// The nest's figures into run.json.
+void record_nest(const NestSummary& n, v1::RunRecord& rec) {
+  auto* r = rec.mutable_nest();
+  r->set_cells(n.cells);
+  r->set_boundary_faces(n.boundary_faces);
+  r->set_mesh_cells(int(n.mesh_cells));
+  r->set_column_width_m(n.column_width_m);
+  r->set_first_layer_m(n.first_layer_m);
+  r->set_band_height_m(n.band_height_m);
+  r->set_inflow_depth_averaged_m3(n.inflow_depth_averaged_m3);
+  r->set_inflow_3d_m3(n.inflow_3d_m3);
+  r->set_inflow_relative_difference(n.inflow_depth_averaged_m3 > 0 ? std::abs(n.inflow_3d_m3 - n.inflow_depth_averaged_m3) / n.inflow_depth_averaged_m3 : 0.0);
+  r->set_volume_error_3d(n.volume_error_3d);
+  r->set_seconds_3d(n.seconds_3d);
+  r->set_recorded_steps(int(n.recorded_steps));
+  r->set_maps("inside the nest's cells the 3D run's (nest/), outside the depth-averaged run's");
+}
+
 void write_record(const std::string& path, const ResolvedScenario& s, const terrain::DemReport& dem_rep, const terrain::Grid& grid,
                   const terrain::ReleaseReport& rel_rep, const engine::Sh2dResult& res, const RunSummary& sum, double continued_from,
                   const HazardOutputs& outputs, int frames, const std::vector<terrain::ReleaseArea>& secondary) {
@@ -47,6 +67,7 @@ void write_record(const std::string& path, const ResolvedScenario& s, const terr
   mb->set_volume_detrained_m3(d.volume_detrained);
   mb->set_volume_entrained_m3(d.volume_entrained);
   record_structures(sum, rec);
+  if (sum.nest) record_nest(*sum.nest, rec);
   for (const auto& q : sum.dams) {
     auto* dr = rec.add_dams();
     dr->set_name(q.name);
@@ -258,8 +279,25 @@ class DepthAveragedRun final : public EngineRun {
   double continued_from_ = std::numeric_limits<double>::quiet_NaN();  // NaN: not continued
   std::unique_ptr<TimeSeriesWriter> series_;
   std::unique_ptr<engine::Sh2dEngine> engine_;
+  std::unique_ptr<nest::NestBoundary> nest_;  // scenario nest: its boundary, recorded every step
   RunSummary sum_;
+
+  void attach_nest(const RunOptions& opt);
 };
+
+// The nest's boundary on the grid (the cells whose centres lie inside its polygons, as the nest's
+// corridor takes them) and its gauges after the dams'. A nested run is not continued from a
+// checkpoint: the record of the boundary does not travel in one.
+void DepthAveragedRun::attach_nest(const RunOptions& opt) {
+  if (!opt.restart_path.empty() || !opt.checkpoint_path.empty())
+    throw ScenarioError("nest: a run with a 3D nest takes no checkpoint and is not continued from one");
+  const std::string what = "nest.path '" + s_.nest->corridor_path + "'";
+  nest_ = std::make_unique<nest::NestBoundary>(grid_, terrain::rasterize_polygons(grid_, s_.nest->corridor_path, s_.scenario.nest().crs(), what),
+                                               what);
+  for (auto& g : nest_->gauges(cfg_.gauges.size())) cfg_.gauges.push_back(std::move(g));
+  nest_->start(0);
+  output_inputs_.nest = nest_->cells();
+}
 
 DepthAveragedRun::DepthAveragedRun(const ResolvedScenario& s, const std::string& out_dir, const RunOptions& opt)
     : s_(s), out_dir_(out_dir), opt_(opt) {
@@ -281,6 +319,7 @@ DepthAveragedRun::DepthAveragedRun(const ResolvedScenario& s, const std::string&
   cfg_.resistance = resistance_areas(s, output_inputs_.resistance_areas);
   cfg_.cover = erodible_cover(s, output_inputs_.cover_areas);
   place_dams(s, output_inputs_.dams, output_inputs_.structures, t_, cfg_);
+  if (s.nest) attach_nest(opt);
 
   // Checkpoints: the solver's whole state between two steps, with the scenario's hash; the time
   // series so far lies beside it (CHECKPOINT.timeseries.h5), so that a continued run's outputs are
@@ -315,6 +354,7 @@ engine::LoopSchedule DepthAveragedRun::schedule() const {
 engine::LoopHooks DepthAveragedRun::hooks() {
   engine::LoopHooks h;
   if (series_) h.frame = [this](double time) { series_->write(time, engine_->state()); };
+  if (nest_) h.after_step = [this](const engine::StepReport&) { nest_->record(engine_->time(), *engine_); };
   h.checkpoint = [this](const engine::LoopState& st) {
     // The frames first: a checkpoint never refers to frames that are not beside it.
     if (series_) series_->save_copy(opt_.checkpoint_path + ".timeseries.h5");
@@ -325,7 +365,12 @@ engine::LoopHooks DepthAveragedRun::hooks() {
 
 RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& times) {
   RunSummary sum = std::move(sum_);
-  const engine::Sh2dResult res = engine_->finish(stop, loop);
+  engine::Sh2dResult res = engine_->finish(stop, loop);
+  if (nest_ && stop != engine::StopReason::cancelled) {  // the 3D nest, its maps inside the nest's cells
+    sum.nest = nest::run_nest(s_, *nest_, res.hazard, (fs::path(out_dir_) / "nest").string(), opt_);
+    sum.notes.push_back("inside the 3D nest (" + std::to_string(sum.nest->cells) +
+                        " cells) the hazard rasters are the 3D engine's (nest/run.json); outside, the depth-averaged engine's");
+  }
   sum.seconds_prepare = times.prepare;
   sum.cpu_seconds = times.cpu;
   int frames = 0;

@@ -36,6 +36,7 @@ figures::HazardMap map_base(const ResolvedScenario& s, const terrain::Grid& grid
   base.cover = overlay.cover;
   base.dams = overlay.dams;
   base.structures = overlay.structures;
+  base.nest = overlay.nest;
   base.max_depth = hz.max_depth;
   base.outline_threshold = s.outline_threshold;
   base.parameters = map_parameters(s, grid, sum.release_volume_m3);

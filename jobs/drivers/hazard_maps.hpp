@@ -40,6 +40,8 @@ struct OutputInputs {
   std::vector<std::vector<double>> cover_areas;
   /// Per dam (scenario `dams[]`), its cells, height and crest.
   std::vector<terrain::DamCells> dams;
+  /// The cells of a 3D nest (scenario `nest`), outlined on the maps; empty: none.
+  std::vector<std::uint8_t> nest;
   /// Per structure (scenario `structures[]`), the cells its footprints touch and its height there.
   std::vector<terrain::DamCells> structures;
 };
@@ -67,6 +69,7 @@ struct MapOverlay {
   std::vector<std::uint8_t> cover;       ///< cells of erodible cover, outlined
   std::vector<std::uint8_t> dams;        ///< cells of dams, outlined
   std::vector<std::uint8_t> structures;  ///< cells of structures, outlined
+  std::vector<std::uint8_t> nest;        ///< cells of a 3D nest, outlined
   products::Line path;
   std::vector<figures::MapPoint> path_marks;
 };

@@ -159,6 +159,7 @@ HazardOutputs write_hazard_outputs(const ResolvedScenario& s, const terrain::Gri
     overlay.dams.resize(dam.height.size(), 0);
     for (std::size_t k = 0; k < dam.height.size(); ++k) overlay.dams[k] |= dam.height[k] > 0;
   }
+  overlay.nest = in.nest;
   for (const auto& st : in.structures) {  // the cells of any structure
     overlay.structures.resize(st.height.size(), 0);
     for (std::size_t k = 0; k < st.height.size(); ++k) overlay.structures[k] |= st.height[k] > 0;

@@ -6,10 +6,28 @@
 #include <string>
 #include <vector>
 
+#include <optional>
+
 #include "engine/run_control.hpp"
+#include "engine/sh2d.hpp"
 #include "jobs/scenario/scenario.hpp"
 
 namespace runout::jobs {
+
+namespace nest {
+class NestBoundary;
+}
+
+/// The 3D part of a nested run (jobs/drivers/nest/run.hpp): what it reads, and what it hands back
+/// to the depth-averaged run at its end.
+struct NestLink {
+  const nest::NestBoundary* boundary = nullptr;  ///< the depth-averaged run's record of the nest's boundary
+  engine::HazardMaps maps;                       ///< the 3D run's maps on the grid (only the nest's cells hold values)
+  double inflow_m3 = 0;        ///< the volume the 3D run took in through the nest's boundary
+  double volume_error = 0;     ///< the 3D run's own balance
+  long mesh_cells = 0;
+  double column_width_m = 0, first_layer_m = 0, band_height_m = 0;
+};
 
 struct RunOptions {
   engine::ProgressHook progress;  ///< optional; returning false cancels the run
@@ -34,6 +52,8 @@ struct RunOptions {
   /// Depth-averaged runs: the terrain cache's folder (the prepared grid of a DEM, area and grid,
   /// shared by the runs that use them, e.g. an ensemble's members); empty: the grid is prepared.
   std::string terrain_cache_dir;
+  /// The 3D run of a nest (ResolvedScenario::nest_part): the link to the depth-averaged run around it.
+  NestLink* nest = nullptr;
 };
 
 /// A dam of the scenario (dams[]) and what passed it (run.json's dams[]).
@@ -44,6 +64,14 @@ struct DamSummary {
   double height_max_m = 0, crest_length_m = 0;
   double crossed_right_m3 = 0, crossed_left_m3 = 0, overflow_m3 = 0;  ///< crest lines
   double max_depth_m = 0;  ///< on the dam's cells (above its crest)
+};
+
+/// The 3D nest of a depth-averaged run (proto NestResult).
+struct NestSummary {
+  int cells = 0, boundary_faces = 0;
+  long mesh_cells = 0, recorded_steps = 0;
+  double column_width_m = 0, first_layer_m = 0, band_height_m = 0;
+  double inflow_depth_averaged_m3 = 0, inflow_3d_m3 = 0, volume_error_3d = 0, seconds_3d = 0;
 };
 
 /// A structure (scenario structures[]) and the flow's load on it (proto StructureResult).
@@ -77,6 +105,7 @@ struct RunSummary {
   double seconds_prepare = 0, seconds_run = 0, seconds_write = 0;
   double cpu_seconds = 0;  ///< processor time of the solve (all threads)
   std::vector<std::string> files;  ///< written, relative to the output directory
+  std::optional<NestSummary> nest;  ///< depth-averaged with a nest
   std::vector<std::string> notes;
   std::vector<DamSummary> dams;  ///< depth-averaged: per dam
   std::vector<StructureSummary> structures;  ///< per structure (scenario structures[])

@@ -179,6 +179,12 @@ void draw_area_edges(cairo_t* cr, const Frame& f, const HazardMap& m, double w) 
     draw_edges(cr, f, [&](int i, int j) { return m.cover[std::size_t(j) * g.nx + i] != 0; }, kCover, 1.6 * w, true, true);
   if (!m.dams.empty())
     draw_edges(cr, f, [&](int i, int j) { return m.dams[std::size_t(j) * g.nx + i] != 0; }, kDam, 2.2 * w, true);
+  if (!m.nest.empty()) {
+    const double dash[] = {4 * w, 3 * w};
+    cairo_set_dash(cr, dash, 2, 0);
+    draw_edges(cr, f, [&](int i, int j) { return m.nest[std::size_t(j) * g.nx + i] != 0; }, kPath, 1.6 * w, false);
+    cairo_set_dash(cr, nullptr, 0, 0);
+  }
   if (!m.structures.empty())
     draw_edges(cr, f, [&](int i, int j) { return m.structures[std::size_t(j) * g.nx + i] != 0; }, kInk, 2.2 * w, true);
 }
@@ -350,6 +356,7 @@ double draw_panel(cairo_t* cr, double x, double y, const HazardMap& m, double co
   if (!m.cover.empty()) item("erodible cover (entrainment)", [&](double yy) { legend_line(cr, x, yy, kCover, 2, true); });
   if (!m.dams.empty()) item("dam or wall", [&](double yy) { legend_line(cr, x, yy, kDam, 3); });
   if (!m.structures.empty()) item("structure", [&](double yy) { legend_line(cr, x, yy, kInk, 3); });
+  if (!m.nest.empty()) item("3D nest: values inside from the 3D engine", [&](double yy) { legend_line(cr, x, yy, kPath, 2); });
   if (!m.max_depth.empty())
     item("outline: max depth > " + label_number(m.outline_threshold) + " m", [&](double yy) { legend_line(cr, x, yy, kOutline, 2); });
   for (const auto& b : m.boundaries)

@@ -36,6 +36,7 @@ struct HazardMap {
   std::vector<std::uint8_t> cover;       ///< cells of erodible cover (entrainment), outlined; empty: none
   std::vector<std::uint8_t> dams;        ///< cells raised by dams and walls, outlined; empty: none
   std::vector<std::uint8_t> structures;  ///< cells of structures (buildings, pylons), outlined; empty: none
+  std::vector<std::uint8_t> nest;        ///< cells of a 3D nest (its values the 3D engine's), outlined dashed; empty: none
   std::vector<double> max_depth;        ///< for the outline
   double outline_threshold = 0.1;       ///< [m]
   std::vector<ClassBoundaries> boundaries;

@@ -410,6 +410,36 @@ void check_resistance(const v1::Scenario& s, const ResolvedScenario& r) {
 
 }  // namespace
 
+namespace {
+
+// The 3D run of a depth-averaged scenario's nest: the same scenario for engine "vof" on the DEM, its
+// mesh's corridor the nest's polygons, its refinement and layers the nest's. What the 3D engine
+// refuses (dams, resistance, cover, secondary releases) is refused for the nest, naming it.
+ResolvedScenario resolve_nest(const v1::Scenario& s, const std::string& base) {
+  const auto& n = s.nest();
+  if (n.path().empty()) bad("nest.path", "missing: the nest's polygons");
+  if (n.refinement() < 1 || n.refinement() > 8) bad("nest.refinement", "must lie in [1, 8], got " + std::to_string(n.refinement()));
+  v1::Scenario d = s;
+  d.clear_nest();
+  d.set_engine("vof");
+  auto* me = d.mutable_mesh();
+  me->set_corridor("polygon");
+  me->set_corridor_path(n.path());
+  me->set_corridor_crs(n.crs());
+  me->set_refinement(n.refinement());
+  if (n.has_first_layer_m()) me->set_first_layer_m(n.first_layer_m());
+  if (n.has_band_height_m()) me->set_band_height_m(n.band_height_m());
+  try {
+    ResolvedScenario r = resolve_scenario(d, base);
+    r.nest_part = true;
+    return r;
+  } catch (const ScenarioError& e) {
+    throw ScenarioError(std::string("nest: the 3D run of the nest: ") + e.what());
+  }
+}
+
+}  // namespace
+
 ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   check_text_limits(s);  // first: nothing else reads an unbounded name or a path cut by a NUL byte
   apply_option_rules(scenario_options(), s);
@@ -417,6 +447,7 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   if (vof && s.has_lab()) return resolve_lab(std::move(s));
   if (!vof && (s.has_mesh() || s.has_vof()))
     bad(s.has_mesh() ? "mesh" : "vof", "only for engine \"vof\" (the 3D engine on the DEM)");
+  if (vof && s.has_nest()) bad("nest", "only for engine \"depth-averaged\": the nest is a 3D run inside a depth-averaged one");
   // The option tables fill the defaults and check every field's range or choices; the checks
   // between fields and the input files follow.
   apply_option_rules(depth_averaged_options(), s);
@@ -446,6 +477,11 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
     check_output_interval("vof.checkpoint_interval_s", s.vof().checkpoint_interval_s(), "numerics.end_time_s", t_end, true);
   }
   require_finite(s, "");
+  if (s.has_nest()) {
+    r.nest = std::make_shared<const ResolvedScenario>(resolve_nest(s, base));
+    for (const auto& f : r.nest->input_files)  // the nest's polygons
+      if (std::find(r.input_files.begin(), r.input_files.end(), f) == r.input_files.end()) r.input_files.push_back(f);
+  }
   r.scenario = std::move(s);
   return r;
 }
@@ -485,6 +521,7 @@ std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version,
   if (s.has_observations()) s.mutable_observations()->clear_outline_path();
   if (s.has_path()) s.mutable_path()->clear_line_path();
   if (s.has_mesh()) s.mutable_mesh()->clear_corridor_path();
+  if (s.has_nest()) s.mutable_nest()->clear_path();
   if (s.has_resistance())
     for (auto& a : *s.mutable_resistance()->mutable_areas()) a.clear_path();
   for (auto& d : *s.mutable_dams()) d.clear_path();

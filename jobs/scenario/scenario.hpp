@@ -3,6 +3,7 @@
 // (defaults, paths relative to the file, names to enums) and validated before anything runs. Every
 // error names the field and the problem.
 #include <stdexcept>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -77,6 +78,12 @@ struct ResolvedScenario {
   std::vector<DamSettings> dams;                   ///< dams[]; none: no dams
   std::vector<DamSettings> structures;             ///< structures[] (footprints); none: no structures
   std::string corridor_path;  ///< mesh.corridor_path (3D engine on the DEM), resolved; empty: none
+  /// Depth-averaged with a `nest`: the nest's 3D run, resolved (engine "vof" on the DEM, its mesh's
+  /// corridor the nest's polygons, its refinement and layers the nest's); null: no nest.
+  std::shared_ptr<const ResolvedScenario> nest;
+  /// The 3D part of a nested run: the corridor (the nest) may leave release cells out (they are the
+  /// depth-averaged run's), and its boundary takes the depth-averaged run's flux.
+  bool nest_part = false;
   bool maps = true;  ///< outputs.maps: the report maps (PNG, PDF)
   std::string report;  ///< outputs.report: "a4" or "a3", the run's report.pdf; "": none
   std::vector<std::string> input_files;  ///< for hashing

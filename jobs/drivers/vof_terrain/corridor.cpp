@@ -42,7 +42,7 @@ Corridor build_corridor(const ResolvedScenario& r, const terrain::Grid& g, const
       left_out += h0[k] > 0 && !c.cells[k];
     }
     if (covered == 0) throw ScenarioError(what + ": '" + r.corridor_path + "' covers no cell of the domain");
-    if (left_out > 0)
+    if (left_out > 0 && !r.nest_part)  // a nest's release outside it is the depth-averaged run's
       throw ScenarioError(what + ": '" + r.corridor_path + "' leaves " + std::to_string(left_out) +
                           " release cell(s) out: the release must lie inside the corridor");
     return c;

@@ -14,7 +14,7 @@ terrain::ColumnMeshSpec default_column_mesh(double max_vertical_m) {
   return {max_vertical_m / 5, 1.2, 8 * max_vertical_m};
 }
 
-std::vector<double> release_alpha(const terrain::ColumnMesh& c, const std::vector<double>& vertical_m) {
+std::vector<double> release_alpha(const terrain::ColumnMesh& c, const std::vector<double>& vertical_m, bool outside_ok) {
   if (vertical_m.size() != std::size_t(c.ni) * std::size_t(c.nk) / std::size_t(c.refinement * c.refinement))
     throw terrain::TerrainError("release: the thickness raster is not of the mesh's grid");
   const double band = c.levels.back();
@@ -27,7 +27,7 @@ std::vector<double> release_alpha(const terrain::ColumnMesh& c, const std::vecto
     // The grid cell, as the user's rasters number it (the refined column lies in it).
     const int i = int(col % std::size_t(c.ni)) / c.refinement, k = int(col / std::size_t(c.ni)) / c.refinement;
     if (!c.kept[col]) {
-      if (h > 0)
+      if (h > 0 && !outside_ok)
         throw terrain::TerrainError("release: material in the grid cell (" + std::to_string(i) + ", " + std::to_string(k) + ") outside the domain");
       continue;
     }

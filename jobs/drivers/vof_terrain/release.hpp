@@ -21,6 +21,6 @@ terrain::ColumnMeshSpec default_column_mesh(double max_vertical_m);
 /// refined columns of a grid cell all take its thickness, so that the volume does not change.
 /// Throws TerrainError naming mesh.band_height_m when a column's release does not fit in the band,
 /// and when material lies in a column outside the domain.
-std::vector<double> release_alpha(const terrain::ColumnMesh& c, const std::vector<double>& vertical_m);
+std::vector<double> release_alpha(const terrain::ColumnMesh& c, const std::vector<double>& vertical_m, bool outside_ok = false);
 
 }  // namespace runout::jobs::vof_terrain

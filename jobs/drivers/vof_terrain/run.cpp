@@ -17,6 +17,7 @@
 #include "jobs/drivers/hazard_outputs.hpp"
 #include "jobs/drivers/vof_lab/monitors.hpp"
 #include "jobs/drivers/vof_support.hpp"
+#include "jobs/drivers/nest/inflow.hpp"
 #include "jobs/drivers/vof_terrain/config.hpp"
 #include "jobs/drivers/vof_terrain/hazard.hpp"
 #include "jobs/drivers/vof_terrain/loads.hpp"
@@ -132,11 +133,19 @@ class TerrainRun final : public EngineRun {
   std::unique_ptr<vof::VofStepping> step_;
   double outflow_ = 0;
   double outflow_corridor_ = 0, outflow_edge_ = 0;  // through the corridor's edge, through the domain's edge
+  double nest_in_ = 0;  // a nest's: what entered through its boundary
 };
 
 TerrainRun::TerrainRun(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt) : r_(r), out_dir_(out_dir), opt_(opt) {
   build_terrain_setup(r, su_);
-  s_ = vof::make_vof_backend(su_.mesh, terrain_config(r, bed_columns(su_.columns, su_.mesh, su_.grid)));
+  vof::VofConfig config = terrain_config(r, bed_columns(su_.columns, su_.mesh, su_.grid));
+  if (r.nest_part) {  // the nest's boundary takes the depth-averaged run's flux
+    if (!opt.nest || !opt.nest->boundary) throw ScenarioError("nest: the 3D part of a nested run needs its depth-averaged run's record");
+    config.bc["nest"] = nest::nest_inflow(su_, *opt.nest->boundary);
+    config.dt_max = std::min(config.dt_max, nest::nest_max_step(su_, *opt.nest->boundary, config.max_co));
+    if (su_.mesh.patch_index("sides") < 0) config.bc.erase("sides");  // a nest inside the domain: its boundary is all "nest"
+  }
+  s_ = vof::make_vof_backend(su_.mesh, config);
   continued = !opt.restart_path.empty();
   state_hash_ = continued || !opt.checkpoint_path.empty() ? terrain_state_hash(r) : std::string();
   VofCheckpoint restart;
@@ -204,9 +213,12 @@ void TerrainRun::balance(double dt) {
   const auto& m = s_->mesh();
   const int sp = m.patch_index("sides");
   const int s0 = sp < 0 ? 0 : m.patches[std::size_t(sp)].start, s1 = sp < 0 ? 0 : s0 + m.patches[std::size_t(sp)].size;
+  const int np = m.patch_index("nest");
+  const int n0 = np < 0 ? 0 : m.patches[std::size_t(np)].start, n1 = np < 0 ? 0 : n0 + m.patches[std::size_t(np)].size;
   for (int f = m.n_internal; f < m.faces(); ++f) {
     const double q = s_->granular_flux()[std::size_t(f)] * dt;
     outflow_ += q;
+    if (f >= n0 && f < n1 && q < 0) nest_in_ -= q;
     if (su_.corridor_edge[std::size_t(f)]) outflow_corridor_ += q;
     else if (f >= s0 && f < s1) outflow_edge_ += q;
   }
@@ -269,7 +281,17 @@ RunSummary TerrainRun::finish(engine::StopReason stop, const RunTimes& times) {
   for (int c = 0; c < s.mesh().cells(); ++c) v_final += s.alpha()[std::size_t(c)] * s.mesh().volume[std::size_t(c)];
   sum.volume_final = v_final;
   sum.volume_outflow = outflow_;
-  sum.volume_error = std::abs(v_final + outflow_ - su_.volume_on_mesh) / su_.volume_on_mesh;
+  // A nest's own balance counts what entered it; its release may be none.
+  sum.volume_error = std::abs(v_final + outflow_ - su_.volume_on_mesh) / std::max(su_.volume_on_mesh + nest_in_, 1e-300);
+  if (opt_.nest) {
+    opt_.nest->maps = hazard_->maps();
+    opt_.nest->inflow_m3 = nest_in_;
+    opt_.nest->volume_error = sum.volume_error;
+    opt_.nest->mesh_cells = su_.mesh.cells();
+    opt_.nest->column_width_m = su_.columns_mesh.dx;
+    opt_.nest->first_layer_m = su_.columns.levels[1];
+    opt_.nest->band_height_m = su_.columns.levels.back();
+  }
   sum.max_speed = 0;
   for (double v : hazard_->maps().max_speed) sum.max_speed = std::max(sum.max_speed, v);
   hazard_figures(r_, su_.grid, su_.h0, hazard_->maps(), sum);

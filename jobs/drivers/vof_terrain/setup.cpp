@@ -81,7 +81,12 @@ void build_terrain_setup(const ResolvedScenario& r, TerrainSetup& out) {
   out.mesh = terrain_mesh(out.columns_mesh, out.frame, out.structure_names);
   out.quality = engine::vof::mesh_quality(out.mesh);
   out.corridor_edge = corridor_edge_faces(out.columns, out.mesh, out.grid);
-  out.alpha = release_alpha(out.columns_mesh, out.vertical);
+  if (r.nest_part) {  // the nest's boundary: its own patch, the depth-averaged run's inflow (jobs/drivers/nest/)
+    const auto edge = out.corridor_edge;
+    engine::vof::split_patch(out.mesh, "sides", "nest", [&](int f) { return edge[std::size_t(f)] != 0; });
+    out.corridor_edge = corridor_edge_faces(out.columns, out.mesh, out.grid);
+  }
+  out.alpha = release_alpha(out.columns_mesh, out.vertical, r.nest_part);
   out.volume_on_mesh = 0;
   for (std::size_t c = 0; c < out.alpha.size(); ++c) out.volume_on_mesh += out.alpha[c] * out.mesh.volume[c];
   const auto& pts = r.scenario.vof().profiles();

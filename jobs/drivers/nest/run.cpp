@@ -1,0 +1,54 @@
+#include "jobs/drivers/nest/run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+
+namespace runout::jobs::nest {
+
+NestSummary run_nest(const ResolvedScenario& parent, const NestBoundary& b, engine::HazardMaps& hz, const std::string& dir,
+                     const RunOptions& opt) {
+  ResolvedScenario r = *parent.nest;
+  r.config.time.t_end = b.end_time();  // the depth-averaged run's end: the record covers no more
+  r.scenario.mutable_numerics()->set_end_time_s(b.end_time());
+  double deepest = b.max_depth();
+  for (std::size_t k = 0; k < b.cells().size(); ++k)
+    if (b.cells()[k]) deepest = std::max(deepest, hz.max_depth[k]);
+  if (!(deepest > 0)) deepest = 1.0;  // nothing reached the nest: any layers do
+  auto* me = r.scenario.mutable_mesh();
+  if (!parent.scenario.nest().has_first_layer_m()) me->set_first_layer_m(deepest / 5);
+  if (!parent.scenario.nest().has_band_height_m()) me->set_band_height_m(8 * deepest);
+  NestLink link;
+  link.boundary = &b;
+  RunOptions o;
+  o.progress = opt.progress;
+  o.progress_every = opt.progress_every;
+  o.terrain_cache_dir = opt.terrain_cache_dir;
+  o.nest = &link;
+  std::filesystem::create_directories(dir);
+  const auto t0 = std::chrono::steady_clock::now();
+  run_scenario(r, dir, o);
+  NestSummary s;
+  s.seconds_3d = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s.cells = b.cell_count();
+  s.boundary_faces = int(b.faces().size());
+  s.recorded_steps = b.steps();
+  s.mesh_cells = link.mesh_cells;
+  s.column_width_m = link.column_width_m;
+  s.first_layer_m = link.first_layer_m;
+  s.band_height_m = link.band_height_m;
+  s.inflow_depth_averaged_m3 = b.inflow_volume();
+  s.inflow_3d_m3 = link.inflow_m3;
+  s.volume_error_3d = link.volume_error;
+  for (std::size_t k = 0; k < b.cells().size(); ++k) {
+    if (!b.cells()[k] || link.maps.max_depth.empty()) continue;
+    hz.max_depth[k] = link.maps.max_depth[k];
+    hz.max_speed[k] = link.maps.max_speed[k];
+    hz.max_pressure[k] = link.maps.max_pressure[k];
+    hz.arrival_time[k] = link.maps.arrival_time[k];
+    if (!hz.final_depth.empty() && !link.maps.final_depth.empty()) hz.final_depth[k] = link.maps.final_depth[k];
+  }
+  return s;
+}
+
+}  // namespace runout::jobs::nest

@@ -1,0 +1,105 @@
+// A 3D nest inside a depth-averaged run (scenario `nest`, one-way coupling): the depth-averaged run
+// records the scheme's own fluxes through the nest's boundary, the 3D engine runs the nest with that
+// inflow, and inside the nest the hazard rasters are the 3D run's.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "jobs/drivers/run.hpp"
+#include "jobs/scenario/scenario.hpp"
+#include "tests/support/run_helpers.hpp"
+
+using namespace runout;
+using namespace runout::test_support::run;
+
+namespace {
+
+constexpr double kX0 = 500000, kY0 = 5200000;
+
+// A slope of 30 deg falling east into a flat at x = 400 m (10 m cells, 600 x 200 m), a block 3 m
+// thick over 60 x 60 m near the top, Coulomb phi 25 deg, delta 20 deg; a nest of 100 x 100 m on
+// the slope below the release, on columns of 5 m.
+v1::Scenario slope_with_nest(const TempDir& d) {
+  const double t = std::tan(30 * M_PI / 180);
+  make_dem_box(d / "dem.tif", 60, 20, 10.0, kX0, kY0, [&](int i, int) { return std::max(0.0, 400 - (i + 0.5) * 10) * t; });
+  make_polygons(d / "rel.geojson", {square(kX0 + 50, kY0 + 70, 60)}, "EPSG:32632");
+  make_polygons(d / "nest.geojson", {square(kX0 + 250, kY0 + 50, 100)}, "EPSG:32632");
+  auto sc = base_scenario(d / "dem.tif", d / "rel.geojson", 10);
+  sc.mutable_releases(0)->set_thickness_m(3);
+  sc.mutable_material()->set_internal_friction_deg(25);
+  sc.mutable_material()->set_bed_friction_deg(20);
+  sc.mutable_numerics()->set_end_time_s(40);
+  sc.mutable_outputs()->set_maps(false);
+  auto* n = sc.mutable_nest();
+  n->set_path("nest.geojson");
+  n->set_refinement(2);
+  return sc;
+}
+
+}  // namespace
+
+// Conservation: the volume the 3D nest takes in equals the depth-averaged flux into it through its
+// boundary within 1 %, the nest's own balance holds to round-off, and the parent's rasters inside the
+// nest are the nest's.
+TEST(Nest, TheNestTakesInTheDepthAveragedFluxAndItsMapsReplaceTheDepthAveragedOnes) {
+  TempDir d;
+  const auto sc = slope_with_nest(d);
+  const auto sum = jobs::run_scenario(jobs::resolve_scenario(sc, d.p.string()), d.p.string());
+  ASSERT_TRUE(sum.nest.has_value());
+  const auto rec = run_record(d / "run.json");
+  ASSERT_TRUE(rec.has_nest());
+  const auto& n = rec.nest();
+  std::printf("nest: %d cells, %d faces, %d mesh cells of %.1f m columns, layers %.2f-%.1f m; in: depth-averaged %.1f m3, 3D %.1f m3 "
+              "(difference %.2e); 3D balance %.1e; %d steps recorded; 3D %.1f s\n",
+              n.cells(), n.boundary_faces(), n.mesh_cells(), n.column_width_m(), n.first_layer_m(), n.band_height_m(),
+              n.inflow_depth_averaged_m3(), n.inflow_3d_m3(), n.inflow_relative_difference(), n.volume_error_3d(), n.recorded_steps(),
+              n.seconds_3d());
+  EXPECT_EQ(n.cells(), 100);
+  EXPECT_EQ(n.boundary_faces(), 40);
+  EXPECT_NEAR(n.column_width_m(), 5.0, 1e-9);
+  EXPECT_GT(n.inflow_depth_averaged_m3(), 0.3 * rec.release().volume_m3());  // most of the flow passes the nest
+  EXPECT_LT(n.inflow_relative_difference(), 0.01);
+  EXPECT_LT(n.volume_error_3d(), 1e-9);
+  const auto nest_run = run_record(d / "nest/run.json");
+  EXPECT_EQ(nest_run.engine(), "vof");
+  const auto outer = read_raster_values(d / "max_depth.tif"), inner = read_raster_values(d / "nest/max_depth.tif");
+  int inside = 0;
+  for (int r = 0; r < outer.h; ++r)
+    for (int i = 0; i < outer.w; ++i) {
+      const double x = outer.cx(i) - kX0, y = outer.cy(r) - kY0;
+      if (x > 250 && x < 350 && y > 50 && y < 150) {
+        ++inside;
+        EXPECT_NEAR(outer.v[std::size_t(r) * outer.w + i], inner.v[std::size_t(r) * inner.w + i], 1e-6) << x << ", " << y;
+      }
+    }
+  EXPECT_EQ(inside, 100);
+  EXPECT_NE(std::find(sum.notes.begin(), sum.notes.end(),
+                      "inside the 3D nest (100 cells) the hazard rasters are the 3D engine's (nest/run.json); outside, the depth-averaged "
+                      "engine's"),
+            sum.notes.end());
+}
+
+// A nest is refused where it cannot be run, naming the field.
+TEST(Nest, BadNestsAreRefusedNamingTheField) {
+  TempDir d;
+  auto sc = slope_with_nest(d);
+  auto vof = sc;
+  vof.set_engine("vof");
+  expect_error(vof, d, "nest: only for engine \"depth-averaged\"");
+  auto thin = sc;
+  make_polygons(d / "thin.geojson", {{{kX0 + 250, kY0 + 50}, {kX0 + 260, kY0 + 50}, {kX0 + 260, kY0 + 150}, {kX0 + 250, kY0 + 150}, {kX0 + 250, kY0 + 50}}},
+                "EPSG:32632");
+  thin.mutable_nest()->set_path("thin.geojson");
+  expect_error(thin, d, "the nest is one cell wide at grid cell (25, 5)");
+  auto edge = sc;
+  make_polygons(d / "edge.geojson", {square(kX0 + 500, kY0 + 50, 100)}, "EPSG:32632");
+  edge.mutable_nest()->set_path("edge.geojson");
+  expect_error(edge, d, "the nest reaches the grid's edge");
+  auto voellmy = sc;
+  voellmy.mutable_material()->set_rheology("voellmy");
+  voellmy.mutable_material()->clear_bed_friction_deg();
+  voellmy.mutable_material()->set_voellmy_mu(0.2);
+  voellmy.mutable_material()->set_voellmy_xi(1000);
+  expect_error(voellmy, d, "nest: the 3D run of the nest:");
+}
