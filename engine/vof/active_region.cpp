@@ -11,8 +11,16 @@ bool ActiveRegion::update(bool force) {
     set(std::vector<int>(nc, 0));
     return true;
   }
-  if (!force && n_active > 0 && material_inside()) return false;
+  if (!force && n_active > 0 && material_inside() && seeds_inside()) return false;
   set(layers_from_material());
+  return true;
+}
+
+// Every cell next to a boundary face that seeds the region now (an inflow, a coupled inflow while
+// material enters) lies inside it.
+bool ActiveRegion::seeds_inside() const {
+  for (int f = m_.n_internal; f < m_.faces(); ++f)
+    if (bcs_[f].seeds_active_region() && bcs_[f].seeds_active_region_at(f) && !active(m_.owner[f])) return false;
   return true;
 }
 
@@ -67,7 +75,7 @@ std::vector<int> ActiveRegion::layers_from_material() const {
       front.push_back(c);
     }
   for (int f = m_.n_internal; f < nf; ++f)
-    if (bcs_[f].seeds_active_region()) {
+    if (bcs_[f].seeds_active_region_at(f)) {
       const int o = m_.owner[f];
       if (d[o] < 0) {
         d[o] = 0;

@@ -52,6 +52,7 @@ class ActiveRegion {
 
  private:
   bool material_inside();
+  bool seeds_inside() const;
   std::vector<int> layers_from_material() const;
 
   const Mesh& m_;

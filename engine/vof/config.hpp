@@ -111,6 +111,9 @@ struct VofConfig {
                                ///< stays stable; the air's speed does not matter for the material)
   double material_alpha = 1e-3;  ///< cells with more material than this count as material
   double dt_initial = 1e-4, dt_max = 1e-2;
+  /// The time the run starts at [s] (initialise()): a nest inside another run starts when material
+  /// first comes near it, on that run's clock.
+  double t_start = 0;
   double c_alpha = 1.0;        ///< interface compression coefficient
   /// The granular phase falls through the air along gravity at this speed [m/s] (a settling flux
   /// w alpha_upper (1 - alpha_lower) across each face with a component along gravity, in the

@@ -230,6 +230,7 @@ void VofSolver::initialise(const std::vector<double>& alpha, const std::vector<V
   F.alpha = alpha;
   for (double a : F.alpha)
     if (!(a >= 0 && a <= 1)) throw VofError("initialise: alpha must lie in [0, 1]");
+  t_ = cfg_.t_start;
   if (!U.empty()) {
     if (U.size() != F.U.size()) throw VofError("initialise: velocity size does not match the mesh");
     F.U = U;

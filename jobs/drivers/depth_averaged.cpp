@@ -45,6 +45,7 @@ void record_nest(const NestSummary& n, v1::RunRecord& rec) {
   r->set_volume_error_3d(n.volume_error_3d);
   r->set_seconds_3d(n.seconds_3d);
   r->set_recorded_steps(int(n.recorded_steps));
+  r->set_start_time_s(n.start_time_s);
   r->set_maps("inside the nest's cells the 3D run's (nest/), outside the depth-averaged run's");
 }
 
@@ -366,15 +367,18 @@ engine::LoopHooks DepthAveragedRun::hooks() {
 RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& times) {
   RunSummary sum = std::move(sum_);
   engine::Sh2dResult res = engine_->finish(stop, loop);
-  if (nest_ && stop != engine::StopReason::cancelled) {  // the 3D nest, its maps inside the nest's cells
-    sum.nest = nest::run_nest(s_, *nest_, res.hazard, (fs::path(out_dir_) / "nest").string(), opt_);
-    sum.notes.push_back("inside the 3D nest (" + std::to_string(sum.nest->cells) +
-                        " cells) the hazard rasters are the 3D engine's (nest/run.json); outside, the depth-averaged engine's");
-  }
   sum.seconds_prepare = times.prepare;
   sum.cpu_seconds = times.cpu;
   int frames = 0;
   if (series_) frames = series_->finish();
+  // The 3D nest after the time series is closed (its own HDF5 files open and close meanwhile).
+  if (nest_ && stop != engine::StopReason::cancelled) {  // the 3D nest, its maps inside the nest's cells
+    bool release_inside = false;
+    for (std::size_t k = 0; k < h0_.size(); ++k) release_inside = release_inside || (h0_[k] > 0 && nest_->cells()[k]);
+    sum.nest = nest::run_nest(s_, *nest_, res.hazard, (fs::path(out_dir_) / "nest").string(), opt_, release_inside);
+    sum.notes.push_back("inside the 3D nest (" + std::to_string(sum.nest->cells) +
+                        " cells) the hazard rasters are the 3D engine's (nest/run.json); outside, the depth-averaged engine's");
+  }
   use_flow_path(s_, grid_, h0_, res.hazard.max_depth, series_ ? series_->mass_centres() : std::vector<std::array<double, 3>>{},
                 output_inputs_);
   sum.seconds_run = times.run;

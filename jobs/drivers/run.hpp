@@ -22,6 +22,7 @@ class NestBoundary;
 /// to the depth-averaged run at its end.
 struct NestLink {
   const nest::NestBoundary* boundary = nullptr;  ///< the depth-averaged run's record of the nest's boundary
+  double start_time = 0;                         ///< when the 3D run starts [s, the depth-averaged run's clock]
   engine::HazardMaps maps;                       ///< the 3D run's maps on the grid (only the nest's cells hold values)
   double inflow_m3 = 0;        ///< the volume the 3D run took in through the nest's boundary
   double volume_error = 0;     ///< the 3D run's own balance
@@ -71,7 +72,7 @@ struct NestSummary {
   int cells = 0, boundary_faces = 0;
   long mesh_cells = 0, recorded_steps = 0;
   double column_width_m = 0, first_layer_m = 0, band_height_m = 0;
-  double inflow_depth_averaged_m3 = 0, inflow_3d_m3 = 0, volume_error_3d = 0, seconds_3d = 0;
+  double inflow_depth_averaged_m3 = 0, inflow_3d_m3 = 0, volume_error_3d = 0, seconds_3d = 0, start_time_s = 0;
 };
 
 /// A structure (scenario structures[]) and the flow's load on it (proto StructureResult).

@@ -103,3 +103,81 @@ TEST(Nest, BadNestsAreRefusedNamingTheField) {
   voellmy.mutable_material()->set_voellmy_xi(1000);
   expect_error(voellmy, d, "nest: the 3D run of the nest:");
 }
+
+namespace {
+
+struct Deposit {
+  double front_x = 0;  ///< the farthest cell east with max depth above 0.1 m [m from the grid's west edge]
+  double area = 0;     ///< cells with max depth above 0.1 m [m2]
+  double volume = 0;   ///< the final depth integrated [m3]
+};
+
+Deposit deposit_of(const std::string& dir) {
+  Deposit d;
+  const auto m = read_raster_values(dir + "/max_depth.tif"), f = read_raster_values(dir + "/deposit.tif");
+  for (int r = 0; r < m.h; ++r)
+    for (int i = 0; i < m.w; ++i) {
+      const double v = m.v[std::size_t(r) * m.w + i], z = f.v[std::size_t(r) * f.w + i];
+      if (std::isfinite(v) && v > 0.1) {
+        d.front_x = std::max(d.front_x, m.cx(i) - kX0);
+        d.area += 30.0 * 30.0;
+      }
+      if (std::isfinite(z)) d.volume += z * 30.0 * 30.0;
+    }
+  return d;
+}
+
+}  // namespace
+
+// A nest over the whole slope (every cell but the grid's edge ring) reproduces the 3D engine's run of
+// the same scenario on the same columns and layers (mesh.corridor "polygon" with the nest's
+// polygon): the slope of 30 deg into a flat on 30 m cells, a block of 2 m (delta 20 deg, phi 25 deg)
+// that stops on the flat. Nothing reaches the nest's boundary, so the nest's run differs from the
+// whole-domain run only by its boundary's condition (open to the still air either way; the nest's
+// cells along it always computed) and its time step's bound. Measured: the same front (1695 m) and
+// area, the deposit's volume within 1e-3.
+TEST(Nest, ANestOverTheWholeSlopeReproducesTheWholeDomain3dRun) {
+  TempDir d;
+  const double t = std::tan(30 * M_PI / 180);
+  make_dem_box(d / "dem.tif", 60, 12, 30.0, kX0, kY0, [&](int i, int) { return std::max(0.0, 1200 - (i + 0.5) * 30) * t; });
+  make_polygons(d / "rel.geojson", {square(kX0 + 150, kY0 + 120, 120)}, "EPSG:32632");
+  make_polygons(d / "nest.geojson", {{{kX0 + 30, kY0 + 30}, {kX0 + 1770, kY0 + 30}, {kX0 + 1770, kY0 + 330}, {kX0 + 30, kY0 + 330}, {kX0 + 30, kY0 + 30}}},
+                "EPSG:32632");
+  auto sc = base_scenario(d / "dem.tif", d / "rel.geojson", 30);
+  sc.mutable_material()->set_internal_friction_deg(25);
+  sc.mutable_material()->set_bed_friction_deg(20);
+  sc.mutable_numerics()->set_end_time_s(120);
+  sc.mutable_outputs()->set_maps(false);
+  auto nested = sc;
+  auto* n = nested.mutable_nest();
+  n->set_path("nest.geojson");
+  n->set_refinement(1);
+  n->set_first_layer_m(0.4);
+  n->set_band_height_m(16);
+  auto whole = sc;
+  whole.set_engine("vof");
+  whole.mutable_vof()->set_write_interval_s(0);
+  auto* me = whole.mutable_mesh();
+  me->set_corridor("polygon");
+  me->set_corridor_path("nest.geojson");
+  me->set_first_layer_m(0.4);
+  me->set_band_height_m(16);
+  fs::create_directories(d / "nested");
+  fs::create_directories(d / "whole");
+  const auto sn = jobs::run_scenario(jobs::resolve_scenario(nested, d.p.string()), d / "nested");
+  const auto sw = jobs::run_scenario(jobs::resolve_scenario(whole, d.p.string()), d / "whole");
+  const Deposit a = deposit_of(d / "nested/nest"), b = deposit_of(d / "whole");
+  const auto rn = run_record(d / "nested/run.json"), rw = run_record(d / "whole/run.json");
+  std::printf("nest: front %.0f m, area %.0f m2, deposit %.1f m3, stop %s at %.1f s; whole: front %.0f m, area %.0f m2, deposit %.1f m3, "
+              "stop %s at %.1f s; into the nest %.3g m3\n",
+              a.front_x, a.area, a.volume, run_record(d / "nested/nest/run.json").solver().stop().c_str(),
+              run_record(d / "nested/nest/run.json").solver().simulated_s(), b.front_x, b.area, b.volume, sw.stop.c_str(), sw.t,
+              rn.nest().inflow_depth_averaged_m3());
+  EXPECT_GT(b.front_x, 1200);  // it reached the flat
+  EXPECT_LT(b.front_x, 1700);  // and stopped well inside
+  EXPECT_NEAR(a.front_x, b.front_x, 30.0);
+  EXPECT_NEAR(a.area / b.area, 1.0, 0.05);
+  EXPECT_NEAR(a.volume / b.volume, 1.0, 0.02);
+  EXPECT_LT(rn.nest().inflow_depth_averaged_m3(), 1e-6 * rw.release().volume_m3());  // nothing crossed the nest's boundary
+  (void)sn;
+}

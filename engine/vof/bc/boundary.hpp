@@ -60,8 +60,11 @@ class BoundaryCondition {
   /// Before each step (and before the initial pressure) with the step's times in c: a condition
   /// that changes in time takes its state for the step here.
   virtual void begin_step(const BcContext&) {}
-  /// The cell next to it always belongs to the active region.
+  /// The cell next to it may belong to the active region for its sake (material may enter there).
   virtual bool seeds_active_region() const { return false; }
+  /// The cell next to boundary face f belongs to the active region in the step being taken
+  /// (default: seeds_active_region(); a coupled inflow: while material enters there).
+  virtual bool seeds_active_region_at(int) const { return seeds_active_region(); }
 };
 
 /// The condition `patch`'s PatchBc names (PatchBc::type, or its kind); throws VofError for an

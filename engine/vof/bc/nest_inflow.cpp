@@ -58,6 +58,7 @@ class NestInflow final : public BoundaryCondition {
   bool opening() const override { return true; }
   bool opening_at(int f) const override { return !entering(f); }
   bool seeds_active_region() const override { return true; }
+  bool seeds_active_region_at(int f) const override { return entering(f); }
 
  private:
   bool entering(int f) const {

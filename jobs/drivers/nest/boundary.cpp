@@ -80,6 +80,14 @@ void NestBoundary::record(double t, const engine::Sh2dEngine& e) {
   }
 }
 
+double NestBoundary::first_inflow_time() const {
+  const std::size_t n = faces_.size();
+  for (std::size_t s = 0; s + 1 < times_.size(); ++s)
+    for (std::size_t k = 0; k < n; ++k)
+      if (entered_[s * n + k] > 0) return times_[s];
+  return times_.back();
+}
+
 double NestBoundary::inflow_volume() const {
   double v = 0;
   for (double x : entered_) v += std::max(x, 0.0);

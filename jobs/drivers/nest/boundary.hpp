@@ -48,6 +48,8 @@ class NestBoundary {
   /// The volume that entered through all faces, summed over the steps (per face and step only what
   /// entered) [m3].
   double inflow_volume() const;
+  /// The start of the first step in which material entered (the record's end when none did).
+  double first_inflow_time() const;
   /// The deepest flow of the cells outside the faces over the record [m].
   double max_depth() const { return max_depth_; }
   /// The fastest depth-averaged speed of the cells outside the faces over the record [m/s].

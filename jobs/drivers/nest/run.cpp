@@ -7,10 +7,8 @@
 namespace runout::jobs::nest {
 
 NestSummary run_nest(const ResolvedScenario& parent, const NestBoundary& b, engine::HazardMaps& hz, const std::string& dir,
-                     const RunOptions& opt) {
-  ResolvedScenario r = *parent.nest;
-  r.config.time.t_end = b.end_time();  // the depth-averaged run's end: the record covers no more
-  r.scenario.mutable_numerics()->set_end_time_s(b.end_time());
+                     const RunOptions& opt, bool release_inside) {
+  ResolvedScenario r = *parent.nest;  // to the scenario's end or its own stop rule; nothing enters after the record's end
   double deepest = b.max_depth();
   for (std::size_t k = 0; k < b.cells().size(); ++k)
     if (b.cells()[k]) deepest = std::max(deepest, hz.max_depth[k]);
@@ -20,6 +18,7 @@ NestSummary run_nest(const ResolvedScenario& parent, const NestBoundary& b, engi
   if (!parent.scenario.nest().has_band_height_m()) me->set_band_height_m(8 * deepest);
   NestLink link;
   link.boundary = &b;
+  link.start_time = release_inside ? 0.0 : std::max(0.0, b.first_inflow_time() - 1.0);
   RunOptions o;
   o.progress = opt.progress;
   o.progress_every = opt.progress_every;
@@ -40,6 +39,7 @@ NestSummary run_nest(const ResolvedScenario& parent, const NestBoundary& b, engi
   s.inflow_depth_averaged_m3 = b.inflow_volume();
   s.inflow_3d_m3 = link.inflow_m3;
   s.volume_error_3d = link.volume_error;
+  s.start_time_s = link.start_time;
   for (std::size_t k = 0; k < b.cells().size(); ++k) {
     if (!b.cells()[k] || link.maps.max_depth.empty()) continue;
     hz.max_depth[k] = link.maps.max_depth[k];

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "engine/vof/loads.hpp"
+#include "jobs/figures/load_plot.hpp"
 #include "jobs/scenario/scenario.hpp"
 
 namespace runout::jobs::vof_terrain {
@@ -41,8 +42,10 @@ void StructureLoads::update(double t, double dt, const vof::VofBackend& s, const
       l.p_max_t = t;
       l.p_max_face = pl.max_face;
       const int o = m.owner[std::size_t(pl.max_face)], j = layer_of_[std::size_t(o)];
-      const auto& lv = su_.columns.levels;  // the face's height above its column's ground
-      l.p_max_height = m.Cf[std::size_t(pl.max_face)].y - (m.centre[std::size_t(o)].y - 0.5 * (lv[std::size_t(j)] + lv[std::size_t(j) + 1]));
+      const auto& lv = su_.columns.levels;  // the columns follow the ground: a wall face spans its layer, a roof lies under it
+      const vof::Vec& S = m.Sf[std::size_t(pl.max_face)];
+      const bool roof = std::abs(S.y) > 0.5 * m.magSf[std::size_t(pl.max_face)];
+      l.p_max_height = roof ? lv[std::size_t(j)] : 0.5 * (lv[std::size_t(j)] + lv[std::size_t(j) + 1]);
     }
     if (h > l.peak) {
       l.peak = h, l.peak_t = t, l.peak_e = e, l.peak_n = n, l.peak_u = u;
@@ -114,6 +117,23 @@ std::string StructureLoads::write_csv(const std::string& out_dir) const {
     }
   if (!f) throw std::runtime_error(out_dir + "/" + name + ": cannot write it");
   return name;
+}
+
+std::vector<std::string> StructureLoads::write_plot(const std::string& out_dir, const std::string& title) const {
+  figures::LoadPlot p;
+  p.title = "Loads on the structures: " + title;
+  p.note = "the pressure's force on walls and roof, horizontal part (the wall's shear is not included); every " +
+           std::to_string(int(std::lround(interval_ * 1000))) + " ms";
+  bool any = false;
+  for (const auto& l : loads_) {
+    figures::LoadPlot::Structure s{l.name, l.t, {}, l.p};
+    for (std::size_t q = 0; q < l.t.size(); ++q) s.force_kn.push_back(std::hypot(l.east[q], l.north[q]));
+    any = any || s.t.size() >= 2;
+    p.structures.push_back(std::move(s));
+  }
+  if (!any) return {};
+  figures::draw_load_plot(out_dir + "/structure_loads.png", out_dir + "/structure_loads.pdf", p);
+  return {"structure_loads.png", "structure_loads.pdf"};
 }
 
 }  // namespace runout::jobs::vof_terrain

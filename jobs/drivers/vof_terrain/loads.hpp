@@ -30,6 +30,9 @@ class StructureLoads {
   /// structure_loads.csv: time_s, structure, force_east_kn, force_north_kn, force_up_kn,
   /// force_horizontal_kn, max_pressure_kpa. Returns the file's name.
   std::string write_csv(const std::string& out_dir) const;
+  /// structure_loads.png and .pdf: the horizontal force and the highest pressure over time, titled
+  /// with `title`. Returns the files' names (none when no structure has two samples).
+  std::vector<std::string> write_plot(const std::string& out_dir, const std::string& title) const;
 
  private:
   struct Load {

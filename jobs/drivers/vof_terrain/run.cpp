@@ -142,6 +142,7 @@ TerrainRun::TerrainRun(const ResolvedScenario& r, const std::string& out_dir, co
   if (r.nest_part) {  // the nest's boundary takes the depth-averaged run's flux
     if (!opt.nest || !opt.nest->boundary) throw ScenarioError("nest: the 3D part of a nested run needs its depth-averaged run's record");
     config.bc["nest"] = nest::nest_inflow(su_, *opt.nest->boundary);
+    config.t_start = opt.nest->start_time;
     config.dt_max = std::min(config.dt_max, nest::nest_max_step(su_, *opt.nest->boundary, config.max_co));
     if (su_.mesh.patch_index("sides") < 0) config.bc.erase("sides");  // a nest inside the domain: its boundary is all "nest"
   }
@@ -303,6 +304,8 @@ RunSummary TerrainRun::finish(engine::StopReason stop, const RunTimes& times) {
   if (!loads_->empty()) {
     loads_->summarise(sum.structures);
     sum.files.push_back(loads_->write_csv(out_dir_));
+    if (r_.maps)
+      for (auto& f : loads_->write_plot(out_dir_, r_.scenario.name().empty() ? "3D run" : r_.scenario.name())) sum.files.push_back(std::move(f));
   }
   const int n_frames = frames_ ? frames_->finish() : 0;
   if (frames_) {
