@@ -29,6 +29,8 @@ class ActiveRegion {
   /// outside at rest; no flux between resting cells; the material outside the halo, which no flux
   /// can reach, summed once.
   void set(const std::vector<int>& d);
+  /// Every cell next to a boundary face that seeds the region in the step being taken lies in it.
+  bool seeds_inside() const;
   /// Forget the region (the next update() builds it in any case).
   void clear() { n_active = 0; }
   /// The number of nonzeros per row of the pressure system over the region.
@@ -52,7 +54,6 @@ class ActiveRegion {
 
  private:
   bool material_inside();
-  bool seeds_inside() const;
   std::vector<int> layers_from_material() const;
 
   const Mesh& m_;

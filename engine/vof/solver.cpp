@@ -312,6 +312,8 @@ StepStats VofSolver::step(double t_limit) {
   I.bc_ctx.t0 = t_ - dt_;
   I.bc_ctx.t1 = t_;
   I.bcs.begin_step(I.bc_ctx);
+  // A coupled inflow that starts in this step must find its cells in the region before alpha moves.
+  if (!I.region.seeds_inside() && I.region.update(true)) I.pEqn.make_system();
   I.update_gravity(t_);
   I.keep_old_time();
 

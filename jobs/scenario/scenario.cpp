@@ -418,7 +418,8 @@ namespace {
 ResolvedScenario resolve_nest(const v1::Scenario& s, const std::string& base) {
   const auto& n = s.nest();
   if (n.path().empty()) bad("nest.path", "missing: the nest's polygons");
-  if (n.refinement() < 1 || n.refinement() > 8) bad("nest.refinement", "must lie in [1, 8], got " + std::to_string(n.refinement()));
+  const int refinement = n.refinement() == 0 ? 4 : n.refinement();  // unset: the default
+  if (refinement < 1 || refinement > 8) bad("nest.refinement", "must lie in [1, 8], got " + std::to_string(refinement));
   v1::Scenario d = s;
   d.clear_nest();
   d.set_engine("vof");
@@ -426,7 +427,7 @@ ResolvedScenario resolve_nest(const v1::Scenario& s, const std::string& base) {
   me->set_corridor("polygon");
   me->set_corridor_path(n.path());
   me->set_corridor_crs(n.crs());
-  me->set_refinement(n.refinement());
+  me->set_refinement(refinement);
   if (n.has_first_layer_m()) me->set_first_layer_m(n.first_layer_m());
   if (n.has_band_height_m()) me->set_band_height_m(n.band_height_m());
   try {
@@ -453,6 +454,7 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   apply_option_rules(depth_averaged_options(), s);
   if (s.has_resistance() && s.resistance().ByteSizeLong() == 0) s.clear_resistance();  // only its defaults: none
   if (s.has_entrainment() && s.entrainment().ByteSizeLong() == 0) s.clear_entrainment();
+  if (s.has_nest() && s.nest().ByteSizeLong() == 0) s.clear_nest();  // only its defaults: none
   if (vof) {
     const double write_given = s.vof().write_interval_s();
     apply_option_rules(terrain_vof_options(), s);

@@ -63,6 +63,11 @@ TEST(Nest, TheNestTakesInTheDepthAveragedFluxAndItsMapsReplaceTheDepthAveragedOn
   EXPECT_LT(n.volume_error_3d(), 1e-9);
   const auto nest_run = run_record(d / "nest/run.json");
   EXPECT_EQ(nest_run.engine(), "vof");
+  // The nest's frames cover its columns' bounding box (20 x 20 columns of 5 m), not the domain.
+  GDALDatasetUniquePtr frame(GDALDataset::Open(("HDF5:\"" + (d / "nest/fields.h5") + "\"://f00000/alpha").c_str(), GDAL_OF_RASTER));
+  ASSERT_TRUE(frame);
+  EXPECT_EQ(frame->GetRasterXSize(), 20);  // east
+  EXPECT_EQ(frame->GetRasterCount(), 20);  // north
   const auto outer = read_raster_values(d / "max_depth.tif"), inner = read_raster_values(d / "nest/max_depth.tif");
   int inside = 0;
   for (int r = 0; r < outer.h; ++r)
@@ -78,6 +83,20 @@ TEST(Nest, TheNestTakesInTheDepthAveragedFluxAndItsMapsReplaceTheDepthAveragedOn
                       "inside the 3D nest (100 cells) the hazard rasters are the 3D engine's (nest/run.json); outside, the depth-averaged "
                       "engine's"),
             sum.notes.end());
+}
+
+// The bundled scenario of validation.md D4 resolves: the farmhouse as a structure of both runs, the
+// nest on 5 m columns (bench.farmhouse_nest runs it).
+TEST(Nest, TheBundledFarmhouseScenarioResolves) {
+  const auto r = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/in-den-arelen-farmhouse.json");
+  ASSERT_TRUE(r.nest);
+  EXPECT_TRUE(r.nest->nest_part);
+  EXPECT_EQ(r.nest->engine, jobs::kVofTerrainEngine);
+  EXPECT_EQ(r.nest->scenario.mesh().refinement(), 2);
+  ASSERT_EQ(r.structures.size(), 1u);
+  ASSERT_EQ(r.nest->structures.size(), 1u);
+  EXPECT_EQ(r.structures[0].name, "farmhouse");
+  EXPECT_NE(std::find(r.input_files.begin(), r.input_files.end(), r.nest->corridor_path), r.input_files.end());
 }
 
 // A nest is refused where it cannot be run, naming the field.

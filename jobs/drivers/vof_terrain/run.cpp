@@ -52,17 +52,27 @@ std::string terrain_state_hash(const ResolvedScenario& r) {
   return scenario_hash(q);
 }
 
-// The frames' grid: i east, j the layer, k north; the georeferenced frame of the mesh.
+// The frames' grid: i east, j the layer, k north, over the meshed columns' bounding box (a corridor
+// or a nest is a small part of the domain); the georeferenced frame of the mesh.
 FrameGrid frame_grid(const TerrainSetup& su) {
+  const auto& c = su.columns;
+  int i0 = c.ni, i1 = -1, k0 = c.nk, k1 = -1;
+  for (int k = 0; k < c.nk; ++k)
+    for (int i = 0; i < c.ni; ++i)
+      for (int j = 0; j < c.layers; ++j)
+        if (c.cell(std::size_t(k) * std::size_t(c.ni) + std::size_t(i), j) >= 0) {
+          i0 = std::min(i0, i), i1 = std::max(i1, i), k0 = std::min(k0, k), k1 = std::max(k1, k);
+          break;
+        }
   FrameGrid g;
-  g.nx = su.columns.ni;
-  g.ny = su.columns.layers;
-  g.nz = su.columns.nk;
+  g.nx = i1 - i0 + 1;
+  g.ny = c.layers;
+  g.nz = k1 - k0 + 1;
   g.three_d = true;
   g.cell.assign(std::size_t(g.nx) * std::size_t(g.ny) * std::size_t(g.nz), -1);
   for (int k = 0; k < g.nz; ++k)
     for (int j = 0; j < g.ny; ++j)
-      for (int i = 0; i < g.nx; ++i) g.cell[g.at(i, j, k)] = su.columns.cell(std::size_t(k) * std::size_t(g.nx) + std::size_t(i), j);
+      for (int i = 0; i < g.nx; ++i) g.cell[g.at(i, j, k)] = c.cell(std::size_t(k + k0) * std::size_t(c.ni) + std::size_t(i + i0), j);
   g.georeferenced = true;
   g.origin_east = su.frame.x;
   g.origin_north = su.frame.y;
