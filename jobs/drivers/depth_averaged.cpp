@@ -371,6 +371,8 @@ RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& tim
   sum.cpu_seconds = times.cpu;
   int frames = 0;
   if (series_) frames = series_->finish();
+  // The structures as the depth-averaged run saw them (before a nest's maps replace its own inside it).
+  sum.structures = structure_summaries(s_, grid_, output_inputs_.structures, res.hazard);
   // The 3D nest after the time series is closed (its own HDF5 files open and close meanwhile).
   if (nest_ && stop != engine::StopReason::cancelled) {  // the 3D nest, its maps inside the nest's cells
     bool release_inside = false;
@@ -389,7 +391,6 @@ RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& tim
   sum.volume_detrained = d.volume_detrained;
   sum.volume_entrained = d.volume_entrained;
   sum.dams = dam_summaries(s_, output_inputs_.dams, res);
-  sum.structures = structure_summaries(s_, grid_, output_inputs_.structures, res.hazard);
   sum.volume_error = d.volume_error();
   sum.t = d.t;
   sum.steps = d.steps;
