@@ -287,11 +287,12 @@ class DepthAveragedRun final : public EngineRun {
 };
 
 // The nest's boundary on the grid (the cells whose centres lie inside its polygons, as the nest's
-// corridor takes them) and its gauges after the dams'. A nested run is not continued from a
-// checkpoint: the record of the boundary does not travel in one.
+// corridor takes them) and its gauges after the dams'. A nested run writes no checkpoint (the
+// record of the boundary does not travel in one; hooks()): interrupted, it runs again from the
+// start, and it is not continued from a checkpoint.
 void DepthAveragedRun::attach_nest(const RunOptions& opt) {
-  if (!opt.restart_path.empty() || !opt.checkpoint_path.empty())
-    throw ScenarioError("nest: a run with a 3D nest takes no checkpoint and is not continued from one");
+  if (!opt.restart_path.empty())
+    throw ScenarioError("nest: a run with a 3D nest is not continued from a checkpoint (it writes none); run it from the start");
   const std::string what = "nest.path '" + s_.nest->corridor_path + "'";
   nest_ = std::make_unique<nest::NestBoundary>(grid_, terrain::rasterize_polygons(grid_, s_.nest->corridor_path, s_.scenario.nest().crs(), what),
                                                what);
@@ -361,6 +362,7 @@ engine::LoopHooks DepthAveragedRun::hooks() {
     if (series_) series_->save_copy(opt_.checkpoint_path + ".timeseries.h5");
     write_sh_checkpoint(opt_.checkpoint_path, hash_, series_ ? series_->frames() : 0, engine_->checkpoint(st));
   };
+  if (nest_) h.checkpoint = nullptr;  // a nested run writes none (attach_nest)
   return h;
 }
 

@@ -45,8 +45,12 @@ v1::Scenario slope_with_nest(const TempDir& d) {
 TEST(Nest, TheNestTakesInTheDepthAveragedFluxAndItsMapsReplaceTheDepthAveragedOnes) {
   TempDir d;
   const auto sc = slope_with_nest(d);
-  const auto sum = jobs::run_scenario(jobs::resolve_scenario(sc, d.p.string()), d.p.string());
+  jobs::RunOptions opt;  // as the job system runs it: with a checkpoint file, which a nested run does not write
+  opt.checkpoint_path = (d / "run.ckpt");
+  opt.checkpoint_interval_s = 5;
+  const auto sum = jobs::run_scenario(jobs::resolve_scenario(sc, d.p.string()), d.p.string(), opt);
   ASSERT_TRUE(sum.nest.has_value());
+  EXPECT_FALSE(fs::exists(d / "run.ckpt"));
   const auto rec = run_record(d / "run.json");
   ASSERT_TRUE(rec.has_nest());
   const auto& n = rec.nest();
@@ -115,6 +119,14 @@ TEST(Nest, BadNestsAreRefusedNamingTheField) {
   make_polygons(d / "edge.geojson", {square(kX0 + 500, kY0 + 50, 100)}, "EPSG:32632");
   edge.mutable_nest()->set_path("edge.geojson");
   expect_error(edge, d, "the nest reaches the grid's edge");
+  try {  // a nested run is not continued from a checkpoint
+    jobs::RunOptions opt;
+    opt.restart_path = (d / "some.ckpt");
+    jobs::run_scenario(jobs::resolve_scenario(sc, d.p.string()), d / "restart", opt);
+    ADD_FAILURE() << "a nested run continued from a checkpoint";
+  } catch (const jobs::ScenarioError& e) {
+    EXPECT_NE(std::string(e.what()).find("nest: a run with a 3D nest is not continued from a checkpoint"), std::string::npos) << e.what();
+  }
   auto voellmy = sc;
   voellmy.mutable_material()->set_rheology("voellmy");
   voellmy.mutable_material()->clear_bed_friction_deg();
