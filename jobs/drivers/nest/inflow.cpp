@@ -35,7 +35,7 @@ FaceMap map_faces(const vof_terrain::TerrainSetup& su, const NestBoundary& b) {
   for (int f = p.start; f < p.start + p.size; ++f) {
     const vof::Vec n = (1.0 / m.magSf[std::size_t(f)]) * m.Sf[std::size_t(f)];  // out of the nest; engine frame: x east, z south
     const vof::Vec in = m.Cf[std::size_t(f)] - (0.25 * w) * n;
-    const double east = in.x + su.frame.x, north = su.frame.y - in.z;
+    const double east = su.frame.east(in), north = su.frame.north(in);
     const int i = int(std::floor((east - g.x_min) / g.dx)), j = int(std::floor((north - g.y_min) / g.dx));
     const int side = std::abs(n.x) > std::abs(n.z) ? (n.x < 0 ? 0 : 1) : (n.z > 0 ? 2 : 3);
     const auto it = by_cell_side.find({std::size_t(j) * std::size_t(g.nx) + std::size_t(i), side});

@@ -34,7 +34,7 @@ engine::vof::Mesh terrain_mesh(const terrain::ColumnMesh& c, const Frame& frame,
   auto column_beyond = [&](int f) -> long {
     const engine::vof::Vec n = (1.0 / m.magSf[std::size_t(f)]) * m.Sf[std::size_t(f)];
     const engine::vof::Vec p = m.Cf[std::size_t(f)] + (0.25 * c.dx) * n;
-    const double east = p.x + frame.x, north = frame.y - p.z;
+    const double east = frame.east(p), north = frame.north(p);
     const int i = int(std::floor((east - c.x_min) / c.dx)), k = int(std::floor((north - c.y_min) / c.dx));
     if (i < 0 || k < 0 || i >= c.ni || k >= c.nk) return -1;
     return long(k) * c.ni + i;

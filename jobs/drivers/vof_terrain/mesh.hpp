@@ -18,6 +18,9 @@ namespace runout::jobs::vof_terrain {
 struct Frame {
   double x = 0, y = 0, z = 0;
   engine::vof::Vec to_engine(double east, double north, double elevation) const { return {east - x, elevation - z, y - north}; }
+  /// A point of the engine's frame in the grid's CRS: its east and north.
+  double east(const engine::vof::Vec& p) const { return p.x + x; }
+  double north(const engine::vof::Vec& p) const { return y - p.z; }
 };
 
 /// The frame of a column mesh: the grid's centre, the lowest ground node.
