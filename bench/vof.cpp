@@ -34,6 +34,9 @@
 //                                          --jobs N (B6, B7, B10): N set-ups at a time, each in a process of its
 //                                          own (0: as many as cores; default 1, so that the wall times are
 //                                          each run's alone)
+//   runout_bench_vof --b7-nest [--check] [--jobs N]  B7 through a nest: the cylinder at 5 mm, the whole chute
+//                                          in 3D against the 3D run on x >= 0.2 m fed by the depth-averaged run
+//                                          of the chute; --check: exit 1 unless the nest conserves and agrees
 //   runout_bench_vof --region              cost per step against the material region: the same failing
 //                                          heap in channels 0.3-2.4 m long, with the active region and
 //                                          with every cell computed
@@ -172,7 +175,7 @@ static int usage() {
   std::fprintf(stderr,
                "usage: runout_bench_vof [--full] [--end T] [--courant C] [--correctors N] [--outer N] [--transpose harmonic|explicit|off] "
                "[--coupling piso|consistent] [--convection upwind|limited_linear] [--coulomb-pressure total|excess] [--wall-viscosity face|cell] [--check] | --b1|--b2-inclined|--b3|--b4|--b5|--b8 "
-               "[--check] | --b6|--b7 [--full] [--check] [--jobs N] | --b10 [--check] [--jobs N] | --b9 [--full] [--check] | --region\n");
+               "[--check] | --b6|--b7 [--full] [--check] [--jobs N] | --b7-nest [--check] [--jobs N] | --b10 [--check] [--jobs N] | --b9 [--full] [--check] | --region\n");
   return 2;
 }
 
@@ -180,7 +183,7 @@ static int usage() {
 // coarser default.
 static int one_case(const std::string& mode, int argc, char** argv) {
   const bool takes_full = mode == "--b6" || mode == "--b7" || mode == "--b9";
-  const bool takes_jobs = mode == "--b6" || mode == "--b7" || mode == "--b10";
+  const bool takes_jobs = mode == "--b6" || mode == "--b7" || mode == "--b7-nest" || mode == "--b10";
   bool full = false, check = false;
   int jobs = 1;
   for (int k = 2; k < argc; ++k) {
@@ -200,6 +203,7 @@ static int one_case(const std::string& mode, int argc, char** argv) {
   if (mode == "--b5") return runout::bench::lab_b5(check);
   if (mode == "--b6") return b6(full, check, jobs);
   if (mode == "--b7") return runout::bench::lab_b7(full, check, jobs);
+  if (mode == "--b7-nest") return runout::bench::lab_b7_nest(check, jobs);
   if (mode == "--b8") return runout::bench::lab_b8(check);
   if (mode == "--b9") return b9(full, check);
   if (mode == "--b10") return runout::bench::lab_b10(check, jobs);

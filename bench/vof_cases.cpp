@@ -259,6 +259,55 @@ int lab_b7(bool full, bool check, int jobs) {
   return check ? c.report() : 0;
 }
 
+// B7 through a nest (validation.md B7, "Through a nest"): the cylinder's chute at 5 mm, the whole chute
+// in 3D against the 3D run on x >= 0.2 m fed by the depth-averaged run of the chute
+// (scenarios/lab/b7-wide-chute-cylinder-nest.json), both to 0.8 s with a station at x = 0.25 m.
+int lab_b7_nest(bool check, int jobs) {
+  Checks c("B7 through a nest");
+  std::vector<runout::jobs::ResolvedScenario> rs;
+  for (const char* name : {"b7-wide-chute-cylinder", "b7-wide-chute-cylinder-nest"}) {
+    auto r = lab_scenario(name);
+    auto* lab = r.scenario.mutable_lab();
+    lab->set_nx(118);
+    lab->set_ny(24);
+    lab->set_nz(59);
+    lab->set_write_interval_s(0);
+    lab->clear_stations_x();
+    lab->add_stations_x(0.25);
+    rs.push_back(std::move(r));
+  }
+  std::vector<Ran> out(rs.size());
+  run_all(rs, jobs, [&](std::size_t k, const Ran& ran) { out[k] = ran; });
+  std::printf("| run | cells | steps | wall [s] | at x = 0.25 m: depth [mm], u [m/s] | deepest column [mm] (x, z) | dry shadow [cm2] | "
+              "peak force [N] | impulse [N s] | highest pressure [Pa] |\n|---|---:|---:|---:|---|---|---:|---:|---:|---:|\n");
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    const auto& j = out[k].json;
+    const auto rec = record(j);
+    const auto& st = rec.stations_size() ? rec.stations(0) : runout::v1::Station();
+    std::printf("| %s | %.0f | %ld | %.0f | %.1f, %.3f | %.1f (%.3f, %.3f) | %.1f | %.3f | %.4f | %.0f |\n", k ? "nest, x >= 0.2 m" : "whole chute",
+                field(j, "cells"), out[k].sum.steps, out[k].sum.seconds_run, 1e3 * st.depth_m(), st.depth_averaged_u_m_s(),
+                1e3 * rec.chute().max_depth_m(), rec.chute().max_depth_x_m(), rec.chute().max_depth_z_m(),
+                1e4 * (rec.chute().obstacles_size() ? rec.chute().obstacles(0).sheltered_dry_area_m2() : NAN), rec.monitors().obstacle_load().peak_force_n(),
+                rec.monitors().obstacle_load().impulse_x_n_s(), rec.monitors().obstacle_load().max_pressure_pa());
+    invariants(c, k ? "the nest" : "the whole chute", out[k]);
+  }
+  const auto w = record(out[0].json), n = record(out[1].json);
+  const auto& nr = n.nest();
+  std::printf("\nnest: depth-averaged run %d steps; inflow %.6e m3 (3D) against %.6e m3 (depth-averaged), difference %.2e; balance %.1e\n",
+              nr.recorded_steps(), nr.inflow_3d_m3(), nr.inflow_depth_averaged_m3(), nr.inflow_relative_difference(), nr.volume_error_3d());
+  std::printf("wall time: nest / whole = %.2f\n", out[1].sum.seconds_run / out[0].sum.seconds_run);
+  auto within = [](double a, double b, double rel) { return std::abs(a - b) <= rel * std::abs(b); };
+  c(nr.inflow_relative_difference() < 0.01, "the nest takes in the depth-averaged flux through its face within 1 %");
+  c(nr.volume_error_3d() < 1e-10, "the nest's own balance to round-off (1e-10)");
+  c(within(n.chute().max_depth_m(), w.chute().max_depth_m(), 0.25), "the deepest column within 25 % of the whole chute's");
+  c(std::abs(n.chute().max_depth_x_m() - w.chute().max_depth_x_m()) <= 2.01 * 0.005, "the deepest column within 2 cells along x of the whole chute's");
+  c(n.chute().obstacles_size() && n.chute().obstacles(0).sheltered_dry_area_m2() > 0, "a dry shadow behind the cylinder");
+  c(within(n.monitors().obstacle_load().peak_force_n(), w.monitors().obstacle_load().peak_force_n(), 0.25), "the cylinder's peak force within 25 % of the whole chute's");
+  c(n.stations_size() && w.stations_size() && within(n.stations(0).depth_m(), w.stations(0).depth_m(), 0.25),
+    "the depth at x = 0.25 m within 25 % of the whole chute's");
+  return check ? c.report() : 0;
+}
+
 // B8 (validation.md B8): the channelised chute with its run-out. Described: the mass stretches down
 // the chute, fans out laterally on the run-out and comes to rest as a round deposit around the end
 // of the bend, its highest point on the chute side.

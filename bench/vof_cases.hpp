@@ -10,6 +10,7 @@ int lab_b3(bool check);
 int lab_b4(bool check);
 int lab_b5(bool check);
 int lab_b7(bool full, bool check, int jobs);  // full: the scenario files' 2.5 mm; otherwise 5 mm; jobs: run_all's
+int lab_b7_nest(bool check, int jobs);  // the cylinder at 5 mm: the whole chute against a nest on x >= 0.2 m
 int lab_b8(bool check);
 int lab_b10(bool check, int jobs);
 

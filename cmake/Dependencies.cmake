@@ -16,6 +16,13 @@ find_package(benchmark REQUIRED)
 find_package(CLI11 CONFIG REQUIRED)  # the command-line parser of `runout` (header-only)
 
 pkg_check_modules(PETSC REQUIRED IMPORTED_TARGET PETSc)
+# Scotch (sequential): the graph partition of a distributed 3D run's mesh.
+find_path(SCOTCH_INCLUDE_DIR scotch.h PATH_SUFFIXES scotch REQUIRED)
+find_library(SCOTCH_LIBRARY scotch REQUIRED)
+find_library(SCOTCHERR_LIBRARY scotcherr REQUIRED)
+add_library(runout::scotch INTERFACE IMPORTED)
+set_target_properties(runout::scotch PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${SCOTCH_INCLUDE_DIR}"
+  INTERFACE_LINK_LIBRARIES "${SCOTCH_LIBRARY};${SCOTCHERR_LIBRARY}")
 # HDF5: the MPI build, the same one PETSc links against, so one process never loads two HDF5s.
 pkg_check_modules(HDF5 REQUIRED IMPORTED_TARGET hdf5-openmpi)
 pkg_check_modules(GRPCPP REQUIRED IMPORTED_TARGET grpc++)

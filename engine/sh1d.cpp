@@ -83,6 +83,8 @@ void validate(const Channel1D& ch, const Sh1dConfig& cfg, const Sh1dState& s) {
   cfg.material.validate();
   if ((cfg.left == Boundary1D::inflow || cfg.right == Boundary1D::inflow) && cfg.inflow.t.empty())
     bad("an inflow boundary needs a hydrograph");
+  if (cfg.gauge.record && !(cfg.gauge.xi >= ch.x0 && cfg.gauge.xi <= ch.x0 + ch.n * ch.dx))
+    bad("the gauge at xi = " + std::to_string(cfg.gauge.xi) + " m lies outside the channel");
 }
 
 // The scheme's state and steps on one channel: ghosts, earth pressure, predictor, positivity
@@ -90,7 +92,7 @@ void validate(const Channel1D& ch, const Sh1dConfig& cfg, const Sh1dState& s) {
 class Sh1dSolver final : public SteppingEngine {
  public:
   Sh1dSolver(const Channel1D& ch, const Sh1dConfig& cfg, const Sh1dState& init)
-      : cfg_(cfg), n(ch.n), dx(ch.dx), g(cfg.gravity), hdry(cfg.dry_depth), lim(cfg.limiter),
+      : cfg_(cfg), n(ch.n), dx(ch.dx), x0(ch.x0), g(cfg.gravity), hdry(cfg.dry_depth), lim(cfg.limiter),
         open(cfg.left != Boundary1D::wall || cfg.right != Boundary1D::wall), curv(cfg.curvature ? 1.0 : 0.0), w(ch.n) {
     fr = cfg.material.friction();  // the law, resolved once (engine/friction)
     mu = fr.mu;
@@ -131,6 +133,7 @@ class Sh1dSolver final : public SteppingEngine {
     return s * dx;
   }
   void fill_ghosts(double t);
+  void read_gauge() const;
   void fill_side(Boundary1D b, bool left, double t);
   void set_beta();
   double next_dt(double t, double t_end) const;
@@ -175,7 +178,7 @@ class Sh1dSolver final : public SteppingEngine {
 
   const Sh1dConfig& cfg_;
   const int n;
-  const double dx, g, hdry;
+  const double dx, x0, g, hdry;
   const Limiter lim;
   const bool open;
   const double curv;
@@ -323,6 +326,15 @@ void Sh1dSolver::average_back() {
   }
 }
 
+void Sh1dSolver::read_gauge() const {
+  if (!cfg_.gauge.record) return;
+  const double s = std::clamp((cfg_.gauge.xi - x0) / dx - 0.5, 0.0, double(n - 1));
+  const int i = std::min(int(s), n - 2);
+  const double a = s - i;
+  const double h = (1 - a) * w.h[i + G] + a * w.h[i + 1 + G], m = (1 - a) * w.m[i + G] + a * w.m[i + 1 + G];
+  cfg_.gauge.record(t_, h, vel(h, m));
+}
+
 StepReport Sh1dSolver::step(double t_end) {
   Sh1dResult& r = r_;
   fill_ghosts(t_);
@@ -338,6 +350,7 @@ StepReport Sh1dSolver::step(double t_end) {
   t_ += dt;
   ++r.steps;
   if (open) r.boundary_exchange += mass() - mass_before;
+  read_gauge();
   double ke = 0, umax = 0;
   for (int i = 0; i < n; ++i) {
     const double h = w.h[i + G], u = vel(h, w.m[i + G]);
@@ -362,6 +375,7 @@ Sh1dResult Sh1dSolver::run() {
   r_.max_depth.assign(n, 0.0);
   r_.max_speed.assign(n, 0.0);
   r_.mass_initial = mass();
+  read_gauge();
   const auto& tc = cfg_.time;
   LoopSchedule schedule;
   schedule.t_end = tc.t_end;

@@ -60,6 +60,14 @@ struct Hydrograph {
   void at(double time, double& h_out, double& u_out) const;
 };
 
+/// A gauge at arc length `xi` inside the channel: at the start and after every step, `record` gets the
+/// time and the depth and velocity there, linear between the cell centres around it (the end cells'
+/// values beyond their centres). No gauge while `record` is empty.
+struct Gauge1D {
+  double xi = 0;
+  std::function<void(double t, double h, double u)> record;
+};
+
 struct Sh1dConfig {
   Material material;
   Limiter limiter = Limiter::minmod;
@@ -69,6 +77,7 @@ struct Sh1dConfig {
   double gravity = 9.81;
   double dry_depth = 1e-8;  ///< below this depth the velocity is taken as zero [m]
   bool curvature = true;    ///< include the centrifugal normal load kappa u^2
+  Gauge1D gauge;            ///< optional
 };
 
 struct Sh1dState {

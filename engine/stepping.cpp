@@ -66,7 +66,8 @@ StopReason run_steps(SteppingEngine& e, const LoopSchedule& s, LoopState& st, co
     // A cancel on the step that reaches the end time comes too late to matter; on the step the stop
     // rule ends the run it still stops the run with a checkpoint (continued, the rule ends it at once).
     const bool at_end = r.t >= s.t_end - kTimeTolerance;
-    if (h.progress && e.steps() % every == 0 && !h.progress(progress_of(r, e.steps())) && !at_end) {
+    const bool cancel = h.progress && e.steps() % every == 0 && !h.progress(progress_of(r, e.steps()));
+    if (e.any(cancel) && !at_end) {
       stop = StopReason::cancelled;
       if (h.checkpoint) h.checkpoint(st);  // the run can continue from here
       break;

@@ -23,6 +23,9 @@ class SteppingEngine {
   virtual StepReport step(double t_end) = 0;
   /// The material's kinetic energy now, in StepReport::kinetic_energy's units.
   virtual double kinetic_energy() const = 0;
+  /// Whether v holds on any of the processes that step this engine together (an engine split over
+  /// MPI ranks): a stop that one process decides (a cancel) stops them all at the same step.
+  virtual bool any(bool v) const { return v; }
 };
 
 /// When a run stops and when frames and checkpoints fall due.

@@ -6,7 +6,7 @@ set -euo pipefail
 RUNOUT_PACKAGES=(
   cmake g++ make ninja-build pkg-config
   libgdal-dev gdal-bin libproj-dev proj-bin
-  petsc-dev libhdf5-openmpi-dev
+  petsc-dev libhdf5-openmpi-dev libscotch-dev openmpi-bin
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler
   libsqlite3-dev libssl-dev openssl
   libcairo2-dev libpango1.0-dev fonts-dejavu-core

@@ -99,10 +99,46 @@ void touch_feature(const Grid& g, OGRGeometry& geom, bool lines, bool centres_on
   if (i >= 0 && j >= 0 && i < g.nx && j < g.ny) touched[std::size_t(j) * g.nx + i] = 1;
 }
 
+// A surface model's heights over the ground on the grid: NaN where it has no value, is outside the
+// domain or stands less than rq.min_height above the ground. A surface more than 100 m above the
+// ground is refused, naming the place.
+std::vector<double> surface_heights(const Grid& g, const DamRequest& rq) {
+  const std::string file = rq.field + ".surface_path '" + rq.surface_path + "'";
+  std::vector<double> h = read_raster_on(rq.surface_path, g, file);
+  for (std::size_t k = 0; k < g.cells(); ++k) {
+    const double v = h[k] - g.z[k];
+    if (!std::isfinite(v) || v < rq.min_height || (!g.outside.empty() && g.outside[k])) {
+      h[k] = NAN;
+      continue;
+    }
+    if (v > 100)
+      throw TerrainError(file + ": the surface lies " + fmt(v, 2) + " m above the ground at (" + fmt(g.cx(int(k % std::size_t(g.nx))), 1) +
+                         ", " + fmt(g.cy(int(k / std::size_t(g.nx))), 1) + "): a structure is at most 100 m high");
+    h[k] = v;
+  }
+  return h;
+}
+
+// A structure from a surface model alone: every cell where it stands min_height above the ground.
+DamCells surface_structure(const Grid& g, const DamRequest& rq) {
+  DamCells d;
+  d.height.assign(g.cells(), 0.0);
+  const auto h = surface_heights(g, rq);
+  for (std::size_t k = 0; k < g.cells(); ++k)
+    if (std::isfinite(h[k])) d.height[k] = h[k], ++d.cells;
+  d.features = 1;
+  if (d.cells == 0)
+    throw TerrainError(rq.field + ".surface_path '" + rq.surface_path + "': stands nowhere in the domain " + fmt(rq.min_height, 2) +
+                       " m or more above the ground (min_height_m)");
+  return d;
+}
+
 }  // namespace
 
 DamCells rasterize_dam(const Grid& g, const DamRequest& rq) {
   init_gdal();
+  if (rq.path.empty() && !rq.surface_path.empty()) return surface_structure(g, rq);
+  const std::vector<double> surface = rq.surface_path.empty() ? std::vector<double>{} : surface_heights(g, rq);
   const std::string file = rq.field + ".path '" + rq.path + "'";
   GDALDatasetUniquePtr ds(GDALDataset::Open(rq.path.c_str(), GDAL_OF_VECTOR));
   if (!ds) throw TerrainError(file + ": cannot read it as a vector file" + gdal_message());
@@ -124,20 +160,25 @@ DamCells rasterize_dam(const Grid& g, const DamRequest& rq) {
       d.lines = d.lines || line;
       polygons += !line;
       if (d.lines && polygons > 0) throw TerrainError(what + ": crest lines and footprints (polygons) in one dam: give them as two dams");
-      const bool top = !rq.top_attribute.empty();
+      const bool top = !rq.top_attribute.empty(), from_surface = !surface.empty();
       const double v = rq.has_height ? rq.height
                        : top         ? field_value(*f, rq.top_attribute, what)
+                       : from_surface ? 0.0
                        : rq.height_attribute.empty() ? -1
                                                      : field_value(*f, rq.height_attribute, what);
-      if (v < 0 && !rq.has_height && !top && rq.height_attribute.empty())
+      if (v < 0 && !rq.has_height && !top && !from_surface && rq.height_attribute.empty())
         throw TerrainError(what + ": no height (set height_m or height_attribute)");
-      if (!top && !(v > 0 && v <= 100)) throw TerrainError(what + ": height must be > 0 m and at most 100 m, got " + fmt(v, 2));
+      if (!top && !from_surface && !(v > 0 && v <= 100)) throw TerrainError(what + ": height must be > 0 m and at most 100 m, got " + fmt(v, 2));
       std::unique_ptr<OGRGeometry> geom(g0->clone());
       if (ct && geom->transform(ct.get()) != OGRERR_NONE) throw TerrainError(what + ": cannot transform it to " + g.crs_name);
       std::vector<std::uint8_t> touched(g.cells(), 0);
       touch_feature(g, *geom, line, rq.centres_only && !line, touched, wx, wy, d.length_m);
       for (std::size_t k = 0; k < g.cells(); ++k) {
         if (!touched[k] || (!g.outside.empty() && g.outside[k])) continue;
+        if (from_surface) {  // the surface model's height here; where it is lower than min_height, not the structure
+          if (std::isfinite(surface[k])) d.height[k] = std::max(d.height[k], surface[k]);
+          continue;
+        }
         const double h = top ? v - g.z[k] : v;  // a top elevation: its height over this cell's ground
         if (top && !(h > 0 && h <= 100))
           throw TerrainError(what + ": its top (" + rq.top_attribute + " = " + fmt(v, 2) + " m) lies " + fmt(h, 2) +
@@ -167,6 +208,9 @@ DamCells rasterize_dam(const Grid& g, const DamRequest& rq) {
     d.crest.push_back(k);
     d.sides.push_back(side);
   }
+  if (d.cells == 0 && !surface.empty())
+    throw TerrainError(file + ": the surface model (" + rq.surface_path + ") stands " + fmt(rq.min_height, 2) +
+                       " m or more above the ground on none of its cells (min_height_m)");
   if (d.cells == 0) throw TerrainError(file + ": lies on no cell of the domain");
   return d;
 }

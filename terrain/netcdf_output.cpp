@@ -76,7 +76,10 @@ void write_time_cube(const std::string& path, const Grid& g, const std::vector<d
     throw TerrainError("writing '" + path + "': the grid's CRS cannot be read back");
   const float nodata = -9999.0f;
   for (const auto& f : fields) {
-    const char* var_opts[] = {"COMPRESS=DEFLATE", "ZLEVEL=4", nullptr};
+    // One chunk per frame: the library's default chunks span many frames, so that writing frame by
+    // frame inflated and deflated each chunk again for every frame (minutes for 600 frames).
+    const std::string block = "BLOCKSIZE=1," + std::to_string(g.ny) + "," + std::to_string(g.nx);
+    const char* var_opts[] = {"COMPRESS=DEFLATE", "ZLEVEL=4", block.c_str(), nullptr};
     auto var = root->CreateMDArray(f.name, {dim_t, dim_y, dim_x}, GDALExtendedDataType::Create(GDT_Float32), const_cast<char**>(var_opts));
     if (!var) throw TerrainError("writing '" + path + "': cannot create " + f.name + gdal_message());
     if (!g.crs_wkt.empty()) var->SetSpatialRef(&srs);

@@ -123,6 +123,11 @@ struct DamRequest {
   double height = 0;            ///< [m]
   std::string height_attribute;
   std::string top_attribute;    ///< each feature's top elevation [m]: the height is the top less the cell's ground
+  /// A surface model (DSM raster): the top at each cell's centre (nearest sample), the height the top
+  /// less the cell's ground; cells where that is below min_height are not the structure. With `path`
+  /// only inside the footprints; without it (empty path) wherever the surface stands that high.
+  std::string surface_path;
+  double min_height = 2;        ///< [m]
   /// Footprints only: the cells whose centres lie inside (at least the cell holding each footprint's
   /// centroid), not the cells the outline passes through (the 3D engine's structures).
   bool centres_only = false;

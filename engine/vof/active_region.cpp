@@ -11,14 +11,23 @@ bool ActiveRegion::update(bool force) {
     set(std::vector<int>(nc, 0));
     return true;
   }
-  if (!force && n_active > 0 && material_inside() && seeds_inside()) return false;
-  set(layers_from_material());
-  return true;
+  // Each rank checks its part (no message inside the checks); the region stays only where every
+  // rank finds it still holds the material and the seeds.
+  bool keep = !force && n_active_total > 0;
+  if (keep) keep = material_inside();
+  if (keep) keep = seeds_inside_here();
+  if (ranks_.comm().any(!keep)) {
+    set(layers_from_material());
+    return true;
+  }
+  return false;
 }
 
 // Every cell next to a boundary face that seeds the region now (an inflow, a coupled inflow while
 // material enters) lies inside it.
-bool ActiveRegion::seeds_inside() const {
+bool ActiveRegion::seeds_inside() const { return !ranks_.comm().any(!seeds_inside_here()); }
+
+bool ActiveRegion::seeds_inside_here() const {
   for (int f = m_.n_internal; f < m_.faces(); ++f)
     if (bcs_[f].seeds_active_region() && bcs_[f].seeds_active_region_at(f) && !active(m_.owner[f])) return false;
   return true;
@@ -65,7 +74,9 @@ bool ActiveRegion::material_inside() {
 // Distance in layers from the material (breadth-first over faces), up to `active_layers`; air
 // beyond the layers joins the reservoir (-1) only where it connects to an atmosphere opening
 // through other such cells: an enclosed pocket (under a lid, in a closed box) keeps its volume, so
-// it stays in the computation (layers + 1).
+// it stays in the computation (layers + 1). Split over ranks, each layer's distances go to the
+// ghosts before the next layer grows from them, so that every own cell's distance is the whole
+// mesh's.
 std::vector<int> ActiveRegion::layers_from_material() const {
   const int nc = m_.cells(), nf = m_.faces(), layers = cfg_.active_layers;
   std::vector<int> d(nc, -1), front, next;
@@ -82,7 +93,8 @@ std::vector<int> ActiveRegion::layers_from_material() const {
         front.push_back(o);
       }
     }
-  for (int k = 1; k <= layers && !front.empty(); ++k) {
+  ranks_.sync(d);
+  for (int k = 1; k <= layers && ranks_.comm().any(!front.empty()); ++k) {
     next.clear();
     for (int c : front)
       for (int f : cell_faces_[c]) {
@@ -93,10 +105,25 @@ std::vector<int> ActiveRegion::layers_from_material() const {
           next.push_back(other);
         }
       }
+    if (ranks_.distributed()) {  // the layer as the ghosts' owners grew it
+      ranks_.sync(d);
+      next.clear();
+      for (int c = 0; c < nc; ++c)
+        if (d[c] == k) next.push_back(c);
+    }
     front.swap(next);
   }
+  flood_from_openings(d);
+  return d;
+}
+
+// The air beyond the layers that an opening reaches through other such air joins the reservoir
+// (stays -1); the rest takes layers + 1. Split over ranks, each rank floods its part from the
+// openings and from the cells its neighbours have reached, until no rank reaches further.
+void ActiveRegion::flood_from_openings(std::vector<int>& d) const {
+  const int nc = m_.cells(), nf = m_.faces();
   std::vector<int> stack;
-  std::vector<char> out(nc, 0);
+  std::vector<int> out(nc, 0);
   for (int f = m_.n_internal; f < nf; ++f)
     if (bcs_[f].opening_at(f)) {
       const int o = m_.owner[f];
@@ -105,21 +132,28 @@ std::vector<int> ActiveRegion::layers_from_material() const {
         stack.push_back(o);
       }
     }
-  while (!stack.empty()) {
-    const int c = stack.back();
-    stack.pop_back();
-    for (int f : cell_faces_[c]) {
-      if (f >= m_.n_internal) continue;
-      const int other = across(m_, f, c);
-      if (d[other] < 0 && !out[other]) {
-        out[other] = 1;
-        stack.push_back(other);
+  for (;;) {
+    while (!stack.empty()) {
+      const int c = stack.back();
+      stack.pop_back();
+      for (int f : cell_faces_[c]) {
+        if (f >= m_.n_internal) continue;
+        const int other = across(m_, f, c);
+        if (d[other] < 0 && !out[other]) {
+          out[other] = 1;
+          stack.push_back(other);
+        }
       }
     }
+    if (!ranks_.distributed()) break;
+    const auto before = out;
+    ranks_.sync(out);
+    if (!ranks_.comm().any(out != before)) break;
+    for (int c = 0; c < nc; ++c)
+      if (out[c]) stack.push_back(c);
   }
   for (int c = 0; c < nc; ++c)
-    if (d[c] < 0 && !out[c]) d[c] = layers + 1;
-  return d;
+    if (d[c] < 0 && !out[c]) d[c] = cfg_.active_layers + 1;
 }
 
 void ActiveRegion::set(const std::vector<int>& d) {
@@ -167,7 +201,7 @@ void ActiveRegion::set(const std::vector<int>& d) {
   for (int c = 0; c < nc; ++c) {
     if (in_halo[c]) {
       halo.push_back(c);
-    } else {
+    } else if (ranks_.own(c)) {
       const double a = F.alpha[c];
       frozen_volume += a * m_.volume[c];
       frozen_min = std::min(frozen_min, a);
@@ -180,18 +214,53 @@ void ActiveRegion::set(const std::vector<int>& d) {
     }
   }
   if (mark_.size() != std::size_t(nc)) mark_.assign(nc, 0u);
+  const Comm& comm = ranks_.comm();
+  frozen_volume = comm.sum(frozen_volume);
+  frozen_min = comm.min(frozen_min);
+  frozen_max = comm.max(frozen_max);
+  if (cells_total_ < 0) cells_total_ = comm.sum((long long)ranks_.owned(nc));
+  number_rows();
+  // A ghost's resting values as its owner set them (a ghost may join the owner's halo, not this part's).
+  ranks_.sync(F.U);
+  ranks_.sync(F.mu);
+  ranks_.sync(F.p);
+  ranks_.sync(F.p_rgh);
 }
 
-std::vector<int> ActiveRegion::pressure_nonzeros() const {
-  std::vector<int> nnz(std::size_t(std::max(1, n_active)), 1);
+// The pressure system's rows: each rank's own region cells in order, the ranks one after another;
+// a ghost's row is its owner's.
+void ActiveRegion::number_rows() {
+  const int nc = m_.cells();
+  n_own_active = 0;
+  for (int c : cells)
+    if (ranks_.own(c)) ++n_own_active;
+  const Comm& comm = ranks_.comm();
+  row_offset = 0;
+  if (comm.size > 1) MPI_Exscan(&n_own_active, &row_offset, 1, MPI_INT, MPI_SUM, comm.comm);
+  if (comm.rank == 0) row_offset = 0;
+  n_active_total = comm.sum((long long)n_own_active);
+  global_row.assign(nc, -1);
+  for (int c = 0; c < nc; ++c)
+    if (index[c] >= 0 && ranks_.own(c)) global_row[c] = row_offset + index[c];
+  ranks_.sync(global_row);
+}
+
+ActiveRegion::Nonzeros ActiveRegion::pressure_nonzeros() const {
+  Nonzeros nz;
+  nz.own.assign(std::size_t(std::max(1, n_own_active)), 1);
+  nz.off.assign(nz.own.size(), 0);
+  auto count = [&](int row_cell, int other) {
+    if (!ranks_.own(row_cell)) return;
+    ++(ranks_.own(other) ? nz.own : nz.off)[std::size_t(index[row_cell])];
+  };
   for (int f = 0; f < m_.n_internal; ++f) {
-    const int io = index[m_.owner[f]], in = index[m_.neighbour[f]];
-    if (io >= 0 && in >= 0) {
-      ++nnz[io];
-      ++nnz[in];
+    const int o = m_.owner[f], n = m_.neighbour[f];
+    if (index[o] >= 0 && index[n] >= 0) {
+      count(o, n);
+      count(n, o);
     }
   }
-  return nnz;
+  return nz;
 }
 
 }  // namespace runout::engine::vof

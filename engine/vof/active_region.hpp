@@ -13,14 +13,15 @@
 #include "engine/vof/fv/ops.hpp"
 #include "engine/vof/hydrostatics.hpp"
 #include "engine/vof/mixture.hpp"
+#include "engine/vof/mpi/ranks.hpp"
 
 namespace runout::engine::vof {
 
 class ActiveRegion {
  public:
   ActiveRegion(const Mesh& m, const CellFaces& cell_faces, const VofConfig& cfg, const Boundaries& bcs, Fields& fields,
-               const Hydrostatics& hydrostatics, const Mixture& mixture)
-      : m_(m), cell_faces_(cell_faces), cfg_(cfg), bcs_(bcs), fields_(fields), hydrostatics_(hydrostatics), mixture_(mixture) {}
+               const Hydrostatics& hydrostatics, const Mixture& mixture, const Ranks& ranks)
+      : m_(m), cell_faces_(cell_faces), cfg_(cfg), bcs_(bcs), fields_(fields), hydrostatics_(hydrostatics), mixture_(mixture), ranks_(ranks) {}
 
   /// Rebuild the region when the material has come near its edge (force: in any case). Returns
   /// true when it changed.
@@ -29,14 +30,21 @@ class ActiveRegion {
   /// outside at rest; no flux between resting cells; the material outside the halo, which no flux
   /// can reach, summed once.
   void set(const std::vector<int>& d);
-  /// Every cell next to a boundary face that seeds the region in the step being taken lies in it.
+  /// Every cell next to a boundary face that seeds the region in the step being taken lies in it
+  /// (on every rank: a distributed run's ranks all call it).
   bool seeds_inside() const;
   /// Forget the region (the next update() builds it in any case).
   void clear() { n_active = 0; }
-  /// The number of nonzeros per row of the pressure system over the region.
-  std::vector<int> pressure_nonzeros() const;
-  /// Every cell takes part (the pressure level is free in a closed domain).
-  bool whole_mesh() const { return n_active == m_.cells(); }
+  /// The nonzeros per own row of the pressure system over the region: in the rank's own columns
+  /// (diagonal block) and in the other ranks' (off).
+  struct Nonzeros {
+    std::vector<int> own, off;
+  };
+  Nonzeros pressure_nonzeros() const;
+  /// Every cell of the whole mesh takes part (the pressure level is free in a closed domain).
+  bool whole_mesh() const { return n_active_total == cells_total_; }
+  /// The ranks the run is split over (a run on one process by default).
+  const Ranks& ranks() const { return ranks_; }
   bool active(int c) const { return index[c] >= 0; }
   const CellFaces& cell_faces() const { return cell_faces_; }
   /// The test "face f is one of `faces`", for grad() over the region's faces.
@@ -49,12 +57,19 @@ class ActiveRegion {
   std::vector<int> halo;    ///< the region and the cells next to it (alpha may change there)
   std::vector<int> faces;   ///< faces of the region's cells, in ascending order (internal faces first)
   std::vector<char> face_in;  ///< per face: 1 when it is one of `faces`
-  int n_active = 0;
+  int n_active = 0;        ///< the region's cells in this part (own and ghosts)
+  int n_own_active = 0;    ///< of them the rank's own: the pressure system's rows here, the first of `cells`
+  int row_offset = 0;      ///< the pressure system's first row of this rank
+  CellField<int> global_row;  ///< per cell, its row in the whole pressure system; -1 outside the region
+  long long n_active_total = 0;  ///< the region's cells over all ranks
   double frozen_volume = 0, frozen_min = 0, frozen_max = 0;  ///< material outside the halo (unchanging)
 
  private:
   bool material_inside();
+  bool seeds_inside_here() const;
   std::vector<int> layers_from_material() const;
+  void flood_from_openings(std::vector<int>& d) const;
+  void number_rows();
 
   const Mesh& m_;
   const CellFaces& cell_faces_;
@@ -63,6 +78,8 @@ class ActiveRegion {
   Fields& fields_;
   const Hydrostatics& hydrostatics_;
   const Mixture& mixture_;
+  const Ranks& ranks_;
+  long long cells_total_ = -1;
   std::vector<unsigned> mark_;  // the quick check's marks
   std::vector<char> halo_flag_; // membership of halo
   unsigned stamp_ = 0;

@@ -22,7 +22,6 @@ class AlphaEqn {
  private:
   void interface_normal(const Fields& F);
   void fluxes_and_bounds(const Fields& F);
-  double boundary_flux(const Fields& F, int f) const;
   void settling_fluxes(const Fields& F);
   int settling_subcycles(const Vec& gravity, double dt);
   void limit_and_update(Fields& F, double dts, int subcycles);

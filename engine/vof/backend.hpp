@@ -1,8 +1,8 @@
 #pragma once
 // The 3D engine as everything outside engine/vof sees it: the set-ups, the run loop's stepping, the
 // frames, the laboratory monitors, the terrain's hazard maps and the checkpoints use this interface,
-// never the solver's class. A back end (the CPU solver of solver.cpp today; a GPU or distributed one
-// later) implements it and is made by make_vof_backend.
+// never the solver's class. A back end (the CPU solver of solver.cpp, or the same split over MPI
+// ranks, mpi/distributed.cpp) implements it and is made by make_vof_backend.
 #include <memory>
 #include <vector>
 
@@ -39,9 +39,14 @@ class VofBackend {
   /// The pressure on boundary face f less the still air's there [Pa]: the cell's pressure carried
   /// hydrostatically to the face (as the Coulomb walls read it), the load a wall or a structure feels.
   virtual double face_pressure(int f) const = 0;
+  /// Whether v holds on any of the processes that run this back end together (a run split over MPI
+  /// ranks decides to stop on every rank alike); v itself on one process.
+  virtual bool any(bool v) const { return v; }
 };
 
-/// The back end for a mesh and configuration (the CPU solver); a bad configuration is a VofError.
+/// The back end for a mesh and configuration: the CPU solver, split over the ranks of MPI_COMM_WORLD
+/// when the program runs under `mpirun -n N` with N > 1 (DistributedVof); a bad configuration is a
+/// VofError.
 std::unique_ptr<VofBackend> make_vof_backend(Mesh mesh, VofConfig cfg);
 
 }  // namespace runout::engine::vof

@@ -144,6 +144,10 @@ struct VofConfig {
   /// the correction where the orthogonal part carries a force (the material) and removes it where the
   /// air rests hydrostatically.
   double non_orthogonal_limiter = 1.0;
+  /// The whole mesh's mean cell size [m] (the cube root of its mean volume), which sets the
+  /// interface normal's guard; 0: the solver's mesh's. A part of a run split over ranks is given the
+  /// whole mesh's.
+  double mean_cell_size = 0;
   bool momentum_predictor = false;  ///< solve the momentum matrix before the correctors (see docs/design/vof.md)
   /// The pressure equation's coefficient: false: 1/A (PISO, interFoam); true: the consistent
   /// 1/(A - H1) of SIMPLEC (H1 the sum of the neighbour coefficients), so that in cells where the

@@ -8,9 +8,10 @@
 
 namespace runout::engine::vof {
 
-Hydrostatics::Hydrostatics(const Mesh& m, const VofConfig& cfg, const Fields& fields)
+Hydrostatics::Hydrostatics(const Mesh& m, const VofConfig& cfg, const Fields& fields, const Ranks& ranks)
     : m_(m),
       fields_(fields),
+      ranks_(ranks),
       gravity_(cfg.gravity),
       rho2_(cfg.rho2),
       excess_(cfg.coulomb_pressure == CoulombPressure::excess),
@@ -26,6 +27,7 @@ void Hydrostatics::resize() {
 void Hydrostatics::update_non_orthogonal_force(const CellFaces& cell_faces, const std::vector<int>& faces, const std::vector<int>& cells) {
   if (!non_orth_) return;
   gauss_gradient_hydrostatic(m_, cell_faces, cells, fields_.p, fields_.rho, gh_, ghf_, grad_p_);
+  ranks_.sync(grad_p_);
   parallel_each(faces, [&](int f) {
     if (f >= m_.n_internal) return;
     const Vec& k = m_.non_orth[f];
@@ -47,8 +49,11 @@ void Hydrostatics::update(double t, const std::function<bool(int)>& opening, boo
   gh_ref_ = 1e300;
   for (int f = m_.n_internal; f < nf; ++f)
     if (opening(f)) gh_ref_ = std::min(gh_ref_, ghf_[f]);
-  if (gh_ref_ == 1e300)  // a closed domain: the level is zero at its highest cell
+  gh_ref_ = ranks_.comm().min(gh_ref_);  // the whole mesh's openings
+  if (gh_ref_ == 1e300) {  // a closed domain: the level is zero at its highest cell
     for (int c = 0; c < nc; ++c) gh_ref_ = std::min(gh_ref_, gh_[c]);
+    gh_ref_ = ranks_.comm().min(gh_ref_);
+  }
 }
 
 void Hydrostatics::zero() {

@@ -9,6 +9,7 @@
 
 #include "engine/vof/config.hpp"
 #include "engine/vof/fields.hpp"
+#include "engine/vof/mpi/ranks.hpp"
 #include "engine/vof/fv/ops.hpp"
 
 namespace runout::engine::vof {
@@ -23,7 +24,8 @@ inline double limited_correction(double corr, double orth, double psi) {
 
 class Hydrostatics {
  public:
-  Hydrostatics(const Mesh& m, const VofConfig& cfg, const Fields& fields);
+  /// ranks: the run's ranks (the reference level is the whole mesh's).
+  Hydrostatics(const Mesh& m, const VofConfig& cfg, const Fields& fields, const Ranks& ranks);
   void resize();
 
   /// Gravity at time t: g.x per cell and face and the reference level, recomputed when g changed
@@ -97,6 +99,7 @@ class Hydrostatics {
  private:
   const Mesh& m_;
   const Fields& fields_;
+  const Ranks& ranks_;
   std::function<Vec(double)> gravity_;
   double rho2_;
   bool excess_;

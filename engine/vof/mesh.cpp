@@ -19,6 +19,12 @@ int Mesh::patch_index(const std::string& name) const {
   return -1;
 }
 
+double Mesh::mean_cell_size() const {
+  double sum = 0;
+  for (double v : volume) sum += v;
+  return std::cbrt(sum / cells());
+}
+
 void Mesh::finish() {
   const int nf = faces();
   magSf.assign(nf, 0);

@@ -45,6 +45,8 @@ struct Mesh {
   FaceField<Vec> non_orth;
 
   int cells() const { return int(volume.size()); }
+  /// The cube root of the mean cell volume [m].
+  double mean_cell_size() const;
   int faces() const { return int(owner.size()); }
   const Patch& patch(const std::string& name) const;
   int patch_index(const std::string& name) const;  ///< -1 when absent

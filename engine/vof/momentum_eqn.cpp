@@ -26,7 +26,8 @@ MomentumEqn::MomentumEqn(const Mesh& m, const VofConfig& cfg, const BcContext& b
   face_vec_.assign(nf, Vec{});
   drA.assign(nc, 0);
   drAt = drA;
-  column_ = cfg.column_friction.columns.columns() > 0;
+  // (Split over ranks by whole columns, a rank may hold none: the columns count on every rank alike.)
+  column_ = region.ranks().comm().any(cfg.column_friction.columns.columns() > 0);
   if (column_) {
     drag_.drag.assign(nc, 0);
     drag_.normal.assign(nc, Vec{});
@@ -61,12 +62,13 @@ Vec MomentumEqn::rA_difference_apply(int c, const Vec& v) const {
   return (rAU[c] - rAtU[c]) * v + (dr * dot(n, v)) * n;
 }
 
-void MomentumEqn::setup_predictor() { solver_.setup(cfg_.momentum_rtol); }
+void MomentumEqn::setup_predictor() { solver_.setup(cfg_.momentum_rtol, region_.ranks()); }
 
 void MomentumEqn::velocity_gradient(Fields& F) const {
   // Per cell of the halo over its faces of the region (the outer cells' other faces carry nothing).
   const auto face_U = [&](int f, int) { return internal(m_, f) ? interpolate(m_, f, F.U) : bcs_[f].velocity(bc_ctx_, f); };
   grad(m_, region_.cell_faces(), region_.halo, face_U, F.gradU, region_.face_in_region());
+  region_.ranks().sync(F.gradU);
 }
 
 void MomentumEqn::update_viscosity(Fields& F) const {
@@ -75,6 +77,8 @@ void MomentumEqn::update_viscosity(Fields& F) const {
     F.nu1[c] = bc_ctx_.viscosity.nu(bc_ctx_.hydrostatics.confining_pressure(c), strain_rate(F.gradU[c]));
     F.mu[c] = bc_ctx_.mixture.mu(F.alpha[c], F.nu1[c]);
   });
+  region_.ranks().sync(F.nu1);
+  region_.ranks().sync(F.mu);
 }
 
 // Boundary values and the transpose viscous part are taken from the current velocity.
@@ -89,6 +93,16 @@ void MomentumEqn::build(const Fields& F, double dt) {
     // The diagonal without the drag (A - D loses its digits where the drag outweighs it).
     parallel_each(region_.halo, [&](int c) { diag_no_drag_[c] = UEqn_.diag[c]; });
     bed_load = add_column_friction(m_, cfg_.column_friction, cfg_.rho1, F, bc_ctx_.hydrostatics, region_, UEqn_, drag_);
+    const Ranks& ranks = region_.ranks();
+    if (ranks.distributed()) {  // the whole mesh's load; a ghost's drag normal as its owner's (rA_along)
+      const Comm& comm = ranks.comm();
+      bed_load.weight_normal = comm.sum(bed_load.weight_normal);
+      bed_load.centripetal = comm.sum(bed_load.centripetal);
+      bed_load.face_pressure = comm.sum(bed_load.face_pressure);
+      bed_load.friction_load = comm.sum(bed_load.friction_load);
+      bed_load.columns = int(comm.sum((long long)bed_load.columns));
+      ranks.sync(drag_.normal);
+    }
   }
   coefficients(F, dt);
 }
@@ -240,6 +254,7 @@ void MomentumEqn::boundary_terms(const Fields& F) {
 void MomentumEqn::coefficients(const Fields& F, double dt) {
   const auto& A = UEqn_.A();
   parallel_each(region_.halo, [&](int c) { rAU[c] = m_.volume[c] / A[c]; });  // 1 / A per unit volume [m3 s/kg]
+  region_.ranks().sync(rAU);
   parallel_each(region_.faces, [&](int f) { rAUf[f] = interpolate_or_owner(m_, f, rAU); });
   if (!cfg_.consistent) return;
   UEqn_.H1(m_, region_.cell_faces(), region_.face_in, region_.halo, H1_);
@@ -247,6 +262,7 @@ void MomentumEqn::coefficients(const Fields& F, double dt) {
     const double V = m_.volume[c];
     rAtU[c] = F.alpha[c] < cfg_.consistent_alpha ? rAU[c] : V / std::max(A[c] - H1_[c], 0.5 * F.rho[c] * V / dt);
   });
+  region_.ranks().sync(rAtU);
   parallel_each(region_.faces, [&](int f) { rAtUf[f] = interpolate_or_owner(m_, f, rAtU); });
   if (column_) normal_coefficients(F, dt);
 }
@@ -266,6 +282,8 @@ void MomentumEqn::normal_coefficients(const Fields& F, double dt) {
     if (cfg_.consistent)
       drAt[c] = F.alpha[c] < cfg_.consistent_alpha ? drA[c] : V / std::max(A0 - H1_[c], 0.5 * F.rho[c] * V / dt) - rAtU[c];
   });
+  region_.ranks().sync(drA);
+  if (cfg_.consistent) region_.ranks().sync(drAt);
   parallel_each(region_.faces, [&](int f) {
     const int o = m_.owner[f];
     const Vec& S = m_.Sf[f];
@@ -285,7 +303,10 @@ void MomentumEqn::normal_coefficients(const Fields& F, double dt) {
 void MomentumEqn::update_HbyA(const Fields& F) {
   UEqn_.H(m_, region_.cell_faces(), region_.face_in, F.U, region_.halo, H_);
   parallel_each(region_.halo, [&](int c) { HbyA[c] = (1.0 / UEqn_.diag[c]) * H_[c]; });
-  if (!column_) return;
+  if (!column_) {
+    region_.ranks().sync(HbyA);
+    return;
+  }
   // Where the column friction acts: (A along the bed, A - D along n)^-1 (H less the drag's explicit
   // part on the normal velocity), the momentum equation with the drag along the bed only.
   parallel_each(region_.halo, [&](int c) {
@@ -296,6 +317,7 @@ void MomentumEqn::update_HbyA(const Fields& F) {
     const Vec& n = drag_.normal[c];
     HbyA[c] = (1.0 / A) * h + ((1.0 / diag_no_drag_[c] - 1.0 / A) * dot(n, h)) * n;
   });
+  region_.ranks().sync(HbyA);
 }
 
 void MomentumEqn::unit_coefficients() {

@@ -84,6 +84,9 @@ class MomentumEqn {
   FaceField<double> diag_o_, diag_n_;  // per face: what it adds to its owner's and neighbour's diagonal
   FaceField<Vec> face_vec_;       // per face: the transpose stress it gives its cells
   std::vector<int> rows_, row_of_;  // the predicted cells (ascending); per cell its row or -1
+  int n_own_rows_ = 0;               // the rank's own rows (the first of rows_; all of them on one process)
+  long long total_rows_ = 0;
+  std::vector<int> global_of_;       // split over ranks: per cell its row in the whole system, or -1
   std::vector<Vec> known_;        // per row: the share of the neighbours that are not predicted
   CsrMatrix A_;
   MomentumSolver solver_;

@@ -45,41 +45,63 @@ void MomentumEqn::predictor_forces() {
 // Predicting the air too let the cell-reconstructed buoyancy force drive air currents over a
 // resting heap's stair-stepped surface (0.1 m/s) that dragged it along at 2 mm/s
 // (docs/design/vof.md). The system's size follows the material, not the mesh.
+//
+// Split over ranks, each rank's rows are its own predicted cells, the ranks one after another; a
+// ghost's row (a column of the rank's rows) is its owner's.
 void MomentumEqn::predictor_rows(const Fields& F) {
   const bool material_only = cfg_.consistent;
+  const Ranks& ranks = region_.ranks();
   rows_.clear();
   for (int c : region_.cells)
     if (!material_only || F.alpha[c] >= cfg_.consistent_alpha) rows_.push_back(c);
   std::sort(rows_.begin(), rows_.end());
   if (row_of_.size() != std::size_t(m_.cells())) row_of_.assign(m_.cells(), -1);
   for (int r = 0; r < int(rows_.size()); ++r) row_of_[rows_[r]] = r;
-  const int n = int(rows_.size());
+  n_own_rows_ = 0;
+  for (int c : rows_) n_own_rows_ += ranks.own(c) ? 1 : 0;
+  const int n = n_own_rows_;
+  if (ranks.distributed()) {
+    int first_row = 0;
+    MPI_Exscan(&n, &first_row, 1, MPI_INT, MPI_SUM, ranks.comm().comm);
+    if (ranks.comm().rank == 0) first_row = 0;
+    total_rows_ = ranks.comm().sum((long long)n);
+    global_of_.assign(m_.cells(), -1);
+    for (int r = 0; r < n; ++r) global_of_[rows_[r]] = first_row + r;
+    ranks.sync(global_of_);
+  } else {
+    total_rows_ = n;
+  }
+  const auto col = [&](int c) { return ranks.distributed() ? global_of_[c] : row_of_[c]; };
+  const auto mine = [&](int r) { return r >= 0 && r < n; };
   const auto& cO = UEqn_.upper;
   const auto& cN = UEqn_.lower;
   known_.assign(n, Vec{});
-  // Per row: the diagonal and an entry per predicted neighbour; columns sorted afterwards.
+  // Per own row: the diagonal and an entry per predicted neighbour; columns sorted afterwards.
   A_.start.assign(std::size_t(n) + 1, 1);
   A_.start[0] = 0;
   for (int f : region_.faces) {
     if (f >= m_.n_internal) break;
     const int ro = row_of_[m_.owner[f]], rn = row_of_[m_.neighbour[f]];
-    if (ro >= 0 && rn >= 0) ++A_.start[ro + 1], ++A_.start[rn + 1];
+    if (ro >= 0 && rn >= 0) {
+      if (mine(ro)) ++A_.start[ro + 1];
+      if (mine(rn)) ++A_.start[rn + 1];
+    }
   }
   for (int r = 0; r < n; ++r) A_.start[r + 1] += A_.start[r];
   A_.col.resize(A_.start[n]);
   A_.val.resize(A_.start[n]);
   std::vector<PetscInt> next(A_.start.begin(), A_.start.end() - 1);
-  for (int r = 0; r < n; ++r) A_.col[next[r]] = r, A_.val[next[r]++] = UEqn_.diag[rows_[r]];
+  for (int r = 0; r < n; ++r) A_.col[next[r]] = col(rows_[r]), A_.val[next[r]++] = UEqn_.diag[rows_[r]];
   for (int f : region_.faces) {
     if (f >= m_.n_internal) break;
     const int o = m_.owner[f], nb = m_.neighbour[f];
     const int ro = row_of_[o], rn = row_of_[nb];
     if (ro >= 0 && rn >= 0) {
-      A_.col[next[ro]] = rn, A_.val[next[ro]++] = -cO[f];
-      A_.col[next[rn]] = ro, A_.val[next[rn]++] = -cN[f];
-    } else if (ro >= 0 && region_.active(nb)) {
+      if (mine(ro)) A_.col[next[ro]] = col(nb), A_.val[next[ro]++] = -cO[f];
+      if (mine(rn)) A_.col[next[rn]] = col(o), A_.val[next[rn]++] = -cN[f];
+    } else if (mine(ro) && region_.active(nb)) {
       known_[ro] = known_[ro] + cO[f] * F.U[nb];
-    } else if (rn >= 0 && region_.active(o)) {
+    } else if (mine(rn) && region_.active(o)) {
       known_[rn] = known_[rn] + cN[f] * F.U[o];
     }
   }
@@ -95,8 +117,8 @@ void MomentumEqn::predictor_rows(const Fields& F) {
 int MomentumEqn::predict(Fields& F, double t) {
   predictor_forces();
   predictor_rows(F);
-  solver_.set_matrix(A_);
-  const int n = int(rows_.size());
+  solver_.set_matrix(A_, total_rows_);
+  const int n = n_own_rows_;
   int its_total = 0;
   auto b = std::vector<double>(n), x = b;
   for (int i = 0; i < dims_; ++i) {
@@ -110,6 +132,7 @@ int MomentumEqn::predict(Fields& F, double t) {
     for (int r = 0; r < n; ++r) comp_ref(F.U[rows_[r]], i) = x[r];
   }
   for (int c : rows_) row_of_[c] = -1;
+  region_.ranks().sync(F.U);
   return its_total;
 }
 

@@ -24,7 +24,10 @@ PressureEqn::PressureEqn(const Mesh& m, const VofConfig& cfg, const BcContext& b
   rec_old_ = rec_;
 }
 
-void PressureEqn::make_system() { solver_.make_system(region_.n_active, region_.pressure_nonzeros()); }
+void PressureEqn::make_system() {
+  const auto nz = region_.pressure_nonzeros();
+  solver_.make_system(region_.n_own_active, region_.row_offset, region_.n_active_total, nz.own, nz.off);
+}
 
 int PressureEqn::correct(Fields& F, const MomentumEqn& UEqn, CorrectorPass pass, double t) {
   solver_.set_tolerance(pass.final);
@@ -53,7 +56,8 @@ int PressureEqn::correct(Fields& F, const MomentumEqn& UEqn, CorrectorPass pass,
     const double diag0 = diag_rows_.empty() ? 0.0 : diag_rows_[0];
     its += solver_.solve({.initial = pass.initial, .reuse = reuse, .closed = closed, .diag0 = diag0}, t);
     solver_.solution(x_rows_);
-    for (int r = 0; r < region_.n_active; ++r) F.p_rgh[region_.cells[r]] = x_rows_[r];
+    for (int r = 0; r < region_.n_own_active; ++r) F.p_rgh[region_.cells[r]] = x_rows_[r];
+    region_.ranks().sync(F.p_rgh);
   }
   correct_flux_and_velocity(F, UEqn, pass.initial, k);
   for (int c : region_.cells) F.p[c] = F.p_rgh[c] + F.rho[c] * bc_ctx_.hydrostatics.gh(c);
@@ -151,7 +155,6 @@ void PressureEqn::gather_face_forces(CellField<Vec>& rec) const {
 // and its preconditioner and assemble only the right-hand side; the diagonal is kept from the
 // step's first call (the closed domain's pinning needs it then too).
 void PressureEqn::assemble(const Fields& F, bool reuse) {
-  const auto& ix = region_.index;
   const auto& coef = pEqn_.upper;
   auto &diag = pEqn_.diag, &rhs = pEqn_.source;
   const CellFaces& cf = region_.cell_faces();
@@ -176,10 +179,16 @@ void PressureEqn::assemble(const Fields& F, bool reuse) {
     diag[c] = d;
   });
   solver_.begin_matrix(reuse);
+  const auto& row = region_.global_row;
+  const Ranks& ranks = region_.ranks();
   if (!reuse)
     for (int f : region_.faces)
-      if (open_[f] == 0 && internal(m_, f) && region_.active(m_.owner[f])) solver_.set_pair(ix[m_.owner[f]], ix[m_.neighbour[f]], -coef[f]);
-  const auto n = std::size_t(region_.n_active);
+      if (open_[f] == 0 && internal(m_, f) && region_.active(m_.owner[f])) {
+        const int o = m_.owner[f], nb = m_.neighbour[f];
+        if (ranks.own(o)) solver_.set_entry(row[o], row[nb], -coef[f]);
+        if (ranks.own(nb)) solver_.set_entry(row[nb], row[o], -coef[f]);
+      }
+  const auto n = std::size_t(region_.n_own_active);
   diag_rows_.resize(n);
   rhs_rows_.resize(n);
   x_rows_.resize(n);
@@ -225,6 +234,7 @@ void PressureEqn::correct_flux_and_velocity(Fields& F, const MomentumEqn& UEqn, 
     F.U[c] = UEqn.HbyA[c] + UEqn.rA_apply(k.consistent, c, R);
     if (k.consistent) F.U[c] = F.U[c] + UEqn.rA_difference_apply(c, reconstruct_(c, rec_old_[c]));
   });
+  region_.ranks().sync(F.U);
 }
 
 // The Gauss gradient of the pressure p over the active region: face values interpolated between
@@ -263,13 +273,24 @@ void PressureEqn::pressure_correction(const Fields& F, const Coupling& k) {
 
 // A closed domain fixes the pressure only up to a constant, but the Coulomb viscosity needs the
 // pressure itself: it is zero in the highest cell (along gravity), the top of the air.
+// Split over ranks, the highest cell is the highest of the ranks' highest own cells (the lowest rank's
+// where two are equally high).
 void PressureEqn::fix_level(Fields& F) {
   const int nc = m_.cells();
   const Hydrostatics& hs = bc_ctx_.hydrostatics;
+  const Ranks& ranks = region_.ranks();
   int top = 0;
-  for (int c = 1; c < nc; ++c)
+  for (int c = 1; c < ranks.owned(nc); ++c)
     if (hs.gh(c) < hs.gh(top)) top = c;
-  const double pmin = F.p[top];
+  double pmin = F.p[top];
+  if (ranks.distributed()) {
+    struct {
+      double gh;
+      int rank;
+    } mine{hs.gh(top), ranks.comm().rank}, best{};
+    MPI_Allreduce(&mine, &best, 1, MPI_DOUBLE_INT, MPI_MINLOC, ranks.comm().comm);
+    MPI_Bcast(&pmin, 1, MPI_DOUBLE, best.rank, ranks.comm().comm);
+  }
   for (int c = 0; c < nc; ++c) {
     F.p[c] -= pmin;
     F.p_rgh[c] -= pmin;

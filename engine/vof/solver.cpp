@@ -16,6 +16,7 @@
 #include "engine/vof/mixture.hpp"
 #include "engine/vof/models/granular_viscosity.hpp"
 #include "engine/vof/momentum_eqn.hpp"
+#include "engine/vof/mpi/distributed.hpp"
 #include "engine/vof/pressure_eqn.hpp"
 
 namespace runout::engine::vof {
@@ -31,27 +32,25 @@ void check_config(const VofConfig& c) {
   if (!(c.consistent_alpha > 0 && c.consistent_alpha <= 1)) throw VofError("consistent_alpha must lie in (0, 1]");
 }
 
-double mean_cell_size(const Mesh& m) {
-  double vsum = 0;
-  for (double v : m.volume) vsum += v;
-  return std::cbrt(vsum / m.cells());
-}
+// The whole mesh's (a part of a distributed run is given it: VofConfig::mean_cell_size).
+double mean_cell_size(const Mesh& m, const VofConfig& c) { return c.mean_cell_size > 0 ? c.mean_cell_size : m.mean_cell_size(); }
 
 }  // namespace
 
 struct VofSolver::Impl {
-  Impl(const Mesh& mesh, const VofConfig& config)
+  Impl(const Mesh& mesh, const VofConfig& config, const Ranks& ranks_of_run)
       : m(mesh),
         cfg(config),
+        ranks(ranks_of_run),
         dims(mesh.thickness > 0 ? 2 : 3),
         bcs(mesh, config.bc),
         viscosity(make_granular_viscosity(config)),
         mixture(config),
-        hydrostatics(mesh, config, F),
+        hydrostatics(mesh, config, F, ranks),
         bc_ctx{mesh, F, hydrostatics, *viscosity, mixture, config.wall_viscosity},
-        region(mesh, cell_faces, config, bcs, F, hydrostatics, mixture),
-        pressure_solver(config),
-        alpha_eqn(mesh, config, bc_ctx, bcs, region, mean_cell_size(mesh)),
+        region(mesh, cell_faces, config, bcs, F, hydrostatics, mixture, ranks),
+        pressure_solver(config, ranks),
+        alpha_eqn(mesh, config, bc_ctx, bcs, region, mean_cell_size(mesh, config)),
         UEqn(mesh, config, bc_ctx, bcs, region, reconstruct, dims),
         pEqn(mesh, config, bc_ctx, bcs, region, reconstruct, pressure_solver) {
     check_config(cfg);
@@ -68,6 +67,7 @@ struct VofSolver::Impl {
 
   const Mesh& m;
   const VofConfig& cfg;
+  const Ranks& ranks;  // the run's ranks: this part's own cells, the ghosts' exchange
   const int dims;
   Fields F;
   Boundaries bcs;
@@ -93,6 +93,7 @@ struct VofSolver::Impl {
   }
   void update_rho() {
     for (int c : region.halo) F.rho[c] = mixture.rho(F.alpha[c]);
+    ranks.sync(F.rho);
   }
   void keep_old_time() {
     for (int c : region.halo) {
@@ -111,6 +112,7 @@ struct VofSolver::Impl {
 VofSolver::Impl::Courant VofSolver::Impl::courant(double dt) const {
   Courant k;
   for (int c : region.cells) {
+    if (!ranks.own(c)) continue;
     double sum = 0;
     for (int f : cell_faces[c]) sum += std::abs(F.phi[f]);
     const double cc = 0.5 * sum / m.volume[c] * dt;
@@ -121,6 +123,11 @@ VofSolver::Impl::Courant VofSolver::Impl::courant(double dt) const {
       k.air_co = std::max(k.air_co, cc);
     }
     if (a > 0.01 && a < 0.99) k.alpha_co = std::max(k.alpha_co, cc);
+  }
+  if (ranks.distributed()) {
+    std::vector<double> v{k.co, k.alpha_co, k.air_co};
+    ranks.comm().max(v);
+    k = {v[0], v[1], v[2]};
   }
   return k;
 }
@@ -144,7 +151,7 @@ double VofSolver::Impl::next_dt(const Courant& co, double dt, double time_left, 
 // carries the inflow to the openings (the same equation without gravity). Starting from zero
 // inside instead piled the first step's inflow into the inflow cells (alpha up to 1.03 in B4).
 void VofSolver::Impl::initial_pressure(double t) {
-  bc_ctx.t0 = bc_ctx.t1 = t;
+  bc_ctx.t0 = bc_ctx.t1 = bc_ctx.tp0 = bc_ctx.tp1 = t;
   bcs.begin_step(bc_ctx);
   UEqn.unit_coefficients();
   region.clear();
@@ -158,7 +165,7 @@ void VofSolver::Impl::initial_pressure(double t) {
       F.phi[f] = *q;
       inflow = true;
     }
-  if (inflow && bcs.has_opening()) {
+  if (ranks.comm().any(inflow) && bcs.has_opening()) {
     const auto p_rgh = F.p_rgh, p = F.p;
     hydrostatics.zero();
     pEqn.correct(F, UEqn, {.initial = true, .final = true}, t);
@@ -169,35 +176,46 @@ void VofSolver::Impl::initial_pressure(double t) {
 }
 
 // Over the halo; the material beyond it does not change (its sums were taken with the region).
+// Split over ranks, over each rank's own cells, then over the ranks.
 void VofSolver::Impl::diagnostics(StepStats& st, double t) {
-  st.alpha_min = 1e300;
-  st.alpha_max = -1e300;
   for (int c : region.halo) div[c] = 0;
   for (int f : region.faces) {
     div[m.owner[f]] += F.phi[f];
     if (internal(m, f)) div[m.neighbour[f]] -= F.phi[f];
   }
-  st.granular_volume = region.frozen_volume;
-  if (region.halo.size() < std::size_t(m.cells())) {
-    st.alpha_min = region.frozen_min;
-    st.alpha_max = region.frozen_max;
-  }
+  st.alpha_min = region.frozen_min;  // (1e300 and -1e300 where no cell lies outside the halo)
+  st.alpha_max = region.frozen_max;
+  double volume = ranks.distributed() ? 0.0 : region.frozen_volume;  // (one process: the sum in the order it always had)
+  int bad = -1;
   for (int c : region.halo) {
+    if (!ranks.own(c)) continue;
     const double a = F.alpha[c];
     const Vec& U = F.U[c];
     st.alpha_min = std::min(st.alpha_min, a);
     st.alpha_max = std::max(st.alpha_max, a);
-    st.granular_volume += a * m.volume[c];
+    volume += a * m.volume[c];
     if (a > 0.5) st.max_speed = std::max(st.max_speed, norm(U));
     if (region.active(c))  // the air at rest outside the active region is a reservoir
       st.divergence = std::max(st.divergence, std::abs(div[c]) / m.volume[c]);
-    if (!std::isfinite(a) || !std::isfinite(U.x) || !std::isfinite(U.y) || !std::isfinite(U.z))
-      throw VofError("the solution is no longer finite at t = " + std::to_string(t) + " s (cell " + std::to_string(c) + ")");
+    if (bad < 0 && (!std::isfinite(a) || !std::isfinite(U.x) || !std::isfinite(U.y) || !std::isfinite(U.z))) bad = c;
   }
+  st.granular_volume = volume;
+  if (ranks.distributed()) {
+    const Comm& comm = ranks.comm();
+    std::vector<double> hi{-st.alpha_min, st.alpha_max, st.max_speed, st.divergence};
+    comm.max(hi);
+    st.alpha_min = -hi[0];
+    st.alpha_max = hi[1];
+    st.max_speed = hi[2];
+    st.divergence = hi[3];
+    st.granular_volume = region.frozen_volume + comm.sum(volume);
+  }
+  if (ranks.comm().any(bad >= 0))
+    throw VofError("the solution is no longer finite at t = " + std::to_string(t) + " s" + (bad >= 0 ? " (cell " + std::to_string(bad) + ")" : ""));
 }
 
-VofSolver::VofSolver(Mesh mesh, VofConfig cfg) : mesh_(std::move(mesh)), cfg_(std::move(cfg)) {
-  impl_ = std::make_unique<Impl>(mesh_, cfg_);
+VofSolver::VofSolver(Mesh mesh, VofConfig cfg, Ranks ranks) : mesh_(std::move(mesh)), cfg_(std::move(cfg)), ranks_(std::move(ranks)) {
+  impl_ = std::make_unique<Impl>(mesh_, cfg_, ranks_);
   dt_ = cfg_.dt_initial;
   impl_->region.set(std::vector<int>(mesh_.cells(), 0));  // until initialise() finds the material, every cell counts
 }
@@ -205,6 +223,9 @@ VofSolver::VofSolver(Mesh mesh, VofConfig cfg) : mesh_(std::move(mesh)), cfg_(st
 VofSolver::~VofSolver() = default;
 
 std::unique_ptr<VofBackend> make_vof_backend(Mesh mesh, VofConfig cfg) {
+  petsc_init();
+  const Comm world = Comm::of(PETSC_COMM_WORLD);
+  if (world.size > 1) return std::make_unique<DistributedVof>(std::move(mesh), std::move(cfg), world);
   return std::make_unique<VofSolver>(std::move(mesh), std::move(cfg));
 }
 
@@ -278,8 +299,8 @@ void VofSolver::restore(const VofState& st) {
   F.nu1 = st.nu1;
   F.phi = st.phi;
   F.U = st.U;
-  I.bc_ctx.t0 = t_ - dt_;  // the conditions as in the step that led here
-  I.bc_ctx.t1 = t_;
+  I.bc_ctx.t0 = I.bc_ctx.tp0 = t_ - dt_;  // the conditions as in the step that led here
+  I.bc_ctx.t1 = I.bc_ctx.tp1 = t_;
   I.bcs.begin_step(I.bc_ctx);
   I.update_gravity(t_, true);
   // rho from alpha everywhere (outside the halo it was last computed from the same alpha).
@@ -309,6 +330,8 @@ StepStats VofSolver::step(double t_limit) {
   const char* limit = "";
   dt_ = I.next_dt(co, dt_, t_limit - t_, limit);
   t_ += dt_;
+  I.bc_ctx.tp0 = I.bc_ctx.t0;  // the step whose pressure solve gave the fluxes alpha is carried by
+  I.bc_ctx.tp1 = I.bc_ctx.t1;
   I.bc_ctx.t0 = t_ - dt_;
   I.bc_ctx.t1 = t_;
   I.bcs.begin_step(I.bc_ctx);
@@ -349,7 +372,7 @@ StepStats VofSolver::step(double t_limit) {
   st.alpha_co = co.alpha_co;
   st.air_co = co.air_co;
   st.dt_limit = limit;
-  st.active_cells = I.region.n_active;
+  st.active_cells = int(I.region.n_active_total);
   I.diagnostics(st, t_);
   st.seconds_pressure = t_p;
   st.seconds_pressure_solve = I.pressure_solver.ksp_seconds;

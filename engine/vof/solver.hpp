@@ -40,13 +40,16 @@
 #include "engine/vof/error.hpp"
 #include "engine/vof/mesh.hpp"
 #include "engine/vof/backend.hpp"
+#include "engine/vof/mpi/ranks.hpp"
 #include "engine/vof/state.hpp"
 
 namespace runout::engine::vof {
 
 class VofSolver final : public VofBackend {
  public:
-  VofSolver(Mesh mesh, VofConfig cfg);
+  /// ranks: a part of a run split over MPI ranks (mesh: the part's cells, own then ghosts;
+  /// docs/design/parallel.md); by default the whole run on this process.
+  VofSolver(Mesh mesh, VofConfig cfg, Ranks ranks = {});
   ~VofSolver();
   VofSolver(const VofSolver&) = delete;
   VofSolver& operator=(const VofSolver&) = delete;
@@ -64,6 +67,8 @@ class VofSolver final : public VofBackend {
   void run(double t_end, const std::function<bool(const StepStats&)>& hook = {});
 
   const Mesh& mesh() const override { return mesh_; }
+  /// The ranks the run is split over (its halo's traffic counters).
+  const Ranks& ranks() const { return ranks_; }
   double time() const override { return t_; }
   const std::vector<double>& alpha() const override;
   const std::vector<Vec>& velocity() const override;
@@ -80,6 +85,7 @@ class VofSolver final : public VofBackend {
   struct Impl;  // the fields, the equations and their solvers (engine/vof/solver.cpp)
   Mesh mesh_;
   VofConfig cfg_;
+  Ranks ranks_;
   double t_ = 0, dt_ = 0;
   std::unique_ptr<Impl> impl_;
 };

@@ -16,6 +16,7 @@ class VofStepping final : public SteppingEngine {
   StepReport step(double t_end) override;
   /// Sum over the cells of alpha V |U|^2 / 2.
   double kinetic_energy() const override;
+  bool any(bool v) const override { return s_.any(v); }
   /// The last step's statistics (Courant numbers, solver iterations, timings).
   const StepStats& last() const { return last_; }
 

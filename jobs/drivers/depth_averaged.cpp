@@ -19,6 +19,7 @@
 #include <sstream>
 
 #include "engine/sh2d.hpp"
+#include "jobs/formats/checkpoint.hpp"
 #include "jobs/formats/iseesnow.hpp"
 #include "jobs/formats/sh_checkpoint.hpp"
 #include "jobs/formats/timeseries.hpp"
@@ -47,6 +48,8 @@ void record_nest(const NestSummary& n, v1::RunRecord& rec) {
   r->set_recorded_steps(int(n.recorded_steps));
   r->set_start_time_s(n.start_time_s);
   r->set_maps("inside the nest's cells the 3D run's (nest/), outside the depth-averaged run's");
+  for (const auto& q : n.structures) record_structure(q, r->add_structures());
+  if (!std::isnan(n.continued_from)) r->set_continued_from_s(n.continued_from);
 }
 
 void write_record(const std::string& path, const ResolvedScenario& s, const terrain::DemReport& dem_rep, const terrain::Grid& grid,
@@ -287,12 +290,14 @@ class DepthAveragedRun final : public EngineRun {
 };
 
 // The nest's boundary on the grid (the cells whose centres lie inside its polygons, as the nest's
-// corridor takes them) and its gauges after the dams'. A nested run writes no checkpoint (the
-// record of the boundary does not travel in one; hooks()): interrupted, it runs again from the
-// start, and it is not continued from a checkpoint.
+// corridor takes them) and its gauges after the dams'. A nested run's checkpoint is its 3D run's
+// (nest/run.cpp): the depth-averaged part writes none (hooks()) and, continued, runs from its start.
 void DepthAveragedRun::attach_nest(const RunOptions& opt) {
-  if (!opt.restart_path.empty())
-    throw ScenarioError("nest: a run with a 3D nest is not continued from a checkpoint (it writes none); run it from the start");
+  if (!opt.restart_path.empty()) {  // before the depth-averaged part: a checkpoint the 3D run cannot read is refused now
+    const VofCheckpoint cp = read_checkpoint(opt.restart_path);
+    if (!(cp.state.t < s_.end_time_s()))
+      throw ScenarioError("checkpoint " + opt.restart_path + " is at t = " + json_number(cp.state.t) + " s, not before numerics.end_time_s");
+  }
   const std::string what = "nest.path '" + s_.nest->corridor_path + "'";
   nest_ = std::make_unique<nest::NestBoundary>(grid_, terrain::rasterize_polygons(grid_, s_.nest->corridor_path, s_.scenario.nest().crs(), what),
                                                what);
@@ -326,7 +331,7 @@ DepthAveragedRun::DepthAveragedRun(const ResolvedScenario& s, const std::string&
   // Checkpoints: the solver's whole state between two steps, with the scenario's hash; the time
   // series so far lies beside it (CHECKPOINT.timeseries.h5), so that a continued run's outputs are
   // the whole run's.
-  continued = !opt.restart_path.empty();
+  continued = !opt.restart_path.empty() && !nest_;  // a nest's checkpoint is its 3D run's
   if (!opt.checkpoint_path.empty() || continued) hash_ = scenario_hash(s);
   if (!continued) {
     engine_ = std::make_unique<engine::Sh2dEngine>(t_, cfg_, std::move(initial_));
@@ -380,6 +385,13 @@ RunSummary DepthAveragedRun::finish(engine::StopReason stop, const RunTimes& tim
     bool release_inside = false;
     for (std::size_t k = 0; k < h0_.size(); ++k) release_inside = release_inside || (h0_[k] > 0 && nest_->cells()[k]);
     sum.nest = nest::run_nest(s_, *nest_, res.hazard, (fs::path(out_dir_) / "nest").string(), opt_, release_inside);
+    if (sum.nest->cancelled) {  // interrupted in the 3D run: no results (its checkpoint continues it)
+      sum.stop = "cancelled";
+      return sum;
+    }
+    if (!std::isnan(sum.nest->continued_from))
+      sum.notes.push_back("the 3D nest continued from its checkpoint at t = " + json_number(sum.nest->continued_from) +
+                          " s (the depth-averaged run ran again from its start)");
     sum.notes.push_back("inside the 3D nest (" + std::to_string(sum.nest->cells) +
                         " cells) the hazard rasters are the 3D engine's (nest/run.json); outside, the depth-averaged engine's");
   }

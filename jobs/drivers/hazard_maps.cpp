@@ -27,6 +27,29 @@ std::string num(double v) { return figures::label_number(v); }
 
 std::string scenario_name(const ResolvedScenario& s) { return s.scenario.name().empty() ? "runout" : s.scenario.name(); }
 
+// The structures' 3D loads (a 3D run's, or a nest's) on every map: a line each in the parameter block
+// and the highest pressure at the structure, with the loads' verdict (vof_terrain::loads_verdict).
+std::string sig3(double v) {  // three significant digits: the loads are no more precise
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
+
+void add_structure_loads(const RunSummary& sum, figures::HazardMap& m) {
+  std::vector<const StructureSummary*> with;
+  for (const auto& q : sum.structures)
+    if (q.loads) with.push_back(&q);
+  if (sum.nest)
+    for (const auto& q : sum.nest->structures)
+      if (q.loads) with.push_back(&q);
+  for (const auto* q : with) {
+    const std::string verdict = q->loads_resolved ? "" : " (not design values: under-resolved, run.json structures[].loads_note)";
+    m.parameters.push_back("3D loads on " + q->name + ": peak force " + sig3(q->peak_force_kn) + " kN, highest pressure " +
+                           sig3(q->max_pressure_kpa) + " kPa" + verdict);
+    m.points.push_back({structure_load_label(q->name, q->max_pressure_kpa, q->loads_resolved), q->x, q->y});
+  }
+}
+
 // What every map of a run shows besides its quantity: release, outline, points, parameters.
 figures::HazardMap map_base(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const engine::HazardMaps& hz,
                             const MapOverlay& overlay, const RunSummary& sum) {
@@ -42,6 +65,7 @@ figures::HazardMap map_base(const ResolvedScenario& s, const terrain::Grid& grid
   base.parameters = map_parameters(s, grid, sum.release_volume_m3);
   for (const auto& n : sum.notes) base.parameters.push_back("note: " + n);  // run.json's notes, on every map
   for (const auto& p : overlay.points) base.points.push_back({p.name, p.x, p.y});
+  add_structure_loads(sum, base);
   base.path = overlay.path;
   base.path_marks = overlay.path_marks;
   return base;
@@ -252,6 +276,10 @@ std::string cover_line(const ResolvedScenario& s) {
 
 }  // namespace
 
+std::string structure_load_label(const std::string& name, double max_pressure_kpa, bool resolved) {
+  return name + ": " + sig3(max_pressure_kpa) + " kPa" + (resolved ? "" : ", not resolved");
+}
+
 std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain::Grid& grid, double release_volume_m3) {
   const auto& m = s.scenario.material();
   std::vector<std::string> p;
@@ -267,9 +295,10 @@ std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain
     p.push_back("dam: " + d.name + (d.request.has_height ? ", " + num(d.request.height) + " m high" : ", height from '" + d.request.height_attribute + "'"));
   for (const auto& d : s.structures)
     p.push_back("structure: " + d.name +
-                (d.request.has_height                  ? ", " + num(d.request.height) + " m high"
-                 : !d.request.top_attribute.empty() ? ", top from '" + d.request.top_attribute + "'"
-                                                    : ", height from '" + d.request.height_attribute + "'"));
+                (d.request.has_height                   ? ", " + num(d.request.height) + " m high"
+                 : !d.request.top_attribute.empty()  ? ", top from '" + d.request.top_attribute + "'"
+                 : !d.request.surface_path.empty()   ? ", top from the surface model '" + fs::path(d.request.surface_path).filename().string() + "'"
+                                                     : ", height from '" + d.request.height_attribute + "'"));
   p.push_back("release: " + num(std::round(release_volume_m3)) + " m³ in " + std::to_string(s.releases.size()) +
               (s.releases.size() == 1 ? " release" : " releases"));
   for (auto& line : map_footer(grid)) p.push_back(std::move(line));

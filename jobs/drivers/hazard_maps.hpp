@@ -56,6 +56,11 @@ OutputInputs read_output_inputs(const ResolvedScenario& s, const terrain::Grid& 
 void use_flow_path(const ResolvedScenario& s, const terrain::Grid& grid, const std::vector<double>& h0, const std::vector<double>& max_depth,
                    const std::vector<std::array<double, 3>>& centres, OutputInputs& in);
 
+/// The label of a structure with 3D loads on a map: its name and highest pressure to three
+/// significant digits, and ", not resolved" where the loads are no design values
+/// ("farmhouse: 15 kPa, not resolved"). The run's maps and the report's use it.
+std::string structure_load_label(const std::string& name, double max_pressure_kpa, bool resolved);
+
 /// The lines of the maps' parameter block: engine, friction, release, grid, software.
 std::vector<std::string> map_parameters(const ResolvedScenario& s, const terrain::Grid& grid, double release_volume_m3);
 /// The last lines of every map's parameter block: the grid ("grid: 10 m, 200 × 150 cells, EPSG:32632")

@@ -295,6 +295,7 @@ std::vector<StructureSummary> structure_summaries(const ResolvedScenario& s, con
   for (std::size_t a = 0; a < cells.size() && a < s.structures.size(); ++a) {
     const auto& h = cells[a].height;
     StructureSummary q;
+    long n = 0;
     q.name = s.structures[a].name;
     q.cells = cells[a].cells;
     auto on = [&](int i, int j) { return i >= 0 && j >= 0 && i < grid.nx && j < grid.ny && h[std::size_t(j) * grid.nx + i] > 0; };
@@ -303,40 +304,48 @@ std::vector<StructureSummary> structure_summaries(const ResolvedScenario& s, con
         const std::size_t k = std::size_t(j) * grid.nx + i;
         if (on(i, j)) {
           q.height_max_m = std::max(q.height_max_m, h[k]);
+          q.x += grid.x_min + (i + 0.5) * grid.dx, q.y += grid.y_min + (j + 0.5) * grid.dx, ++n;
           continue;
         }
         if (!(on(i - 1, j) || on(i + 1, j) || on(i, j - 1) || on(i, j + 1))) continue;
         q.max_depth_next_m = std::max(q.max_depth_next_m, hz.max_depth[k]);
         if (!hz.max_pressure.empty()) q.max_pressure_next_kpa = std::max(q.max_pressure_next_kpa, hz.max_pressure[k] / 1000);
       }
+    if (n > 0) q.x /= double(n), q.y /= double(n);
     out.push_back(q);
   }
   return out;
 }
 
+void record_structure(const StructureSummary& q, v1::StructureResult* r) {
+  r->set_name(q.name);
+  r->set_x(q.x);
+  r->set_y(q.y);
+  r->set_cells(int(q.cells));
+  r->set_height_max_m(q.height_max_m);
+  r->set_max_depth_next_m(q.max_depth_next_m);
+  r->set_max_pressure_next_kpa(q.max_pressure_next_kpa);
+  if (!q.loads) return;
+  r->set_loads_resolved(q.loads_resolved);
+  r->set_loads_note(q.loads_note);
+  r->set_column_width_m(q.column_width_m);
+  r->set_peak_force_kn(q.peak_force_kn);
+  r->set_peak_force_time_s(q.peak_force_time_s);
+  r->set_peak_force_east_kn(q.peak_force_east_kn);
+  r->set_peak_force_north_kn(q.peak_force_north_kn);
+  r->set_peak_force_up_kn(q.peak_force_up_kn);
+  r->set_impulse_kn_s(q.impulse_kn_s);
+  r->set_max_pressure_kpa(q.max_pressure_kpa);
+  r->set_max_pressure_time_s(q.max_pressure_time_s);
+  r->set_max_pressure_height_m(q.max_pressure_height_m);
+  r->set_wall_area_m2(q.wall_area_m2);
+  for (double v : q.front_height_m) r->add_front_profile_height_m(v);
+  for (double v : q.front_alpha) r->add_front_profile_alpha(v);
+  for (double v : q.front_speed_m_s) r->add_front_profile_speed_m_s(v);
+}
+
 void record_structures(const RunSummary& sum, v1::RunRecord& rec) {
-  for (const auto& q : sum.structures) {
-    auto* r = rec.add_structures();
-    r->set_name(q.name);
-    r->set_cells(int(q.cells));
-    r->set_height_max_m(q.height_max_m);
-    r->set_max_depth_next_m(q.max_depth_next_m);
-    r->set_max_pressure_next_kpa(q.max_pressure_next_kpa);
-    if (!q.loads) continue;
-    r->set_peak_force_kn(q.peak_force_kn);
-    r->set_peak_force_time_s(q.peak_force_time_s);
-    r->set_peak_force_east_kn(q.peak_force_east_kn);
-    r->set_peak_force_north_kn(q.peak_force_north_kn);
-    r->set_peak_force_up_kn(q.peak_force_up_kn);
-    r->set_impulse_kn_s(q.impulse_kn_s);
-    r->set_max_pressure_kpa(q.max_pressure_kpa);
-    r->set_max_pressure_time_s(q.max_pressure_time_s);
-    r->set_max_pressure_height_m(q.max_pressure_height_m);
-    r->set_wall_area_m2(q.wall_area_m2);
-    for (double v : q.front_height_m) r->add_front_profile_height_m(v);
-    for (double v : q.front_alpha) r->add_front_profile_alpha(v);
-    for (double v : q.front_speed_m_s) r->add_front_profile_speed_m_s(v);
-  }
+  for (const auto& q : sum.structures) record_structure(q, rec.add_structures());
 }
 
 }  // namespace runout::jobs

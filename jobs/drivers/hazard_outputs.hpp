@@ -43,6 +43,8 @@ std::string steep_terrain_note(const ResolvedScenario& s, const terrain::Grid& g
 /// pressure of the maps `hz` (density rho [kg/m3] times the squared speed, in kPa).
 std::vector<StructureSummary> structure_summaries(const ResolvedScenario& s, const terrain::Grid& grid,
                                                   const std::vector<terrain::DamCells>& cells, const engine::HazardMaps& hz);
+/// One structure into a run.json StructureResult (the load figures only where it has loads).
+void record_structure(const StructureSummary& q, v1::StructureResult* r);
 /// The structures of `sum` into run.json's structures[].
 void record_structures(const RunSummary& sum, v1::RunRecord& rec);
 

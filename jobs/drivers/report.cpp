@@ -10,6 +10,7 @@
 #include <optional>
 #include <sstream>
 
+#include "jobs/drivers/hazard_maps.hpp"
 #include "jobs/drivers/hazard_outputs.hpp"
 #include "jobs/figures/palette.hpp"
 #include "jobs/figures/pen.hpp"
@@ -106,17 +107,6 @@ std::vector<figures::ReportSection> summary(const v1::RunRecord& rec) {
   return out;
 }
 
-std::vector<figures::ReportTable> tables(const v1::RunRecord& rec) {
-  figures::ReportTable pts{"Points of interest", {"point", "max depth [m]", "max speed [m/s]", "max pressure [kPa]", "zone", "arrival [s]", "inside the outline"}, {}};
-  for (const auto& p : rec.results().points_of_interest())
-    pts.rows.push_back({p.name(), num(p.max_depth_m(), 3), num(p.max_speed_m_s(), 3), num(p.max_pressure_kpa(), 4), p.zone().empty() ? "–" : p.zone(),
-                        p.has_arrival_time_s() ? num(p.arrival_time_s(), 3) : "–", p.inside_outline() ? "yes" : "no"});
-  figures::ReportTable zones{"Pressure zones (" + rec.results().pressure_zones_criterion() + ")", {"zone", "from [kPa]", "to [kPa]", "area [km²]", "polygons"}, {}};
-  for (const auto& z : rec.results().pressure_zones())
-    zones.rows.push_back({z.name(), num(z.from_kpa()), z.has_to_kpa() ? num(z.to_kpa()) : "–", num(z.area_m2() / 1e6, 3), std::to_string(z.polygons())});
-  return {pts, zones};
-}
-
 // The maps' extent: the outline and the release with a margin of a tenth (at least 200 m), on the grid.
 std::array<double, 4> extent(const terrain::Grid& g, const std::vector<double>& depth, const std::vector<double>& release, double threshold) {
   double x0 = HUGE_VAL, y0 = HUGE_VAL, x1 = -HUGE_VAL, y1 = -HUGE_VAL;
@@ -132,7 +122,36 @@ std::array<double, 4> extent(const terrain::Grid& g, const std::vector<double>& 
   return {std::max(g.x_min, x0 - m), std::max(g.y_min, y0 - m), std::min(g.x_min + g.nx * g.dx, x1 + m), std::min(g.y_min + g.ny * g.dx, y1 + m)};
 }
 
+// The structures: the flow next to each (the run's maps) and, from a 3D run or a nest's, its loads
+// with their verdict.
+figures::ReportTable structures_table(const v1::RunRecord& rec) {
+  figures::ReportTable t{"Structures", {"structure", "height [m]", "flow next to it [m]", "ρu² next to it [kPa]", "3D peak force [kN]",
+                                        "3D highest pressure [kPa]", "3D loads"}, {}};
+  for (const auto& q : rec.structures()) {
+    const v1::StructureResult* l = q.has_peak_force_kn() ? &q : nullptr;
+    for (const auto& n : rec.nest().structures())
+      if (n.name() == q.name() && n.has_peak_force_kn()) l = &n;
+    t.rows.push_back({q.name(), num(q.height_max_m(), 3), num(q.max_depth_next_m(), 3), num(q.max_pressure_next_kpa(), 4),
+                      l ? num(l->peak_force_kn(), 4) : "–", l ? num(l->max_pressure_kpa(), 4) : "–",
+                      !l ? "–" : l->loads_resolved() ? "resolved" : "not design values (under-resolved)"});
+  }
+  return t;
+}
+
 }  // namespace
+
+std::vector<figures::ReportTable> report_tables(const v1::RunRecord& rec) {
+  figures::ReportTable pts{"Points of interest", {"point", "max depth [m]", "max speed [m/s]", "max pressure [kPa]", "zone", "arrival [s]", "inside the outline"}, {}};
+  for (const auto& p : rec.results().points_of_interest())
+    pts.rows.push_back({p.name(), num(p.max_depth_m(), 3), num(p.max_speed_m_s(), 3), num(p.max_pressure_kpa(), 4), p.zone().empty() ? "–" : p.zone(),
+                        p.has_arrival_time_s() ? num(p.arrival_time_s(), 3) : "–", p.inside_outline() ? "yes" : "no"});
+  figures::ReportTable zones{"Pressure zones (" + rec.results().pressure_zones_criterion() + ")", {"zone", "from [kPa]", "to [kPa]", "area [km²]", "polygons"}, {}};
+  for (const auto& z : rec.results().pressure_zones())
+    zones.rows.push_back({z.name(), num(z.from_kpa()), z.has_to_kpa() ? num(z.to_kpa()) : "–", num(z.area_m2() / 1e6, 3), std::to_string(z.polygons())});
+  std::vector<figures::ReportTable> out{pts, zones};
+  if (rec.structures_size() > 0) out.push_back(structures_table(rec));
+  return out;
+}
 
 bool write_report_output(const std::string& run_dir, const std::string& paper, RunSummary& sum) {
   const fs::path pdf = fs::path(run_dir) / "report.pdf", part = fs::path(run_dir) / "report.pdf.part";
@@ -169,7 +188,7 @@ figures::ReportLayout write_run_report(const std::string& run_dir, const std::st
   r.subtitle = "Hazard maps of a " + rec.engine() + " run of " + rec.created_utc() + ", runout " + rec.software().version() + " (" +
                rec.software().git_commit().substr(0, 10) + "); report of " + today_utc();
   r.sections = summary(rec);
-  r.tables = tables(rec);
+  r.tables = report_tables(rec);
   std::string dem = rec.inputs_size() > 0 ? fs::path(rec.inputs(0).path()).filename().string() : rec.scenario().dem().path();
   r.footer = r.title + "  ·  DEM: " + dem + " (" + rec.dem().source_crs() + ", " + num(rec.dem().source_resolution_m(), 3) + " m; its owner's terms apply)  ·  runout " +
              rec.software().version();
@@ -184,6 +203,10 @@ figures::ReportLayout write_run_report(const std::string& run_dir, const std::st
   base.max_depth = depth;
   base.outline_threshold = thr;
   for (const auto& p : rec.results().points_of_interest()) base.points.push_back({p.name(), p.x(), p.y()});
+  for (const auto* list : {&rec.structures(), &rec.nest().structures()})  // the structures with 3D loads, as on the run's maps
+    for (const auto& q : *list)
+      if (q.has_peak_force_kn())
+        base.points.push_back({structure_load_label(q.name(), q.max_pressure_kpa(), q.loads_resolved()), q.x(), q.y()});
   const auto cols = read_profile(dir / "path_profile.csv");
   for (std::size_t k = 0; k < cols[1].size(); ++k) base.path.emplace_back(cols[1][k], cols[2][k]);
   r.profile = profile(rec, cols, r.title);

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "jobs/drivers/run.hpp"
+#include "jobs/formats/run_record.hpp"
 #include "jobs/figures/report.hpp"
 
 namespace runout::jobs {
@@ -20,6 +21,11 @@ struct ReportOptions {
 /// beside and moved into place. Returns false, with a note in `sum.notes` and no file, when the
 /// report cannot be made: the run's results stand without it.
 bool write_report_output(const std::string& run_dir, const std::string& paper, RunSummary& sum);
+
+/// The report's tables from a run's record: the points of interest, the pressure zones and, where
+/// the run has structures, the structures (the flow next to each; a 3D run's or a nest's loads with
+/// their verdict).
+std::vector<figures::ReportTable> report_tables(const v1::RunRecord& rec);
 
 /// Write the report of the run in `run_dir` to `pdf_path`. Throws std::runtime_error naming the file
 /// that is missing or unreadable (a laboratory run has no maps on terrain: refused).

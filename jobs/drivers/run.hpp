@@ -28,6 +28,7 @@ struct NestLink {
   double volume_error = 0;     ///< the 3D run's own balance
   long mesh_cells = 0;
   double column_width_m = 0, first_layer_m = 0, band_height_m = 0;
+  double continued_from = NAN;  ///< the 3D run's checkpoint time when it continued from one
 };
 
 struct RunOptions {
@@ -67,14 +68,6 @@ struct DamSummary {
   double max_depth_m = 0;  ///< on the dam's cells (above its crest)
 };
 
-/// The 3D nest of a depth-averaged run (proto NestResult).
-struct NestSummary {
-  int cells = 0, boundary_faces = 0;
-  long mesh_cells = 0, recorded_steps = 0;
-  double column_width_m = 0, first_layer_m = 0, band_height_m = 0;
-  double inflow_depth_averaged_m3 = 0, inflow_3d_m3 = 0, volume_error_3d = 0, seconds_3d = 0, start_time_s = 0;
-};
-
 /// A structure (scenario structures[]) and the flow's load on it (proto StructureResult).
 struct StructureSummary {
   std::string name;
@@ -85,6 +78,21 @@ struct StructureSummary {
   double peak_force_kn = 0, peak_force_time_s = 0, peak_force_east_kn = 0, peak_force_north_kn = 0, peak_force_up_kn = 0;
   double impulse_kn_s = 0, max_pressure_kpa = 0, max_pressure_time_s = 0, max_pressure_height_m = 0, wall_area_m2 = 0;
   std::vector<double> front_height_m, front_alpha, front_speed_m_s;
+  double x = 0, y = 0;  ///< its cells' centroid in the grid's CRS
+  bool loads_resolved = false;  ///< 3D: the impact is resolved (StructureLoads::summarise's rule)
+  std::string loads_note;       ///< 3D: why the loads are (not) design values
+  double column_width_m = 0;    ///< 3D: the mesh's column width
+};
+
+/// The 3D nest of a depth-averaged run (proto NestResult).
+struct NestSummary {
+  int cells = 0, boundary_faces = 0;
+  long mesh_cells = 0, recorded_steps = 0;
+  double column_width_m = 0, first_layer_m = 0, band_height_m = 0;
+  double inflow_depth_averaged_m3 = 0, inflow_3d_m3 = 0, volume_error_3d = 0, seconds_3d = 0, start_time_s = 0;
+  std::vector<StructureSummary> structures;  ///< the 3D run's: the structures' loads
+  bool cancelled = false;       ///< the 3D run was stopped by the progress hook: the nested run writes no results
+  double continued_from = NAN;  ///< the 3D run continued from a checkpoint at this time [s]; NaN: from its start
 };
 
 struct RunSummary {

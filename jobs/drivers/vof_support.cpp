@@ -2,7 +2,10 @@
 
 #include <petscsys.h>
 
+#include "engine/vof/mpi/distributed.hpp"
+
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 
 namespace runout::jobs {
@@ -21,6 +24,51 @@ std::string petsc_options() {
   std::string s(all);
   PetscFree(all);
   return s;
+}
+
+}  // namespace runout::jobs
+
+namespace runout::jobs {
+
+void record_distribution(const engine::vof::VofBackend& backend, long steps, v1::RunRecord& rec) {
+  const auto* d = dynamic_cast<const engine::vof::DistributedVof*>(&backend);
+  if (!d) return;
+  const auto& comm = d->partition().parts;
+  const auto t = d->take_traffic();
+  const engine::vof::Comm& c = engine::vof::Comm::of(PETSC_COMM_WORLD);
+  auto* out = rec.mutable_execution()->mutable_distribution();
+  out->set_ranks(comm);
+  out->set_cells(d->mesh().cells());
+  out->set_cut_faces(d->partition().cut_faces);
+  out->set_imbalance(d->partition().imbalance);
+  out->set_ghost_share(double(c.sum((long long)d->part().ghosts())) / d->mesh().cells());
+  const double per = 1.0 / double(std::max(1L, steps));
+  out->set_exchanges_per_step(double(t.exchanges) * per);
+  out->set_halo_bytes_per_step(double(c.sum(t.bytes)) * per);
+  out->set_by_columns(d->part().columns.columns() > 0);
+  out->set_strips(d->partition().strips);
+}
+
+LaunchRanks launch_ranks() {
+  // Open MPI's mpirun, MPICH's launchers (PMI), Slurm's srun (its tasks).
+  const std::pair<const char*, const char*> vars[] = {
+      {"OMPI_COMM_WORLD_RANK", "OMPI_COMM_WORLD_SIZE"}, {"PMI_RANK", "PMI_SIZE"}, {"SLURM_PROCID", "SLURM_NTASKS"}};
+  for (const auto& [r, n] : vars) {
+    const char* rank = std::getenv(r);
+    const char* size = std::getenv(n);
+    if (rank && size) return {std::atoi(rank), std::max(1, std::atoi(size))};
+  }
+  return {};
+}
+
+void finish_mpi(int exit_code) {
+  PetscBool started = PETSC_FALSE;
+  PetscInitialized(&started);
+  if (!started) return;
+  int size = 1;
+  MPI_Comm_size(PETSC_COMM_WORLD, &size);
+  if (exit_code != 0 && size > 1) MPI_Abort(PETSC_COMM_WORLD, exit_code);
+  PetscFinalize();
 }
 
 }  // namespace runout::jobs

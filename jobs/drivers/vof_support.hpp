@@ -4,6 +4,7 @@
 #include <string>
 
 #include "engine/vof/backend.hpp"
+#include "runout/v1/run_record.pb.h"
 #include "jobs/drivers/run.hpp"
 
 namespace runout::jobs {
@@ -15,5 +16,23 @@ std::mutex& petsc_turn();
 /// PETSc's options database as the run used it (PETSC_OPTIONS and the engine's defaults); empty
 /// before PETSc started.
 std::string petsc_options();
+
+/// The run record's `execution.distribution` when `backend` ran split over MPI ranks (collective:
+/// every rank calls it); steps: the run's steps.
+void record_distribution(const engine::vof::VofBackend& backend, long steps, v1::RunRecord& rec);
+
+/// This process's place under an MPI launcher (`mpirun -n N`, `srun` with N tasks), read from the
+/// launcher's environment before MPI starts: {0, 1} when the program runs alone. A 3D run then
+/// splits over the N processes (engine/vof/mpi/distributed.hpp).
+struct LaunchRanks {
+  int rank = 0, size = 1;
+};
+LaunchRanks launch_ranks();
+
+/// At the end of a program that may have run split over MPI ranks: PETSc finished, and with it MPI
+/// when PETSc started it (a launcher reports a process that ends without it as failed). A failure
+/// (exit_code != 0) on one rank of several aborts them all with that code: the others would wait
+/// for it in their next exchange.
+void finish_mpi(int exit_code);
 
 }  // namespace runout::jobs

@@ -162,7 +162,9 @@ int worker_main(int in_fd, int out_fd) {
     v1::WorkerEvent ev;
     if (sum.stop == "cancelled" && !task.validate_only()) {
       ev.mutable_interrupted()->set_simulated_s(sum.t);
-      ev.mutable_interrupted()->set_checkpoint_written(!task.checkpoint_path().empty());
+      // Whether a checkpoint lies there now: a nested run stopped in its depth-averaged part has none.
+      std::error_code ec;
+      ev.mutable_interrupted()->set_checkpoint_written(!task.checkpoint_path().empty() && std::filesystem::exists(task.checkpoint_path(), ec));
     } else {
       auto* d = ev.mutable_done();
       d->set_steps(sum.steps);

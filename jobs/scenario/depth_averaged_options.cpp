@@ -147,8 +147,53 @@ OptionTable output_options() {
   };
 }
 
-// The `variations` block (an ensemble, jobs/ensemble): checked here field by field; what the values
-// make (members, the aggregate's settings) is jobs/ensemble/variations.cpp's.
+// What is built on the ground and where 3D runs: dams and walls, structures, a 3D nest.
+OptionTable works_options() {
+  return {
+      {"dams[].name", T::text, U::as_given, "", {}, {}, "", "the dam's name in run.json and on the maps; default \"dam N\"",
+       "ResolvedScenario::dams"},
+      {"dams[].path", T::path, U::required, "", {}, {}, "",
+       "crest lines or footprints (polygons) in any CRS: a step of the height on the cells they touch",
+       "ResolvedScenario::dams"},
+      {"dams[].crs", T::text, U::as_given, "", {}, {}, "", "the file's CRS when it has none", "ResolvedScenario::dams"},
+      {"dams[].height_m", T::number, U::as_given, "", Range{0, 100, true}, {}, "m", "the dam's height above the ground (or height_attribute)",
+       "DamRequest::height"},
+      {"dams[].height_attribute", T::text, U::as_given, "", {}, {}, "", "the attribute that holds each feature's height",
+       "DamRequest::height_attribute"},
+      {"nest.path", T::path, U::as_given, "", {}, {}, "",
+       "a 3D nest: polygons (any CRS); the grid cells whose centres lie inside are run by the 3D engine with the "
+       "depth-averaged flux through their boundary, and their hazard rasters are the 3D run's",
+       "ResolvedScenario::nest"},
+      {"nest.crs", T::text, U::as_given, "", {}, {}, "", "the nest polygons' CRS when the file has none", "ResolvedScenario::nest"},
+      {"nest.refinement", T::integer, U::keep, "4", Range{1, 8}, {}, "",
+       "the nest's mesh columns per grid cell along each axis (columns of the grid's cell over this)", "ResolvedScenario::nest"},
+      {"nest.first_layer_m", T::number, U::as_given, "", Range{0, 100, true}, {}, "m",
+       "the nest mesh's ground layer; default a fifth of the deepest flow through the nest", "ResolvedScenario::nest"},
+      {"nest.band_height_m", T::number, U::as_given, "", Range{0, 1000, true}, {}, "m",
+       "the nest mesh's height above the ground; default eight times the deepest flow through the nest", "ResolvedScenario::nest"},
+      {"structures[].name", T::text, U::as_given, "", {}, {}, "", "the structure's name in run.json, the loads' files and on the maps; default \"structure N\"",
+       "ResolvedScenario::structures"},
+      {"structures[].path", T::path, U::as_given, "", {}, {}, "",
+       "footprints (polygons) in any CRS: a wall of the height on the cells they touch (depth-averaged), an obstacle with its own walls (3D); "
+       "required but with surface_path",
+       "ResolvedScenario::structures"},
+      {"structures[].crs", T::text, U::as_given, "", {}, {}, "", "the file's CRS when it has none", "ResolvedScenario::structures"},
+      {"structures[].height_m", T::number, U::as_given, "", Range{0, 100, true}, {}, "m",
+       "the structure's height above the ground (or height_attribute, or top_attribute)", "DamRequest::height"},
+      {"structures[].height_attribute", T::text, U::as_given, "", {}, {}, "", "the attribute that holds each feature's height [m]",
+       "DamRequest::height_attribute"},
+      {"structures[].top_attribute", T::text, U::as_given, "", {}, {}, "",
+       "the attribute that holds each feature's top elevation [m]; its height is the top less each cell's ground", "DamRequest::top_attribute"},
+      {"structures[].surface_path", T::path, U::as_given, "", {}, {}, "",
+       "a surface model (DSM, raster in any CRS): the top at each cell's centre; with path inside the footprints, without it the cells "
+       "where it stands min_height_m above the ground",
+       "DamRequest::surface_path"},
+      {"structures[].min_height_m", T::number, U::as_given, "", Range{0, 100, true}, {}, "m",
+       "with surface_path: the least height of the surface over the ground that counts as the structure; default 2",
+       "DamRequest::min_height"},
+  };
+}
+
 // What lies on the ground: resistance areas (forest) and the erodible cover (entrainment).
 OptionTable ground_options() {
   return {
@@ -209,42 +254,11 @@ OptionTable ground_options() {
        }},
       {"entrainment.density_kg_m3", T::number, U::keep, "100", Range{1, 1000}, {}, "kg/m^3",
        "the cover's density for the areas that give none (com1DFA's rhoEnt)", "ErodibleCover::density"},
-      {"dams[].name", T::text, U::as_given, "", {}, {}, "", "the dam's name in run.json and on the maps; default \"dam N\"",
-       "ResolvedScenario::dams"},
-      {"dams[].path", T::path, U::required, "", {}, {}, "",
-       "crest lines or footprints (polygons) in any CRS: a step of the height on the cells they touch",
-       "ResolvedScenario::dams"},
-      {"dams[].crs", T::text, U::as_given, "", {}, {}, "", "the file's CRS when it has none", "ResolvedScenario::dams"},
-      {"dams[].height_m", T::number, U::as_given, "", Range{0, 100, true}, {}, "m", "the dam's height above the ground (or height_attribute)",
-       "DamRequest::height"},
-      {"dams[].height_attribute", T::text, U::as_given, "", {}, {}, "", "the attribute that holds each feature's height",
-       "DamRequest::height_attribute"},
-      {"nest.path", T::path, U::as_given, "", {}, {}, "",
-       "a 3D nest: polygons (any CRS); the grid cells whose centres lie inside are run by the 3D engine with the "
-       "depth-averaged flux through their boundary, and their hazard rasters are the 3D run's",
-       "ResolvedScenario::nest"},
-      {"nest.crs", T::text, U::as_given, "", {}, {}, "", "the nest polygons' CRS when the file has none", "ResolvedScenario::nest"},
-      {"nest.refinement", T::integer, U::keep, "4", Range{1, 8}, {}, "",
-       "the nest's mesh columns per grid cell along each axis (columns of the grid's cell over this)", "ResolvedScenario::nest"},
-      {"nest.first_layer_m", T::number, U::as_given, "", Range{0, 100, true}, {}, "m",
-       "the nest mesh's ground layer; default a fifth of the deepest flow through the nest", "ResolvedScenario::nest"},
-      {"nest.band_height_m", T::number, U::as_given, "", Range{0, 1000, true}, {}, "m",
-       "the nest mesh's height above the ground; default eight times the deepest flow through the nest", "ResolvedScenario::nest"},
-      {"structures[].name", T::text, U::as_given, "", {}, {}, "", "the structure's name in run.json, the loads' files and on the maps; default \"structure N\"",
-       "ResolvedScenario::structures"},
-      {"structures[].path", T::path, U::required, "", {}, {}, "",
-       "footprints (polygons) in any CRS: a wall of the height on the cells they touch (depth-averaged), an obstacle with its own walls (3D)",
-       "ResolvedScenario::structures"},
-      {"structures[].crs", T::text, U::as_given, "", {}, {}, "", "the file's CRS when it has none", "ResolvedScenario::structures"},
-      {"structures[].height_m", T::number, U::as_given, "", Range{0, 100, true}, {}, "m",
-       "the structure's height above the ground (or height_attribute, or top_attribute)", "DamRequest::height"},
-      {"structures[].height_attribute", T::text, U::as_given, "", {}, {}, "", "the attribute that holds each feature's height [m]",
-       "DamRequest::height_attribute"},
-      {"structures[].top_attribute", T::text, U::as_given, "", {}, {}, "",
-       "the attribute that holds each feature's top elevation [m]; its height is the top less each cell's ground", "DamRequest::top_attribute"},
-        };
+  };
 }
 
+// The `variations` block (an ensemble, jobs/ensemble): checked here field by field; what the values
+// make (members, the aggregate's settings) is jobs/ensemble/variations.cpp's.
 OptionTable variation_options() {
   const Range positive{0, kMaxDepthThreshold * 1e3, true};
   return {
@@ -460,7 +474,7 @@ OptionTable numerics_options() {
 const OptionTable& depth_averaged_options() {
   static const OptionTable t = [] {
     OptionTable v;
-    for (auto* part : {terrain_options, material_options, numerics_options, output_options, ground_options, variation_options})
+    for (auto* part : {terrain_options, material_options, numerics_options, output_options, ground_options, works_options, variation_options})
       for (auto& o : part()) v.push_back(std::move(o));
     return v;
   }();

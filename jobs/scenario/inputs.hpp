@@ -30,7 +30,10 @@ void for_each_input_path(v1::Scenario& s, F f) {
   for (int k = 0; k < s.resistance().areas_size(); ++k)
     each("resistance.areas[" + std::to_string(k) + "].path", s.mutable_resistance()->mutable_areas(k)->mutable_path());
   for (int k = 0; k < s.dams_size(); ++k) each("dams[" + std::to_string(k) + "].path", s.mutable_dams(k)->mutable_path());
-  for (int k = 0; k < s.structures_size(); ++k) each("structures[" + std::to_string(k) + "].path", s.mutable_structures(k)->mutable_path());
+  for (int k = 0; k < s.structures_size(); ++k) {
+    each("structures[" + std::to_string(k) + "].path", s.mutable_structures(k)->mutable_path());
+    each("structures[" + std::to_string(k) + "].surface_path", s.mutable_structures(k)->mutable_surface_path());
+  }
   if (s.has_nest()) each("nest.path", s.mutable_nest()->mutable_path());
   for (int k = 0; k < s.entrainment().areas_size(); ++k) {
     const std::string at = "entrainment.areas[" + std::to_string(k) + "]";

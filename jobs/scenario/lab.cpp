@@ -74,6 +74,47 @@ void check_boundaries(const v1::Lab& l, bool three_d) {
   }
 }
 
+// The upstream extent of an obstacle along x [m].
+double obstacle_upstream_x(const v1::LabObstacle& o) {
+  if (o.shape() == "cylinder") return o.x() - o.radius();
+  if (o.shape() == "polygon") {
+    double x = o.polygon_xy(0);
+    for (int q = 0; q + 1 < o.polygon_xy_size(); q += 2) x = std::min(x, o.polygon_xy(q));
+    return x;
+  }
+  // A tetrahedron's footprint: an equilateral triangle whose corners lie a / sqrt(3) from its centre,
+  // a corner upstream (edge first) or a side a / (2 sqrt(3)) upstream (face first; geometry.cpp).
+  const double r = o.edge() / std::sqrt(3.0);
+  return o.x() - (o.shape() == "tetrahedron-edge" ? r : 0.5 * r);
+}
+
+// A nest (lab.nest): fed only by a whole left side's inflow on a fixed plane channel, its face inside
+// the domain with at least 4 cells below it and upstream of every obstacle.
+void check_nest(const v1::Lab& l) {
+  if (!(l.nest().x_min() > l.x_min() && l.nest().x_min() < l.x_max())) bad("lab.nest.x_min", "must lie between lab.x_min and lab.x_max");
+  const LabNestFace face = lab_nest_face(l);  // what the run takes: the checks below are on it
+  const double x = face.x;
+  if (face.cells < 4) bad("lab.nest.x_min", "leaves fewer than 4 cells to the 3D run");
+  if (face.cells >= l.nx()) bad("lab.nest.x_min", "lies on the inflow (the nearest face of the cells is x_min): no chute above it");
+  if (l.has_chute()) bad("lab.nest", "a nest needs a plane chute (not lab.chute)");
+  if (l.rotation_period_s() > 0) bad("lab.nest", "a nest needs a fixed channel (not lab.rotation_period_s)");
+  if (!l.fill().empty()) bad("lab.fill", "a nested laboratory run is fed only through its inflow (no fill regions)");
+  int inflows = 0;
+  for (const auto& b : l.boundaries())
+    if (b.side() == "left") {
+      if (b.kind() != "inflow" || b.has_from() || b.has_to()) bad("lab.boundaries", "a nest needs the whole left side an inflow (no from/to)");
+      ++inflows;
+    }
+  if (inflows != 1) bad("lab.boundaries", "a nest needs the whole left side an inflow (the depth-averaged run's source)");
+  for (int k = 0; k < l.obstacles_size(); ++k)
+    if (obstacle_upstream_x(l.obstacles(k)) <= x)
+      bad("lab.nest.x_min", "must lie upstream of lab.obstacles[" + std::to_string(k) + "] (the depth-averaged run does not see it; the face moves to " +
+                                json_number(x) + " m, the nearest face of the cells)");
+  for (int k = 0; k < l.stations_x_size(); ++k)
+    if (l.stations_x(k) < x)
+      bad("lab.stations_x[" + std::to_string(k) + "]", "lies above the nest's face (" + json_number(x) + " m): the 3D run does not cover it");
+}
+
 // The granular viscosity model with the lab block's parameters: each in its row's range and the
 // model's own checks (engine/vof/models; for mu(I) the join of its branches).
 void check_rheology(const v1::Lab& l) {
@@ -84,6 +125,14 @@ void check_rheology(const v1::Lab& l) {
 }
 
 }  // namespace
+
+LabNestFace lab_nest_face(const v1::Lab& l) {
+  const double dx = (l.x_max() - l.x_min()) / l.nx();
+  LabNestFace f;
+  f.cells = int(std::lround((l.x_max() - l.nest().x_min()) / dx));
+  f.x = l.x_max() - f.cells * dx;
+  return f;
+}
 
 void apply_lab_rheology(const v1::Lab& l, engine::vof::VofConfig& c) {
   if (l.has_side_wall_width_m()) {
@@ -111,11 +160,12 @@ ResolvedScenario resolve_lab(v1::Scenario s) {
   check_obstacles(l, three_d);
   bool fed = false;
   for (const auto& b : l.boundaries()) fed |= b.kind() == "inflow";
-  if (l.fill().empty() && !fed) bad("lab.fill", "at least one region of granular material is needed (or an inflow)");
+  if (l.fill().empty() && !fed && !l.has_nest()) bad("lab.fill", "at least one region of granular material is needed (or an inflow)");
   if (l.has_chute()) check_chute(l, three_d);
   check_fill(l, three_d);
   check_boundaries(l, three_d);
   check_rheology(l);
+  if (l.has_nest()) check_nest(l);
   if (l.has_side_wall_width_m() != l.has_side_wall_friction_deg())
     bad(l.has_side_wall_width_m() ? "lab.side_wall_friction_deg" : "lab.side_wall_width_m",
         "the side walls need both their width and their friction angle");

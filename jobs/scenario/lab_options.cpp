@@ -130,6 +130,10 @@ OptionTable lab_run_options() {
        "layers of air cells computed around the material; -1: every cell", "VofConfig::active_layers"},
       {"lab.checkpoint_interval_s", T::number, U::as_given, "", Range{0, kTime}, {}, "s",
        "with `runout run --checkpoint`: a checkpoint this often (simulated time)", "run control", "only when interrupted"},
+      {"lab.nest.x_min", T::number, U::as_given, "", kCoord, {}, "m",
+       "a nest: the 3D run covers [nest.x_min, x_max], the chute above runs on the depth-averaged engine (1D) from the left "
+       "inflow and feeds it there (upstream of every obstacle; moved to the nearest face of the cells)",
+       "the 3D mesh and its left side"},
       {"lab.obstacles[].shape", T::choice, U::required, "", {}, {"polygon", "cylinder", "tetrahedron-edge", "tetrahedron-face"}, "",
        "cells inside are left out (cylinder, tetrahedra: 3D)", "mesh"},
       coord("lab.obstacles[].polygon_xy[]", "polygon: x1, y1, x2, y2, ... (at least 3 corners)"),

@@ -254,13 +254,18 @@ void resolve_cover(const v1::Scenario& s, const std::string& base, ResolvedScena
 }
 
 // A dam's or a structure's file with its name (or `fallback`) and height fields, as a request.
+bool has_surface(const v1::Dam&) { return false; }
+bool has_surface(const v1::Structure& d) { return !d.surface_path().empty(); }
+
 template <class M>
 DamSettings vector_with_height(const M& d, const std::string& f, const std::string& fallback, const std::string& base, ResolvedScenario& r) {
   DamSettings q;
   q.name = d.name().empty() ? fallback : d.name();
   q.request.field = f;
-  q.request.path = path_in(base, d.path(), f + ".path");
-  add_vector(q.request.path, f + ".path", r);
+  if (!d.path().empty() || !has_surface(d)) {  // a structure from a surface model may go without footprints
+    q.request.path = path_in(base, d.path(), f + ".path");
+    add_vector(q.request.path, f + ".path", r);
+  }
   q.request.crs = d.crs();
   q.request.has_height = d.has_height_m();
   q.request.height = d.height_m();
@@ -286,10 +291,18 @@ void resolve_structures(const v1::Scenario& s, const std::string& base, Resolved
     DamSettings q = vector_with_height(s.structures(a), f, "structure " + std::to_string(a + 1), base, r);
     for (const auto& other : r.structures)
       if (other.name == q.name) bad(f + ".name", "\"" + q.name + "\" names another structure already; each needs its own name");
-    q.request.top_attribute = s.structures(a).top_attribute();
-    const int given = int(q.request.has_height) + int(!q.request.height_attribute.empty()) + int(!q.request.top_attribute.empty());
-    if (given == 0) bad(f, "needs height_m, height_attribute or top_attribute");
-    if (given > 1) bad(f, "give one of height_m, height_attribute and top_attribute, not several");
+    const auto& st = s.structures(a);
+    q.request.top_attribute = st.top_attribute();
+    if (!st.surface_path().empty()) {
+      q.request.surface_path = path_in(base, st.surface_path(), f + ".surface_path");
+      add_raster(q.request.surface_path, f + ".surface_path", r);
+    }
+    if (st.has_min_height_m() && st.surface_path().empty()) bad(f + ".min_height_m", "only with surface_path");
+    q.request.min_height = st.has_min_height_m() ? st.min_height_m() : 2.0;
+    const int given = int(q.request.has_height) + int(!q.request.height_attribute.empty()) + int(!q.request.top_attribute.empty()) +
+                      int(!q.request.surface_path.empty());
+    if (given == 0) bad(f, "needs height_m, height_attribute, top_attribute or surface_path");
+    if (given > 1) bad(f, "give one of height_m, height_attribute, top_attribute and surface_path, not several");
     r.structures.push_back(q);
   }
 }
@@ -446,8 +459,7 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   apply_option_rules(scenario_options(), s);
   const bool vof = s.engine() == "vof";
   if (vof && s.has_lab()) return resolve_lab(std::move(s));
-  if (!vof && (s.has_mesh() || s.has_vof()))
-    bad(s.has_mesh() ? "mesh" : "vof", "only for engine \"vof\" (the 3D engine on the DEM)");
+  if (!vof && s.has_mesh()) bad("mesh", "only for engine \"vof\" (the 3D engine on the DEM); a nest's mesh is in `nest`");
   if (vof && s.has_nest()) bad("nest", "only for engine \"depth-averaged\": the nest is a 3D run inside a depth-averaged one");
   // The option tables fill the defaults and check every field's range or choices; the checks
   // between fields and the input files follow.
@@ -455,6 +467,8 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   if (s.has_resistance() && s.resistance().ByteSizeLong() == 0) s.clear_resistance();  // only its defaults: none
   if (s.has_entrainment() && s.entrainment().ByteSizeLong() == 0) s.clear_entrainment();
   if (s.has_nest() && s.nest().ByteSizeLong() == 0) s.clear_nest();  // only its defaults: none
+  if (!vof && s.has_vof() && !s.has_nest())  // a depth-averaged scenario's `vof` block is its nest's 3D run
+    bad("vof", "only for engine \"vof\" (the 3D engine on the DEM), or for the 3D run of a depth-averaged scenario's nest");
   if (vof) {
     const double write_given = s.vof().write_interval_s();
     apply_option_rules(terrain_vof_options(), s);

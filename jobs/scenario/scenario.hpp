@@ -154,6 +154,14 @@ ResolvedScenario load_scenario(const std::string& path);
 /// Resolve and validate a message; relative paths are taken from `base_dir`. Throws ScenarioError.
 ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base_dir);
 
+/// A laboratory nest's face: lab.nest.x_min moved to the nearest face of the lab's cells, and the
+/// lab's cells from it to x_max (what the 3D run takes).
+struct LabNestFace {
+  double x = 0;
+  int cells = 0;
+};
+LabNestFace lab_nest_face(const v1::Lab& lab);
+
 /// The laboratory block's granular rheology into the engine's configuration: lab.rheology, the
 /// granular viscosity models' parameters (by their rows, engine/vof/models/registry.hpp; those not
 /// set are the lab material's, lab_model_defaults) and the side walls' friction of a plane set-up.

@@ -313,8 +313,10 @@ int fetch(const std::vector<std::string>& args) {
     int count = 0;
     auto download_all = [&](const std::string& job, const v1::ListResultsResponse& list, const fs::path& into) {
       for (const auto& f : list.files()) {
-        if (f.name().empty() || f.name()[0] == '.' || f.name().find_first_of("/\\") != std::string::npos)
-          throw service::RpcError(int(grpc::StatusCode::DATA_LOSS), "the server named a result '" + f.name() + "': not a plain file name");
+        if (!service::result_name_ok(f.name()))
+          throw service::RpcError(int(grpc::StatusCode::DATA_LOSS),
+                                  "the server named a result '" + f.name() + "': not a plain file name (or one folder and a plain file name)");
+        if (f.name().find('/') != std::string::npos) fs::create_directories((into / f.name()).parent_path());
         client.download(job, f.name(), (into / f.name()).string());
         bytes += f.bytes();
         ++count;

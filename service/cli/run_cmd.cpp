@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "jobs/drivers/run.hpp"
+#include "jobs/drivers/vof_support.hpp"
 #include "service/cli/commands.hpp"
 #include "service/cli/output_dir.hpp"
 #include "service/cli/run_ensemble.hpp"
@@ -32,8 +34,12 @@ void print_summary(const jobs::RunSummary& sum, bool vof, const fs::path& dest) 
     std::printf("mesh        %d x %d cells of %.4g m (plane, channel coordinates)\n", sum.nx, sum.ny, sum.dx);
     std::printf("run         %ld steps to t = %.3f s, %.2f s wall (solve %.2f, write %.2f)\n", sum.steps, sum.t,
                 sum.seconds_prepare + sum.seconds_run + sum.seconds_write, sum.seconds_run, sum.seconds_write);
-    std::printf("granular    %.6g m3 initial, %.6g m3 final (relative error %.1e)\n", sum.volume_initial, sum.volume_final,
-                sum.volume_error);
+    if (std::isnan(sum.volume_error))  // an inflow brings material in: the run has no conservation figure of its own
+      std::printf("granular    %.6g m3 initial, %.6g m3 final (material came in through a boundary: no relative error)\n",
+                  sum.volume_initial, sum.volume_final);
+    else
+      std::printf("granular    %.6g m3 initial, %.6g m3 final (relative error %.1e)\n", sum.volume_initial, sum.volume_final,
+                  sum.volume_error);
     std::printf("flow        peak speed %.3f m/s, front at x = %.4f m, deposit height %.4f m (run.json has the rest)\n",
                 sum.max_speed, sum.runout_m, sum.max_depth);
     std::printf("results in  %s:", dest.string().c_str());
@@ -235,6 +241,52 @@ int run_ensemble_into(const jobs::ResolvedScenario& resolved, const RunArgs& a, 
   return kOk;
 }
 
+// A rank other than 0 of a run split over MPI ranks (`mpirun -n N runout run ...`): it takes its
+// part of the 3D engine's steps and runs the same set-up and outputs into a private folder, which
+// it removes; rank 0 writes DIR (docs/design/parallel.md). Its checks are rank 0's, but DIR is not
+// its to check.
+int run_other_rank(const jobs::ResolvedScenario& resolved, const RunArgs& a, int rank) {
+  std::error_code ec;
+  const fs::path tmp = fs::temp_directory_path() / ("runout-rank" + std::to_string(rank) + "-" + std::to_string(getpid()));
+  fs::remove_all(tmp, ec);
+  fs::create_directories(tmp / "out", ec);
+  if (ec) {
+    std::cerr << "runout run (rank " << rank << "): cannot create " << tmp << ": " << ec.message() << "\n";
+    return kOutput;
+  }
+  jobs::RunOptions opt;
+  opt.iseesnow_id = a.iseesnow;
+  if (!a.checkpoint.empty()) opt.checkpoint_path = (tmp / "checkpoint").string();
+  opt.restart_path = a.restart;
+  opt.progress = [](const engine::Progress&) { return !g_interrupted.load(); };
+  jobs::RunSummary sum;
+  const int rc = execute(resolved, tmp / "out", opt, false, sum);
+  fs::remove_all(tmp, ec);
+  return rc != kOk ? rc : sum.stop == "cancelled" ? kCancelled : kOk;
+}
+
+// Rank 0's (or the only process's) run: DIR checked, staged and published.
+int run_checked(const jobs::ResolvedScenario& resolved, const RunArgs& a, const fs::path& dest, bool ensemble, int workers) {
+  {  // A previous result that --force replaces must not hold what this run reads or writes.
+    std::vector<std::string> used = resolved.input_files;
+    for (const auto& f : {fs::absolute(a.scenario).string(), a.checkpoint, a.restart}) used.push_back(f);
+    if (const auto f = input_inside(dest, used); !f.empty()) {
+      std::cerr << "runout run: output directory '" << a.out << "' holds '" << f
+                << "', which this run needs: --force would delete it; choose another --out\n";
+      return kOutput;
+    }
+  }
+  // Results go to a temporary sibling directory first and appear under DIR only when complete.
+  StagedOutput staged(dest, a.force);
+  if (!staged.ok()) {
+    std::cerr << "runout run: " << staged.error() << "\n";
+    return kOutput;
+  }
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+  return ensemble ? run_ensemble_into(resolved, a, workers, staged, dest) : run_single(resolved, a, staged, dest);
+}
+
 }  // namespace
 
 int run(const std::vector<std::string>& args) {
@@ -259,24 +311,19 @@ int run(const std::vector<std::string>& args) {
   const bool ensemble = jobs::ensemble::is_ensemble(resolved.scenario);
   int workers = 0;
   if (const int rc = check_run_kind(app, a, ensemble, workers); rc >= 0) return rc;
-  {  // A previous result that --force replaces must not hold what this run reads or writes.
-    std::vector<std::string> used = resolved.input_files;
-    for (const auto& f : {fs::absolute(a.scenario).string(), a.checkpoint, a.restart}) used.push_back(f);
-    if (const auto f = input_inside(dest, used); !f.empty()) {
-      std::cerr << "runout run: output directory '" << a.out << "' holds '" << f
-                << "', which this run needs: --force would delete it; choose another --out\n";
-      return kOutput;
+  const auto launch = jobs::launch_ranks();
+  if (launch.size > 1) {
+    if (ensemble) {
+      std::cerr << "runout run: an ensemble runs its members on this machine's cores itself (--workers); mpirun -n N is for one 3D run\n";
+      return kUsage;
     }
+    std::signal(SIGINT, on_interrupt);
+    std::signal(SIGTERM, on_interrupt);
+    const int rc = launch.rank > 0 ? run_other_rank(resolved, a, launch.rank) : run_checked(resolved, a, dest, ensemble, workers);
+    jobs::finish_mpi(rc == kCancelled ? 0 : rc);  // (a cancel stops every rank at the same step)
+    return rc;
   }
-  // Results go to a temporary sibling directory first and appear under DIR only when complete.
-  StagedOutput staged(dest, a.force);
-  if (!staged.ok()) {
-    std::cerr << "runout run: " << staged.error() << "\n";
-    return kOutput;
-  }
-  std::signal(SIGINT, on_interrupt);
-  std::signal(SIGTERM, on_interrupt);
-  return ensemble ? run_ensemble_into(resolved, a, workers, staged, dest) : run_single(resolved, a, staged, dest);
+  return run_checked(resolved, a, dest, ensemble, workers);
 }
 
 }  // namespace runout::cli

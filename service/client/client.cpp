@@ -19,6 +19,13 @@ namespace runout::service {
 
 std::string state_word(v1::JobState s) { return jobs::state_name(s); }
 
+bool result_name_ok(const std::string& name) {
+  auto plain = [](const std::string& p) { return !p.empty() && p[0] != '.' && p.find_first_of("/\\") == std::string::npos; };
+  const auto slash = name.find('/');
+  if (slash == std::string::npos) return plain(name);
+  return plain(name.substr(0, slash)) && plain(name.substr(slash + 1));
+}
+
 struct Client::Impl {
   ClientOptions opt;
   std::shared_ptr<grpc::Channel> channel;

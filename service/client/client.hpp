@@ -62,4 +62,9 @@ v1::Scenario upload_inputs(Client& c, v1::Scenario s, const std::string& base_di
 /// "queued", "running", ...
 std::string state_word(v1::JobState s);
 
+/// Whether a result's name from the server is safe to write under an output folder: a plain file
+/// name, or one folder and a plain file name ("nest/run.json"); no part empty or starting with a
+/// dot, no backslash.
+bool result_name_ok(const std::string& name);
+
 }  // namespace runout::service

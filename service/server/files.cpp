@@ -100,19 +100,29 @@ void Server::Impl::collect_uploads(const std::vector<std::string>& only, const s
   }
 }
 
-// The files of a job the client may download: the results of a succeeded job, and its log.
+// The files of a job the client may download: the results of a succeeded job, those of its folders
+// one level down as "FOLDER/NAME" (a nest's 3D run: nest/run.json), and its log. A download names
+// one of these exactly, so no other path is reachable.
 std::vector<v1::ResultFile> Server::Impl::result_files(const jobs::StoredJob& j) {
   std::vector<v1::ResultFile> out;
   std::error_code ec;
   if (j.job.state() == v1::SUCCEEDED && !j.results_removed) {
     const fs::path d = sched->results_dir(j.job.scenario_hash());
-    for (const auto& e : fs::directory_iterator(d, ec)) {
-      if (!e.is_regular_file(ec)) continue;
-      v1::ResultFile f;
-      f.set_name(e.path().filename().string());
-      f.set_bytes(std::int64_t(e.file_size(ec)));
-      out.push_back(f);
-    }
+    std::function<void(const fs::path&, const std::string&)> list = [&](const fs::path& dir, const std::string& prefix) {
+      for (const auto& e : fs::directory_iterator(dir, ec)) {
+        const std::string name = e.path().filename().string();
+        if (e.is_symlink(ec)) continue;
+        if (e.is_directory(ec)) {  // one level down only, not a hidden folder
+          if (prefix.empty() && !name.empty() && name[0] != '.') list(e.path(), name + "/");
+        } else if (e.is_regular_file(ec)) {
+          v1::ResultFile f;
+          f.set_name(prefix + name);
+          f.set_bytes(std::int64_t(e.file_size(ec)));
+          out.push_back(f);
+        }
+      }
+    };
+    list(d, "");
     std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.name() < b.name(); });
   }
   const fs::path lg = sched->log_path(j.job.id());

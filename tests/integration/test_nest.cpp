@@ -45,12 +45,12 @@ v1::Scenario slope_with_nest(const TempDir& d) {
 TEST(Nest, TheNestTakesInTheDepthAveragedFluxAndItsMapsReplaceTheDepthAveragedOnes) {
   TempDir d;
   const auto sc = slope_with_nest(d);
-  jobs::RunOptions opt;  // as the job system runs it: with a checkpoint file, which a nested run does not write
+  jobs::RunOptions opt;  // as the job system runs it: with a checkpoint file, the 3D nest's
   opt.checkpoint_path = (d / "run.ckpt");
   opt.checkpoint_interval_s = 5;
   const auto sum = jobs::run_scenario(jobs::resolve_scenario(sc, d.p.string()), d.p.string(), opt);
   ASSERT_TRUE(sum.nest.has_value());
-  EXPECT_FALSE(fs::exists(d / "run.ckpt"));
+  EXPECT_TRUE(fs::exists(d / "run.ckpt"));
   const auto rec = run_record(d / "run.json");
   ASSERT_TRUE(rec.has_nest());
   const auto& n = rec.nest();
@@ -103,6 +103,45 @@ TEST(Nest, TheBundledFarmhouseScenarioResolves) {
   EXPECT_NE(std::find(r.input_files.begin(), r.input_files.end(), r.nest->corridor_path), r.input_files.end());
 }
 
+// Interrupted in its 3D nest (as the job system stops a worker), a nested run writes no results and
+// leaves the 3D run's checkpoint; continued from it, the depth-averaged part runs again from its
+// start and the 3D nest goes on from the checkpoint, to the uninterrupted run's results.
+TEST(Nest, AnInterruptedNestedRunContinuesFromItsThreeDCheckpoint) {
+  TempDir d;
+  const auto r = jobs::resolve_scenario(slope_with_nest(d), d.p.string());
+  jobs::RunOptions whole;
+  const auto ref = jobs::run_scenario(r, d / "whole", whole);
+  jobs::RunOptions cut;
+  cut.checkpoint_path = d / "cut.ckpt";
+  cut.checkpoint_interval_s = 5;
+  cut.progress = [&](const engine::Progress&) { return !fs::exists(d / "cut.ckpt"); };  // stop after the 3D run's first checkpoint
+  cut.progress_every = 1;
+  const auto stopped = jobs::run_scenario(r, d / "cut", cut);
+  EXPECT_EQ(stopped.stop, "cancelled");
+  EXPECT_FALSE(fs::exists(d / "cut/run.json"));
+  ASSERT_TRUE(fs::exists(d / "cut.ckpt"));
+  jobs::RunOptions go_on;
+  go_on.restart_path = d / "cut.ckpt";
+  const auto sum = jobs::run_scenario(r, d / "continued", go_on);
+  const auto a = run_record(d / "whole/run.json"), b = run_record(d / "continued/run.json");
+  ASSERT_TRUE(b.nest().has_continued_from_s());
+  std::printf("continued from t = %.2f s (3D start %.2f s): 3D inflow %.6f vs %.6f m3, balance %.1e; stop %s vs %s\n",
+              b.nest().continued_from_s(), b.nest().start_time_s(), b.nest().inflow_3d_m3(), a.nest().inflow_3d_m3(),
+              b.nest().volume_error_3d(), sum.stop.c_str(), ref.stop.c_str());
+  EXPECT_GT(b.nest().continued_from_s(), b.nest().start_time_s());
+  EXPECT_NEAR(b.nest().inflow_3d_m3(), a.nest().inflow_3d_m3(), 1e-6 * a.nest().inflow_3d_m3());
+  EXPECT_LT(b.nest().volume_error_3d(), 1e-9);
+  EXPECT_NE(std::find_if(b.notes().begin(), b.notes().end(), [](const std::string& n) { return n.find("the 3D nest continued from its checkpoint") == 0; }),
+            b.notes().end());
+  const auto da = read_raster_values(d / "whole/max_depth.tif"), db = read_raster_values(d / "continued/max_depth.tif");
+  ASSERT_EQ(da.v.size(), db.v.size());
+  double worst = 0;
+  for (std::size_t k = 0; k < da.v.size(); ++k)
+    if (std::isfinite(da.v[k]) && std::isfinite(db.v[k])) worst = std::max(worst, std::abs(da.v[k] - db.v[k]));
+  std::printf("largest difference of the max depth: %.2e m\n", worst);
+  EXPECT_LT(worst, 1e-3);
+}
+
 // A nest is refused where it cannot be run, naming the field.
 TEST(Nest, BadNestsAreRefusedNamingTheField) {
   TempDir d;
@@ -119,20 +158,45 @@ TEST(Nest, BadNestsAreRefusedNamingTheField) {
   make_polygons(d / "edge.geojson", {square(kX0 + 500, kY0 + 50, 100)}, "EPSG:32632");
   edge.mutable_nest()->set_path("edge.geojson");
   expect_error(edge, d, "the nest reaches the grid's edge");
-  try {  // a nested run is not continued from a checkpoint
+  try {  // a checkpoint the nest's 3D run cannot read is refused before the depth-averaged part runs
     jobs::RunOptions opt;
     opt.restart_path = (d / "some.ckpt");
     jobs::run_scenario(jobs::resolve_scenario(sc, d.p.string()), d / "restart", opt);
-    ADD_FAILURE() << "a nested run continued from a checkpoint";
+    ADD_FAILURE() << "a nested run continued from a missing checkpoint";
   } catch (const jobs::ScenarioError& e) {
-    EXPECT_NE(std::string(e.what()).find("nest: a run with a 3D nest is not continued from a checkpoint"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("checkpoint " + (d / "some.ckpt") + ": no such file"), std::string::npos) << e.what();
   }
+  EXPECT_FALSE(fs::exists(d / "restart/timeseries.h5"));
   auto voellmy = sc;
   voellmy.mutable_material()->set_rheology("voellmy");
   voellmy.mutable_material()->clear_bed_friction_deg();
   voellmy.mutable_material()->set_voellmy_mu(0.2);
   voellmy.mutable_material()->set_voellmy_xi(1000);
   expect_error(voellmy, d, "nest: the 3D run of the nest:");
+  auto lone_vof = sc;  // a depth-averaged scenario's `vof` block is its nest's 3D run: without a nest it is refused
+  lone_vof.clear_nest();
+  lone_vof.mutable_vof()->set_write_interval_s(1);
+  expect_error(lone_vof, d, "vof: only for engine \"vof\" (the 3D engine on the DEM), or for the 3D run of a depth-averaged scenario's nest");
+  auto mesh = sc;
+  mesh.mutable_mesh()->set_refinement(2);
+  expect_error(mesh, d, "mesh: only for engine \"vof\" (the 3D engine on the DEM); a nest's mesh is in `nest`");
+}
+
+// A depth-averaged scenario's `vof` block sets its nest's 3D run (frames, Courant number): the nest's
+// resolved scenario carries it, with the option table's defaults for what it leaves out.
+TEST(Nest, TheVofBlockOfADepthAveragedScenarioSetsTheNestsThreeDRun) {
+  TempDir d;
+  auto sc = slope_with_nest(d);
+  sc.mutable_vof()->set_write_interval_s(0.5);
+  sc.mutable_vof()->set_max_courant(0.1);
+  const auto r = jobs::resolve_scenario(sc, d.p.string());
+  ASSERT_TRUE(r.nest);
+  EXPECT_DOUBLE_EQ(r.nest->scenario.vof().write_interval_s(), 0.5);
+  EXPECT_DOUBLE_EQ(r.nest->scenario.vof().max_courant(), 0.1);
+  EXPECT_EQ(r.nest->scenario.vof().outer_correctors(), 3);  // the default
+  auto too_often = sc;
+  too_often.mutable_vof()->set_write_interval_s(0.001);
+  expect_error(too_often, d, "nest: the 3D run of the nest: vof.write_interval_s");
 }
 
 namespace {

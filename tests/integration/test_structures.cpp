@@ -8,7 +8,9 @@
 #include <fstream>
 #include <vector>
 
+#include "jobs/drivers/report.hpp"
 #include "jobs/drivers/run.hpp"
+#include "jobs/drivers/vof_terrain/loads.hpp"
 #include "jobs/scenario/scenario.hpp"
 #include "tests/support/run_helpers.hpp"
 #include "terrain/column_mesh.hpp"
@@ -38,6 +40,16 @@ v1::Scenario collapse(const TempDir& d, double building_height) {
   st->set_path("house.geojson");
   st->set_height_m(building_height);
   return sc;
+}
+
+// A footprint request of the given height (the scenario's resolution makes these from structures[]).
+terrain::DamRequest footprints(const std::string& field, const std::string& path, double height) {
+  terrain::DamRequest q;
+  q.field = field;
+  q.path = path;
+  q.has_height = true;
+  q.height = height;
+  return q;
 }
 
 jobs::RunSummary run_in(const TempDir& d, const v1::Scenario& sc, const std::string& name) {
@@ -78,7 +90,9 @@ TEST(Structures, ABuildingIsAWallTheDepthAveragedFlowGoesRound) {
   const auto again = read_raster_values(d / "top/max_depth.tif").v;
   ASSERT_EQ(again.size(), depth.v.size());
   for (std::size_t k = 0; k < again.size(); ++k)
-    if (!(std::isnan(again[k]) && std::isnan(depth.v[k]))) ASSERT_EQ(again[k], depth.v[k]) << k;
+    if (!(std::isnan(again[k]) && std::isnan(depth.v[k]))) {
+      ASSERT_EQ(again[k], depth.v[k]) << k;
+    }
 }
 
 // Bad structures are refused before the run, naming the field and the file.
@@ -87,10 +101,10 @@ TEST(Structures, BadStructuresAreRefusedNamingTheField) {
   auto sc = collapse(d, 20);
   auto none = sc;
   none.mutable_structures(0)->clear_height_m();
-  expect_error(none, d, "structures[0]: needs height_m, height_attribute or top_attribute");
+  expect_error(none, d, "structures[0]: needs height_m, height_attribute, top_attribute or surface_path");
   auto both = sc;
   both.mutable_structures(0)->set_top_attribute("roof");
-  expect_error(both, d, "structures[0]: give one of height_m, height_attribute and top_attribute");
+  expect_error(both, d, "structures[0]: give one of height_m, height_attribute, top_attribute and surface_path");
   auto twice = sc;
   *twice.add_structures() = sc.structures(0);
   expect_error(twice, d, "structures[1].name");
@@ -114,8 +128,7 @@ TEST(Structures, TheThreeDMeshLeavesTheStructuresColumnsOutUpToTheirTop) {
                 "EPSG:32632");
   make_polygons(d / "pylon.geojson", {square(kX0 + 71, kY0 + 71, 1)}, "EPSG:32632");
   auto m = terrain::column_mesh(g, spec);
-  terrain::place_structures(m, g,
-                            {{"structures[0]", d / "house.geojson", "", true, 6.4, ""}, {"structures[1]", d / "pylon.geojson", "", true, 20.0, ""}});
+  terrain::place_structures(m, g, {footprints("structures[0]", d / "house.geojson", 6.4), footprints("structures[1]", d / "pylon.geojson", 20.0)});
   int house = 0, pylon = 0;
   for (std::size_t col = 0; col < m.kept.size(); ++col) {
     if (m.structure[col] == 0) {
@@ -130,9 +143,25 @@ TEST(Structures, TheThreeDMeshLeavesTheStructuresColumnsOutUpToTheirTop) {
   }
   EXPECT_EQ(house, 4 * 2);
   EXPECT_EQ(pylon, 1);
+  // The same house from a surface model on 2.5 m cells (the ground at 100 m): the same columns and layers.
+  make_dem_box(d / "dsm.tif", 40, 40, 2.5, kX0, kY0, [](int i, int r) {
+    const double x = (i + 0.5) * 2.5, y = (40 - r - 0.5) * 2.5;
+    return x > 20 && x < 40 && y > 20 && y < 30 ? 106.4 : 100.0;
+  });
+  auto from_surface = terrain::column_mesh(g, spec);
+  terrain::DamRequest dsm;
+  dsm.field = "structures[0]";
+  dsm.surface_path = d / "dsm.tif";
+  terrain::place_structures(from_surface, g, {dsm});
+  EXPECT_EQ(from_surface.base, [&] {
+    auto b = m.base;
+    for (std::size_t col = 0; col < b.size(); ++col)
+      if (m.structure[col] != 0) b[col] = 0;  // the house alone
+    return b;
+  }());
   auto low = terrain::column_mesh(g, spec);
   try {
-    terrain::place_structures(low, g, {{"structures[0]", d / "house.geojson", "", true, 0.4, ""}});
+    terrain::place_structures(low, g, {footprints("structures[0]", d / "house.geojson", 0.4)});
     ADD_FAILURE() << "a structure lower than half the first layer was taken";
   } catch (const terrain::TerrainError& e) {
     EXPECT_NE(std::string(e.what()).find("structures[0]: lower than half the mesh's first layer"), std::string::npos) << e.what();
@@ -178,6 +207,20 @@ TEST(Structures, TheThreeDEngineReportsTheFlowsLoadOnABuilding) {
   EXPECT_GT(s.wall_area_m2(), 2 * (20 + 40) * 9.0);  // its walls up to the layer below its top, and its roof
   EXPECT_GT(s.front_profile_height_m_size(), 3);
   EXPECT_GT(s.max_depth_next_m(), 0.3);
+  EXPECT_NEAR(s.x(), kX0 + 210, 5.01);  // the centroid of its grid cells
+  EXPECT_NEAR(s.y(), kY0 + 120, 5.01);
+  // Columns of several metres for a flow of about a metre: the loads are reported, and said to be
+  // no design values.
+  ASSERT_TRUE(s.has_loads_resolved());
+  EXPECT_FALSE(s.loads_resolved());
+  EXPECT_GT(s.column_width_m(), 1.0);
+  EXPECT_NE(s.loads_note().find("not design values"), std::string::npos) << s.loads_note();
+  // The report's table of structures says so too.
+  const auto tables = jobs::report_tables(rec);
+  ASSERT_EQ(tables.size(), 3u);
+  ASSERT_EQ(tables[2].rows.size(), 1u);
+  EXPECT_EQ(tables[2].rows[0].front(), "farmhouse");
+  EXPECT_EQ(tables[2].rows[0].back(), "not design values (under-resolved)");
   EXPECT_LT(rec.mass_balance().relative_error(), 1e-6);
   std::ifstream csv(d / "3d/structure_loads.csv");
   std::string line;
@@ -186,4 +229,92 @@ TEST(Structures, TheThreeDEngineReportsTheFlowsLoadOnABuilding) {
   int rows = 0;
   while (std::getline(csv, line)) rows += line.find("\"farmhouse\"") != std::string::npos;
   EXPECT_GE(rows, 200);  // every 0.1 s of the 40 s, or every step where the steps are longer
+}
+
+// A structure from a surface model (DSM): its cells are where the surface stands min_height_m above
+// the ground (the cell centre's sample), its height the surface less the ground. Alone, or inside
+// footprints, the same building gives the same run; bad surfaces are refused naming the field.
+TEST(Structures, ASurfaceModelGivesTheBuildingsCellsAndHeights) {
+  TempDir d;
+  auto sc = collapse(d, 20);
+  // The surface: the building's 3 x 6 cells 20 m high (a 1.5 m fence east of it stays below min_height_m).
+  make_dem_of(d / "dsm.tif", 60, 10.0, [](int i, int r) {
+    const double x = (i + 0.5) * 10, y = (60 - r - 0.5) * 10;  // the raster's rows run north to south
+    if (x > 350 && x < 380 && y > 270 && y < 330) return 20.0;
+    return x > 400 && x < 410 ? 1.5 : 0.0;
+  });
+  auto alone = sc;
+  alone.mutable_structures(0)->clear_height_m();
+  alone.mutable_structures(0)->clear_path();
+  alone.mutable_structures(0)->set_surface_path("dsm.tif");
+  run_in(d, alone, "alone");
+  const auto rec = run_record(d / "alone/run.json");
+  ASSERT_EQ(rec.structures_size(), 1);
+  EXPECT_EQ(rec.structures(0).cells(), 18);
+  EXPECT_EQ(rec.structures(0).height_max_m(), 20);
+  EXPECT_NEAR(rec.structures(0).x(), kX0 + 365, 1e-6);
+  EXPECT_NEAR(rec.structures(0).y(), kY0 + 300, 1e-6);
+  const auto depth = read_raster_values(d / "alone/max_depth.tif");
+  EXPECT_EQ(depth.max_where([](double x, double y) { return x > kX0 + 350 && x < kX0 + 380 && y > kY0 + 270 && y < kY0 + 330; }), 0.0);
+  EXPECT_GT(depth.max_where([](double x, double y) { return x > kX0 + 400 && (y < kY0 + 260 || y > kY0 + 340); }), 0.1);
+
+  auto inside = sc;  // the footprints touch 27 cells; the surface stands on 18 of them
+  inside.mutable_structures(0)->clear_height_m();
+  inside.mutable_structures(0)->set_surface_path("dsm.tif");
+  run_in(d, inside, "inside");
+  EXPECT_EQ(run_record(d / "inside/run.json").structures(0).cells(), 18);
+  const auto again = read_raster_values(d / "inside/max_depth.tif").v;
+  ASSERT_EQ(again.size(), depth.v.size());
+  for (std::size_t k = 0; k < again.size(); ++k)
+    if (!(std::isnan(again[k]) && std::isnan(depth.v[k]))) {
+      ASSERT_EQ(again[k], depth.v[k]) << k;
+    }
+
+  auto low = alone;  // the fence counts when min_height_m is below its 1.5 m
+  low.mutable_structures(0)->set_min_height_m(1);
+  const auto r = jobs::resolve_scenario(low, d.p.string());
+  EXPECT_EQ(terrain::rasterize_dam(terrain::grid_of_raster(d / "dem.tif", "test"), r.structures[0].request).cells, 18 + 60);
+
+  auto expect_error = [&](const v1::Scenario& bad, const std::string& what) {
+    try {
+      run_in(d, bad, "bad");
+      ADD_FAILURE() << "accepted: " << what;
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  auto high = alone;
+  high.mutable_structures(0)->set_min_height_m(50);
+  expect_error(high, "structures[0].surface_path '" + (d / "dsm.tif") + "': stands nowhere in the domain 50.00 m or more above the ground");
+  auto both = inside;
+  both.mutable_structures(0)->set_height_m(8);
+  expect_error(both, "structures[0]: give one of height_m, height_attribute, top_attribute and surface_path, not several");
+  auto min_only = sc;
+  min_only.mutable_structures(0)->set_min_height_m(1);
+  expect_error(min_only, "structures[0].min_height_m: only with surface_path");
+  auto none = alone;
+  none.mutable_structures(0)->clear_surface_path();
+  expect_error(none, "structures[0].path");
+  auto missing = alone;
+  missing.mutable_structures(0)->set_surface_path("no-such.tif");
+  expect_error(missing, "structures[0].surface_path");
+}
+
+// The loads' verdict: columns at most a quarter of the flow's depth next to the structure resolve the
+// impact (the wall-impact verification's resolution); wider ones do not, and the note says why, with
+// the figures, and that the loads are no design values.
+TEST(Structures, LoadsAreDesignValuesOnlyOnColumnsAQuarterOfTheFlowDepth) {
+  jobs::StructureSummary q;
+  q.max_depth_next_m = 0.34;
+  jobs::vof_terrain::loads_verdict(5.0, q);
+  EXPECT_FALSE(q.loads_resolved);
+  EXPECT_DOUBLE_EQ(q.column_width_m, 5.0);
+  EXPECT_NE(q.loads_note.find("not design values: columns 5 m wide for a flow 0.34 m deep"), std::string::npos) << q.loads_note;
+  EXPECT_NE(q.loads_note.find("at most a quarter of the depth, 0.085 m"), std::string::npos) << q.loads_note;
+  jobs::vof_terrain::loads_verdict(0.085, q);
+  EXPECT_TRUE(q.loads_resolved);
+  EXPECT_EQ(q.loads_note.find("not design values"), std::string::npos) << q.loads_note;
+  q.max_depth_next_m = 0;  // no flow next to it: nothing resolved
+  jobs::vof_terrain::loads_verdict(0.01, q);
+  EXPECT_FALSE(q.loads_resolved);
 }

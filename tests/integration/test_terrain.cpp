@@ -129,6 +129,8 @@ TEST(Terrain, SyntheticSlopeRunsAndWritesEveryOutput) {
   ASSERT_TRUE(ncd);
   ASSERT_EQ(ncd->GetDimensionCount(), 3u);
   EXPECT_EQ(ncd->GetUnit(), "m");
+  // One chunk per frame: chunks across frames are inflated and deflated again for each frame written.
+  EXPECT_EQ(ncd->GetBlockSize(), (std::vector<GUInt64>{1, 120, 120}));
   std::vector<float> cube_frame(static_cast<std::size_t>(n));
   const GUInt64 start[3] = {GUInt64(frames / 2 - 1), 0, 0};
   const size_t count[3] = {1, 120, 120};

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <vector>
 
 #include "engine/sh1d.hpp"
 
@@ -79,6 +81,38 @@ TEST(Sh1d, InflowDeliversTheHydrographDischarge) {
   EXPECT_DOUBLE_EQ(h, 0.5);
   cfg.inflow.at(20, h, u);
   EXPECT_DOUBLE_EQ(h, 0.0);
+}
+
+// A gauge downstream of a steady inflow (a laboratory nest's face, jobs/drivers/vof_lab/nest.hpp):
+// it reads before the front arrives a dry bed, then the inflow's discharge (steady: h u is the same
+// all along the channel), in a flow thinner and faster than at the inflow (45 deg against 32 deg
+// friction accelerates it). A gauge outside the channel is refused.
+TEST(Sh1d, AGaugeRecordsTheSteadyDischargeDownstreamOfAnInflow) {
+  const int n = 240;
+  auto ch = Channel1D::uniform(n, 0.59 / n, 0.0, 45 * kDeg);
+  auto cfg = coulomb(32, 2.0);
+  cfg.left = Boundary1D::inflow;
+  cfg.right = Boundary1D::outflow;
+  cfg.inflow = Hydrograph{{0.0}, {0.015}, {1.0}};
+  std::vector<double> t, h, u;
+  cfg.gauge.xi = 0.2;
+  cfg.gauge.record = [&](double time, double depth, double speed) {
+    t.push_back(time);
+    h.push_back(depth);
+    u.push_back(speed);
+  };
+  const auto r = run_sh1d(ch, cfg, Sh1dState{std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)});
+  ASSERT_EQ(long(t.size()), r.steps + 1);  // the start and every step
+  EXPECT_EQ(t.front(), 0.0);
+  EXPECT_EQ(h.front(), 0.0);
+  EXPECT_DOUBLE_EQ(t.back(), 2.0);
+  EXPECT_NEAR(h.back() * u.back(), 0.015, 0.015 * 1e-3);
+  EXPECT_LT(h.back(), 0.013);
+  EXPECT_GT(u.back(), 1.15);
+  std::printf("gauge at 0.2 m after 2 s: h = %.3f mm, u = %.3f m/s, q = %.6f m2/s (inflow 0.015)\n", 1e3 * h.back(), u.back(),
+              h.back() * u.back());
+  cfg.gauge.xi = 0.6;
+  EXPECT_THROW(run_sh1d(ch, cfg, Sh1dState{std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)}), std::invalid_argument);
 }
 
 TEST(Sh1d, KineticEnergyStopRule) {

@@ -470,6 +470,111 @@ TEST(Scenarios, LabB7WideChuteFlowsAroundTheTetrahedron) {
   expect_resolve_error(bad, {"lab.obstacles[0].shape"});
 }
 
+// B7 through a nest (validation.md B7, "Through a nest"; coarse: 1.25 cm cells to 0.7 s): the
+// cylinder's chute with the 3D run on x >= 0.2 m only, fed there by the depth-averaged run of the
+// whole chute, against the whole chute in 3D. The nest takes in what the depth-averaged run carried
+// through its face within 1 %, keeps its own balance to round-off and alpha within [0, 1]; the flow
+// it meets at the
+// cylinder (the pile-up in front of it, the dry shadow behind it, the flow at x = 0.25 m) agrees
+// with the whole chute's within the bounds measured at this resolution and stated in validation.md.
+// Continued from a checkpoint, it ends as the uninterrupted run.
+TEST(Scenarios, LabB7ThroughANestAgreesWithTheWholeChute) {
+  auto whole = jobs::load_scenario(std::string(RUNOUT_SOURCE_DIR) + "/scenarios/lab/b7-wide-chute-cylinder.json").scenario;
+  auto* lab = whole.mutable_lab();
+  lab->set_nx(47);
+  lab->set_ny(10);
+  lab->set_nz(24);
+  lab->set_end_time_s(0.7);
+  lab->set_write_interval_s(0.35);
+  lab->add_stations_x(0.25);
+  auto nested = whole;
+  nested.mutable_lab()->mutable_nest()->set_x_min(0.2);
+  struct Ran {
+    runout::v1::RunRecord rec;
+    double seconds = 0;
+    std::string csv;
+  };
+  auto run = [](const runout::v1::Scenario& s) {
+    TempDir d;
+    const auto sum = jobs::run_scenario(jobs::resolve_scenario(s, "."), d.p.string());
+    EXPECT_EQ(sum.stop, "end-time");
+    return Ran{run_record(d / "run.json"), sum.seconds_run, read_text(d / "nest_inflow.csv")};
+  };
+  const Ran w = run(whole), n = run(nested);
+  const auto& nr = n.rec.nest();
+  std::printf("B7 cylinder, 1.25 cm: whole chute %.1f s, nest %.1f s (%d cells; 1D %d cells, %d steps); inflow 3D %.4e m3, depth-averaged %.4e "
+              "m3 (difference %.2e), balance %.1e\n",
+              w.seconds, n.seconds, nr.mesh_cells(), 4 * 47, nr.recorded_steps(), nr.inflow_3d_m3(), nr.inflow_depth_averaged_m3(),
+              nr.inflow_relative_difference(), nr.volume_error_3d());
+  EXPECT_FALSE(w.rec.has_nest());
+  EXPECT_EQ(n.rec.mesh().nx(), 31);  // (0.59 - 0.2) m over 1.255 cm cells
+  EXPECT_EQ(nr.mesh_cells(), n.rec.mesh().cells());
+  EXPECT_LT(nr.inflow_relative_difference(), 0.01);
+  EXPECT_LT(nr.volume_error_3d(), 1e-10);
+  EXPECT_LE(record_figure(n.rec, "alpha_max"), 1 + 1e-6);  // carried by divergence-free fluxes (engine/vof/alpha_eqn.cpp)
+  EXPECT_GE(record_figure(n.rec, "alpha_min"), -1e-6);
+  EXPECT_NE(n.csv.find("time_s,depth_m,velocity_m_s,discharge_m2_s"), std::string::npos);
+  EXPECT_NE(nr.maps().find("x >= 0.2009"), std::string::npos) << nr.maps();  // 0.2 m on the nearest face of the 1.255 cm cells
+  const auto& wc = w.rec.chute();
+  const auto& nc = n.rec.chute();
+  const double dx = 0.59 / 47;
+  std::printf("deepest column: whole %.1f mm at (%.3f, %.3f), nest %.1f mm at (%.3f, %.3f); dry shadow %.1f / %.1f cm2\n", 1e3 * wc.max_depth_m(),
+              wc.max_depth_x_m(), wc.max_depth_z_m(), 1e3 * nc.max_depth_m(), nc.max_depth_x_m(), nc.max_depth_z_m(),
+              1e4 * wc.obstacles(0).sheltered_dry_area_m2(), 1e4 * nc.obstacles(0).sheltered_dry_area_m2());
+  const auto& ws = w.rec.stations(0);
+  const auto& ns = n.rec.stations(0);
+  std::printf("x = 0.25 m: whole %.1f mm at %.3f m/s, nest %.1f mm at %.3f m/s\n", 1e3 * ws.depth_m(), ws.depth_averaged_u_m_s(), 1e3 * ns.depth_m(),
+              ns.depth_averaged_u_m_s());
+  EXPECT_NEAR(nc.max_depth_m(), wc.max_depth_m(), 0.25 * wc.max_depth_m());
+  EXPECT_LE(std::abs(nc.max_depth_x_m() - wc.max_depth_x_m()), 2.01 * dx);
+  EXPECT_GT(nc.obstacles(0).sheltered_dry_area_m2(), 0.0);
+  EXPECT_NEAR(ns.depth_m(), ws.depth_m(), 0.25 * ws.depth_m());
+  // Continued from its checkpoint (0.35 s), the nest ends as the run that wrote it: the depth-averaged
+  // part runs again, the 3D run and its count of the inflow go on from the checkpoint.
+  auto with_cp = nested;
+  with_cp.mutable_lab()->set_checkpoint_interval_s(0.35);
+  const auto rc = jobs::resolve_scenario(with_cp, ".");
+  TempDir first, again;
+  jobs::RunOptions o;
+  o.checkpoint_path = first / "cp.h5";
+  ASSERT_EQ(jobs::run_scenario(rc, first.p.string(), o).stop, "end-time");
+  jobs::RunOptions o2;
+  o2.restart_path = first / "cp.h5";
+  ASSERT_EQ(jobs::run_scenario(rc, again.p.string(), o2).stop, "end-time");
+  const auto r1 = run_record(first / "run.json"), r2 = run_record(again / "run.json");
+  EXPECT_NEAR(r2.nest().continued_from_s(), 0.35, 0.01);
+  EXPECT_EQ(r2.nest().inflow_3d_m3(), r1.nest().inflow_3d_m3());
+  EXPECT_EQ(r2.nest().volume_error_3d(), r1.nest().volume_error_3d());
+  EXPECT_EQ(r2.chute().max_depth_m(), r1.chute().max_depth_m());
+  EXPECT_EQ(r1.nest().inflow_3d_m3(), nr.inflow_3d_m3());  // checkpoints do not change the run
+  // A nest needs the whole left side an inflow, no fill, and its face above the obstacles and the stations.
+  auto bad = nested;
+  bad.mutable_lab()->mutable_nest()->set_x_min(0.32);
+  expect_resolve_error(bad, {"lab.nest.x_min", "lab.obstacles[0]"});
+  bad = nested;
+  bad.mutable_lab()->set_stations_x(0, 0.1);
+  expect_resolve_error(bad, {"lab.stations_x[0]"});
+  // The checks are on the face the run takes: 0.31 m upstream of the cylinder (0.3104 m) moves to
+  // 0.3138 m, inside it; a station at 0.2005 m lies above the face 0.2 m moves to (0.2009 m); 6 mm
+  // moves to the inflow.
+  bad = nested;
+  bad.mutable_lab()->mutable_nest()->set_x_min(0.31);
+  bad.mutable_lab()->set_stations_x(0, 0.4);
+  expect_resolve_error(bad, {"lab.nest.x_min", "lab.obstacles[0]", "0.3138"});
+  bad = nested;
+  bad.mutable_lab()->set_stations_x(0, 0.2005);
+  expect_resolve_error(bad, {"lab.stations_x[0]", "0.20085"});
+  bad = nested;
+  bad.mutable_lab()->mutable_nest()->set_x_min(0.006);
+  expect_resolve_error(bad, {"lab.nest.x_min", "on the inflow"});
+  bad = nested;
+  bad.mutable_lab()->mutable_boundaries(0)->set_kind("wall");
+  expect_resolve_error(bad, {"lab.boundaries", "inflow"});
+  bad = nested;
+  bad.mutable_lab()->mutable_nest()->set_x_min(0.58);
+  expect_resolve_error(bad, {"lab.nest.x_min", "fewer than 4 cells"});
+}
+
 // B1 with the fine sand's measured angle of repose, 37 deg (validation.md B1, coarse: 8 mm cells to
 // 3.5 s, 182 deg): with mu(I) (the material's parameters) the fill fails before 80 deg and then keeps
 // a flowing layer over the rigid bulk at a steady angle (measured 43.0 +- 3.6 deg, layer 3.7 cm; on

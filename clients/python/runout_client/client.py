@@ -45,8 +45,12 @@ def is_final(state: int) -> bool:
 
 
 def _plain_name(name: str) -> bool:
-    """A result name that is safe to use as a file name in the output folder (as runout fetch checks)."""
-    return bool(name) and not name.startswith(".") and "/" not in name and "\\" not in name
+    """A result name that is safe to write under the output folder (as runout fetch checks): a plain
+    file name, or one folder and a plain file name (a nest's ``nest/run.json``)."""
+    def plain(part: str) -> bool:
+        return bool(part) and not part.startswith(".") and "/" not in part and "\\" not in part
+    folder, slash, rest = name.partition("/")
+    return plain(folder) and (not slash or plain(rest))
 
 
 class Client:
@@ -322,6 +326,7 @@ class Client:
             if not _plain_name(f.name):
                 raise RunoutError(grpc.StatusCode.DATA_LOSS, f"the server named a result '{f.name}': not a plain file name",
                                   f"fetch {job_id}")
+            (out / f.name).parent.mkdir(parents=True, exist_ok=True)
             paths.append(self.download(job_id, f.name, out / f.name))
         return paths
 

@@ -251,6 +251,14 @@ class ClientTest(unittest.TestCase):
             self.assertRunoutError(code, call, "no-such-job", contains="no-such-job")
         self.assertRunoutError(code, c.fetch, "no-such-job", TMP / "nothing")
 
+    def test_3b_result_names(self) -> None:
+        # What fetch writes under its folder: a plain name, or one folder and a plain name (a nest's results).
+        from runout_client import client as mod
+        for ok in ("run.json", "nest/run.json"):
+            self.assertTrue(mod._plain_name(ok), ok)
+        for bad in ("", ".x", "../jobs.db", "nest/../x", "a/b/c", "nest/", "/abs", "a\\b", "nest/.x"):
+            self.assertFalse(mod._plain_name(bad), bad)
+
     def test_4_bad_scenarios(self) -> None:
         c, code = self.client, grpc.StatusCode.INVALID_ARGUMENT
         s = json.loads(SCENARIO.read_text())

@@ -36,6 +36,9 @@ struct BcContext {
   const Mixture& mixture;
   WallViscosity wall_viscosity;
   double t0 = 0, t1 = 0;  ///< the step being taken (begin_step): from t0 to t1
+  /// The step whose pressure solve gave the fluxes the alpha equation carries in this one: the last
+  /// step, or at the start the initial pressure's instant (tp0 = tp1).
+  double tp0 = 0, tp1 = 0;
 };
 
 class BoundaryCondition {
@@ -43,6 +46,10 @@ class BoundaryCondition {
   virtual ~BoundaryCondition() = default;
   /// The phase fraction on boundary face f (default: zero gradient, the cell's).
   virtual double alpha(const BcContext& c, int f) const { return c.fields.alpha[c.mesh.owner[f]]; }
+  /// The phase fraction that enters through face f with the last pressure solve's flux, which the
+  /// alpha equation carries (default: alpha()). A condition whose fixed flux changes from step to
+  /// step gives the fill that went with that flux (its state in the step c.tp0-c.tp1).
+  virtual double carried_alpha(const BcContext& c, int f) const { return alpha(c, f); }
   /// The velocity on boundary face f.
   virtual Vec velocity(const BcContext& c, int f) const = 0;
   /// Its terms in the momentum matrix's row of the cell next to f (diagonal and source), with the

@@ -51,12 +51,13 @@ void MomentumSolver::destroy_system() {
   if (b_) VecDestroy(&b_);
 }
 
-void MomentumSolver::setup(double rtol) {
-  petsc_check(KSPCreate(PETSC_COMM_SELF, &ksp_), "KSPCreate");
+void MomentumSolver::setup(double rtol, const Ranks& ranks) {
+  ranks_ = &ranks;
+  petsc_check(KSPCreate(ranks.comm().comm, &ksp_), "KSPCreate");
   petsc_check(KSPSetType(ksp_, KSPBCGS), "KSPSetType");
   PC pc;
   petsc_check(KSPGetPC(ksp_, &pc), "KSPGetPC");
-  petsc_check(PCSetType(pc, PCILU), "PCSetType ilu");
+  petsc_check(PCSetType(pc, ranks.distributed() ? PCBJACOBI : PCILU), "PCSetType ilu");
   petsc_check(KSPSetTolerances(ksp_, rtol, 1e-300, PETSC_DEFAULT, 2000), "KSPSetTolerances");
   petsc_check(KSPSetInitialGuessNonzero(ksp_, PETSC_TRUE), "KSPSetInitialGuessNonzero");
   // PETSc options with the prefix runout_u_ override these.
@@ -64,8 +65,25 @@ void MomentumSolver::setup(double rtol) {
   petsc_check(KSPSetFromOptions(ksp_), "KSPSetFromOptions");
 }
 
-void MomentumSolver::set_matrix(const CsrMatrix& A) {
+void MomentumSolver::set_matrix(const CsrMatrix& A, long long total) {
   const int n = A.rows();
+  if (ranks_->distributed()) {  // the rows' columns differ with the ghosts' rows: made anew
+    petsc_check(KSPReset(ksp_), "KSPReset");
+    destroy_system();
+    n_ = n;
+    total_ = total;
+    if (total_ == 0) return;
+    const MPI_Comm comm = ranks_->comm().comm;
+    const auto N = PetscInt(total);
+    petsc_check(MatCreate(comm, &M_), "MatCreate");
+    petsc_check(MatSetSizes(M_, n_, n_, N, N), "MatSetSizes");
+    petsc_check(MatSetType(M_, MATMPIAIJ), "MatSetType");
+    petsc_check(MatMPIAIJSetPreallocationCSR(M_, A.start.data(), A.col.data(), A.val.data()), "MatMPIAIJSetPreallocationCSR");
+    petsc_check(VecCreateMPI(comm, n_, N, &x_), "VecCreateMPI");
+    petsc_check(VecDuplicate(x_, &b_), "VecDuplicate");
+    petsc_check(KSPSetOperators(ksp_, M_, M_), "KSPSetOperators");
+    return;
+  }
   if (n != n_ || A.start != start_ || A.col != col_) {
     petsc_check(KSPReset(ksp_), "KSPReset");  // (a new size: the old operators and factors go)
     destroy_system();
@@ -90,7 +108,7 @@ void MomentumSolver::set_matrix(const CsrMatrix& A) {
 }
 
 int MomentumSolver::solve(const std::vector<double>& b, std::vector<double>& x, double t) {
-  if (n_ <= 0) return 0;
+  if (ranks_->distributed() ? total_ == 0 : n_ <= 0) return 0;  // (split over ranks, a rank without rows still takes part)
   PetscScalar* v = nullptr;
   petsc_check(VecGetArray(b_, &v), "VecGetArray");
   std::copy(b.begin(), b.begin() + n_, v);

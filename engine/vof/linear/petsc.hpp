@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "engine/vof/config.hpp"
+#include "engine/vof/mpi/ranks.hpp"
 #include "engine/vof/state.hpp"
 
 namespace runout::engine::vof {
@@ -27,51 +28,59 @@ struct CsrMatrix {
 };
 
 /// The momentum predictor's system over the cells it predicts (the rows change with the material):
-/// the velocity components share the matrix.
+/// the velocity components share the matrix. Split over ranks: each rank's own rows, with the whole
+/// system's column numbers, one PETSc matrix over the ranks (ILU: block Jacobi).
 class MomentumSolver {
  public:
   MomentumSolver() = default;
   MomentumSolver(const MomentumSolver&) = delete;
   MomentumSolver& operator=(const MomentumSolver&) = delete;
   ~MomentumSolver();
-  /// rtol: VofConfig::momentum_rtol.
-  void setup(double rtol);
-  /// The matrix for the next solves (made anew when its rows or structure changed).
-  void set_matrix(const CsrMatrix& A);
+  /// rtol: VofConfig::momentum_rtol; ranks: the run's.
+  void setup(double rtol, const Ranks& ranks);
+  /// The matrix for the next solves: this rank's rows of `total`, their columns the whole system's
+  /// (made anew when its rows or structure changed; split over ranks, at every call).
+  void set_matrix(const CsrMatrix& A, long long total);
   /// Solve with the right-hand side b and the initial guess x (a value per row); the solution into x.
   /// Returns the iterations; throws when the solver does not converge (t: the time, for the message).
   int solve(const std::vector<double>& b, std::vector<double>& x, double t);
 
  private:
   void destroy_system();
+  const Ranks* ranks_ = nullptr;
   int n_ = -1;
+  long long total_ = 0;  // the whole system's rows
   std::vector<PetscInt> start_, col_;  // the structure of M_
   Mat M_ = nullptr;
   ::Vec x_ = nullptr, b_ = nullptr;
   KSP ksp_ = nullptr;
 };
 
-/// The pressure system over the active region's cells (rows in the region's order).
+/// The pressure system over the active region's cells (rows in the region's order; split over
+/// ranks, each rank's own cells' rows, the ranks one after another, as one PETSc matrix over the
+/// run's communicator).
 class PressureSolver {
  public:
-  explicit PressureSolver(const VofConfig& cfg) : cfg_(cfg) {}
+  PressureSolver(const VofConfig& cfg, const Ranks& ranks) : cfg_(cfg), ranks_(ranks) {}
   PressureSolver(const PressureSolver&) = delete;
   PressureSolver& operator=(const PressureSolver&) = delete;
   ~PressureSolver();
 
   /// The solver: CG with an algebraic multigrid preconditioner. Made anew with every system (GAMG
   /// keeps its coarse levels' solvers, whose sizes would not fit another); checks the
-  /// preconditioner's name.
+  /// preconditioner's name. Over several ranks "ilu" is block Jacobi with ILU(0) in each rank's
+  /// block (PETSc's ILU is sequential).
   void make_ksp();
-  /// (Re)create the system for `rows` rows with nnz nonzeros per row.
-  void make_system(int rows, const std::vector<int>& nnz);
+  /// (Re)create the system: this rank's `rows` rows from `first_row` of `total`, with own_nnz
+  /// nonzeros per row in the rank's own columns and off_nnz in the other ranks'.
+  void make_system(int rows, int first_row, long long total, const std::vector<int>& own_nnz, const std::vector<int>& off_nnz);
   /// The relative tolerance of the next solves: the last corrector's or the ones before it.
   void set_tolerance(bool final);
 
   /// Start the matrix (reuse: a later corrector of the step keeps the step's matrix).
   void begin_matrix(bool reuse);
-  /// The off-diagonal pair (i, j), (j, i) of a symmetric matrix.
-  void set_pair(PetscInt i, PetscInt j, double value);
+  /// The off-diagonal entry (i, j) (whole-system rows and columns; i one of this rank's rows).
+  void set_entry(PetscInt i, PetscInt j, double value);
   /// The diagonal (unless reuse), the right-hand side and the initial guess of every row; then the
   /// matrix assembled (unless reuse).
   void set_rows(const std::vector<double>& diag, const std::vector<double>& rhs, const std::vector<double>& x0, bool reuse);
@@ -106,7 +115,9 @@ class PressureSolver {
   void timed_solve(Mat Ap);
 
   const VofConfig& cfg_;
+  const Ranks& ranks_;
   int n_ = 0;
+  int first_row_ = 0;
   Mat A_ = nullptr;
   ::Vec x_ = nullptr, b_ = nullptr, r_ = nullptr, dx_ = nullptr;
   KSP ksp_ = nullptr;

@@ -18,7 +18,7 @@ PressureSolver::~PressureSolver() {
 
 void PressureSolver::make_ksp() {
   if (ksp_) KSPDestroy(&ksp_);
-  petsc_check(KSPCreate(PETSC_COMM_SELF, &ksp_), "KSPCreate");
+  petsc_check(KSPCreate(ranks_.comm().comm, &ksp_), "KSPCreate");
   petsc_check(KSPSetType(ksp_, KSPCG), "KSPSetType");
   PC pc;
   petsc_check(KSPGetPC(ksp_, &pc), "KSPGetPC");
@@ -40,7 +40,9 @@ void PressureSolver::make_ksp() {
     // ILU(0) over the region's rows: on terrain-following meshes, whose thin layers couple each
     // column about 10^4 times more strongly than the columns to each other, CG takes half GAMG's
     // iterations, each solve about a ninth of the time (docs/design/vof.md).
-    petsc_check(PCSetType(pc, PCILU), "PCSetType ilu");
+    // Over ranks, block Jacobi with ILU(0) in each rank's block (PETSc's defaults for the blocks): a
+    // column mesh split by whole columns keeps each column's coupling inside a block.
+    petsc_check(PCSetType(pc, ranks_.distributed() ? PCBJACOBI : PCILU), "PCSetType ilu");
   } else if (cfg_.pressure_pc == "hypre") {
     if (PCSetType(pc, PCHYPRE)) throw VofError("pressure_pc: this PETSc has no hypre (valid here: gamg)");
     petsc_check(PCHYPRESetType(pc, "boomeramg"), "PCHYPRESetType");
@@ -55,7 +57,7 @@ void PressureSolver::make_ksp() {
   petsc_check(KSPSetFromOptions(ksp_), "KSPSetFromOptions");
 }
 
-void PressureSolver::make_system(int rows, const std::vector<int>& nnz) {
+void PressureSolver::make_system(int rows, int first_row, long long total, const std::vector<int>& own_nnz, const std::vector<int>& off_nnz) {
   if (A_) MatDestroy(&A_);
   if (Apin_) MatDestroy(&Apin_);
   if (Apc_) MatDestroy(&Apc_);
@@ -64,10 +66,18 @@ void PressureSolver::make_system(int rows, const std::vector<int>& nnz) {
   for (::Vec* v : {&x_, &b_, &r_, &dx_})
     if (*v) VecDestroy(v);
   n_ = rows;
-  const std::vector<PetscInt> nz(nnz.begin(), nnz.end());
-  petsc_check(MatCreateSeqAIJ(PETSC_COMM_SELF, n_, n_, 0, nz.data(), &A_), "MatCreateSeqAIJ");
+  first_row_ = first_row;
+  const std::vector<PetscInt> nz(own_nnz.begin(), own_nnz.end()), oz(off_nnz.begin(), off_nnz.end());
+  if (!ranks_.distributed()) {
+    petsc_check(MatCreateSeqAIJ(PETSC_COMM_SELF, n_, n_, 0, nz.data(), &A_), "MatCreateSeqAIJ");
+    petsc_check(VecCreateSeq(PETSC_COMM_SELF, n_, &x_), "VecCreateSeq");
+  } else {
+    const MPI_Comm comm = ranks_.comm().comm;
+    const auto N = PetscInt(total);
+    petsc_check(MatCreateAIJ(comm, n_, n_, N, N, 0, nz.data(), 0, oz.data(), &A_), "MatCreateAIJ");
+    petsc_check(VecCreateMPI(comm, n_, N, &x_), "VecCreateMPI");
+  }
   petsc_check(MatSetOption(A_, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
-  petsc_check(VecCreateSeq(PETSC_COMM_SELF, n_, &x_), "VecCreateSeq");
   petsc_check(VecDuplicate(x_, &b_), "VecDuplicate");
   petsc_check(VecDuplicate(x_, &r_), "VecDuplicate");
   petsc_check(VecDuplicate(x_, &dx_), "VecDuplicate");
@@ -84,10 +94,9 @@ void PressureSolver::begin_matrix(bool reuse) {
   if (!reuse) petsc_check(MatZeroEntries(A_), "MatZeroEntries");
 }
 
-void PressureSolver::set_pair(PetscInt i, PetscInt j, double value) {
+void PressureSolver::set_entry(PetscInt i, PetscInt j, double value) {
   const PetscScalar v = value;
   petsc_check(MatSetValues(A_, 1, &i, 1, &j, &v, INSERT_VALUES), "MatSetValues");
-  petsc_check(MatSetValues(A_, 1, &j, 1, &i, &v, INSERT_VALUES), "MatSetValues");
 }
 
 void PressureSolver::set_rows(const std::vector<double>& diag, const std::vector<double>& rhs, const std::vector<double>& x0, bool reuse) {
@@ -96,7 +105,7 @@ void PressureSolver::set_rows(const std::vector<double>& diag, const std::vector
   petsc_check(VecGetArray(x_, &xv), "VecGetArray");
   for (int k = 0; k < n_; ++k) {
     if (!reuse) {
-      const PetscInt r0 = k;
+      const PetscInt r0 = first_row_ + k;
       const PetscScalar v = diag[k];
       petsc_check(MatSetValues(A_, 1, &r0, 1, &r0, &v, INSERT_VALUES), "MatSetValues");
     }
@@ -141,10 +150,11 @@ int PressureSolver::solve(const Solve& s, double t) {
       if (!same) {
         if (Apin_) petsc_check(MatCopy(A_, Apin_, SAME_NONZERO_PATTERN), "MatCopy");
         else petsc_check(MatDuplicate(A_, MAT_COPY_VALUES, &Apin_), "MatDuplicate");
-        const PetscInt row0 = 0;
-        petsc_check(MatZeroRowsColumns(Apin_, 1, &row0, s.diag0, dx_, r_), "MatZeroRowsColumns");
+        const PetscInt row0 = 0;  // the whole system's first row: rank 0's
+        const PetscInt n0 = ranks_.comm().rank == 0 ? 1 : 0;
+        petsc_check(MatZeroRowsColumns(Apin_, n0, &row0, s.diag0, dx_, r_), "MatZeroRowsColumns");
       } else {
-        petsc_check(VecSetValue(r_, 0, 0.0, INSERT_VALUES), "VecSetValue");  // dx_0 = 0
+        if (ranks_.comm().rank == 0) petsc_check(VecSetValue(r_, 0, 0.0, INSERT_VALUES), "VecSetValue");  // dx_0 = 0
         VecAssemblyBegin(r_);
         VecAssemblyEnd(r_);
       }
@@ -209,7 +219,10 @@ void PressureSolver::save_pc(VofState& st) const {
   st.pc_cols.clear();
   st.pc_first_values.clear();
   st.pc_values.clear();
-  if (!Apc_) return;
+  // A distributed run's checkpoint carries no preconditioner: the run it continues (on any number
+  // of ranks) builds one from its first matrix (docs/design/parallel.md).
+  if (ranks_.distributed()) st.pc_builds = 0;
+  if (!Apc_ || ranks_.distributed()) return;
   PetscInt n = 0;
   petsc_check(MatGetSize(Apc_, &n, nullptr), "MatGetSize");
   st.pc_rows.push_back(0);

@@ -24,10 +24,18 @@ NestSummary run_nest(const ResolvedScenario& parent, const NestBoundary& b, engi
   o.progress_every = opt.progress_every;
   o.terrain_cache_dir = opt.terrain_cache_dir;
   o.nest = &link;
+  // A nested run's checkpoint is its 3D run's: the depth-averaged part runs again from its start
+  // (it is deterministic and takes seconds) and hands the 3D run the same record.
+  o.checkpoint_path = opt.checkpoint_path;
+  o.checkpoint_interval_s = opt.checkpoint_interval_s;
+  o.restart_path = opt.restart_path;
   std::filesystem::create_directories(dir);
   const auto t0 = std::chrono::steady_clock::now();
-  run_scenario(r, dir, o);
+  RunSummary inner = run_scenario(r, dir, o);
   NestSummary s;
+  s.cancelled = inner.stop == "cancelled";
+  s.continued_from = link.continued_from;  // NaN unless it continued from a checkpoint
+  s.structures = std::move(inner.structures);
   s.seconds_3d = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   s.cells = b.cell_count();
   s.boundary_faces = int(b.faces().size());
@@ -40,7 +48,7 @@ NestSummary run_nest(const ResolvedScenario& parent, const NestBoundary& b, engi
   s.inflow_3d_m3 = link.inflow_m3;
   s.volume_error_3d = link.volume_error;
   s.start_time_s = link.start_time;
-  for (std::size_t k = 0; k < b.cells().size(); ++k) {
+  for (std::size_t k = 0; k < b.cells().size() && !s.cancelled; ++k) {
     if (!b.cells()[k] || link.maps.max_depth.empty()) continue;
     hz.max_depth[k] = link.maps.max_depth[k];
     hz.max_speed[k] = link.maps.max_speed[k];

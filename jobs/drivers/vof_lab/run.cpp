@@ -17,6 +17,7 @@
 #include "jobs/drivers/vof_support.hpp"
 #include "jobs/drivers/vof_lab/figures.hpp"
 #include "jobs/drivers/vof_lab/monitors.hpp"
+#include "jobs/drivers/vof_lab/nest.hpp"
 #include "jobs/drivers/vof_lab/results.hpp"
 #include "jobs/drivers/vof_lab/setup.hpp"
 #include "jobs/formats/checkpoint.hpp"
@@ -81,7 +82,7 @@ class LabRun final : public EngineRun {
  private:
   std::lock_guard<std::mutex> turn_{petsc_turn()};  // first: held until the solver is gone
   const ResolvedScenario& r_;
-  const v1::Lab& L_;
+  const v1::Lab L_;  // the lab block, or with a nest the part the 3D run takes (nest.hpp)
   std::string out_dir_;
   const RunOptions& opt_;
   LabSetup su_;
@@ -92,11 +93,17 @@ class LabRun final : public EngineRun {
   RunningFigures fig_;
   std::unique_ptr<LabMonitors> mon_;
   std::unique_ptr<vof::VofStepping> step_;
+  std::unique_ptr<FaceRecord> face_;  // a nest's: the depth-averaged run's record at its face
+  FaceBalance balance_;
 };
 
 LabRun::LabRun(const ResolvedScenario& r, const std::string& out_dir, const RunOptions& opt)
-    : r_(r), L_(r.scenario.lab()), out_dir_(out_dir), opt_(opt) {
+    : r_(r), L_(r.scenario.lab().has_nest() ? nest_part(r.scenario.lab()) : r.scenario.lab()), out_dir_(out_dir), opt_(opt) {
   build_setup(L_, su_);
+  if (r.scenario.lab().has_nest()) {  // the chute above on the depth-averaged engine (run again when continued: it is deterministic)
+    face_ = std::make_unique<FaceRecord>(record_face(r.scenario.lab(), su_.mat));
+    attach_face(*face_, L_, su_.m, su_.config);
+  }
   s_ = vof::make_vof_backend(su_.m, su_.config);
   state_hash_ = lab_state_hash(r);
   continued = !opt.restart_path.empty();
@@ -109,6 +116,14 @@ LabRun::LabRun(const ResolvedScenario& r, const std::string& out_dir, const RunO
       throw ScenarioError("checkpoint " + opt.restart_path + ": " + e.what());
     }
     continued_from_ = restart.state.t;
+    if (face_) {
+      try {
+        balance_.in = restart.figures.at("nest_inflow_m3");
+        balance_.out = restart.figures.at("nest_outflow_m3");
+      } catch (const std::out_of_range&) {
+        throw ScenarioError("checkpoint " + opt.restart_path + ": has no nest balance (written by a run without lab.nest?)");
+      }
+    }
   } else {
     s_->initialise(su_.alpha);
   }
@@ -139,6 +154,7 @@ engine::LoopHooks LabRun::hooks() {
   h.after_step = [this](const engine::StepReport& r) {
     fig_.step(step_->last());
     mon_->after_step(r.t, *s_);
+    if (face_) balance_.step(*s_, r.dt);
   };
   h.frame = [this](double t) { frames_->write(t, *s_); };
   h.checkpoint = [this](const engine::LoopState&) {
@@ -146,6 +162,7 @@ engine::LoopHooks LabRun::hooks() {
     cp.scenario_hash = state_hash_;
     fig_.save(cp);
     mon_->save(cp);
+    if (face_) cp.figures["nest_inflow_m3"] = balance_.in, cp.figures["nest_outflow_m3"] = balance_.out;
     cp.state = s_->state();
     write_checkpoint(opt_.checkpoint_path, cp);
   };
@@ -193,11 +210,20 @@ RunSummary LabRun::finish(engine::StopReason stop, const RunTimes& times) {
   plan.title = title;
   if (g.three_d) write_chute(L_, su_, s, plan, rec);
   sum.files = {"fields.h5", "fields.xmf", "figure.png", "run.json", "comparison.png"};
+  if (face_) {  // a nest: its inflows and balance; the record as CSV
+    write_nest(*face_, balance_, dep.volume, s.time(), su_.m.cells(), g.dx, *rec.mutable_nest());
+    if (continued) rec.mutable_nest()->set_continued_from_s(continued_from_);
+    sum.volume_error = rec.nest().volume_error_3d();
+    rec.mutable_results()->set_volume_relative_error(sum.volume_error);
+    write_face_csv(out_dir_ + "/nest_inflow.csv", *face_);
+    sum.files.push_back("nest_inflow.csv");
+  }
   sum.seconds_write = since(t2);
 
   write_timings(sum, fig_, su_.m.cells(), rec);
   for (const auto& f : sum.files) rec.add_outputs(f);
   rec.mutable_execution()->set_petsc_options(petsc_options());
+  record_distribution(s, fig_.steps, rec);
   write_run_record(out_dir_ + "/run.json", rec);
   if (g.three_d) figures::write_plan_figure(out_dir_ + "/comparison.png", plan);
   else write_section_comparison(out_dir_ + "/comparison.png", title, L_, su_, s, dep, *mon_);

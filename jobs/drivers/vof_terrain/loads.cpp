@@ -91,6 +91,23 @@ void StructureLoads::restore(const VofCheckpoint& cp, const std::string& path) {
   }
 }
 
+void loads_verdict(double column_width_m, StructureSummary& q) {
+  const double depth = q.max_depth_next_m;
+  q.column_width_m = column_width_m;
+  q.loads_resolved = depth > 0 && column_width_m <= 0.25 * depth;
+  char b[512];
+  if (q.loads_resolved)
+    std::snprintf(b, sizeof b, "columns %.3g m wide for a flow %.3g m deep next to it: the impact is resolved (at most a quarter of the depth)",
+                  column_width_m, depth);
+  else
+    std::snprintf(b, sizeof b,
+                  "not design values: columns %.3g m wide for a flow %.3g m deep next to it do not resolve the impact (they must be at most "
+                  "a quarter of the depth, %.3g m); on wider columns the flow passes the wall's cells without stopping and the loads "
+                  "grow as the columns shrink (validation.md D4)",
+                  column_width_m, depth, 0.25 * depth);
+  q.loads_note = b;
+}
+
 void StructureLoads::summarise(std::vector<StructureSummary>& out) const {
   for (const auto& l : loads_)
     for (auto& q : out) {
@@ -101,6 +118,7 @@ void StructureLoads::summarise(std::vector<StructureSummary>& out) const {
       q.impulse_kn_s = l.impulse, q.max_pressure_kpa = l.p_max, q.max_pressure_time_s = l.p_max_t;
       q.max_pressure_height_m = l.p_max_height, q.wall_area_m2 = l.area;
       q.front_height_m = l.front_h, q.front_alpha = l.front_a, q.front_speed_m_s = l.front_s;
+      loads_verdict(su_.columns_mesh.dx, q);
     }
 }
 

@@ -16,6 +16,12 @@
 
 namespace runout::jobs::vof_terrain {
 
+/// Whether the loads of a structure in a flow `depth_m` deep next to it resolve the impact on
+/// columns `column_width_m` wide: at most a quarter of the depth (the wall-impact verification holds
+/// its force to 15 % with four cells over the flow's depth, and the farmhouse's loads grow as the
+/// columns shrink where they are wider: validation.md D4). Sets q.loads_resolved and q.loads_note.
+void loads_verdict(double column_width_m, StructureSummary& q);
+
 class StructureLoads {
  public:
   StructureLoads(const TerrainSetup& su, double interval);
@@ -25,7 +31,8 @@ class StructureLoads {
   void save(VofCheckpoint& cp) const;
   /// Throws ScenarioError naming `path` when the checkpoint lacks a structure's figures.
   void restore(const VofCheckpoint& cp, const std::string& path);
-  /// The figures into the summaries (matched by name).
+  /// The figures into the summaries (matched by name, their max_depth_next_m set), with the verdict
+  /// of loads_verdict on each.
   void summarise(std::vector<StructureSummary>& out) const;
   /// structure_loads.csv: time_s, structure, force_east_kn, force_north_kn, force_up_kn,
   /// force_horizontal_kn, max_pressure_kpa. Returns the file's name.

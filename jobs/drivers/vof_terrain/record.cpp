@@ -102,6 +102,7 @@ void write_terrain_record(const std::string& path, const ResolvedScenario& r, co
   for (const auto& file : sum.files) rec.add_outputs(file);
   rec.add_outputs("run.json");
   rec.mutable_execution()->set_petsc_options(petsc_options());
+  if (f.backend) record_distribution(*f.backend, long(f.fig.steps), rec);
   write_run_record(path, rec);
 }
 

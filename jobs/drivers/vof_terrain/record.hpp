@@ -9,6 +9,7 @@
 #include "jobs/drivers/run.hpp"
 #include "jobs/drivers/vof_lab/monitors.hpp"
 #include "jobs/drivers/vof_terrain/hazard.hpp"
+#include "engine/vof/backend.hpp"
 #include "jobs/drivers/vof_terrain/setup.hpp"
 
 namespace runout::jobs::vof_terrain {
@@ -24,6 +25,7 @@ struct TerrainRunFacts {
   double corridor_outflow = 0;     ///< [m3] through the corridor's edge
   double domain_edge_outflow = 0;  ///< [m3] through the domain's edge
   std::vector<std::string> notes;  ///< run.json's notes
+  const engine::vof::VofBackend* backend = nullptr;  ///< the engine (a run split over MPI ranks records its split)
 };
 
 void write_terrain_record(const std::string& path, const ResolvedScenario& r, const TerrainRunFacts& f);

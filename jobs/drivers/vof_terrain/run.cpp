@@ -173,6 +173,7 @@ TerrainRun::TerrainRun(const ResolvedScenario& r, const std::string& out_dir, co
       throw ScenarioError("checkpoint " + opt.restart_path + ": " + e.what());
     }
     continued_from_ = restart.state.t;
+    if (opt.nest) opt.nest->continued_from = continued_from_;
   } else {
     s_->initialise(su_.alpha);
   }
@@ -206,6 +207,7 @@ void TerrainRun::save(VofCheckpoint& cp) const {
   cp.figures["ke_peak"] = loop.kinetic_energy_peak;
   cp.figures["corridor_outflow_m3"] = outflow_corridor_;
   cp.figures["domain_edge_outflow_m3"] = outflow_edge_;
+  if (r_.nest_part) cp.figures["nest_inflow_m3"] = nest_in_;
 }
 
 void TerrainRun::restore(const VofCheckpoint& cp, const std::string& path) {
@@ -218,6 +220,10 @@ void TerrainRun::restore(const VofCheckpoint& cp, const std::string& path) {
   loop.kinetic_energy_peak = cp.figures.at("ke_peak");
   outflow_corridor_ = cp.figures.at("corridor_outflow_m3");
   outflow_edge_ = cp.figures.at("domain_edge_outflow_m3");
+  if (r_.nest_part) {
+    if (!cp.figures.count("nest_inflow_m3")) throw ScenarioError("checkpoint " + path + ": damaged (no figure 'nest_inflow_m3')");
+    nest_in_ = cp.figures.at("nest_inflow_m3");
+  }
 }
 
 void TerrainRun::balance(double dt) {
@@ -308,11 +314,11 @@ RunSummary TerrainRun::finish(engine::StopReason stop, const RunTimes& times) {
   hazard_figures(r_, su_.grid, su_.h0, hazard_->maps(), sum);
   require_finite_figures({{"final volume", v_final}, {"outflow volume", outflow_}, {"maximum speed", sum.max_speed},
                           {"maximum depth", sum.max_depth}, {"runout", sum.runout_m}});
+  sum.structures = structure_summaries(r_, su_.grid, su_.output_inputs.structures, hazard_->maps());
+  if (!loads_->empty()) loads_->summarise(sum.structures);  // before the maps, which show the loads
   const auto outputs = write_hazard_outputs(r_, su_.grid, su_.h0, hazard_->maps(), su_.output_inputs, out_dir_, sum);
   write_3d_rasters(su_, *hazard_, out_dir_, sum);
-  sum.structures = structure_summaries(r_, su_.grid, su_.output_inputs.structures, hazard_->maps());
   if (!loads_->empty()) {
-    loads_->summarise(sum.structures);
     sum.files.push_back(loads_->write_csv(out_dir_));
     if (r_.maps)
       for (auto& f : loads_->write_plot(out_dir_, r_.scenario.name().empty() ? "3D run" : r_.scenario.name())) sum.files.push_back(std::move(f));
@@ -325,7 +331,7 @@ RunSummary TerrainRun::finish(engine::StopReason stop, const RunTimes& times) {
   sum.seconds_write = since(t2);
   const std::vector<std::string> record_notes = corridor_notes();
   sum.notes.insert(sum.notes.end(), record_notes.begin(), record_notes.end());
-  TerrainRunFacts facts{su_, *hazard_, fig_, sum, continued_from_, outputs, n_frames, outflow_corridor_, outflow_edge_, record_notes};
+  TerrainRunFacts facts{su_, *hazard_, fig_, sum, continued_from_, outputs, n_frames, outflow_corridor_, outflow_edge_, record_notes, s_.get()};
   write_terrain_record(out_dir_ + "/run.json", r_, facts);
   sum.files.push_back("run.json");
   return sum;
