@@ -2,6 +2,7 @@
 
 #include <petscsys.h>
 
+#include "engine/vof/linear/petsc.hpp"
 #include "engine/vof/mpi/distributed.hpp"
 
 #include <algorithm>
@@ -59,6 +60,26 @@ LaunchRanks launch_ranks() {
     if (rank && size) return {std::atoi(rank), std::max(1, std::atoi(size))};
   }
   return {};
+}
+
+std::string share_from_rank0(const std::string& bytes) {
+  engine::vof::petsc_init();
+  int rank = 0;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  long long n = (long long)bytes.size();
+  MPI_Bcast(&n, 1, MPI_LONG_LONG, 0, PETSC_COMM_WORLD);
+  std::string out = rank == 0 ? bytes : std::string(std::size_t(n), '\0');
+  for (long long at = 0; at < n;) {  // in pieces an int counts
+    const int piece = int(std::min<long long>(n - at, 1 << 30));
+    MPI_Bcast(out.data() + at, piece, MPI_CHAR, 0, PETSC_COMM_WORLD);
+    at += piece;
+  }
+  return out;
+}
+
+int finish_worker_ranks(int exit_code) {
+  finish_mpi(exit_code);
+  return exit_code;
 }
 
 void finish_mpi(int exit_code) {

@@ -35,4 +35,11 @@ LaunchRanks launch_ranks();
 /// for it in their next exchange.
 void finish_mpi(int exit_code);
 
+/// Under a launcher: rank 0's `bytes` on every rank (MPI started through PETSc first). A worker's
+/// task reaches rank 0 alone (mpirun and srun --input=0 give the others no standard input).
+std::string share_from_rank0(const std::string& bytes);
+
+/// finish_mpi(exit_code), then exit_code: a worker's last word under a launcher.
+int finish_worker_ranks(int exit_code);
+
 }  // namespace runout::jobs

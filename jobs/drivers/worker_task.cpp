@@ -1,5 +1,6 @@
 #include "jobs/drivers/worker_task.hpp"
 
+#include <fcntl.h>
 #include <omp.h>
 #include <signal.h>
 #include <sys/statvfs.h>
@@ -16,6 +17,7 @@
 
 #include "jobs/drivers/ensemble_aggregate.hpp"
 #include "jobs/drivers/run.hpp"
+#include "jobs/drivers/vof_support.hpp"
 #include "jobs/ensemble/variations.hpp"
 #include "jobs/scenario/scenario.hpp"
 #include "runout/v1/worker.pb.h"
@@ -91,39 +93,30 @@ int aggregate(const ResolvedScenario& r, const v1::WorkerTask& task, int events)
   return send_event(events, ev) ? 0 : 3;
 }
 
-}  // namespace
-
-int worker_main(int in_fd, int out_fd) {
-  // Stray prints of libraries go to the log (standard error), never into the event stream.
-  const int events = dup(out_fd);
-  if (events < 0) return 3;
-  dup2(2, out_fd);
-  std::signal(SIGTERM, on_stop);
-  std::signal(SIGINT, on_stop);
-  std::signal(SIGPIPE, SIG_IGN);
-  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit makes writes fail (and the run report it), not the process die
-
+std::string read_all(int fd) {
   std::string in;
-  {
-    char b[65536];
-    for (;;) {
-      const ssize_t n = ::read(in_fd, b, sizeof b);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) break;
-      in.append(b, std::size_t(n));
-    }
+  char b[65536];
+  for (;;) {
+    const ssize_t n = ::read(fd, b, sizeof b);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    in.append(b, std::size_t(n));
   }
-  v1::WorkerTask task;
+  return in;
+}
+
+// The task's run, its progress and its one outcome on `events`. `failed` tells whether the outcome
+// is a failure (under a launcher, the ranks are then ended together).
+int run_task(const v1::WorkerTask& task, int events, bool& failed_run) {
   auto failed = [&](const std::string& error, bool bad_input) {
+    failed_run = true;
     v1::WorkerEvent ev;
     const std::string ckpt = task.checkpoint_path().empty() ? "" : std::filesystem::path(task.checkpoint_path()).parent_path().string();
     ev.mutable_failed()->set_error(bad_input ? error : with_disk_state(error, {task.out_dir(), ckpt}));
     ev.mutable_failed()->set_bad_input(bad_input);
     return send_event(events, ev) ? 0 : 3;
   };
-  if (!task.ParseFromString(in)) return failed("the worker received an unreadable task", false);
   if (task.threads() > 0) omp_set_num_threads(task.threads());
-
   try {
     const ResolvedScenario r = resolve_scenario(task.scenario(), "/");
     if (ensemble::is_ensemble(r.scenario)) return aggregate(r, task, events);
@@ -185,6 +178,65 @@ int worker_main(int in_fd, int out_fd) {
   } catch (const std::exception& e) {
     return failed(e.what(), false);
   }
+}
+
+// A rank other than 0 of a task split over MPI ranks: it takes its part of the 3D run's steps and
+// runs the same set-up and outputs into a private folder, which it removes; it writes no events
+// (rank 0 speaks for the run) and no checkpoint of the task's (rank 0 writes it).
+int run_other_rank(v1::WorkerTask task, int rank) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path tmp = fs::temp_directory_path(ec) / ("runout-worker-rank" + std::to_string(rank) + "-" + std::to_string(getpid()));
+  fs::remove_all(tmp, ec);
+  fs::create_directories(tmp / "out", ec);
+  if (ec) {
+    std::fprintf(stderr, "runout worker (rank %d): cannot create %s: %s\n", rank, tmp.c_str(), ec.message().c_str());
+    return 4;
+  }
+  task.set_out_dir((tmp / "out").string());
+  if (!task.checkpoint_path().empty()) task.set_checkpoint_path((tmp / "checkpoint.h5").string());
+  const int quiet = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+  bool failed_run = false;
+  const int rc = run_task(task, quiet, failed_run);
+  if (quiet >= 0) ::close(quiet);
+  fs::remove_all(tmp, ec);
+  return rc != 0 ? rc : failed_run ? 1 : 0;
+}
+
+}  // namespace
+
+int worker_main(int in_fd, int out_fd) {
+  // Under an MPI launcher (the task's ranks: mpirun -n N, srun with N tasks) the worker runs N
+  // times; rank 0 reads the task and shares it, speaks for the run and writes its results.
+  const LaunchRanks launch = launch_ranks();
+  // Stray prints of libraries go to the log (standard error), never into the event stream.
+  const int events = dup(out_fd);
+  if (events < 0) return 3;
+  dup2(2, out_fd);
+  std::signal(SIGTERM, on_stop);
+  std::signal(SIGINT, on_stop);
+  // A stop under mpirun: mpirun forwards SIGUSR1 to every rank, while it answers SIGTERM by
+  // killing them all within about two seconds (no time for the checkpoint).
+  std::signal(SIGUSR1, on_stop);
+  std::signal(SIGPIPE, SIG_IGN);
+  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit makes writes fail (and the run report it), not the process die
+
+  std::string in = launch.rank == 0 ? read_all(in_fd) : std::string();
+  if (launch.size > 1) in = share_from_rank0(in);
+  v1::WorkerTask task;
+  if (!task.ParseFromString(in)) {
+    if (launch.rank > 0) return finish_worker_ranks(4);
+    v1::WorkerEvent ev;
+    ev.mutable_failed()->set_error("the worker received an unreadable task");
+    const int rc = send_event(events, ev) ? 0 : 3;
+    return launch.size > 1 ? finish_worker_ranks(1) : rc;
+  }
+  if (launch.rank > 0) return finish_worker_ranks(run_other_rank(task, launch.rank));
+  bool failed_run = false;
+  const int rc = run_task(task, events, failed_run);
+  if (launch.size == 1) return rc;
+  ::close(events);  // the outcome is out before the ranks end
+  return finish_worker_ranks(rc != 0 ? rc : failed_run ? 1 : 0);
 }
 
 }  // namespace runout::jobs

@@ -47,6 +47,7 @@ constexpr double kMaxEndTime = 1e5;         // numerics.end_time_s, outputs.time
 constexpr double kMaxDepthThreshold = 100;  // outline and flow thresholds [m]
 constexpr double kMaxZonePressure = 1e5;    // outputs.pressure_zones_kpa[].from_kpa [kPa]: 100 MPa
 constexpr int kMaxZones = 16;
+constexpr double kMaxRanks = 65536;         // ranks: a large cluster's partition (a server sets its own bound)
 
 // outputs.pressure_zones_kpa: named, ascending and distinct; none: the Swiss practice (blue from 3
 // kPa, red from 30 kPa).
@@ -83,6 +84,9 @@ const OptionTable& scenario_options() {
        "the service's wall-time limit of one attempt (checked by the server); not part of the hash", "the service's job", "the server's"},
       {"limits.max_memory_bytes", T::integer, U::as_given, "", {}, {}, "bytes",
        "the service's memory limit of the job's process; not part of the hash", "the service's job", "the server's"},
+      {"ranks", T::integer, U::as_given, "", Range{0, kMaxRanks}, {}, "",
+       "the MPI ranks of the job's 3D run (the local worker pool: mpirun; Slurm: one job of this many tasks); not part of the hash",
+       "the service's job", "one process"},
   };
   return t;
 }

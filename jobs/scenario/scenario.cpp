@@ -458,6 +458,12 @@ ResolvedScenario resolve_scenario(v1::Scenario s, const std::string& base) {
   check_text_limits(s);  // first: nothing else reads an unbounded name or a path cut by a NUL byte
   apply_option_rules(scenario_options(), s);
   const bool vof = s.engine() == "vof";
+  if (s.ranks() > 1) {
+    if (s.has_variations() || s.has_zoning())
+      bad("ranks", "an ensemble's members run on one process each; ranks splits one 3D run over MPI ranks");
+    if (!vof && !s.has_nest())
+      bad("ranks", "only for a 3D run (engine \"vof\", or a depth-averaged scenario's nest): the depth-averaged engine runs on one process");
+  }
   if (vof && s.has_lab()) return resolve_lab(std::move(s));
   if (!vof && s.has_mesh()) bad("mesh", "only for engine \"vof\" (the 3D engine on the DEM); a nest's mesh is in `nest`");
   if (vof && s.has_nest()) bad("nest", "only for engine \"depth-averaged\": the nest is a 3D run inside a depth-averaged one");
@@ -552,6 +558,7 @@ std::string scenario_hash(const ResolvedScenario& r, int depth_averaged_version,
   if (s.has_observations() && s.observations().ByteSizeLong() == 0) s.clear_observations();
   if (s.has_variations() && s.variations().ByteSizeLong() == 0) s.clear_variations();
   s.clear_limits();  // a job's limits do not change what it computes
+  s.clear_ranks();   // nor, beyond round-off, the ranks it runs on
   std::string bytes;
   {
     google::protobuf::io::StringOutputStream so(&bytes);

@@ -256,8 +256,11 @@ struct Scheduler::Attempt {
 void Scheduler::run_job(StoredJob job) {
   JobContext jc(*this, std::move(job));
   const std::string& id = jc.id;
+  const int ranks = std::max(1, jc.sj.scenario.ranks());
+  // A job over MPI ranks takes one slot; its ranks share the slot's threads (at least one each).
+  const int threads = std::max(1, cfg_.threads_per_run / ranks);
   jc.say("attempt " + std::to_string(jc.sj.job.attempts()) + ": started (scenario " + jc.hash.substr(0, 12) + ", " +
-         std::to_string(cfg_.threads_per_run) + " threads)");
+         (ranks > 1 ? std::to_string(ranks) + " MPI ranks of " : std::string()) + std::to_string(threads) + " threads)");
   log("job " + id + ": started");
   {
     std::lock_guard lk(mu_);
@@ -299,7 +302,8 @@ void Scheduler::run_job(StoredJob job) {
   task.set_job_id(id);
   *task.mutable_scenario() = jc.sj.scenario;
   task.set_out_dir(jc.tmp.string());
-  task.set_threads(cfg_.threads_per_run);
+  task.set_threads(threads);
+  task.set_ranks(ranks);
   task.set_progress_interval_s(0.25);
   task.set_checkpoint_path(jc.cp);
   task.set_checkpoint_interval_s(-1);  // a twentieth of the end time (the worker knows it, defaults filled in)
@@ -363,7 +367,7 @@ Scheduler::Attempt Scheduler::supervise(JobContext& jc, const v1::WorkerTask& ta
     if (slurm_)
       run = std::make_unique<SlurmStep>(*slurm_, task, log_path(id));
     else
-      run = std::make_unique<WorkerProcess>(cfg_.worker_exe, task, log_path(id));
+      run = std::make_unique<WorkerProcess>(cfg_.worker_exe, task, log_path(id), cfg_.mpi_launcher);
     Execution& w = *run;
     jc.say(w.where());
     const auto t0 = std::chrono::steady_clock::now();

@@ -51,6 +51,9 @@ struct SchedulerConfig {
   int max_crashes = 3;              ///< a job whose worker crashed this often fails
   std::vector<std::string> data_roots;  ///< the server's data roots (left out of messages to clients)
   bool terrain_cache = true;        ///< depth-averaged runs share prepared grids (STATE/cache/terrain)
+  /// The local launcher of a job over several MPI ranks (a scenario's `ranks`): its command and
+  /// options, before "-n RANKS EXE worker" (jobs/system/worker.hpp). Empty: such jobs run on one process.
+  std::vector<std::string> mpi_launcher = {"mpirun", "--oversubscribe", "--bind-to", "none"};
   /// Run the jobs as tasks of Slurm job arrays (jobs/system/slurm.hpp) instead of local worker
   /// processes; `workers` is then how many tasks may be on the cluster at once.
   std::optional<SlurmConfig> slurm;

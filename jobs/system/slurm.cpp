@@ -115,7 +115,11 @@ SlurmSubmitter::Submitted SlurmSubmitter::submit(const v1::WorkerTask& task, con
     pending_.clear();
     leader_ = false;
     lk.unlock();
-    submit_batch(batch);
+    // An array's tasks share its --ntasks: a task over several MPI ranks goes into an array with
+    // those of the same ranks.
+    std::map<int, std::vector<std::shared_ptr<Pending>>> by_ranks;
+    for (auto& q : batch) by_ranks[std::max(1, q->task.ranks())].push_back(q);
+    for (auto& [ranks, group] : by_ranks) submit_batch(group);
     lk.lock();
     cv_.notify_all();
   }
@@ -144,6 +148,7 @@ void SlurmSubmitter::submit_batch(std::vector<std::shared_ptr<Pending>> batch) {
       open_[dir] = int(batch.size());
     }
     int threads = 1;
+    const int ranks = std::max(1, batch.front()->task.ranks());
     for (std::size_t k = 0; k < batch.size(); ++k) {
       std::string bytes;
       batch[k]->task.SerializeToString(&bytes);
@@ -151,17 +156,25 @@ void SlurmSubmitter::submit_batch(std::vector<std::shared_ptr<Pending>> batch) {
       std::ofstream(fs::path(dir) / (std::to_string(k) + ".log")) << batch[k]->log_path;
       threads = std::max(threads, batch[k]->task.threads());
     }
-    // Each task: its task file in, its events out (a file per Slurm attempt), its log appended.
+    // Each task: its task file in, its events out (a file per Slurm attempt), its log appended. A
+    // task over several MPI ranks is one srun step of that many tasks, the task file to rank 0.
     const std::string script = (fs::path(dir) / "run.sh").string();
+    std::string launch;
+    if (ranks > 1) {
+      launch = "srun --ntasks=" + std::to_string(ranks) + " --cpus-per-task=" + std::to_string(threads) + " --input=0";
+      if (cfg_.mpi != "cluster") launch += " --mpi=" + cfg_.mpi;  // (a plugin's name: letters, digits, _)
+      launch += " ";
+    }
     std::ofstream(script) << "#!/bin/sh\n"
                           << "d=" << quoted(dir) << "\n"
                           << "k=\"$SLURM_ARRAY_TASK_ID\"\n"
-                          << "exec " << quoted(cfg_.worker_exe) << " worker < \"$d/$k.task\" >> \"$d/$k.events.${SLURM_RESTART_COUNT:-0}\""
+                          << "exec " << launch << quoted(cfg_.worker_exe) << " worker < \"$d/$k.task\" >> \"$d/$k.events.${SLURM_RESTART_COUNT:-0}\""
                           << " 2>> \"$(cat \"$d/$k.log\")\"\n";
     fs::permissions(script, fs::perms::owner_all | fs::perms::group_read | fs::perms::others_read);
     std::vector<std::string> args = {"--parsable", "--array=0-" + std::to_string(batch.size() - 1), "--job-name=" + cfg_.job_name,
                                      "--chdir=" + dir, "--output=" + (fs::path(dir) / "slurm-%A_%a.out").string(),
-                                     "--open-mode=append", "--requeue", "--ntasks=1", "--cpus-per-task=" + std::to_string(threads)};
+                                     "--open-mode=append", "--requeue", "--ntasks=" + std::to_string(ranks),
+                                     "--cpus-per-task=" + std::to_string(threads)};
     if (!cfg_.partition.empty()) args.push_back("--partition=" + cfg_.partition);
     args.insert(args.end(), cfg_.sbatch_args.begin(), cfg_.sbatch_args.end());
     args.push_back(script);
@@ -209,7 +222,8 @@ void SlurmSubmitter::release(const std::string& dir) {
   fs::remove_all(dir, ec);  // every task of the array has ended: its files go
 }
 
-SlurmStep::SlurmStep(SlurmSubmitter& s, const v1::WorkerTask& task, const std::string& log_path) : s_(s), sub_(s.submit(task, log_path)) {}
+SlurmStep::SlurmStep(SlurmSubmitter& s, const v1::WorkerTask& task, const std::string& log_path)
+    : s_(s), sub_(s.submit(task, log_path)), ranks_(std::max(1, task.ranks())) {}
 
 SlurmStep::~SlurmStep() {
   if (!final_) {  // followed no further (the scheduler gave up on it): it must not run on unseen
@@ -291,7 +305,12 @@ std::optional<v1::WorkerEvent> SlurmStep::next_event(std::chrono::milliseconds t
 void SlurmStep::signal(int sig) {
   int rc = 0;
   if (sig == SIGTERM && state_ == "RUNNING") {
-    s_.command("scancel", {"--signal=TERM", "--batch", sub_.id}, rc);  // the worker ends at its step, with a checkpoint
+    // The worker ends at its step, with a checkpoint: the batch step is the worker, or, for a task
+    // over MPI ranks, srun, whose step's tasks (the ranks) get the signal.
+    if (ranks_ > 1)
+      s_.command("scancel", {"--signal=TERM", sub_.id}, rc);
+    else
+      s_.command("scancel", {"--signal=TERM", "--batch", sub_.id}, rc);
   } else {
     s_.command("scancel", {sub_.id}, rc);
   }

@@ -17,6 +17,11 @@
 //   NODE_FAIL, BOOT_FAIL, OUT_OF_MEMORY, TIMEOUT, DEADLINE -> killed (a crash: run again, counted)
 // Tasks are submitted with --requeue: Slurm itself runs again a task whose node failed, and the
 // scheduler goes on following it (the next attempt's events file).
+//
+// A task over several MPI ranks (WorkerTask.ranks, a scenario's `ranks`) is an array of its own
+// (with the tasks of the same ranks) of --ntasks=RANKS: its batch step execs `srun --input=0`, which
+// starts the ranks on the job's nodes; rank 0 reads the task file and writes the events. A stop is
+// SIGTERM to the job's steps (the ranks), not to the batch step.
 #include <condition_variable>
 #include <deque>
 #include <map>
@@ -36,6 +41,9 @@ struct SlurmConfig {
   std::string job_name;                  ///< every array's name (one per state directory: "runout-<hash>")
   double batch_window_s = 0.3;           ///< tasks submitted within this much of each other share an array
   std::string commands_dir;              ///< where sbatch, scontrol and scancel are; empty: PATH
+  /// A task over several MPI ranks: srun --mpi= this ("pmix": Debian's Open MPI through Slurm's
+  /// PMIx plugin); "cluster": the cluster's own MpiDefault.
+  std::string mpi = "pmix";
 };
 
 /// Batches tasks into job arrays and submits them (one per state directory).
@@ -105,6 +113,7 @@ class SlurmStep : public Execution {
   std::string buf_;
   bool final_ = false, closed_ = false, gone_ = false;
   int sent_ = 0;  ///< the last signal we sent
+  int ranks_ = 1;  ///< the task's MPI ranks (an srun step of this many tasks when > 1)
   std::chrono::steady_clock::time_point last_poll_{};
 };
 

@@ -11,7 +11,9 @@
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 #include <thread>
@@ -47,7 +49,58 @@ std::string self_executable() {
   return "/proc/self/exe";
 }
 
-WorkerProcess::WorkerProcess(const std::string& exe, const v1::WorkerTask& task, const std::string& log_path) {
+namespace {
+
+// Whether a command (a path, or a name on PATH) is an executable file.
+bool on_path(const std::string& cmd) {
+  if (cmd.find('/') != std::string::npos) return ::access(cmd.c_str(), X_OK) == 0;
+  const char* path = std::getenv("PATH");
+  std::string dirs = path ? path : "/usr/bin:/bin";
+  for (std::size_t at = 0; at <= dirs.size();) {
+    const std::size_t end = std::min(dirs.find(':', at), dirs.size());
+    const std::string dir = dirs.substr(at, end - at);
+    if (::access(((dir.empty() ? "." : dir) + "/" + cmd).c_str(), X_OK) == 0) return true;
+    at = end + 1;
+  }
+  return false;
+}
+
+// The worker's command line: `EXE worker`, or under a launcher for a task over several MPI ranks
+// `LAUNCHER... -n RANKS EXE worker`. The launcher starts EXE in processes of its own, where
+// /proc/self/exe would name the launcher: it gets the program's own path.
+std::vector<std::string> worker_command(const std::string& exe, const v1::WorkerTask& task, const std::vector<std::string>& launcher) {
+  if (task.ranks() <= 1 || launcher.empty()) return {exe, "worker"};
+  std::error_code ec;
+  std::string path = exe;
+  if (exe == "/proc/self/exe") {
+    path = std::filesystem::read_symlink(exe, ec).string();
+    if (ec) throw std::runtime_error("cannot start a worker over MPI ranks: the program's path: " + ec.message());
+  }
+  if (!on_path(launcher.front()))
+    throw std::runtime_error("cannot start a job over " + std::to_string(task.ranks()) + " MPI ranks: the launcher '" + launcher.front() +
+                             "' was not found (Debian: apt-get install openmpi-bin; the server's mpi_launcher)");
+  std::vector<std::string> a = launcher;
+  for (const std::string& x : {std::string("-n"), std::to_string(task.ranks()), path, std::string("worker")}) a.push_back(x);
+  return a;
+}
+
+// Resident memory of a process and every process below it [bytes]: a launcher's ranks count.
+std::int64_t tree_resident(pid_t pid, int depth) {
+  std::ifstream f("/proc/" + std::to_string(pid) + "/statm");
+  long size = 0, resident = 0;
+  std::int64_t total = (f >> size >> resident) ? std::int64_t(resident) * sysconf(_SC_PAGESIZE) : 0;
+  if (depth > 8) return total;
+  std::ifstream c("/proc/" + std::to_string(pid) + "/task/" + std::to_string(pid) + "/children");
+  for (long child; c >> child;) total += tree_resident(pid_t(child), depth + 1);
+  return total;
+}
+
+}  // namespace
+
+WorkerProcess::WorkerProcess(const std::string& exe, const v1::WorkerTask& task, const std::string& log_path,
+                             const std::vector<std::string>& launcher) {
+  std::vector<std::string> args = worker_command(exe, task, launcher);
+  launched_ = args.size() > 2;
   std::signal(SIGPIPE, SIG_IGN);  // a worker that dies before reading its task must not take us down
   int in[2], out[2];
   if (pipe2(in, O_CLOEXEC) != 0) throw std::runtime_error(std::string("cannot start a worker: pipe: ") + std::strerror(errno));
@@ -57,8 +110,9 @@ WorkerProcess::WorkerProcess(const std::string& exe, const v1::WorkerTask& task,
     throw std::runtime_error(std::string("cannot start a worker: pipe: ") + std::strerror(errno));
   }
   const int log = ::open(log_path.c_str(), O_WRONLY | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
-  std::string a0 = exe, a1 = "worker";
-  char* argv[] = {a0.data(), a1.data(), nullptr};
+  std::vector<char*> argv;
+  for (auto& x : args) argv.push_back(x.data());
+  argv.push_back(nullptr);
   const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid == 0) {
@@ -75,7 +129,7 @@ WorkerProcess::WorkerProcess(const std::string& exe, const v1::WorkerTask& task,
     sigemptyset(&none);
     sigprocmask(SIG_SETMASK, &none, nullptr);  // the server blocks SIGTERM/SIGINT in its threads
     ::signal(SIGPIPE, SIG_DFL);
-    execv(argv[0], argv);
+    execvp(argv[0], argv.data());
     _exit(127);
   }
   const int err = errno;
@@ -163,7 +217,9 @@ std::optional<v1::WorkerEvent> WorkerProcess::next_event(std::chrono::millisecon
 void WorkerProcess::signal(int sig) {
   if (reaped_ || pid_ <= 0) return;
   sent_ = true;
-  ::kill(pid_, sig);
+  // A launcher answers SIGTERM by killing its ranks within seconds; SIGUSR1 it passes on to every
+  // rank, which ends at the end of its step (with the checkpoint) as a worker does on SIGTERM.
+  ::kill(pid_, launched_ && sig == SIGTERM ? SIGUSR1 : sig);
 }
 
 void WorkerProcess::stop(std::chrono::milliseconds grace) {
@@ -198,11 +254,6 @@ std::optional<WorkerExit> WorkerProcess::wait(std::chrono::milliseconds timeout)
   }
 }
 
-std::int64_t WorkerProcess::resident_bytes() const {
-  std::ifstream f("/proc/" + std::to_string(pid_) + "/statm");
-  long size = 0, resident = 0;
-  if (!(f >> size >> resident)) return 0;
-  return std::int64_t(resident) * sysconf(_SC_PAGESIZE);
-}
+std::int64_t WorkerProcess::resident_bytes() const { return launched_ ? tree_resident(pid_, 0) : tree_resident(pid_, 9); }
 
 }  // namespace runout::jobs

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "jobs/system/execution.hpp"
 #include "runout/v1/worker.pb.h"
@@ -30,8 +31,12 @@ class WorkerProcess : public Execution {
  public:
   /// Starts `exe worker` with the task on its standard input and its standard error appended to
   /// `log_path`. The process dies with the thread that started it (PR_SET_PDEATHSIG), so a killed
-  /// server leaves no worker behind. Throws std::runtime_error when it cannot start.
-  WorkerProcess(const std::string& exe, const v1::WorkerTask& task, const std::string& log_path);
+  /// server leaves no worker behind. A task over several MPI ranks (task.ranks() > 1) with a
+  /// `launcher` ("mpirun", its options) starts `launcher... -n RANKS exe worker` instead: the
+  /// launcher passes the task to rank 0 and rank 0's events back, and takes its ranks with it when
+  /// it is killed; a stop reaches the ranks as SIGUSR1. Throws std::runtime_error when it cannot start.
+  WorkerProcess(const std::string& exe, const v1::WorkerTask& task, const std::string& log_path,
+                const std::vector<std::string>& launcher = {});
   /// Kills a worker that is still running and reaps it.
   ~WorkerProcess() override;
   WorkerProcess(const WorkerProcess&) = delete;
@@ -49,7 +54,8 @@ class WorkerProcess : public Execution {
   void stop(std::chrono::milliseconds grace);
   /// Wait for the process to end (at most `timeout`; nothing when it has not).
   std::optional<WorkerExit> wait(std::chrono::milliseconds timeout) override;
-  /// Resident memory of the process [bytes] (0 when it cannot be read).
+  /// Resident memory of the process [bytes] (0 when it cannot be read); under a launcher, of the
+  /// launcher and its ranks together.
   std::int64_t resident_bytes() const override;
 
  private:
@@ -62,6 +68,7 @@ class WorkerProcess : public Execution {
   bool closed_ = false;
   bool reaped_ = false;
   bool sent_ = false;
+  bool launched_ = false;  ///< started by an MPI launcher (several ranks)
   WorkerExit exit_;
   std::string buf_;
 };

@@ -145,9 +145,11 @@ struct ClientApp {
 
 int submit(const std::vector<std::string>& args) {
   ClientApp c("Upload the scenario's input files and queue it; prints the job id and state.", "runout submit");
-  std::string file, request_id;
+  std::string file, request_id, ranks;
   bool wait = false, server_paths = false, quiet = false;
   c.app.add_option("SCENARIO.json", file, "The scenario file (required)");
+  c.app.add_option("--ranks", ranks, "Run the job's 3D run over N MPI ranks (the scenario's `ranks`; docs/design/parallel.md)")
+      ->type_name("N");
   c.app.add_flag("--wait", wait, "Follow the job to its end (progress on standard error); exit as watch does");
   c.app.add_flag("--quiet", quiet, "With --wait: no progress lines");
   c.app.add_option("--request-id", request_id, "Idempotency key: a repeated submission with it answers the same job")
@@ -157,7 +159,9 @@ int submit(const std::vector<std::string>& args) {
   if (const int rc = c.parse(args); rc >= 0) return rc;
   if (file.empty())
     return usage_error("runout submit", "usage: runout submit SCENARIO.json [--wait] [--quiet] [--request-id ID] "
-                                        "[--server-paths] (see runout submit --help)");
+                                        "[--server-paths] [--ranks N] (see runout submit --help)");
+  const auto n_ranks = positive_int(ranks);
+  if (c.app.count("--ranks") && !n_ranks) return usage_error("runout submit", "--ranks takes a positive integer, got '" + ranks + "'");
   v1::Scenario s;
   try {
     std::ifstream in(file);
@@ -165,6 +169,7 @@ int submit(const std::vector<std::string>& args) {
     std::stringstream ss;
     ss << in.rdbuf();
     s = jobs::parse_scenario_json(ss.str());
+    if (n_ranks) s.set_ranks(*n_ranks);
   } catch (const jobs::ScenarioError& e) {
     std::cerr << "runout submit: " << e.what() << "\n";
     return kBadInput;

@@ -312,6 +312,9 @@ int run(const std::vector<std::string>& args) {
   int workers = 0;
   if (const int rc = check_run_kind(app, a, ensemble, workers); rc >= 0) return rc;
   const auto launch = jobs::launch_ranks();
+  if (const int want = resolved.scenario.ranks(); want > 1 && want != launch.size && launch.rank == 0)
+    std::cerr << "runout run: note: the scenario's ranks is " << want << ", this run has " << launch.size
+              << " (runout run splits over the processes its launcher starts: mpirun -n " << want << " runout run ...)\n";
   if (launch.size > 1) {
     if (ensemble) {
       std::cerr << "runout run: an ensemble runs its members on this machine's cores itself (--workers); mpirun -n N is for one 3D run\n";

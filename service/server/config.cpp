@@ -46,6 +46,14 @@ v1::ServerConfig resolve_config(v1::ServerConfig c) {
   if (c.max_crashes() < 0 || c.max_crashes() > 100) throw ConfigError("max_crashes: must lie in 1..100");
   if (c.backend().empty()) c.set_backend("local");
   if (c.backend() != "local" && c.backend() != "slurm") throw ConfigError("backend: unknown '" + c.backend() + "' (valid: local, slurm)");
+  if (c.max_ranks_per_job() == 0) c.set_max_ranks_per_job(c.backend() == "local" ? std::max(1, int(sysconf(_SC_NPROCESSORS_ONLN))) : 1024);
+  if (c.max_ranks_per_job() < 1 || c.max_ranks_per_job() > 65536) throw ConfigError("max_ranks_per_job: must lie in 1..65536");
+  if (c.mpi_launcher_size() == 0)
+    for (const char* a : {"mpirun", "--oversubscribe", "--bind-to", "none"}) c.add_mpi_launcher(a);
+  if (c.mpi_launcher(0).empty()) throw ConfigError("mpi_launcher: its first word is the launcher's command (default mpirun)");
+  if (c.slurm_mpi().empty()) c.set_slurm_mpi("pmix");
+  if (c.slurm_mpi().find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_") != std::string::npos)
+    throw ConfigError("slurm_mpi: '" + c.slurm_mpi() + "' is not an MPI plugin's name (srun --mpi=list; \"cluster\": the cluster's default)");
   std::error_code ec;
   fs::create_directories(c.state_dir(), ec);
   if (ec) throw ConfigError("state_dir '" + c.state_dir() + "': " + ec.message());

@@ -120,11 +120,13 @@ void Server::Impl::start_scheduler() {
   sc.stop_grace_s = cfg.stop_grace_s();
   sc.max_crashes = cfg.max_crashes();
   sc.data_roots.assign(cfg.data_roots().begin(), cfg.data_roots().end());
+  sc.mpi_launcher.assign(cfg.mpi_launcher().begin(), cfg.mpi_launcher().end());
   if (cfg.backend() == "slurm") {
     jobs::SlurmConfig slurm;
     slurm.partition = cfg.slurm_partition();
     slurm.sbatch_args.assign(cfg.slurm_sbatch_args().begin(), cfg.slurm_sbatch_args().end());
     slurm.worker_exe = cfg.slurm_worker();
+    slurm.mpi = cfg.slurm_mpi();
     sc.slurm = slurm;
     sc.max_job_memory_bytes = 0;  // Slurm enforces memory (sbatch --mem); the server cannot see the nodes
   }

@@ -110,8 +110,12 @@ Status check_text(const v1::SubmitRequest& req) {
   return Status::OK;
 }
 
-// The job's limits: within the server's.
-Status check_limits(const v1::ServerConfig& cfg, const v1::JobLimits& l) {
+// The job's limits, and its ranks: within the server's.
+Status check_limits(const v1::ServerConfig& cfg, const v1::Scenario& s) {
+  if (s.ranks() < 0 || s.ranks() > cfg.max_ranks_per_job())
+    return {StatusCode::INVALID_ARGUMENT, "ranks: must lie in 1.." + std::to_string(cfg.max_ranks_per_job()) +
+                                              " on this server (max_ranks_per_job; 0: one process), got " + std::to_string(s.ranks())};
+  const v1::JobLimits& l = s.limits();
   if (!(std::isfinite(l.max_wall_s()) && l.max_wall_s() >= 0 && l.max_wall_s() <= cfg.max_job_wall_s()))
     return {StatusCode::INVALID_ARGUMENT, "limits.max_wall_s: must lie in [0, " + jobs::json_number(cfg.max_job_wall_s()) +
                                               "] s (0: the server's limit), got " + jobs::json_number(l.max_wall_s())};
@@ -156,7 +160,7 @@ Status Server::Impl::SubmitScenario(grpc::ServerContext* ctx, const v1::SubmitRe
   if (auto st = answer_retry(owner, *req, request_hash, resp)) return st->ok() ? *st : refuse(*st);
   if (auto st = full_disk(cfg); !st.ok()) return refuse(st);
   if (auto st = resolve_inputs(s, in_flight); !st.ok()) return refuse(st);
-  if (auto st = check_limits(cfg, s.limits()); !st.ok()) return refuse(st);
+  if (auto st = check_limits(cfg, s); !st.ok()) return refuse(st);
   const std::vector<std::string> roots(cfg.data_roots().begin(), cfg.data_roots().end());
   std::string hash;
   std::optional<jobs::ensemble::Plan> plan;  // an ensemble: its members

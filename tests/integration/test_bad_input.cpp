@@ -98,6 +98,15 @@ const std::vector<BadCase> kDepthAveraged = {
     {"min slope 90", [](v1::Scenario& s) { rel(s).set_min_slope_deg(90); }, "releases[0].min_slope_deg", "[0, 90) deg"},
     {"max slope nan", [](v1::Scenario& s) { rel(s).set_max_slope_deg(kNaN); }, "releases[0].max_slope_deg", "(0, 90] deg"},
     {"density inf", [](v1::Scenario& s) { s.mutable_material()->set_density_kg_m3(kInf); }, "material.density_kg_m3", "(0, 10000] kg/m3, got inf"},
+    {"ranks -1", [](v1::Scenario& s) { s.set_ranks(-1); }, "ranks", "0..65536"},
+    {"ranks for the depth-averaged engine", [](v1::Scenario& s) { s.set_ranks(2); }, "ranks", "the depth-averaged engine runs on one process"},
+    {"ranks for an ensemble",
+     [](v1::Scenario& s) {
+       s.set_ranks(2);
+       s.set_engine("vof");
+       s.mutable_variations()->set_samples(2);
+     },
+     "ranks", "an ensemble's members run on one process each"},
     {"density 1e308", [](v1::Scenario& s) { s.mutable_material()->set_density_kg_m3(1e308); }, "material.density_kg_m3", "(0, 10000] kg/m3"},
     {"density -300", [](v1::Scenario& s) { s.mutable_material()->set_density_kg_m3(-300); }, "material.density_kg_m3", "got -300"},
     {"bed friction 90", [](v1::Scenario& s) { s.mutable_material()->set_bed_friction_deg(90); }, "material.bed_friction_deg", "[0, 90)"},
@@ -190,6 +199,24 @@ void expect_refused(const std::vector<BadCase>& cases, v1::Scenario (*base)(), c
 
 TEST(BadScenario, DepthAveragedFieldsOutsideTheirRangesAreRefused) { expect_refused(kDepthAveraged, arelen, kDataDir); }
 TEST(BadScenario, LabFieldsOutsideTheirRangesAreRefused) { expect_refused(kLab, b10, kLabDir); }
+
+// A 3D run's ranks are accepted (laboratory, terrain, a depth-averaged scenario's nest) and change
+// nothing it computes: not the scenario's hash.
+TEST(Scenarios, RanksAreForThreeDRunsAndLeaveTheHashAlone) {
+  auto lab = b10();
+  const auto one = jobs::resolve_scenario(lab, kLabDir);
+  lab.set_ranks(4);
+  const auto four = jobs::resolve_scenario(lab, kLabDir);
+  EXPECT_EQ(jobs::scenario_hash(one), jobs::scenario_hash(four));
+  auto terrain = arelen();
+  terrain.set_engine("vof");
+  terrain.set_ranks(2);
+  EXPECT_EQ(resolve_error(terrain, kDataDir), "");
+  auto nested = arelen();
+  nested.mutable_nest()->set_path("../../scenarios/data/arelen/farmhouse-nest.geojson");
+  nested.set_ranks(2);
+  EXPECT_EQ(resolve_error(nested, kDataDir), "");
+}
 
 // The bounds themselves are valid (the ranges are closed where the README says so).
 TEST(BadScenario, ValuesAtTheBoundsAreAccepted) {

@@ -252,6 +252,18 @@ TEST(Service, BadScenariosTokensAndPathsGetTheRightCodes) {
   s = arelen();
   s.mutable_numerics()->set_limiter("vanLeer");
   EXPECT_EQ(code_of([&] { alpha.submit(s); }), int(grpc::StatusCode::INVALID_ARGUMENT));
+  // More MPI ranks than the server gives a job (max_ranks_per_job; locally the machine's cores).
+  s = arelen();
+  s.set_engine("vof");
+  s.set_ranks(100000);
+  try {
+    alpha.submit(s);
+    FAIL();
+  } catch (const service::RpcError& e) {
+    EXPECT_EQ(e.code, int(grpc::StatusCode::INVALID_ARGUMENT));
+    EXPECT_NE(std::string(e.what()).find("ranks: must lie in 1.."), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("max_ranks_per_job"), std::string::npos) << e.what();
+  }
   // Paths outside the data roots: '..', absolute paths elsewhere, links that leave a root; every
   // input field is held to them, a release's thickness raster too.
   const std::pair<const char*, std::function<void(v1::Scenario&, const std::string&)>> fields[] = {
@@ -294,6 +306,39 @@ TEST(Service, BadScenariosTokensAndPathsGetTheRightCodes) {
   EXPECT_EQ(beta.list().jobs_size(), 0);
   EXPECT_EQ(code_of([&] { alpha.get("jdoesnotexist"); }), int(grpc::StatusCode::NOT_FOUND));
   alpha.watch(j.id());
+}
+
+// The server's settings for jobs over MPI ranks are checked at its start, naming the key.
+TEST(Service, BadRanksSettingsStopTheServerAtItsStart) {
+  TempDir d;
+  for (const auto& [json, key] : std::vector<std::pair<std::string, std::string>>{
+           {R"({"max_ranks_per_job": -2})", "max_ranks_per_job: must lie in 1..65536"},
+           {R"({"mpi_launcher": [""]})", "mpi_launcher: its first word"},
+           {R"({"slurm_mpi": "pmix; rm -rf /"})", "slurm_mpi: 'pmix; rm -rf /' is not an MPI plugin's name"}}) {
+    std::ofstream(d.p / "server.json") << json;
+    const std::string cmd = std::string(RUNOUT_BIN) + " serve --config " + (d.p / "server.json").string() + " --state-dir " +
+                            (d.p / "state").string() + " --listen 127.0.0.1:0 2> " + (d.p / "err").string();
+    EXPECT_NE(std::system(cmd.c_str()), 0) << json;
+    std::ifstream in(d.p / "err");
+    const std::string err((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(err.find(key), std::string::npos) << json << ": " << err;
+  }
+}
+
+// A job over MPI ranks whose launcher is missing fails at once, naming the launcher (not as a
+// crash run again three times).
+TEST(Service, AJobOverRanksWithoutItsLauncherFailsAndSaysWhy) {
+  TempDir d;
+  std::ofstream(d.p / "server.json") << R"({"mpi_launcher": ["/nonexistent/mpirun"], "max_ranks_per_job": 4})";
+  ServerProcess srv(d.p / "state", {"--config", (d.p / "server.json").string(), "--data-root", kScenarios, "--threads-per-run", "1"});
+  service::Client c(client_options(srv.address(), ""));
+  auto s = jobs::parse_scenario_json(read_text(kScenarios + "/in-den-arelen-3d-regress.json"));  // paths inside the data root
+  s.mutable_numerics()->set_end_time_s(1);
+  s.set_ranks(2);
+  const auto fin = c.watch(c.submit(s).id());
+  EXPECT_EQ(fin.state(), v1::FAILED);
+  EXPECT_NE(fin.error().find("the launcher '/nonexistent/mpirun' was not found"), std::string::npos) << fin.error();
+  EXPECT_EQ(fin.attempts(), 1);
 }
 
 TEST(Service, QueueLimitPerClient) {

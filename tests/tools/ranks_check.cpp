@@ -1,8 +1,9 @@
-// ranks_check ONE MANY RANKS [FIGURE:RELTOL | RASTER.tif:ABSTOL]...: a run split over MPI ranks
+// ranks_check ONE MANY RANKS [FIGURE:RELTOL | RASTER.tif:ABSTOL | RASTER.tif:P%]...: a run split over MPI ranks
 // (results in MANY) against the same run on one process (ONE). Reads both run.json as
 // runout.v1.RunRecord; MANY's record must say it ran on RANKS ranks and ONE's on one. Each figure
 // (jobs::figure_by_name) must agree within its relative tolerance; each raster must have the same
-// cells with data and agree within its absolute tolerance on them. Prints a line per check; exits 1
+// cells with data and agree within its absolute tolerance on them (P%: P percent of the largest
+// value ONE's raster holds). Prints a line per check; exits 1
 // when one fails, 2 on a bad command line. The mpi tests (tests/mpi/run_on_ranks.sh) use it.
 #include <gdal_priv.h>
 
@@ -41,7 +42,7 @@ Raster read_raster(const std::string& path) {
 
 int main(int argc, char** argv) {
   if (argc < 4) {
-    std::fprintf(stderr, "usage: ranks_check ONE MANY RANKS [FIGURE:RELTOL | RASTER.tif:ABSTOL]...\n");
+    std::fprintf(stderr, "usage: ranks_check ONE MANY RANKS [FIGURE:RELTOL | RASTER.tif:ABSTOL | RASTER.tif:P%%]...\n");
     return 2;
   }
   GDALAllRegister();
@@ -65,16 +66,18 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "ranks_check: '%s' has no tolerance\n", arg.c_str());
         return 2;
       }
-      const std::string name = arg.substr(0, colon);
-      const double tol = std::atof(arg.substr(colon + 1).c_str());
+      const std::string name = arg.substr(0, colon), limit = arg.substr(colon + 1);
+      double tol = std::atof(limit.c_str());
       if (name.size() > 4 && name.substr(name.size() - 4) == ".tif") {
         const auto x = read_raster(one + "/" + name), y = read_raster(many + "/" + name);
-        double worst = 0;
+        double worst = 0, top = 0;
         long long only = 0;
         for (std::size_t q = 0; q < x.v.size() && q < y.v.size(); ++q) {
           if (x.ok[q] != y.ok[q]) ++only;
           else if (x.ok[q]) worst = std::max(worst, std::abs(x.v[q] - y.v[q]));
+          if (x.ok[q]) top = std::max(top, std::abs(x.v[q]));
         }
+        if (!limit.empty() && limit.back() == '%') tol *= top / 100;  // "2%": of the one process's largest value
         const bool ok = x.v.size() == y.v.size() && only == 0 && worst <= tol;
         std::printf("%s %s: largest difference %.3g (limit %.3g), cells with data in one only %lld\n", ok ? "ok  " : "FAIL", name.c_str(), worst, tol,
                     only);
