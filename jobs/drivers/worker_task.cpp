@@ -234,7 +234,7 @@ int worker_main(int in_fd, int out_fd) {
   if (launch.rank > 0) return finish_worker_ranks(run_other_rank(task, launch.rank));
   bool failed_run = false;
   const int rc = run_task(task, events, failed_run);
-  if (launch.size == 1) return rc;
+  if (launch.size == 1) return finish_worker_ranks(rc);  // (PETSc finalised, MPI with it, when a 3D run started them)
   ::close(events);  // the outcome is out before the ranks end
   return finish_worker_ranks(rc != 0 ? rc : failed_run ? 1 : 0);
 }

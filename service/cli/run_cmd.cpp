@@ -326,7 +326,9 @@ int run(const std::vector<std::string>& args) {
     jobs::finish_mpi(rc == kCancelled ? 0 : rc);  // (a cancel stops every rank at the same step)
     return rc;
   }
-  return run_checked(resolved, a, dest, ensemble, workers);
+  const int rc = run_checked(resolved, a, dest, ensemble, workers);
+  jobs::finish_mpi(0);  // a 3D run started MPI through PETSc: a launcher (mpirun -n 1) wants it finalised
+  return rc;
 }
 
 }  // namespace runout::cli
