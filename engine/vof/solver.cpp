@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <unordered_map>
 
 #include "engine/vof/active_region.hpp"
 #include "engine/vof/alpha_eqn.hpp"
@@ -276,7 +277,20 @@ VofState VofSolver::state() const {
   st.phi = F.phi;
   st.U = F.U;
   st.active_cells = I.region.cells;
-  I.pressure_solver.save_pc(st);
+  if (!ranks_.distributed()) {
+    I.pressure_solver.save_pc(st);
+    return st;
+  }
+  // A rank's part names the columns by its cells (own and ghosts); DistributedVof::state makes the
+  // whole region's rows of them.
+  std::unordered_map<PetscInt, int> cell_of;
+  for (int c : I.region.cells) cell_of[PetscInt(I.region.global_row[c])] = c;
+  PressureSolver::PcColumns cols;
+  cols.stored = [&](PetscInt j) {
+    const auto it = cell_of.find(j);
+    return it == cell_of.end() ? -1 : it->second;
+  };
+  I.pressure_solver.save_pc(st, cols);
   return st;
 }
 
@@ -315,7 +329,10 @@ void VofSolver::restore(const VofState& st) {
   F.U = st.U;
   F.mu = st.mu;
   I.pEqn.make_system();
-  I.pressure_solver.restore_pc(st, !I.bcs.has_opening() && I.region.whole_mesh());
+  PressureSolver::PcColumns cols;  // a rank's part: its cells (VofSolver::state)
+  if (ranks_.distributed())
+    cols.system = [&](int c) { return c >= 0 && std::size_t(c) < nc ? PetscInt(I.region.global_row[c]) : PetscInt(-1); };
+  I.pressure_solver.restore_pc(st, !I.bcs.has_opening() && I.region.whole_mesh(), cols);
 }
 
 // One step: the phase fraction with the last fluxes, then the momentum matrix and the pressure

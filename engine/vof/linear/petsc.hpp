@@ -6,6 +6,8 @@
 // equations hand them coefficients; nothing else in the engine calls PETSc.
 #include <petscksp.h>
 
+#include <functional>
+
 #include <string>
 #include <vector>
 
@@ -98,20 +100,28 @@ class PressureSolver {
   /// Add s to every row of the solution (a closed domain's level).
   void shift(double s);
 
+  /// How a checkpoint names the system's columns. Empty: as the system's own (a run on one
+  /// process: the active region's rows). A rank of a run over several stores the cells of its part
+  /// (VofSolver gives the maps), which DistributedVof turns into the whole region's rows.
+  struct PcColumns {
+    std::function<int(PetscInt)> stored;  ///< the system's column as stored (-1: none)
+    std::function<PetscInt(int)> system;  ///< a stored column as the system's (-1: none)
+  };
   /// The pressure solver's cross-step state for a checkpoint: the refresh counter and the operators
-  /// the preconditioner was built from (compressed rows; both share the active region's structure).
-  void save_pc(VofState& st) const;
+  /// the preconditioner was built from (compressed rows over this rank's rows, in order; both share
+  /// the active region's structure).
+  void save_pc(VofState& st, const PcColumns& cols = {}) const;
   /// After make_system() for the restored region: the refresh counter, and the preconditioner
   /// built as the run that wrote the checkpoint built it (closed: placed where a closed domain's
   /// run had it).
-  void restore_pc(const VofState& st, bool closed);
+  void restore_pc(const VofState& st, bool closed, const PcColumns& cols = {});
 
   bool later_outer = false;  ///< in an outer corrector after the step's first (the preconditioner is kept)
   double ksp_seconds = 0;    ///< time in KSPSolve since step() last took it
 
  private:
   void remember_pc(Mat Ap);
-  void set_operator(Mat M, const VofState& st, const std::vector<double>& values);
+  void set_operator(Mat M, const VofState& st, const std::vector<double>& values, const PcColumns& cols);
   void timed_solve(Mat Ap);
 
   const VofConfig& cfg_;

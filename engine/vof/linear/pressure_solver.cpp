@@ -212,21 +212,16 @@ void PressureSolver::remember_pc(Mat Ap) {
   ++pc_builds_;
 }
 
-void PressureSolver::save_pc(VofState& st) const {
+void PressureSolver::save_pc(VofState& st, const PcColumns& cols) const {
   st.steps_since_pc = steps_since_pc_;
   st.pc_builds = pc_builds_ > 1 ? 2 : pc_builds_;
   st.pc_rows.clear();
   st.pc_cols.clear();
   st.pc_first_values.clear();
   st.pc_values.clear();
-  // A distributed run's checkpoint carries no preconditioner: the run it continues (on any number
-  // of ranks) builds one from its first matrix (docs/design/parallel.md).
-  if (ranks_.distributed()) st.pc_builds = 0;
-  if (!Apc_ || ranks_.distributed()) return;
-  PetscInt n = 0;
-  petsc_check(MatGetSize(Apc_, &n, nullptr), "MatGetSize");
+  if (!Apc_) return;
   st.pc_rows.push_back(0);
-  for (PetscInt i = 0; i < n; ++i) {
+  for (PetscInt i = first_row_; i < first_row_ + n_; ++i) {  // this rank's rows
     PetscInt nc1 = 0, nc0 = 0;
     const PetscInt *c1 = nullptr, *c0 = nullptr;
     const PetscScalar *v1 = nullptr, *v0 = nullptr;
@@ -234,7 +229,7 @@ void PressureSolver::save_pc(VofState& st) const {
     petsc_check(MatGetRow(Apc_first_, i, &nc0, &c0, &v0), "MatGetRow");
     const bool same = nc0 == nc1 && std::equal(c0, c0 + nc0, c1);
     for (PetscInt k = 0; same && k < nc1; ++k) {
-      st.pc_cols.push_back(int(c1[k]));
+      st.pc_cols.push_back(cols.stored ? cols.stored(c1[k]) : int(c1[k]));
       st.pc_values.push_back(double(v1[k]));
       st.pc_first_values.push_back(double(v0[k]));
     }
@@ -247,13 +242,15 @@ void PressureSolver::save_pc(VofState& st) const {
 
 // Set the operator's values from compressed rows (the structure the active region's system has)
 // and assemble it.
-void PressureSolver::set_operator(Mat M, const VofState& st, const std::vector<double>& values) {
+void PressureSolver::set_operator(Mat M, const VofState& st, const std::vector<double>& values, const PcColumns& cols) {
+  PetscInt total = 0;
+  petsc_check(MatGetSize(M, &total, nullptr), "MatGetSize");
   for (int i = 0; i < n_; ++i) {
     const int k0 = st.pc_rows[i], k1 = st.pc_rows[std::size_t(i) + 1];
     if (k0 < 0 || k1 < k0 || std::size_t(k1) > st.pc_cols.size()) throw VofError("restore: the checkpoint's pressure operator is damaged");
     for (int k = k0; k < k1; ++k) {
-      const PetscInt r0 = i, c0 = st.pc_cols[k];
-      if (c0 < 0 || c0 >= n_) throw VofError("restore: the checkpoint's pressure operator is damaged");
+      const PetscInt r0 = first_row_ + i, c0 = cols.system ? cols.system(st.pc_cols[k]) : PetscInt(st.pc_cols[k]);
+      if (c0 < 0 || c0 >= total) throw VofError("restore: the checkpoint's pressure operator is damaged");
       const PetscScalar v = values[k];
       if (MatSetValues(M, 1, &r0, 1, &c0, &v, INSERT_VALUES))
         throw VofError("restore: the checkpoint's pressure operator does not fit the active region's system");
@@ -267,7 +264,7 @@ void PressureSolver::set_operator(Mat M, const VofState& st, const std::vector<d
 // rebuilt since, from the latest one, and placed where that run had it (A, or Apin in a closed
 // domain), so that the following steps, which reassemble the operator and keep or refresh the
 // preconditioner, are that run's.
-void PressureSolver::restore_pc(const VofState& st, bool closed) {
+void PressureSolver::restore_pc(const VofState& st, bool closed, const PcColumns& cols) {
   steps_since_pc_ = st.steps_since_pc;
   if (st.pc_builds <= 0) return;  // none built yet: the system stays fresh
   if (st.pc_rows.size() != std::size_t(n_) + 1 || st.pc_cols.size() != st.pc_values.size() ||
@@ -278,14 +275,14 @@ void PressureSolver::restore_pc(const VofState& st, bool closed) {
     Mat Ap = A_;
     if (closed) {
       if (!Apin_) {
-        set_operator(A_, st, values);
+        set_operator(A_, st, values, cols);
         petsc_check(MatDuplicate(A_, MAT_COPY_VALUES, &Apin_), "MatDuplicate");
       } else {
-        set_operator(Apin_, st, values);
+        set_operator(Apin_, st, values, cols);
       }
       Ap = Apin_;
     } else {
-      set_operator(A_, st, values);
+      set_operator(A_, st, values, cols);
     }
     petsc_check(KSPSetOperators(ksp_, Ap, Ap), "KSPSetOperators");
     petsc_check(KSPSetReusePreconditioner(ksp_, PETSC_FALSE), "KSPSetReusePreconditioner");

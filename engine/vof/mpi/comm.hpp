@@ -47,8 +47,23 @@ struct Comm {
   void max(std::vector<double>& v) const {
     if (size > 1) MPI_Allreduce(MPI_IN_PLACE, v.data(), int(v.size()), MPI_DOUBLE, MPI_MAX, comm);
   }
+  /// Every rank's `mine`, one after another in the ranks' order, on every rank.
+  std::vector<int> all_gather(const std::vector<int>& mine) const { return gather_all(mine, MPI_INT); }
+  std::vector<double> all_gather(const std::vector<double>& mine) const { return gather_all(mine, MPI_DOUBLE); }
 
  private:
+  template <class T>
+  std::vector<T> gather_all(const std::vector<T>& mine, MPI_Datatype type) const {
+    if (size == 1) return mine;
+    int n = int(mine.size());
+    const auto ranks = static_cast<std::size_t>(size);
+    std::vector<int> counts(ranks), at(ranks, 0);
+    MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+    for (std::size_t r = 1; r < counts.size(); ++r) at[r] = at[r - 1] + counts[r - 1];
+    std::vector<T> all(std::size_t(at.back() + counts.back()));
+    MPI_Allgatherv(mine.data(), n, type, all.data(), counts.data(), at.data(), type, comm);
+    return all;
+  }
   double reduce(double v, MPI_Op op) const {
     if (size == 1) return v;
     double r = 0;

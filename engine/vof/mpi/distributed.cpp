@@ -27,6 +27,80 @@ VofConfig part_config(const VofConfig& cfg, const Mesh& whole, const MeshPart& p
   return c;
 }
 
+// The pressure preconditioner's operators of the ranks' rows (each rank's: its own region cells in
+// ascending order, columns as cells of its part; VofSolver::state) as the whole region's compressed
+// rows: rows and columns by the whole region's cells in ascending order, the format of a run on one
+// process (VofState). st.active_cells is the whole region.
+void gather_pc(const VofState& ps, const MeshPart& part, const Comm& comm, int whole_cells, VofState& st) {
+  std::vector<int> ids;      // (row, column) as cells of the whole mesh
+  std::vector<double> vals;  // (value at the latest build, value at the first)
+  const std::size_t rows = ps.pc_rows.empty() ? 0 : ps.pc_rows.size() - 1;
+  for (std::size_t k = 0; k < rows; ++k) {
+    const int row = part.cell_global[std::size_t(ps.active_cells[k])];
+    for (int e = ps.pc_rows[k]; e < ps.pc_rows[k + 1]; ++e) {
+      const int c = ps.pc_cols[std::size_t(e)];
+      if (c < 0 || std::size_t(c) >= part.cell_global.size()) throw VofError("state: the pressure operator names a cell outside the rank's part");
+      ids.insert(ids.end(), {row, part.cell_global[std::size_t(c)]});
+      vals.insert(vals.end(), {ps.pc_values[std::size_t(e)], ps.pc_first_values[std::size_t(e)]});
+    }
+  }
+  const std::vector<int> all_ids = comm.all_gather(ids);
+  const std::vector<double> all_vals = comm.all_gather(vals);
+  std::vector<int> at(std::size_t(whole_cells), -1);  // a cell's place in the whole region
+  for (std::size_t k = 0; k < st.active_cells.size(); ++k) at[std::size_t(st.active_cells[k])] = int(k);
+  struct Entry {
+    int row, col;
+    double v, first;
+  };
+  std::vector<Entry> e(all_ids.size() / 2);
+  for (std::size_t q = 0; q < e.size(); ++q) {
+    e[q] = {at[std::size_t(all_ids[2 * q])], at[std::size_t(all_ids[2 * q + 1])], all_vals[2 * q], all_vals[2 * q + 1]};
+    if (e[q].row < 0 || e[q].col < 0) throw VofError("state: the pressure operator names a cell outside the active region");
+  }
+  std::sort(e.begin(), e.end(), [](const Entry& a, const Entry& b) { return a.row != b.row ? a.row < b.row : a.col < b.col; });
+  st.pc_rows.assign(1, 0);
+  std::size_t q = 0;
+  for (int r = 0; r < int(st.active_cells.size()); ++r) {
+    for (; q < e.size() && e[q].row == r; ++q) {
+      st.pc_cols.push_back(e[q].col);
+      st.pc_values.push_back(e[q].v);
+      st.pc_first_values.push_back(e[q].first);
+    }
+    st.pc_rows.push_back(int(st.pc_cols.size()));
+  }
+}
+
+// The whole region's compressed rows (a checkpoint's, written on any rank count) as this rank's:
+// the rows of its own region cells in ascending order, columns as cells of its part. local: a
+// whole-mesh cell's number in the part (-1: not in it).
+void scatter_pc(const VofState& st, const MeshPart& part, const std::vector<int>& local, VofState& ps) {
+  ps.steps_since_pc = st.steps_since_pc;
+  ps.pc_builds = st.pc_builds;
+  if (st.pc_builds <= 0) return;
+  const std::size_t n = st.active_cells.size();
+  if (st.pc_rows.size() != n + 1 || st.pc_cols.size() != st.pc_values.size() || st.pc_first_values.size() != st.pc_values.size() ||
+      st.pc_rows.back() != int(st.pc_cols.size()))
+    throw VofError("restore: the checkpoint's pressure operator does not match its active region");
+  std::vector<int> at(local.size(), -1);
+  for (std::size_t k = 0; k < n; ++k) at[std::size_t(st.active_cells[k])] = int(k);
+  ps.pc_rows.assign(1, 0);
+  for (int c : ps.active_cells) {
+    if (c >= part.owned) break;  // (own cells first: the part numbers them before its ghosts)
+    const int k = at[std::size_t(part.cell_global[std::size_t(c)])];
+    const int k0 = st.pc_rows[std::size_t(k)], k1 = st.pc_rows[std::size_t(k) + 1];
+    if (k0 < 0 || k1 < k0 || std::size_t(k1) > st.pc_cols.size()) throw VofError("restore: the checkpoint's pressure operator is damaged");
+    for (int e = k0; e < k1; ++e) {
+      const int j = st.pc_cols[std::size_t(e)];
+      const int lc = j >= 0 && std::size_t(j) < n ? local[std::size_t(st.active_cells[std::size_t(j)])] : -1;
+      if (lc < 0) throw VofError("restore: the checkpoint's pressure operator is damaged (it couples cells that are not neighbours)");
+      ps.pc_cols.push_back(lc);
+      ps.pc_values.push_back(st.pc_values[std::size_t(e)]);
+      ps.pc_first_values.push_back(st.pc_first_values[std::size_t(e)]);
+    }
+    ps.pc_rows.push_back(int(ps.pc_cols.size()));
+  }
+}
+
 }  // namespace
 
 DistributedVof::DistributedVof(Mesh whole, VofConfig cfg, Comm comm) : whole_(std::move(whole)) {
@@ -77,7 +151,9 @@ void DistributedVof::initialise(const std::vector<double>& alpha, const std::vec
 }
 
 // The whole mesh's state from the ranks' own cells and faces; the active region as the whole
-// mesh's cell numbers; no preconditioner (a run split over ranks builds its own).
+// mesh's cell numbers; the pressure preconditioner's operators as the whole region's rows (so that a
+// run continued on the same rank count builds the same blocks, and on any other its own from the
+// same operator).
 VofState DistributedVof::state() const {
   const VofState ps = solver_->state();
   VofState st;
@@ -99,6 +175,15 @@ VofState DistributedVof::state() const {
   h.gather(mine, whole);
   for (int c = 0; c < whole_.cells(); ++c)
     if (whole[std::size_t(c)]) st.active_cells.push_back(c);
+  st.steps_since_pc = ps.steps_since_pc;  // (every rank's alike: the refresh is decided with the matrix)
+  st.pc_builds = ps.pc_builds;
+  if (ps.pc_builds > 0 && ranks().distributed()) gather_pc(ps, part_, ranks().comm(), whole_.cells(), st);
+  if (ps.pc_builds > 0 && !ranks().distributed()) {  // one rank: its part is the whole mesh, its format the whole's
+    st.pc_rows = ps.pc_rows;
+    st.pc_cols = ps.pc_cols;
+    st.pc_values = ps.pc_values;
+    st.pc_first_values = ps.pc_first_values;
+  }
   return st;
 }
 
@@ -127,6 +212,16 @@ void DistributedVof::restore(const VofState& st) {
     if (local[std::size_t(g)] >= 0) ps.active_cells.push_back(local[std::size_t(g)]);
   }
   std::sort(ps.active_cells.begin(), ps.active_cells.end());
+  if (ranks().distributed()) {
+    scatter_pc(st, part_, local, ps);
+  } else {  // one rank: the whole mesh's format is its own
+    ps.steps_since_pc = st.steps_since_pc;
+    ps.pc_builds = st.pc_builds;
+    ps.pc_rows = st.pc_rows;
+    ps.pc_cols = st.pc_cols;
+    ps.pc_values = st.pc_values;
+    ps.pc_first_values = st.pc_first_values;
+  }
   solver_->restore(ps);
   stale();
 }
