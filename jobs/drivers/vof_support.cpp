@@ -5,9 +5,14 @@
 #include "engine/vof/linear/petsc.hpp"
 #include "engine/vof/mpi/distributed.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
-#include <cstdlib>
+#include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <thread>
 
 namespace runout::jobs {
 
@@ -62,6 +67,27 @@ LaunchRanks launch_ranks() {
   return {};
 }
 
+RankScratch::RankScratch(int rank) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path dir = fs::temp_directory_path(ec) / ("runout-rank" + std::to_string(rank) + "-" + std::to_string(getpid()));
+  fs::remove_all(dir, ec);
+  fs::create_directories(dir / "out", ec);
+  if (ec) {
+    error_ = "cannot create " + dir.string() + ": " + ec.message();
+    return;
+  }
+  dir_ = dir.string();
+}
+
+RankScratch::~RankScratch() {
+  std::error_code ec;
+  if (!dir_.empty()) std::filesystem::remove_all(dir_, ec);
+}
+
+std::string RankScratch::out_dir() const { return (std::filesystem::path(dir_) / "out").string(); }
+std::string RankScratch::checkpoint_path() const { return (std::filesystem::path(dir_) / "checkpoint.h5").string(); }
+
 std::string share_from_rank0(const std::string& bytes) {
   engine::vof::petsc_init();
   int rank = 0;
@@ -88,7 +114,12 @@ void finish_mpi(int exit_code) {
   if (!started) return;
   int size = 1;
   MPI_Comm_size(PETSC_COMM_WORLD, &size);
-  if (exit_code != 0 && size > 1) MPI_Abort(PETSC_COMM_WORLD, exit_code);
+  if (exit_code != 0 && size > 1) {
+    int rank = 0;
+    MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+    if (rank > 0) std::this_thread::sleep_for(std::chrono::seconds(2));
+    MPI_Abort(PETSC_COMM_WORLD, exit_code);
+  }
   PetscFinalize();
 }
 

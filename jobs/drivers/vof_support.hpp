@@ -32,8 +32,27 @@ LaunchRanks launch_ranks();
 /// At the end of a program that may have run split over MPI ranks: PETSc finished, and with it MPI
 /// when PETSc started it (a launcher reports a process that ends without it as failed). A failure
 /// (exit_code != 0) on one rank of several aborts them all with that code: the others would wait
-/// for it in their next exchange.
+/// for it in their next exchange. A rank other than 0 waits two seconds before it aborts, so that
+/// rank 0, when it failed alike (bad input fails every rank), says why (its message, a worker's
+/// outcome) before the launcher ends it.
 void finish_mpi(int exit_code);
+
+/// The private folder of a rank other than 0 of a run split over MPI ranks: the rank runs the same
+/// set-up and outputs as rank 0 into it (TMPDIR/runout-rank<R>-<pid>; its results in out/, its
+/// checkpoint beside), and the folder goes with this. error() says why it could not be made.
+class RankScratch {
+ public:
+  explicit RankScratch(int rank);
+  ~RankScratch();
+  RankScratch(const RankScratch&) = delete;
+  RankScratch& operator=(const RankScratch&) = delete;
+  const std::string& error() const { return error_; }
+  std::string out_dir() const;
+  std::string checkpoint_path() const;
+
+ private:
+  std::string dir_, error_;
+};
 
 /// Under a launcher: rank 0's `bytes` on every rank (MPI started through PETSc first). A worker's
 /// task reaches rank 0 alone (mpirun and srun --input=0 give the others no standard input).

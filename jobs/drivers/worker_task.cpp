@@ -184,22 +184,17 @@ int run_task(const v1::WorkerTask& task, int events, bool& failed_run) {
 // runs the same set-up and outputs into a private folder, which it removes; it writes no events
 // (rank 0 speaks for the run) and no checkpoint of the task's (rank 0 writes it).
 int run_other_rank(v1::WorkerTask task, int rank) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::path tmp = fs::temp_directory_path(ec) / ("runout-worker-rank" + std::to_string(rank) + "-" + std::to_string(getpid()));
-  fs::remove_all(tmp, ec);
-  fs::create_directories(tmp / "out", ec);
-  if (ec) {
-    std::fprintf(stderr, "runout worker (rank %d): cannot create %s: %s\n", rank, tmp.c_str(), ec.message().c_str());
+  const RankScratch scratch(rank);
+  if (!scratch.error().empty()) {
+    std::fprintf(stderr, "runout worker (rank %d): %s\n", rank, scratch.error().c_str());
     return 4;
   }
-  task.set_out_dir((tmp / "out").string());
-  if (!task.checkpoint_path().empty()) task.set_checkpoint_path((tmp / "checkpoint.h5").string());
+  task.set_out_dir(scratch.out_dir());
+  if (!task.checkpoint_path().empty()) task.set_checkpoint_path(scratch.checkpoint_path());
   const int quiet = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
   bool failed_run = false;
   const int rc = run_task(task, quiet, failed_run);
   if (quiet >= 0) ::close(quiet);
-  fs::remove_all(tmp, ec);
   return rc != 0 ? rc : failed_run ? 1 : 0;
 }
 

@@ -84,11 +84,16 @@ std::vector<std::string> worker_command(const std::string& exe, const v1::Worker
   return a;
 }
 
-// Resident memory of a process and every process below it [bytes]: a launcher's ranks count.
-std::int64_t tree_resident(pid_t pid, int depth) {
+// Resident memory of a process [bytes] (0 when it cannot be read).
+std::int64_t process_resident(pid_t pid) {
   std::ifstream f("/proc/" + std::to_string(pid) + "/statm");
   long size = 0, resident = 0;
-  std::int64_t total = (f >> size >> resident) ? std::int64_t(resident) * sysconf(_SC_PAGESIZE) : 0;
+  return (f >> size >> resident) ? std::int64_t(resident) * sysconf(_SC_PAGESIZE) : 0;
+}
+
+// Of a process and every process below it: a launcher's ranks count.
+std::int64_t tree_resident(pid_t pid, int depth) {
+  std::int64_t total = process_resident(pid);
   if (depth > 8) return total;
   std::ifstream c("/proc/" + std::to_string(pid) + "/task/" + std::to_string(pid) + "/children");
   for (long child; c >> child;) total += tree_resident(pid_t(child), depth + 1);
@@ -254,6 +259,6 @@ std::optional<WorkerExit> WorkerProcess::wait(std::chrono::milliseconds timeout)
   }
 }
 
-std::int64_t WorkerProcess::resident_bytes() const { return launched_ ? tree_resident(pid_, 0) : tree_resident(pid_, 9); }
+std::int64_t WorkerProcess::resident_bytes() const { return launched_ ? tree_resident(pid_, 0) : process_resident(pid_); }
 
 }  // namespace runout::jobs

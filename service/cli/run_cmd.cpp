@@ -246,22 +246,18 @@ int run_ensemble_into(const jobs::ResolvedScenario& resolved, const RunArgs& a, 
 // it removes; rank 0 writes DIR (docs/design/parallel.md). Its checks are rank 0's, but DIR is not
 // its to check.
 int run_other_rank(const jobs::ResolvedScenario& resolved, const RunArgs& a, int rank) {
-  std::error_code ec;
-  const fs::path tmp = fs::temp_directory_path() / ("runout-rank" + std::to_string(rank) + "-" + std::to_string(getpid()));
-  fs::remove_all(tmp, ec);
-  fs::create_directories(tmp / "out", ec);
-  if (ec) {
-    std::cerr << "runout run (rank " << rank << "): cannot create " << tmp << ": " << ec.message() << "\n";
+  const jobs::RankScratch scratch(rank);
+  if (!scratch.error().empty()) {
+    std::cerr << "runout run (rank " << rank << "): " << scratch.error() << "\n";
     return kOutput;
   }
   jobs::RunOptions opt;
   opt.iseesnow_id = a.iseesnow;
-  if (!a.checkpoint.empty()) opt.checkpoint_path = (tmp / "checkpoint").string();
+  if (!a.checkpoint.empty()) opt.checkpoint_path = scratch.checkpoint_path();
   opt.restart_path = a.restart;
   opt.progress = [](const engine::Progress&) { return !g_interrupted.load(); };
   jobs::RunSummary sum;
-  const int rc = execute(resolved, tmp / "out", opt, false, sum);
-  fs::remove_all(tmp, ec);
+  const int rc = execute(resolved, scratch.out_dir(), opt, false, sum);
   return rc != kOk ? rc : sum.stop == "cancelled" ? kCancelled : kOk;
 }
 

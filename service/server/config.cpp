@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "jobs/system/scheduler.hpp"
 #include "service/server/inputs.hpp"
 #include "service/server/server.hpp"
 
@@ -49,7 +50,7 @@ v1::ServerConfig resolve_config(v1::ServerConfig c) {
   if (c.max_ranks_per_job() == 0) c.set_max_ranks_per_job(c.backend() == "local" ? std::max(1, int(sysconf(_SC_NPROCESSORS_ONLN))) : 1024);
   if (c.max_ranks_per_job() < 1 || c.max_ranks_per_job() > 65536) throw ConfigError("max_ranks_per_job: must lie in 1..65536");
   if (c.mpi_launcher_size() == 0)
-    for (const char* a : {"mpirun", "--oversubscribe", "--bind-to", "none"}) c.add_mpi_launcher(a);
+    for (const auto& a : jobs::SchedulerConfig{}.mpi_launcher) c.add_mpi_launcher(a);
   if (c.mpi_launcher(0).empty()) throw ConfigError("mpi_launcher: its first word is the launcher's command (default mpirun)");
   if (c.slurm_mpi().empty()) c.set_slurm_mpi("pmix");
   if (c.slurm_mpi().find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_") != std::string::npos)

@@ -16,9 +16,7 @@ CLUSTER="$SRC/tests/support/slurm_cluster.sh"
 DIR=$(mktemp -d /tmp/runout-ranks-job.XXXXXX)
 chmod 755 "$DIR"  # munged refuses a socket folder under a folder others cannot search
 SERVER_PID=
-export OMP_NUM_THREADS=1 OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-export OMPI_MCA_btl_vader_single_copy_mechanism=none  # (a container without ptrace refuses cross-memory attach)
-export OMPI_MCA_mpi_yield_when_idle=1
+. "$(dirname "$0")/mpi_env.sh"
 fail() {
   echo "job_on_ranks ($BACKEND): FAILED: $*"
   [[ -f $DIR/server.log ]] && tail -20 "$DIR/server.log"

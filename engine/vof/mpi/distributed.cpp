@@ -27,6 +27,16 @@ VofConfig part_config(const VofConfig& cfg, const Mesh& whole, const MeshPart& p
   return c;
 }
 
+// The pressure preconditioner's state as it stands (a run on one rank: its part is the whole mesh).
+void copy_pc(const VofState& from, VofState& to) {
+  to.steps_since_pc = from.steps_since_pc;
+  to.pc_builds = from.pc_builds;
+  to.pc_rows = from.pc_rows;
+  to.pc_cols = from.pc_cols;
+  to.pc_values = from.pc_values;
+  to.pc_first_values = from.pc_first_values;
+}
+
 // The pressure preconditioner's operators of the ranks' rows (each rank's: its own region cells in
 // ascending order, columns as cells of its part; VofSolver::state) as the whole region's compressed
 // rows: rows and columns by the whole region's cells in ascending order, the format of a run on one
@@ -175,15 +185,13 @@ VofState DistributedVof::state() const {
   h.gather(mine, whole);
   for (int c = 0; c < whole_.cells(); ++c)
     if (whole[std::size_t(c)]) st.active_cells.push_back(c);
+  if (!ranks().distributed()) {  // one rank: its part is the whole mesh, its format the whole's
+    copy_pc(ps, st);
+    return st;
+  }
   st.steps_since_pc = ps.steps_since_pc;  // (every rank's alike: the refresh is decided with the matrix)
   st.pc_builds = ps.pc_builds;
-  if (ps.pc_builds > 0 && ranks().distributed()) gather_pc(ps, part_, ranks().comm(), whole_.cells(), st);
-  if (ps.pc_builds > 0 && !ranks().distributed()) {  // one rank: its part is the whole mesh, its format the whole's
-    st.pc_rows = ps.pc_rows;
-    st.pc_cols = ps.pc_cols;
-    st.pc_values = ps.pc_values;
-    st.pc_first_values = ps.pc_first_values;
-  }
+  if (ps.pc_builds > 0) gather_pc(ps, part_, ranks().comm(), whole_.cells(), st);
   return st;
 }
 
@@ -212,16 +220,10 @@ void DistributedVof::restore(const VofState& st) {
     if (local[std::size_t(g)] >= 0) ps.active_cells.push_back(local[std::size_t(g)]);
   }
   std::sort(ps.active_cells.begin(), ps.active_cells.end());
-  if (ranks().distributed()) {
+  if (ranks().distributed())
     scatter_pc(st, part_, local, ps);
-  } else {  // one rank: the whole mesh's format is its own
-    ps.steps_since_pc = st.steps_since_pc;
-    ps.pc_builds = st.pc_builds;
-    ps.pc_rows = st.pc_rows;
-    ps.pc_cols = st.pc_cols;
-    ps.pc_values = st.pc_values;
-    ps.pc_first_values = st.pc_first_values;
-  }
+  else
+    copy_pc(st, ps);  // one rank: the whole mesh's format is its own
   solver_->restore(ps);
   stale();
 }
